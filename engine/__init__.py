@@ -1,0 +1,1 @@
+"""formgraph: a node-graph procedural design engine."""

@@ -1,0 +1,1 @@
+"""Node families of formgraph: one module per family, registered on import."""

@@ -1,0 +1,1 @@
+"""The pyvista viewer of formgraph (imports pyvista lazily)."""
