@@ -1,0 +1,30 @@
+"""Run the benchmarks: ``python bench/run.py`` (all) or ``python bench/run.py nurbs mesh``.
+
+The "vs ours" column is the reference's time divided by ours: above 1x we are faster.
+"""
+
+from __future__ import annotations
+
+import importlib
+import sys
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+
+from harness import Table  # noqa: E402
+
+
+def main(argv: list[str]) -> int:
+    names = argv or sorted(p.stem[len("bench_") :] for p in HERE.glob("bench_*.py"))
+    table = Table()
+    for name in names:
+        module = importlib.import_module(f"bench_{name}")
+        print(f"running bench_{name} ...", file=sys.stderr, flush=True)
+        module.run(table)
+    print(table.render())
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main(sys.argv[1:]))
