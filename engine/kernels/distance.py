@@ -30,26 +30,26 @@ __all__ = ["Nearest", "RowParity", "SegmentTree", "point_segment"]
 def point_segment(
     p: np.ndarray, a: np.ndarray, b: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Distance from points to segments, pairwise.
+    """Distance from points to segments, pairwise (broadcasting over leading axes).
 
     Parameters
     ----------
-    p, a, b : (n, 2) float
+    p, a, b : (..., 2) float
         Points and segment ends (a segment may have zero length).
 
     Returns
     -------
-    dist : (n,) float
-    t : (n,) float
+    dist : (...) float
+    t : (...) float
         Parameter of the nearest point ``a + t (b - a)``, in [0, 1].
     """
-    ab = b - a
-    ap = p - a
-    den = np.einsum("ij,ij->i", ab, ab)
-    num = np.einsum("ij,ij->i", ap, ab)
+    ux, uy = b[..., 0] - a[..., 0], b[..., 1] - a[..., 1]
+    dx, dy = p[..., 0] - a[..., 0], p[..., 1] - a[..., 1]
+    den = ux * ux + uy * uy
+    num = dx * ux + dy * uy
     t = np.clip(np.divide(num, den, out=np.zeros_like(num), where=den > 0), 0.0, 1.0)
-    d = ap - t[:, None] * ab
-    return np.sqrt(np.einsum("ij,ij->i", d, d)), t
+    ex, ey = dx - t * ux, dy - t * uy
+    return np.sqrt(ex * ex + ey * ey), t
 
 
 @dataclass(frozen=True)
@@ -110,11 +110,8 @@ class SegmentTree:
         axa = ca[:, 0]
         axb = cb[:, -1]
         ends = np.concatenate([ca, cb], axis=1)
-        m = ends.shape[1]
-        da, _ = point_segment(
-            ends.reshape(-1, 2), np.repeat(axa, m, axis=0), np.repeat(axb, m, axis=0)
-        )
-        rad = da.reshape(n_leaves, m).max(axis=1)
+        da, _ = point_segment(ends, axa[:, None], axb[:, None])
+        rad = da.max(axis=1)
         # Missing leaves copy the last real axis (a true curve point keeps the upper bound
         # valid) with radius -inf, so their lower bound is +inf and they are never entered.
         extra = width - n_leaves
@@ -131,12 +128,9 @@ class SegmentTree:
             ra, rb, rr = ca[1::2], cb[1::2], cr[1::2]
             missing = np.isneginf(rr)
             pb = np.where(missing[:, None], lb, rb)
-            d1, _ = point_segment(la, la, pb)
-            d2, _ = point_segment(lb, la, pb)
-            d3, _ = point_segment(ra, la, pb)
-            d4, _ = point_segment(rb, la, pb)
-            left = lr + np.maximum(d1, d2)
-            right = rr + np.maximum(d3, d4)
+            d, _ = point_segment(np.stack([la, lb, ra, rb]), la, pb)
+            left = lr + np.maximum(d[0], d[1])
+            right = rr + np.maximum(d[2], d[3])
             levels.append((la, pb, np.maximum(left, right)))
         # Per level, contiguous node fields (gathered one by one, which numpy does far
         # faster than rows): start x, y, axis vector x, y, 1 / |axis|^2 (0 if none), radius.
@@ -167,11 +161,16 @@ class SegmentTree:
         lo = np.broadcast_to(np.asarray(lo, dtype=float), (q,))
         hi = np.broadcast_to(np.asarray(hi, dtype=float), (q,))
         px, py = np.ascontiguousarray(p[:, 0]), np.ascontiguousarray(p[:, 1])
-        best = np.full(q, np.inf)
-        qi = np.arange(q)
-        node = np.zeros(q, dtype=np.int64)
-        for level, (ax, ay, ux, uy, inv, rad) in enumerate(self._levels):
-            if level:
+        hi2 = np.square(np.maximum(hi, 0.0))
+        lo2 = np.where(lo > 0, np.square(lo), -1.0)
+        best2 = np.full(q, np.inf)  # squared distance to the nearest curve point seen
+        # Few points: start a few levels down (all their nodes), saving numpy calls.
+        start = min(self.depth, max(0, int(np.log2(max(1024 // max(q, 1), 1)))))
+        qi = np.repeat(np.arange(q), 2**start)
+        node = np.tile(np.arange(2**start), q)
+        for level in range(start, self.depth + 1):
+            ax, ay, ux, uy, inv, rad = self._levels[level]
+            if level > start:
                 qi = np.repeat(qi, 2)
                 node = np.repeat(2 * node, 2)
                 node[1::2] += 1
@@ -183,18 +182,18 @@ class SegmentTree:
             t = np.clip((dx * ux_ + dy * uy_) * inv.take(node), 0.0, 1.0)
             ex = dx - t * ux_
             ey = dy - t * uy_
-            lb = np.sqrt(ex * ex + ey * ey) - rad.take(node)
-            ex = dx - ux_
-            ey = dy - uy_
-            ub = np.sqrt(np.minimum(dx * dx + dy * dy, ex * ex + ey * ey))
-            np.minimum.at(best, qi, ub)
-            # Drop a node that cannot beat the best upper bound (or the band's top), and
-            # every node of a point already certified below the band.
-            cut = np.where(best < lo, -np.inf, np.minimum(best, hi))
-            keep = np.flatnonzero(lb <= cut.take(qi))
+            # The axis start is a curve point: an upper bound. (Its end is the next node's
+            # start, so it adds little.)
+            np.minimum.at(best2, qi, dx * dx + dy * dy)
+            # Drop a node whose capsule is farther than the best upper bound (or the band's
+            # top), and every node of a point already certified below the band.
+            cut = np.sqrt(np.minimum(best2, hi2))
+            cut[best2 < lo2] = -np.inf
+            thr = cut.take(qi) + rad.take(node)
+            keep = np.flatnonzero((thr >= 0) & (ex * ex + ey * ey <= thr * thr))
             qi, node = qi.take(keep), node.take(keep)
             if _DEBUG:
-                print(level, lb.size, qi.size)
+                print(level, keep.size, qi.size)
 
         # Leaves: brute force over their segments.
         seg = (node[:, None] * self.leaf + np.arange(self.leaf)).reshape(-1)
@@ -205,19 +204,21 @@ class SegmentTree:
         t = np.clip((dx * ux + dy * uy) * inv, 0.0, 1.0)
         ex = dx - t * ux
         ey = dy - t * uy
-        d = np.sqrt(ex * ex + ey * ey)
-        dist = np.full(q, np.inf)
-        np.minimum.at(dist, qs, d)
-        hit = d == dist[qs]
+        d2 = ex * ex + ey * ey
+        dist2 = np.full(q, np.inf)
+        np.minimum.at(dist2, qs, d2)
+        hit = np.flatnonzero(d2 == dist2.take(qs))
         segment = np.full(q, -1, dtype=np.int64)
         param = np.zeros(q)
         # Ties give several hits per point; any one of them is a nearest segment.
         segment[qs[hit]] = np.minimum(seg[hit], self.n - 1)
         param[qs[hit]] = t[hit]
+        dist = np.sqrt(dist2)
+        best = np.sqrt(best2)
         found = np.isfinite(dist)
         exact = found & (dist <= hi)
         out = np.where(found, dist, best)
-        near = ~found & (best < lo)
+        near = ~found & (best2 < lo2)
         far = ~found & ~near
         out[far] = np.maximum(best[far], np.nextafter(hi[far], np.inf))
         segment[~exact] = -1
