@@ -89,6 +89,7 @@ def trace_crossings(
     value: Callable[[np.ndarray], np.ndarray],
     level: float,
     below: bool,
+    centre: Callable[[np.ndarray], np.ndarray] | None = None,
 ) -> Crossings:
     """Link the crossed edges of a field into closed loops.
 
@@ -109,6 +110,10 @@ def trace_crossings(
         Contour level.
     below : bool
         The inside is ``field < level`` if True, ``field > level`` if False.
+    centre : callable, optional
+        ``centre(cell_ids) -> (m,) float``, the field at the centres of the given cells
+        (flat ids of their lower-left samples); asked only for saddle cells. Default: the
+        mean of the four corners (the bilinear interpolant's value there).
 
     Returns
     -------
@@ -151,8 +156,14 @@ def trace_crossings(
     inside = (vals < level) if below else (vals > level)
     bits = inside.astype(np.int8)
     case = bits[0] | (bits[1] << 1) | (bits[2] << 2) | (bits[3] << 3)
-    centre = vals.mean(axis=0)
-    centre_in = (centre < level) if below else (centre > level)
+    mid = vals.mean(axis=0)
+    if centre is not None:
+        saddle = np.flatnonzero((case == 5) | (case == 10))
+        if saddle.size:
+            # Each saddle cell is entered twice; ask once per cell.
+            cells, inverse = np.unique(corner[saddle], return_inverse=True)
+            mid[saddle] = centre(cells)[inverse]
+    centre_in = (mid < level) if below else (mid > level)
     exit_side = _EXIT[case, entry, centre_in.astype(np.int8)].astype(np.int64)
     if (exit_side < 0).any():  # cannot happen with consistent values; never index with -1
         raise ValueError("inconsistent field samples: a contour enters a cell it cannot leave")

@@ -189,7 +189,9 @@ class SegmentTree:
             # top), and every node of a point already certified below the band.
             cut = np.sqrt(np.minimum(best2, hi2))
             cut[best2 < lo2] = -np.inf
-            thr = cut.take(qi) + rad.take(node)
+            # (A hair of slack: the node holding the bound's own point must never be lost
+            # to rounding.)
+            thr = (cut.take(qi) + rad.take(node)) * (1 + 1e-12)
             keep = np.flatnonzero((thr >= 0) & (ex * ex + ey * ey <= thr * thr))
             qi, node = qi.take(keep), node.take(keep)
             if _DEBUG:
