@@ -400,7 +400,7 @@ def offset_polylines(
         # Every point within 0.9 |d| of the level lies on the level's side of the input, so
         # the unsigned distance alone can make the loops exact.
         tol = _TOLERANCE * (extent if extent > 0 else 2 * radius)
-        loops = exact_loops(tree, xy, cr.offsets, radius, 1.5 * cell, tol / 4, distance < 0)
+        loops = exact_loops(tree, xy, cr.offsets, radius, 1.5 * cell, tol / 2, distance < 0)
         if smooth:
             loops = smooth_loops(tree, loops, radius, smooth)
         xy, offsets = loops.xy, loops.offsets()

@@ -162,7 +162,7 @@ def project(tree: SegmentTree, p: np.ndarray, radius: float, band: float):
     return moved, normal, near.segment, near.dist, ok
 
 
-def _crossing(tree, p0, p1, d0, radius, tol, iterations=30):
+def _crossing(tree, p0, p1, d0, radius, tol, iterations=16):
     """Where the distance equals ``radius`` on the segments ``p0 -> p1``.
 
     Regula falsi with the Illinois modification (Dowell & Jarratt, BIT 1971) on
@@ -186,8 +186,10 @@ def _crossing(tree, p0, p1, d0, radius, tol, iterations=30):
     point = np.zeros((m, 2))
     normal = np.zeros((m, 2))
     seg = np.zeros(m, dtype=np.int64)
+    if m == 0:
+        return found, point, normal, seg
     band = 0.9 * radius
-    eps = 1e-3 * tol
+    eps = 1e-2 * tol
     g0 = d0 - radius
     end = tree.query(p1, radius - band, radius + band)
     g1 = end.dist - radius
@@ -224,7 +226,7 @@ def _crossing(tree, p0, p1, d0, radius, tol, iterations=30):
     return found, point, normal, seg
 
 
-def _corner(tree, s1, s2, start, radius, tol, chases=3, iterations=6):
+def _corner(tree, s1, s2, start, radius, tol, chases=2, iterations=4):
     """Where the offsets of two segments meet near ``start``: a corner of the level set.
 
     Solves ``dist(x, s1) = dist(x, s2) = radius`` by Newton's method (exact in one step for
@@ -250,7 +252,7 @@ def _corner(tree, s1, s2, start, radius, tol, chases=3, iterations=6):
     n1_all, n2_all = np.zeros((m, 2)), np.zeros((m, 2))
     s1, s2 = s1.copy(), s2.copy()
     eps = 1e-3 * tol
-    act = np.arange(m)
+    act = np.arange(m) if m else np.zeros(0, dtype=np.int64)
     for _ in range(chases):
         if act.size == 0:
             break
@@ -389,19 +391,27 @@ def refine_chords(
         meet = (sin != 0) & (along > -0.25) & (along < 1.25)
         bad = np.where(meet, height > tol, skew > tol)
         # The bound needs one sign of curvature; a chord whose normals turn a lot may hide
-        # a line, an arc and a notch (as at the mouth of a V): ask at its midpoint.
-        suspect = np.flatnonzero(~bad & (np.einsum("ij,ij->i", nu, nw) < _COS30) & (clen > tol))
-        mid = u[suspect] + c[suspect] / 2
-        moved, _, _, _, ok = project(tree, mid, radius, 0.9 * radius)
-        bad[suspect] = ~ok | (np.hypot(*(moved - mid).T) > tol)
+        # a line, an arc and a notch (as at the mouth of a V): ask at a chord point.
+        suspect = ~bad & (np.einsum("ij,ij->i", nu, nw) < _COS30) & (clen > tol)
+        reach_k = (sin != 0) & (np.hypot(*ku.T) < 0.9 * radius)
+        reach_k &= np.hypot(*(k - u - c).T) < 0.9 * radius
+        inside = reach_k & (along > 0) & (along < 1)
+        # The chord point below k (kept off the chord's ends), moved onto the level along
+        # the gradient: the check of a suspect chord, and step 3 below.
+        ask = np.flatnonzero(bad | suspect)
+        m = u + np.where(inside, np.clip(along, 0.2, 0.8), 0.5)[:, None] * c
+        m = m[ask]
+        p3, n3, s3, dist_m, ok3 = project(tree, m, radius, 0.9 * radius)
+        strays = ~ok3 | (np.hypot(*(p3 - m).T) > tol)
+        bad[ask] |= suspect[ask] & strays
         loops.todo[todo] = False
         if not bad.any():
             break
+        keep = bad[ask]
+        m, p3, n3, s3, dist_m, ok3 = m[keep], p3[keep], n3[keep], s3[keep], dist_m[keep], ok3[keep]
         todo, nxt, u, c, k, along = todo[bad], nxt[bad], u[bad], c[bad], k[bad], along[bad]
         clen, nu, nw = clen[bad], nu[bad], nw[bad]
-        reach_k = (sin[bad] != 0) & (np.hypot(*(k - u).T) < 0.9 * radius)
-        reach_k &= np.hypot(*(k - u - c).T) < 0.9 * radius
-        inside = reach_k & (along > 0) & (along < 1)
+        reach_k, inside = reach_k[bad], inside[bad]
         # New vertices keep clear of the chord's ends.
         gap = np.maximum(eps, 1e-3 * clen)
         pick = _Picks(todo.size)
@@ -427,29 +437,27 @@ def refine_chords(
             & (np.einsum("ij,ij->i", nu, nw) < _COS30)
             & (loops.seg[todo] != loops.seg_in[nxt])
         )
-        start = np.where(reach_k[rows, None], k[rows], u[rows] + c[rows] / 2)
-        ends = loops.seg[todo[rows]], loops.seg_in[nxt[rows]]
-        ok, p2, n_in, s_in, n_out, s_out = _corner(tree, *ends, start, radius, tol)
-        ok &= _fits(loops, todo[rows], nxt[rows], p2, gap[rows])
-        ok &= np.hypot(*(p2 - u[rows]).T) < 0.9 * radius
-        take(rows, ok, p2, n_out, s_out, n_in, s_in)
-        # 3. The chord point below k, moved along the gradient.
-        m = u + np.where(inside, np.clip(along, 0.2, 0.8), 0.5)[:, None] * c
+        if rows.size:
+            start = np.where(reach_k[rows, None], k[rows], u[rows] + c[rows] / 2)
+            ends = loops.seg[todo[rows]], loops.seg_in[nxt[rows]]
+            ok, p2, n_in, s_in, n_out, s_out = _corner(tree, *ends, start, radius, tol)
+            ok &= _fits(loops, todo[rows], nxt[rows], p2, gap[rows])
+            ok &= np.hypot(*(p2 - u[rows]).T) < 0.9 * radius
+            take(rows, ok, p2, n_out, s_out, n_in, s_in)
+        # 3. The chord point below k, moved along the gradient (projected above).
+        at = np.einsum("ij,ij->i", p3 - u, c) / clen**2
+        slid = ok3 & ~((at > 0.1) & (at < 0.9))
         rows = np.flatnonzero(~found)
-        p2, n2, s2, dist, ok = project(tree, m[rows], radius, 0.9 * radius)
-        at = np.einsum("ij,ij->i", p2 - u[rows], c[rows]) / clen[rows] ** 2
-        slid = ok & ~((at > 0.1) & (at < 0.9))
-        take(rows, ok & ~slid, p2, n2, s2)
-        slid_rows, slid_p, slid_n, slid_s = rows[slid], p2[slid], n2[slid], s2[slid]
-        dist_m = np.zeros(todo.size)
-        dist_m[rows] = dist
+        take(rows, (ok3 & ~slid)[rows], p3[rows], n3[rows], s3[rows])
+        slid_rows = np.flatnonzero(slid & ~found)
+        slid_p, slid_n, slid_s = p3[slid_rows], n3[slid_rows], s3[slid_rows]
         # 4. Near a corner that point slides toward a chord end: look between it and k,
         # where the distance crosses the level.
         rows = np.flatnonzero(~found & inside)
-        ok, p3, n3, s3 = _crossing(tree, m[rows], k[rows], dist_m[rows], radius, tol)
+        ok, p4, n4, s4 = _crossing(tree, m[rows], k[rows], dist_m[rows], radius, tol)
         # (That segment may meet the level again past the chord's ends, folding the loop.)
-        ok &= _between(u[rows], c[rows], p3) & _fits(loops, todo[rows], nxt[rows], p3, gap[rows])
-        take(rows, ok, p3, n3, s3)
+        ok &= _between(u[rows], c[rows], p4) & _fits(loops, todo[rows], nxt[rows], p4, gap[rows])
+        take(rows, ok, p4, n4, s4)
         # 5. Straight across the chord, toward the level: out of the region (on the
         # loop's left) if the chord point is in it, else into it. This also finds a spike
         # of the region narrower than a cell.
@@ -458,9 +466,9 @@ def refine_chords(
         region = (dist_m[rows] > radius) == far_inside
         reach = 0.85 * radius - np.hypot(*(m - u)[rows].T)
         end = m[rows] + np.where(region, -1.0, 1.0)[:, None] * reach[:, None] * left
-        ok, p4, n4, s4 = _crossing(tree, m[rows], end, dist_m[rows], radius, tol)
-        ok &= (reach > 0) & _between(u[rows], c[rows], p4)
-        take(rows, ok & _fits(loops, todo[rows], nxt[rows], p4, gap[rows]), p4, n4, s4)
+        ok, p5, n5, s5 = _crossing(tree, m[rows], end, dist_m[rows], radius, tol)
+        ok &= (reach > 0) & _between(u[rows], c[rows], p5)
+        take(rows, ok & _fits(loops, todo[rows], nxt[rows], p5, gap[rows]), p5, n5, s5)
         # 6. A projection that slid toward an end is still a point of the level.
         last = ~found[slid_rows] & _between(u[slid_rows], c[slid_rows], slid_p)
         last &= _fits(loops, todo[slid_rows], nxt[slid_rows], slid_p, gap[slid_rows])
