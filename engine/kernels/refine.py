@@ -33,6 +33,7 @@ from .distance import Nearest, SegmentTree, point_segment
 __all__ = ["Loops", "exact_loops", "project", "refine_chords", "simplify", "smooth", "tidy"]
 
 _COS30 = float(np.cos(np.radians(30)))
+_UNTANGLE = 8  # chords ahead checked for a crossing by the final clean-up
 
 
 @dataclass
@@ -589,6 +590,14 @@ def tidy(loops: Loops, gap: float) -> Loops:
         )
         cut[nxt[back]] = True
         cut |= _detours(loops, gap)
+        # A chord crossing one a few chords ahead: the vertices between are twisted.
+        steps = [nxt]  # steps[o - 1] = the vertex o ahead
+        for _ in range(_UNTANGLE):
+            steps.append(nxt[steps[-1]])
+        for o in range(2, _UNTANGLE + 1):
+            crossing = _crosses(xy, nxt, steps[o - 1], steps[o])
+            for between in steps[:o]:
+                cut[between[crossing]] = True
         if not cut.any():
             break
         loops = loops.select(~cut)
