@@ -13,11 +13,19 @@ from typing import Any
 from .registry import REQUIRED, NodeSpec, Port, node_types
 from .types import Kind, PortType, Vec3
 
-WIRE = {"type": "string", "pattern": r"^@[A-Za-z_][\w-]*(\.[A-Za-z_]\w*)?$",
-        "description": "a wire: '@node' or '@node.output'"}
+WIRE = {
+    "type": "string",
+    "pattern": r"^@[A-Za-z_][\w-]*(\.[A-Za-z_]\w*)?$",
+    "description": "a wire: '@node' or '@node.output'",
+}
 EXPR = {"type": "string", "pattern": "^=", "description": "an expression over the graph params"}
-ESCAPED = {"type": "object", "properties": {"value": {}}, "required": ["value"],
-           "additionalProperties": False, "description": "a literal written as {value: ...}"}
+ESCAPED = {
+    "type": "object",
+    "properties": {"value": {}},
+    "required": ["value"],
+    "additionalProperties": False,
+    "description": "a literal written as {value: ...}",
+}
 
 
 def _kind_schema(k: Kind) -> dict[str, Any]:
@@ -29,15 +37,21 @@ def _kind_schema(k: Kind) -> dict[str, Any]:
     elif base is float:
         item = {"type": "number"}
     elif base is Vec3:
-        item = {"type": "array", "items": {"anyOf": [{"type": "number"}, EXPR]},
-                "minItems": 2, "maxItems": 3}
+        item = {
+            "type": "array",
+            "items": {"anyOf": [{"type": "number"}, EXPR]},
+            "minItems": 2,
+            "maxItems": 3,
+        }
     elif isinstance(base, type) and issubclass(base, enum.Enum):
         item = {"enum": [m.value for m in base]}
     elif isinstance(base, type) and issubclass(base, str):
         item = {"type": "string"}
     elif getattr(base, "__name__", "") == "Points":
-        item = {"type": "array", "items": {"type": "array", "items": {"type": "number"},
-                                           "minItems": 2, "maxItems": 3}}
+        item = {
+            "type": "array",
+            "items": {"type": "array", "items": {"type": "number"}, "minItems": 2, "maxItems": 3},
+        }
     else:
         item = {}  # geometry: only through a wire or a param
     if k.is_list:
@@ -75,20 +89,29 @@ def json_schema() -> dict[str, Any]:
     registry = node_types()
     branches = []
     for name, spec in registry.items():
-        branches.append({
-            "if": {"properties": {"type": {"const": name}}, "required": ["type"]},
-            "then": {
-                "description": spec.summary,
-                "properties": {"type": {"const": name},
-                               **{p.name: port_schema(p) for p in spec.inputs.values()}},
-                "required": ["type", *[p.name for p in spec.inputs.values() if p.required]],
-                "additionalProperties": False,
-            },
-        })
+        branches.append(
+            {
+                "if": {"properties": {"type": {"const": name}}, "required": ["type"]},
+                "then": {
+                    "description": spec.summary,
+                    "properties": {
+                        "type": {"const": name},
+                        **{p.name: port_schema(p) for p in spec.inputs.values()},
+                    },
+                    "required": ["type", *[p.name for p in spec.inputs.values() if p.required]],
+                    "additionalProperties": False,
+                },
+            }
+        )
     param_long = {
         "type": "object",
-        "properties": {"default": {}, "min": {"type": "number"}, "max": {"type": "number"},
-                       "doc": {"type": "string"}, "type": {"type": "string"}},
+        "properties": {
+            "default": {},
+            "min": {"type": "number"},
+            "max": {"type": "number"},
+            "doc": {"type": "string"},
+            "type": {"type": "string"},
+        },
         "additionalProperties": False,
     }
     return {
@@ -101,8 +124,12 @@ def json_schema() -> dict[str, Any]:
         "properties": {
             "formgraph": {"const": 1, "description": "format version"},
             "description": {"type": "string"},
-            "params": {"type": "object", "additionalProperties": {
-                "anyOf": [param_long, {"type": ["number", "string", "boolean", "array"]}]}},
+            "params": {
+                "type": "object",
+                "additionalProperties": {
+                    "anyOf": [param_long, {"type": ["number", "string", "boolean", "array"]}]
+                },
+            },
             "nodes": {
                 "type": "object",
                 "additionalProperties": {
@@ -164,9 +191,13 @@ def catalogue_text() -> str:
 
 def markdown() -> str:
     """The node catalogue as Markdown (``docs/nodes.md``)."""
-    lines = ["# Node catalogue", "",
-             "Generated from the registry by `formgraph nodes --markdown`; do not edit by hand.",
-             "Angles are in degrees; a coordinate given as [x, y] gets z = 0.", ""]
+    lines = [
+        "# Node catalogue",
+        "",
+        "Generated from the registry by `formgraph nodes --markdown`; do not edit by hand.",
+        "Angles are in degrees; a coordinate given as [x, y] gets z = 0.",
+        "",
+    ]
     registry = node_types()
     families = sorted({s.family for s in registry.values()})
     lines.append("Families: " + ", ".join(f"[{f}](#{f})" for f in families) + ".")
@@ -175,8 +206,9 @@ def markdown() -> str:
         if spec.family != family:
             family = spec.family
             lines += ["", f"## {family}", ""]
-        ret = ", ".join(f"{k}: {t.name}" if spec.multi_output else t.name
-                        for k, t in spec.outputs.items())
+        ret = ", ".join(
+            f"{k}: {t.name}" if spec.multi_output else t.name for k, t in spec.outputs.items()
+        )
         lines += [f"### `{name}` -> {ret}", "", spec.summary, ""]
         if spec.inputs:
             lines += ["| input | type | default | description |", "|---|---|---|---|"]

@@ -70,9 +70,13 @@ def check_graph(g: Graph, extra: list[Problem] | None = None) -> list[Problem]:
         if spec is None:
             if nd.type:
                 # the SPEC's form: file:line, then the type (the node is named after it)
-                problems.append(Problem(Where(file, nd.line),
-                                        f"unknown node type '{nd.type}'{suggest(nd.type, registry)}"
-                                        f" in node '{nd.name}'"))
+                problems.append(
+                    Problem(
+                        Where(file, nd.line),
+                        f"unknown node type '{nd.type}'{suggest(nd.type, registry)}"
+                        f" in node '{nd.name}'",
+                    )
+                )
             continue
         problems.extend(_check_node(g, nd, spec, registry))
 
@@ -80,7 +84,9 @@ def check_graph(g: Graph, extra: list[Problem] | None = None) -> list[Problem]:
     return problems
 
 
-def _check_node(g: Graph, nd: NodeDef, spec: NodeSpec, registry: dict[str, NodeSpec]) -> list[Problem]:
+def _check_node(
+    g: Graph, nd: NodeDef, spec: NodeSpec, registry: dict[str, NodeSpec]
+) -> list[Problem]:
     out: list[Problem] = []
     file = g.file_label
 
@@ -92,8 +98,11 @@ def _check_node(g: Graph, nd: NodeDef, spec: NodeSpec, registry: dict[str, NodeS
         add(message, port)
     for port in nd.raw:
         if port not in spec.inputs:
-            add(f"'{nd.type}' has no input '{port}'{suggest(port, spec.inputs)}; its inputs are "
-                f"{', '.join(spec.inputs) or 'none'}", port)
+            add(
+                f"'{nd.type}' has no input '{port}'{suggest(port, spec.inputs)}; its inputs are "
+                f"{', '.join(spec.inputs) or 'none'}",
+                port,
+            )
     for port, p in spec.inputs.items():
         if port not in nd.raw:
             if p.required:
@@ -106,8 +115,9 @@ def _check_node(g: Graph, nd: NodeDef, spec: NodeSpec, registry: dict[str, NodeS
     return out
 
 
-def _check_input(g: Graph, nd: NodeDef, pt: PortType, value: Input,
-                 registry: dict[str, NodeSpec]) -> list[str]:
+def _check_input(
+    g: Graph, nd: NodeDef, pt: PortType, value: Input, registry: dict[str, NodeSpec]
+) -> list[str]:
     if isinstance(value, Wire):
         return _check_wire(g, pt, value, registry)
     if isinstance(value, Literal):
@@ -136,8 +146,10 @@ def _check_wire(g: Graph, pt: PortType, wire: Wire, registry: dict[str, NodeSpec
     target = g._nodes.get(wire.node)
     if target is None:
         if wire.node in g._params:
-            return [f"'@{wire.node}' wires to a node, but '{wire.node}' is a param: write "
-                    f"'={wire.node}'"]
+            return [
+                f"'@{wire.node}' wires to a node, but '{wire.node}' is a param: write "
+                f"'={wire.node}'"
+            ]
         return [f"wire to missing node '@{wire.node}'{suggest(wire.node, g._nodes)}"]
     spec = registry.get(target.type)
     if spec is None:
@@ -145,11 +157,15 @@ def _check_wire(g: Graph, pt: PortType, wire: Wire, registry: dict[str, NodeSpec
     if wire.output is not None and wire.output not in spec.outputs:
         if not spec.multi_output:
             return [f"'{target.type}' has a single output: write '@{wire.node}', not '{wire}'"]
-        return [f"'{target.type}' has no output '{wire.output}'; its outputs are "
-                f"{', '.join(spec.outputs)}"]
+        return [
+            f"'{target.type}' has no output '{wire.output}'; its outputs are "
+            f"{', '.join(spec.outputs)}"
+        ]
     if wire.output is None and spec.multi_output:
-        return [f"'{target.type}' has several outputs; pick one: "
-                f"{', '.join('@' + wire.node + '.' + o for o in spec.outputs)}"]
+        return [
+            f"'{target.type}' has several outputs; pick one: "
+            f"{', '.join('@' + wire.node + '.' + o for o in spec.outputs)}"
+        ]
     produced = spec.output_type(wire.output)
     if not pt.accepts(produced):
         return [f"expected {pt.name}, got {produced.name} from '{wire}'"]
@@ -204,8 +220,10 @@ def _static_value(g: Graph, item: Input) -> Any:
 def _expr_names_problem(g: Graph, e: Expr) -> str | None:
     unknown = sorted(e.compiled.names - set(g._params))
     if unknown:
-        return (f"expression '={e.text}' names unknown param '{unknown[0]}'"
-                f"{suggest(unknown[0], g._params)}; params are {', '.join(g._params) or 'none'}")
+        return (
+            f"expression '={e.text}' names unknown param '{unknown[0]}'"
+            f"{suggest(unknown[0], g._params)}; params are {', '.join(g._params) or 'none'}"
+        )
     return None
 
 
@@ -226,7 +244,11 @@ def _check_expr(g: Graph, pt: PortType, e: Expr) -> list[str]:
     except (ExpressionError, ValueError, TypeError, ZeroDivisionError) as exc:
         return [f"expression '={e.text}' fails with the param defaults: {exc}"]
     if pt.is_expression:
-        return [] if isinstance(value, str) else [f"expected an expression (text), got {describe(value)}"]
+        return (
+            []
+            if isinstance(value, str)
+            else [f"expected an expression (text), got {describe(value)}"]
+        )
     return [f"{m} (from '={e.text}')" for m in _coerce_problems(pt, value)]
 
 
@@ -248,8 +270,7 @@ def _check_cycles(g: Graph) -> list[Problem]:
         order = list(g._nodes)
         start = min(range(len(cycle)), key=lambda i: order.index(cycle[i]))
         path = cycle[start:] + cycle[:start]
-        problems.append(Problem(Where(g.file_label),
-                                "cycle: " + " -> ".join(path + [path[0]])))
+        problems.append(Problem(Where(g.file_label), "cycle: " + " -> ".join(path + [path[0]])))
         if len(problems) >= 10:
             break
     return problems

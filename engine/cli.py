@@ -26,18 +26,29 @@ class UsageError(Exception):
 
 
 def _parser() -> argparse.ArgumentParser:
-    ap = argparse.ArgumentParser(prog="formgraph",
-                                 description="Evaluate, check, view and document formgraph graphs.")
+    ap = argparse.ArgumentParser(
+        prog="formgraph", description="Evaluate, check, view and document formgraph graphs."
+    )
     ap.add_argument("--debug", action="store_true", help="show Python tracebacks")
     sub = ap.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     def graph_options(p: argparse.ArgumentParser) -> None:
-        p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
-                       help="override a graph param (parsed by the param's type)")
-        p.add_argument("--budget", type=int, default=DEFAULT_BUDGET,
-                       help=f"element budget per node (default {DEFAULT_BUDGET:,})")
-        p.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
-                       help=argparse.SUPPRESS)
+        p.add_argument(
+            "--set",
+            action="append",
+            default=[],
+            metavar="NAME=VALUE",
+            help="override a graph param (parsed by the param's type)",
+        )
+        p.add_argument(
+            "--budget",
+            type=int,
+            default=DEFAULT_BUDGET,
+            help=f"element budget per node (default {DEFAULT_BUDGET:,})",
+        )
+        p.add_argument(
+            "--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS
+        )
 
     run = sub.add_parser("run", help="evaluate nodes (default: every sink) and write exports")
     run.add_argument("graph")
@@ -50,8 +61,9 @@ def _parser() -> argparse.ArgumentParser:
 
     chk = sub.add_parser("check", help="validate a graph; exit 1 with every problem")
     chk.add_argument("graph")
-    chk.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
-                       help=argparse.SUPPRESS)
+    chk.add_argument(
+        "--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS
+    )
 
     view = sub.add_parser("view", help="show a node's output (window, or PNG with --screenshot)")
     view.add_argument("graph")
@@ -70,12 +82,14 @@ def _parser() -> argparse.ArgumentParser:
     nodes = sub.add_parser("nodes", help="the node catalogue, or one node type's ports")
     nodes.add_argument("type", nargs="?")
     nodes.add_argument("--markdown", action="store_true", help="the catalogue as Markdown")
-    nodes.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
-                       help=argparse.SUPPRESS)
+    nodes.add_argument(
+        "--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS
+    )
 
     schema = sub.add_parser("schema", help="JSON Schema of the YAML format")
-    schema.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
-                       help=argparse.SUPPRESS)
+    schema.add_argument(
+        "--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS
+    )
     return ap
 
 
@@ -91,8 +105,10 @@ def parse_sets(graph: Any, items: Sequence[str]) -> dict[str, Any]:
         if name not in defs:
             from .check import suggest
 
-            raise GraphError(f"--set {name}: unknown param{suggest(name, defs)}; params are "
-                             f"{', '.join(defs) or 'none'}")
+            raise GraphError(
+                f"--set {name}: unknown param{suggest(name, defs)}; params are "
+                f"{', '.join(defs) or 'none'}"
+            )
         default = defs[name].default
         if isinstance(default, str):
             value: Any = text
@@ -101,7 +117,11 @@ def parse_sets(graph: Any, items: Sequence[str]) -> dict[str, Any]:
                 value = yaml.safe_load(text)
             except yaml.YAMLError:
                 raise UsageError(f"--set {name}: cannot read {text!r}") from None
-            if isinstance(default, float) and isinstance(value, int) and not isinstance(value, bool):
+            if (
+                isinstance(default, float)
+                and isinstance(value, int)
+                and not isinstance(value, bool)
+            ):
                 value = float(value)
         out[name] = value
     return out
@@ -137,8 +157,10 @@ def _profile_table(stats: dict[str, Any], nodes: dict[str, str]) -> str:
     for name, st in stats.items():
         total += st.seconds
         size = _size(st.nbytes)
-        rows.append(f"{name:<24} {nodes.get(name, ''):<24} {st.status:<9} {st.seconds:>9.4f} "
-                    f"{size:>10}  {'; '.join(st.warnings)}")
+        rows.append(
+            f"{name:<24} {nodes.get(name, ''):<24} {st.status:<9} {st.seconds:>9.4f} "
+            f"{size:>10}  {'; '.join(st.warnings)}"
+        )
     rows.append(f"{'total':<24} {'':<24} {'':<9} {total:>9.4f}")
     return "\n".join(rows)
 
@@ -167,7 +189,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     progress = _ProgressLine(sys.stderr)
     g.progress = progress
     try:
-        outs = (g.evaluate(args.nodes, **params) if args.nodes else g.evaluate_all(**params))
+        outs = g.evaluate(args.nodes, **params) if args.nodes else g.evaluate_all(**params)
     finally:
         progress.clear()
     for name, value in outs.items():
@@ -252,8 +274,14 @@ def cmd_schema(args: argparse.Namespace) -> int:
     return 0
 
 
-COMMANDS = {"run": cmd_run, "check": cmd_check, "view": cmd_view, "watch": cmd_watch,
-            "nodes": cmd_nodes, "schema": cmd_schema}
+COMMANDS = {
+    "run": cmd_run,
+    "check": cmd_check,
+    "view": cmd_view,
+    "watch": cmd_watch,
+    "nodes": cmd_nodes,
+    "schema": cmd_schema,
+}
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -286,8 +314,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         if args.debug:
             traceback.print_exc()
         else:
-            print(f"formgraph: internal error: {type(exc).__name__}: {exc} (run with --debug "
-                  f"for the traceback, and please report it)", file=sys.stderr)
+            print(
+                f"formgraph: internal error: {type(exc).__name__}: {exc} (run with --debug "
+                f"for the traceback, and please report it)",
+                file=sys.stderr,
+            )
         return 1
 
 

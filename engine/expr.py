@@ -160,14 +160,18 @@ def compile_expression(text: str, allowed: set[str] | frozenset[str] | None = No
     if not isinstance(text, str):
         raise ExpressionError(f"an expression must be a string, got {type(text).__name__}")
     if len(text) > MAX_LENGTH:
-        raise ExpressionError(f"expression is {len(text)} characters long; the limit is {MAX_LENGTH}")
+        raise ExpressionError(
+            f"expression is {len(text)} characters long; the limit is {MAX_LENGTH}"
+        )
     try:
         tree = ast.parse(text.strip(), mode="eval")
     except SyntaxError as exc:
         raise ExpressionError(f"expression {text!r} is not valid: {exc.msg}") from None
     count = sum(1 for _ in ast.walk(tree))
     if count > MAX_NODES:
-        raise ExpressionError(f"expression {text!r} is too large ({count} parts; limit {MAX_NODES})")
+        raise ExpressionError(
+            f"expression {text!r} is too large ({count} parts; limit {MAX_NODES})"
+        )
     names: set[str] = set()
     fn = _Compiler(text, allowed, names).visit(tree.body)
     return Compiled(text, frozenset(names), fn)
@@ -264,7 +268,9 @@ class _Compiler:
 
     def visit_Call(self, node: ast.Call) -> Callable[[Env], Any]:
         if not isinstance(node.func, ast.Name) or node.func.id not in FUNCTIONS:
-            what = f"calling '{node.func.id}'" if isinstance(node.func, ast.Name) else "calling this"
+            what = (
+                f"calling '{node.func.id}'" if isinstance(node.func, ast.Name) else "calling this"
+            )
             raise self.refuse(node, what)
         if node.keywords:
             raise self.refuse(node, "a keyword argument")

@@ -258,8 +258,10 @@ class ParametricCurve(Curve):
     def evaluate(self, t: Any) -> np.ndarray:
         scalar = np.ndim(t) == 0
         tt = np.atleast_1d(np.asarray(t, dtype=np.float64))
-        cols = [np.broadcast_to(np.asarray(f(t=tt), dtype=np.float64), tt.shape) for f in
-                (self.fx, self.fy, self.fz)]
+        cols = [
+            np.broadcast_to(np.asarray(f(t=tt), dtype=np.float64), tt.shape)
+            for f in (self.fx, self.fy, self.fz)
+        ]
         xyz = np.stack(cols, axis=-1)
         bad = ~np.isfinite(xyz).all(axis=-1)
         if bad.any():
@@ -370,7 +372,9 @@ class NurbsSurface(Surface):
         object.__setattr__(self, "degree_v", int(degree_v))
         object.__setattr__(self, "knots_u", ku)
         object.__setattr__(self, "knots_v", kv)
-        object.__setattr__(self, "weights", w if w is not None else frozen_array(np.ones(cp.shape[:2])))
+        object.__setattr__(
+            self, "weights", w if w is not None else frozen_array(np.ones(cp.shape[:2]))
+        )
         object.__setattr__(self, "rational", bool(rational))
 
     def _args(self) -> tuple[Any, ...]:
@@ -427,8 +431,10 @@ class ParametricSurface(Surface):
 
     def evaluate(self, u: Any, v: Any) -> np.ndarray:
         uu, vv = np.broadcast_arrays(np.asarray(u, np.float64), np.asarray(v, np.float64))
-        cols = [np.broadcast_to(np.asarray(f(u=uu, v=vv), np.float64), uu.shape) for f in
-                (self.fx, self.fy, self.fz)]
+        cols = [
+            np.broadcast_to(np.asarray(f(u=uu, v=vv), np.float64), uu.shape)
+            for f in (self.fx, self.fy, self.fz)
+        ]
         xyz = np.stack(cols, axis=-1)
         bad = ~np.isfinite(xyz).all(axis=-1)
         if bad.any():
@@ -482,7 +488,9 @@ class Mesh(Geometry):
             fi = np.asarray(face_indices, dtype=np.int64).ravel()
             fo = np.asarray(face_offsets, dtype=np.int64).ravel()
         if fo.size == 0 or fo[0] != 0 or fo[-1] != fi.size or np.any(np.diff(fo) < 0):
-            raise ValueError("face_offsets must start at 0, never decrease and end at len(face_indices)")
+            raise ValueError(
+                "face_offsets must start at 0, never decrease and end at len(face_indices)"
+            )
         sizes = np.diff(fo)
         if sizes.size and sizes.min() < 3:
             bad = int(np.argmax(sizes < 3))

@@ -51,9 +51,14 @@ class NodeStat:
 Progress = Callable[[str, int, int], None]
 
 
-def load(path: str | os.PathLike[str], *, out_dir: str | os.PathLike[str] = "out",
-         cache_dir: str | os.PathLike[str] | None = None, budget: int = DEFAULT_BUDGET,
-         memory_bytes: int = 1 << 30) -> Graph:
+def load(
+    path: str | os.PathLike[str],
+    *,
+    out_dir: str | os.PathLike[str] = "out",
+    cache_dir: str | os.PathLike[str] | None = None,
+    budget: int = DEFAULT_BUDGET,
+    memory_bytes: int = 1 << 30,
+) -> Graph:
     """Read and check a graph file.
 
     Raises
@@ -66,8 +71,14 @@ def load(path: str | os.PathLike[str], *, out_dir: str | os.PathLike[str] = "out
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
         raise GraphError(f"{path}: cannot read the graph file: {exc}") from None
-    return Graph.from_text(text, file=str(path), out_dir=out_dir, cache_dir=cache_dir,
-                           budget=budget, memory_bytes=memory_bytes)
+    return Graph.from_text(
+        text,
+        file=str(path),
+        out_dir=out_dir,
+        cache_dir=cache_dir,
+        budget=budget,
+        memory_bytes=memory_bytes,
+    )
 
 
 class Graph:
@@ -81,9 +92,16 @@ class Graph:
     8
     """
 
-    def __init__(self, *, out_dir: str | os.PathLike[str] = "out",
-                 cache_dir: str | os.PathLike[str] | None = None, budget: int = DEFAULT_BUDGET,
-                 memory_bytes: int = 1 << 30, description: str = "", file: str | None = None):
+    def __init__(
+        self,
+        *,
+        out_dir: str | os.PathLike[str] = "out",
+        cache_dir: str | os.PathLike[str] | None = None,
+        budget: int = DEFAULT_BUDGET,
+        memory_bytes: int = 1 << 30,
+        description: str = "",
+        file: str | None = None,
+    ):
         self.file = file
         self.description = description
         self.out_dir = Path(out_dir)
@@ -102,8 +120,9 @@ class Graph:
     # ----------------------------------------------------------------------- building
 
     @classmethod
-    def from_text(cls, text: str, *, file: str | None = None, check: bool = True,
-                  **kwargs: Any) -> Graph:
+    def from_text(
+        cls, text: str, *, file: str | None = None, check: bool = True, **kwargs: Any
+    ) -> Graph:
         doc = parse(text, file or "<graph>")
         g = cls(file=file, description=doc.description, **kwargs)
         g._params = doc.params
@@ -118,8 +137,16 @@ class Graph:
     def file_label(self) -> str:
         return self.file if self.file else "<graph>"
 
-    def add_param(self, name: str, default: Any = None, *, min: float | None = None,
-                  max: float | None = None, doc: str = "", type: str | None = None) -> None:
+    def add_param(
+        self,
+        name: str,
+        default: Any = None,
+        *,
+        min: float | None = None,
+        max: float | None = None,
+        doc: str = "",
+        type: str | None = None,
+    ) -> None:
         """Declare a graph param (``type`` names a geometry type for a Python input slot)."""
         long_form = any(x is not None for x in (min, max, type)) or bool(doc)
         p = ParamDef(name, default, None, type, min, max, doc, None, long_form)
@@ -181,9 +208,14 @@ class Graph:
             if p is None:
                 from .check import suggest
 
-                problems.append(Problem(Where(self.file_label), f"unknown param '{name}'"
-                                        f"{suggest(name, self._params)}; params are "
-                                        f"{', '.join(self._params) or 'none'}"))
+                problems.append(
+                    Problem(
+                        Where(self.file_label),
+                        f"unknown param '{name}'"
+                        f"{suggest(name, self._params)}; params are "
+                        f"{', '.join(self._params) or 'none'}",
+                    )
+                )
                 continue
             try:
                 out[name] = check_param_value(p, value)
@@ -276,8 +308,11 @@ class Graph:
         Path(path).write_text(text, encoding="utf-8")
 
     def _as_data(self) -> Any:
-        return (self.description, {n: p.to_yaml() for n, p in self._params.items()},
-                [(n, nd.to_yaml()) for n, nd in self._nodes.items()])
+        return (
+            self.description,
+            {n: p.to_yaml() for n, p in self._params.items()},
+            [(n, nd.to_yaml()) for n, nd in self._nodes.items()],
+        )
 
     def __eq__(self, other: object) -> bool:
         return isinstance(other, Graph) and self._as_data() == other._as_data()
@@ -352,9 +387,15 @@ class _Run:
         if isinstance(value, Expr):
             missing = [n for n in value.compiled.names if self.values.get(n) is None]
             if missing:
-                raise GraphError([Problem(self.where(name, port),
-                                          f"param '{missing[0]}' has no value; pass it as "
-                                          f"evaluate(..., {missing[0]}=...)")])
+                raise GraphError(
+                    [
+                        Problem(
+                            self.where(name, port),
+                            f"param '{missing[0]}' has no value; pass it as "
+                            f"evaluate(..., {missing[0]}=...)",
+                        )
+                    ]
+                )
             try:
                 return self.g._expr_value(value, self.values)
             except (ValueError, TypeError, ZeroDivisionError, ExpressionError) as exc:
@@ -370,8 +411,9 @@ class _Run:
         t0 = time.perf_counter()
         hit, value, source = self.lookup(key, spec)
         if hit:
-            self.stats[name] = NodeStat("cached", time.perf_counter() - t0,
-                                        _cache.sizeof(value), source=source)
+            self.stats[name] = NodeStat(
+                "cached", time.perf_counter() - t0, _cache.sizeof(value), source=source
+            )
         else:
             value = self.compute(name, nd, spec)
         self.results[name] = value
@@ -415,10 +457,16 @@ class _Run:
         try:
             value = spec.func(**kwargs)
         except BudgetError as exc:
-            raise BudgetError([Problem(self.where(name), p.message) for p in exc.problems]) from None
+            raise BudgetError(
+                [Problem(self.where(name), p.message) for p in exc.problems]
+            ) from None
         except GraphError as exc:
-            raise type(exc)([Problem(self.where(name, getattr(exc, "port", None)), p.message)
-                             for p in exc.problems]) from None
+            raise type(exc)(
+                [
+                    Problem(self.where(name, getattr(exc, "port", None)), p.message)
+                    for p in exc.problems
+                ]
+            ) from None
         except InputError as exc:
             raise NodeError(self.where(name, exc.port), nd.type, str(exc)) from exc
         except (ValueError, ZeroDivisionError) as exc:
@@ -453,6 +501,8 @@ class _Run:
         try:
             return out_type.coerce(value)
         except (TypeMismatch, ValueError) as exc:
-            raise NodeError(self.where(name), nd.type,
-                            f"returned a value that does not fit its output {out_type.name}: {exc}"
-                            ) from None
+            raise NodeError(
+                self.where(name),
+                nd.type,
+                f"returned a value that does not fit its output {out_type.name}: {exc}",
+            ) from None

@@ -43,7 +43,7 @@ class Items:
     items: tuple[Input, ...]
 
 
-Input = Union[Literal, Wire, Expr, Items]
+Input = Union[Literal, Wire, Expr, Items]  # noqa: UP007 (a runtime alias)
 
 
 def parse_input(raw: Any) -> Input:
@@ -145,8 +145,14 @@ class NodeDef:
     parse_errors: dict[str, str] = field(default_factory=dict)
 
     @classmethod
-    def make(cls, name: str, type_: str, raw: dict[str, Any], line: int | None = None,
-             input_lines: dict[str, int] | None = None) -> NodeDef:
+    def make(
+        cls,
+        name: str,
+        type_: str,
+        raw: dict[str, Any],
+        line: int | None = None,
+        input_lines: dict[str, int] | None = None,
+    ) -> NodeDef:
         nd = cls(name, type_, dict(raw), {}, line, dict(input_lines or {}))
         for port, value in raw.items():
             try:

@@ -22,7 +22,12 @@ def path_problem(relpath: str) -> str | None:
     if "\x00" in relpath:
         return "an output path must not contain NUL characters"
     posix, win = PurePosixPath(relpath), PureWindowsPath(relpath)
-    if posix.is_absolute() or win.is_absolute() or win.drive or relpath.startswith(("/", "\\", "~")):
+    if (
+        posix.is_absolute()
+        or win.is_absolute()
+        or win.drive
+        or relpath.startswith(("/", "\\", "~"))
+    ):
         return f"output path {relpath!r} is absolute; give a path relative to the output directory"
     if ".." in posix.parts or ".." in win.parts:
         return f"output path {relpath!r} leaves the output directory ('..')"
@@ -44,7 +49,10 @@ def resolve_output(out_dir: str | os.PathLike[str], relpath: str) -> Path:
     target = root / PurePosixPath(relpath.replace("\\", "/"))
     real = target.resolve()  # follows any symlinks that exist along the way
     if real != root and root not in real.parents:
-        raise PathError(f"output path {relpath!r} leads outside the output directory {str(root)!r} (through a symlink)")
+        raise PathError(
+            f"output path {relpath!r} leads outside the output directory {str(root)!r} "
+            f"(through a symlink)"
+        )
     if real == root:
         raise PathError(f"output path {relpath!r} names the output directory itself")
     return real

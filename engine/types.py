@@ -243,12 +243,16 @@ def _coerce_kind(k: Kind, value: Any) -> Any:
             return base(value)
         except ValueError:
             options = ", ".join(repr(m.value) for m in base)
-            raise TypeMismatch(f"{value!r} is not a valid option, must be one of {options}") from None
+            raise TypeMismatch(
+                f"{value!r} is not a valid option, must be one of {options}"
+            ) from None
     if base is Points and not isinstance(value, Geometry):
         try:
             return Points(value)
         except ValueError as exc:
-            raise TypeMismatch(f"expected Points (a list of [x, y, z]), got {describe(value)}: {exc}") from None
+            raise TypeMismatch(
+                f"expected Points (a list of [x, y, z]), got {describe(value)}: {exc}"
+            ) from None
     if isinstance(base, type) and isinstance(value, base):
         return value
     raise TypeMismatch(f"expected {base.__name__}, got {describe(value)}")

@@ -43,8 +43,9 @@ def parse(text: str, file: str = "<graph>") -> Document:
     """Parse graph text into a :class:`Document`; problems are collected, not raised."""
     doc = Document()
 
-    def problem(message: str, line: int | None = None, node: str | None = None,
-                input: str | None = None) -> None:
+    def problem(
+        message: str, line: int | None = None, node: str | None = None, input: str | None = None
+    ) -> None:
         doc.problems.append(Problem(Where(file, line, node, input), message))
 
     if len(text.encode()) > MAX_BYTES:
@@ -54,8 +55,10 @@ def parse(text: str, file: str = "<graph>") -> Document:
         root = yaml.compose(text, Loader=yaml.SafeLoader)
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
-        problem(f"not valid YAML: {getattr(exc, 'problem', None) or exc}",
-                mark.line + 1 if mark else None)
+        problem(
+            f"not valid YAML: {getattr(exc, 'problem', None) or exc}",
+            mark.line + 1 if mark else None,
+        )
         return doc
     if root is None or not isinstance(root, yaml.MappingNode):
         problem("a graph file is a mapping with 'formgraph: 1' and 'nodes:'", 1)
@@ -76,8 +79,11 @@ def parse(text: str, file: str = "<graph>") -> Document:
         k, v = top["formgraph"]
         version = _value(v, problem, None, None)
         if version != FORMAT_VERSION:
-            problem(f"format version {version!r} is not supported (this formgraph reads "
-                    f"{FORMAT_VERSION})", _line(k))
+            problem(
+                f"format version {version!r} is not supported (this formgraph reads "
+                f"{FORMAT_VERSION})",
+                _line(k),
+            )
 
     if "description" in top:
         desc = _value(top["description"][1], problem, None, None)
@@ -111,8 +117,9 @@ def parse(text: str, file: str = "<graph>") -> Document:
             problem("node name appears twice", line, name)
             continue
         if not name.replace("-", "_").isidentifier():
-            problem("node names are letters, digits, '_' and '-', not starting with a digit",
-                    line, name)
+            problem(
+                "node names are letters, digits, '_' and '-', not starting with a digit", line, name
+            )
         if name in doc.params:
             problem(f"the name '{name}' is both a param and a node", line, name)
         if not isinstance(nv, yaml.MappingNode):
@@ -128,7 +135,7 @@ def parse(text: str, file: str = "<graph>") -> Document:
                 problem("input appears twice", _line(ik), name, port)
                 continue
             bad: list[str] = []
-            value = _value(iv, lambda msg, *a: bad.append(msg), name, port)
+            value = _value(iv, lambda msg, *a, bad=bad: bad.append(msg), name, port)
             if port == "type":
                 node_type = value
                 bad and problem(bad[0], _line(ik), name)
@@ -154,8 +161,13 @@ def _value(node: yaml.Node, problem: Any, where_node: str | None, port: str | No
     try:
         return _construct(node)
     except yaml.YAMLError as exc:
-        problem(f"cannot read this value: {getattr(exc, 'problem', None) or exc} (only plain "
-                f"YAML data is allowed; no !!python tags)", _line(node), where_node, port)
+        problem(
+            f"cannot read this value: {getattr(exc, 'problem', None) or exc} (only plain "
+            f"YAML data is allowed; no !!python tags)",
+            _line(node),
+            where_node,
+            port,
+        )
         return None
 
 
@@ -166,10 +178,14 @@ def _param(name: str, node: yaml.Node, problem: Any) -> ParamDef | None:
         return ParamDef(name, value, line=line)
     unknown = set(value) - {"default", "min", "max", "doc", "type"}
     if unknown:
-        problem(f"param '{name}': unknown key(s) {', '.join(sorted(map(str, unknown)))} "
-                f"(expected default, min, max, doc, type)", line)
-    p = ParamDef(name, value.get("default"), line=line, long_form=True,
-                 doc=str(value.get("doc", "") or ""))
+        problem(
+            f"param '{name}': unknown key(s) {', '.join(sorted(map(str, unknown)))} "
+            f"(expected default, min, max, doc, type)",
+            line,
+        )
+    p = ParamDef(
+        name, value.get("default"), line=line, long_form=True, doc=str(value.get("doc", "") or "")
+    )
     for bound in ("min", "max"):
         b = value.get(bound)
         if b is not None and (isinstance(b, bool) or not isinstance(b, (int, float))):
@@ -195,5 +211,6 @@ def dump(description: str, params: dict[str, ParamDef], nodes: dict[str, NodeDef
     if params:
         data["params"] = {n: p.to_yaml() for n, p in params.items()}
     data["nodes"] = {n: nd.to_yaml() for n, nd in nodes.items()}
-    return yaml.safe_dump(data, sort_keys=False, default_flow_style=None, allow_unicode=True,
-                          width=100)
+    return yaml.safe_dump(
+        data, sort_keys=False, default_flow_style=None, allow_unicode=True, width=100
+    )
