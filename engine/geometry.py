@@ -32,7 +32,7 @@ def as_xyz(values: Any, what: str = "points") -> np.ndarray:
     try:
         a = np.asarray(values, dtype=np.float64)
     except (TypeError, ValueError):
-        raise ValueError(f"{what} must be a list of [x, y] or [x, y, z] numbers") from None
+        a = _pad_rows(values, what)
     if a.ndim == 1 and a.size in (2, 3):
         a = a[None, :]
     if a.size == 0:
@@ -48,6 +48,18 @@ def as_xyz(values: Any, what: str = "points") -> np.ndarray:
         bad = int(np.argwhere(~np.isfinite(a))[0, 0])
         raise ValueError(f"{what}: coordinate {bad} is not finite ({a[bad].tolist()})")
     return frozen_array(a)
+
+
+def _pad_rows(values: Any, what: str) -> np.ndarray:
+    """Mixed [x, y] and [x, y, z] rows (z = 0 where it is missing)."""
+    try:
+        rows = [list(map(float, r)) for r in values]
+    except (TypeError, ValueError):
+        raise ValueError(f"{what} must be a list of [x, y] or [x, y, z] numbers") from None
+    for i, r in enumerate(rows):
+        if len(r) not in (2, 3):
+            raise ValueError(f"{what}: point {i} has {len(r)} coordinates; give [x, y] or [x, y, z]")
+    return np.array([r + [0.0] * (3 - len(r)) for r in rows], dtype=np.float64).reshape(-1, 3)
 
 
 class Geometry:
