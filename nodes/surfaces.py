@@ -27,7 +27,12 @@ def _rows(points: list[Points], closed_u: bool, closed_v: bool) -> np.ndarray:
         need = 3 if closed else 2
         if n < need:
             side = "closed" if closed else "open"
-            raise InputError("points", f"an {side} grid needs at least {need} {what}, got {n}")
+            raise InputError(
+                "points",
+                f"an {side} grid needs at least {need} {what}, got {n} (the input is "
+                f"{len(sizes)} row(s) of {sizes[0]} point(s); a grid is a list of rows, "
+                "each a list of points)",
+            )
     return np.stack([r.xyz for r in points])
 
 
