@@ -16,6 +16,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from . import cache as _cache
 from .check import check_graph, check_param_value
 from .errors import (
@@ -290,9 +292,13 @@ class Graph:
     def _expr_value(self, e: Expr, values: dict[str, Any]) -> Any:
         if e.compiled.is_bare_name:
             return values[e.text.strip()]
-        value = e.compiled(values)
-        if hasattr(value, "ndim") and value.ndim == 0:
-            value = value.item()
+        env = {
+            n: np.asarray(values[n], dtype=np.float64) if isinstance(values[n], list) else values[n]
+            for n in e.compiled.names
+        }  # list params act as vectors
+        value = e.compiled(env)
+        if hasattr(value, "ndim"):
+            value = value.item() if value.ndim == 0 else value.tolist()
         if isinstance(value, float) and value != value:
             raise ValueError(f"'={e.text}' is not a number (NaN)")
         if isinstance(value, float) and value in (float("inf"), float("-inf")):
