@@ -218,3 +218,38 @@ def markdown() -> str:
                 lines.append(f"| `{p.name}` | {ty} | {_default_text(p)} | {doc} |")
             lines.append("")
     return "\n".join(lines).rstrip() + "\n"
+
+
+BEGIN = "<!-- catalogue:begin (generated: python -m formgraph.catalogue README.md) -->"
+END = "<!-- catalogue:end -->"
+
+
+def readme_table() -> str:
+    """The compact catalogue the README shows: one row per node type."""
+    rows = ["| node | inputs ([optional]) | output | what it does |", "|---|---|---|---|"]
+    for name, spec in node_types().items():
+        ports = ", ".join(p.name if p.required else f"[{p.name}]" for p in spec.inputs.values())
+        ret = ", ".join(t.name for t in spec.outputs.values())
+        summary = spec.summary.replace("|", "\\|")
+        rows.append(f"| `{name}` | {ports} | {ret} | {summary} |")
+    return "\n".join(rows)
+
+
+def update_readme(path: str) -> bool:
+    """Rewrite the generated catalogue section of ``path``; True when it changed."""
+    from pathlib import Path
+
+    p = Path(path)
+    text = p.read_text(encoding="utf-8")
+    start, end = text.index(BEGIN), text.index(END)
+    new = text[:start] + BEGIN + "\n" + readme_table() + "\n" + text[end:]
+    if new != text:
+        p.write_text(new, encoding="utf-8")
+    return new != text
+
+
+if __name__ == "__main__":  # pragma: no cover
+    import sys
+
+    for arg in sys.argv[1:]:
+        print(f"{arg}: {'updated' if update_readme(arg) else 'current'}")
