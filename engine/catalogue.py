@@ -11,7 +11,7 @@ import enum
 from typing import Any
 
 from .registry import REQUIRED, NodeSpec, Port, node_types
-from .types import Kind, PortType, Vec3
+from .types import Faces, Kind, PortType, Vec3
 
 WIRE = {
     "type": "string",
@@ -47,6 +47,11 @@ def _kind_schema(k: Kind) -> dict[str, Any]:
         item = {"enum": [m.value for m in base]}
     elif isinstance(base, type) and issubclass(base, str):
         item = {"type": "string"}
+    elif base is Faces:
+        item = {
+            "type": "array",
+            "items": {"type": "array", "items": {"type": "integer"}, "minItems": 3},
+        }
     elif getattr(base, "__name__", "") == "Points":
         item = {
             "type": "array",
