@@ -34,6 +34,7 @@ __all__ = [
     "arc_length_table",
     "parameters_at_lengths",
     "bisector_offset",
+    "drop_repeats",
 ]
 
 CurveTuple = tuple[np.ndarray, int, np.ndarray, "np.ndarray | None"]
@@ -116,6 +117,12 @@ def _spans(p: np.ndarray, closed: bool) -> tuple[np.ndarray, np.ndarray, np.ndar
         return q, d[:0], length[:0]
     d = _span_vectors(q, closed)
     return q, d, _norms(d)
+
+
+def drop_repeats(points: np.ndarray, closed: bool = False) -> np.ndarray:
+    """``points`` (n, 3) without any point equal to the one before it (and, when closed,
+    without trailing copies of the first point): a polyline with no zero-length span."""
+    return _spans(_as_points(points), closed)[0].copy()
 
 
 def _bezier_knots(breaks: np.ndarray) -> np.ndarray:
