@@ -3,7 +3,8 @@
 Pure numpy array functions, vectorized over parameters, following L. Piegl and W. Tiller,
 *The NURBS Book* (2nd ed., 1997); algorithm numbers are cited in each docstring. This
 module gathers the family's public names; the code lives in ``nurbs_basis`` (spans, basis
-functions, validation), ``nurbs_curve`` (curve evaluation, circles, arcs) and
+functions, validation), ``nurbs_curve`` (curve evaluation, circles, arcs), ``nurbs_knots`` (insertion,
+refinement, elevation, Bezier decomposition, compatibility) and
 ``nurbs_surface`` (surface evaluation and normals).
 
 Curves are ``(control_points (n, 3), degree, knots (n + degree + 1,), weights (n,) | None)``;
@@ -33,6 +34,17 @@ from .nurbs_curve import (
     plane_frame,
     project,
 )
+from .nurbs_knots import (
+    clamp,
+    decompose_bezier,
+    elevate_degree,
+    insert_knot,
+    is_clamped,
+    make_compatible,
+    refine_knots,
+    reparametrize,
+    respace,
+)
 from .nurbs_surface import (
     basis_matrix,
     surface_derivatives,
@@ -48,6 +60,15 @@ __all__ = [
     "basis_matrix",
     "blossom_basis",
     "circle",
+    "clamp",
+    "decompose_bezier",
+    "elevate_degree",
+    "insert_knot",
+    "is_clamped",
+    "make_compatible",
+    "refine_knots",
+    "reparametrize",
+    "respace",
     "clamped_uniform_knots",
     "curve_derivatives",
     "curve_evaluate",
