@@ -284,8 +284,9 @@ def rotation_minimizing_frames(
         phi = math.atan2(float(np.cross(back, r0) @ t[0]), float(back @ r0))
         seg = np.linalg.norm(x[nxt] - x, axis=1)
         total = float(seg.sum())
-        frac = np.concatenate([[0.0], np.cumsum(seg)[:-1]]) / total if total > 0 else \
-            np.arange(m) / m
+        frac = (
+            np.concatenate([[0.0], np.cumsum(seg)[:-1]]) / total if total > 0 else np.arange(m) / m
+        )
         r = _rotate_about(r, t, phi * frac)
     r = r - np.sum(r * t, axis=1)[:, None] * t  # remove rounding drift
     r /= np.linalg.norm(r, axis=1)[:, None]

@@ -70,8 +70,11 @@ def _averaged_knots(u: np.ndarray, degree: int) -> np.ndarray:
     """Clamped knots by averaging the parameters (Eq. 9.8)."""
     p = degree
     k = len(u)
-    inner = np.lib.stride_tricks.sliding_window_view(u[1:-1], p).mean(axis=1)[: k - p - 1] \
-        if k - p - 1 > 0 else np.empty(0)
+    inner = (
+        np.lib.stride_tricks.sliding_window_view(u[1:-1], p).mean(axis=1)[: k - p - 1]
+        if k - p - 1 > 0
+        else np.empty(0)
+    )
     return np.concatenate([np.zeros(p + 1), inner, np.ones(p + 1)])
 
 

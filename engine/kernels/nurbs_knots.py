@@ -73,8 +73,8 @@ def respace(degree: int, knots: np.ndarray, pw: np.ndarray, new_knots: np.ndarra
     a = knots[p]
     lo = np.maximum(tau[:n_new], a)
     mu = find_spans(p, knots, lo)
-    args = np.lib.stride_tricks.sliding_window_view(tau[1:], p)[:n_new] if p else np.empty(
-        (n_new, 0)
+    args = (
+        np.lib.stride_tricks.sliding_window_view(tau[1:], p)[:n_new] if p else np.empty((n_new, 0))
     )
     alpha = blossom_basis(p, knots, mu, args)
     idx = mu[:, None] - p + np.arange(p + 1)
@@ -333,8 +333,9 @@ def decompose_bezier(
     a, b = U[spans], U[spans + 1]
     kk = np.arange(p + 1)
     # argument j of Bezier point k is b when j < k, else a
-    args = np.where(np.arange(p)[None, None, :] < kk[None, :, None], b[:, None, None],
-                    a[:, None, None])  # (segments, p+1, p)
+    args = np.where(
+        np.arange(p)[None, None, :] < kk[None, :, None], b[:, None, None], a[:, None, None]
+    )  # (segments, p+1, p)
     mu = np.repeat(spans, p + 1)
     alpha = blossom_basis(p, U, mu, args.reshape(-1, p))
     pw = homogeneous(control_points, weights)
@@ -344,9 +345,7 @@ def decompose_bezier(
     return cp, w
 
 
-def reparametrize(
-    knots: np.ndarray, t0: float, t1: float, degree: int | None = None
-) -> np.ndarray:
+def reparametrize(knots: np.ndarray, t0: float, t1: float, degree: int | None = None) -> np.ndarray:
     """Map a knot vector affinely so that the domain becomes ``[t0, t1]``.
 
     Parameters
