@@ -415,6 +415,9 @@ def doo_sabin(
     in a single face, valence 2) is kept in its V-face and stays put, as Catmull-Clark
     keeps it.
 
+    Two sheets that touch at a vertex (a non-manifold vertex) get a V-face each and come
+    apart, so the output is always manifold.
+
     Counts per level: ``V' = H + 2B + C`` (``H`` the sum of face sizes, ``B`` boundary edges,
     ``C`` corners), ``F' = F + E + V`` (vertices used by faces).
 
