@@ -83,12 +83,11 @@ def faces_from_lists(faces: Sequence[Sequence[int]]) -> tuple[np.ndarray, np.nda
     """
     flat: list[np.ndarray] = []
     for f, face in enumerate(faces):
-        a = np.asarray(face)
-        if a.ndim != 1 or not (
-            np.issubdtype(a.dtype, np.integer) or (a.size and (a == np.round(a)).all())
-        ):
-            raise ValueError(f"face {f} must be a list of vertex indices, got {face!r}")
-        if np.issubdtype(a.dtype, np.floating) and not np.isfinite(a).all():
+        a = np.asarray(face) if isinstance(face, (list, tuple, np.ndarray)) else np.asarray(None)
+        ok = a.ndim == 1 and a.dtype.kind in "iu"
+        if a.ndim == 1 and a.dtype.kind == "f":
+            ok = bool(np.isfinite(a).all() and (a == np.round(a)).all())
+        if not ok:
             raise ValueError(f"face {f} must be a list of vertex indices, got {face!r}")
         flat.append(a.astype(np.int64))
     sizes = np.array([a.size for a in flat], dtype=np.int64)
