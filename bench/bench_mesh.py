@@ -48,7 +48,7 @@ def run(table) -> None:
     sizes = np.diff(fo).tolist()
     for levels in (1, 2):
         n_faces = 10_000 * 4**levels
-        case = f"catmull_clark torus 10k quads, {levels} level(s) -> {n_faces:,} quads"
+        case = f"catmull_clark 10k-quad torus, {levels} lvl -> {n_faces // 1000}k quads"
         table.time(case, "formgraph", lambda lv=levels: catmull_clark(v, fi, fo, lv))
         table.time(
             case, "pyopensubdiv", lambda lv=levels: _opensubdiv(lv, verts, faces, flat, sizes)
@@ -58,7 +58,7 @@ def run(table) -> None:
             "pymeshlab",
             lambda lv=levels: _pymeshlab(v, fi, "meshing_surface_subdivision_catmull_clark", lv),
         )
-    case = "doo_sabin torus 10k quads, 1 level -> 30,000 faces"
+    case = "doo_sabin 10k-quad torus, 1 lvl -> 30k faces"
     table.time(case, "formgraph", lambda: doo_sabin(v, fi, fo, 1))
     table.time(
         case, "pymeshlab", lambda: _pymeshlab(v, fi, "meshing_surface_subdivision_doo_sabin", 1)
