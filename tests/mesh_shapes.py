@@ -80,3 +80,16 @@ def split_quads(fi: np.ndarray, fo: np.ndarray, which: np.ndarray):
         else:
             out.append(face)
     return flat(out)
+
+
+def pillow():
+    """Two skew quads glued along all four edges: every vertex has valence 2."""
+    v = np.array([[1, 1, 1], [1, -1, -1], [-1, 1, -1], [-1, -1, 1]], dtype=float)
+    return (v, *flat([[0, 1, 2, 3], [0, 3, 2, 1]]))
+
+
+def quad_and_pentagon():
+    """A closed mesh: two pentagons glued along their whole boundary; vertex 4 splits what
+    would be a quad's edge (valence 2)."""
+    v = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0.2], [0, 1, 0], [0.5, 0, 0.5]], dtype=float)
+    return (v, *flat([[0, 4, 1, 2, 3], [0, 3, 2, 1, 4]]))
