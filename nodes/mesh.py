@@ -8,7 +8,7 @@ whose face count (known in closed form) would pass the element budget.
 
 from __future__ import annotations
 
-from typing import Annotated, Any
+from typing import Annotated
 
 import numpy as np
 from formgraph.errors import InputError
@@ -16,7 +16,7 @@ from formgraph.geometry import Mesh, Points
 from formgraph.kernels import meshops, subdivision
 from formgraph.kernels.halfedge import HalfEdges, MeshTopologyError
 from formgraph.registry import Context, Range, node
-from formgraph.types import Vec3
+from formgraph.types import Faces, Vec3
 
 
 def _arrays(mesh: Mesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -38,7 +38,7 @@ def _guard_counts(ctx: Context, counts: list[tuple[int, int, int]]) -> None:
 
 
 @node("mesh.from_faces", version=1)
-def from_faces(vertices: Points, faces: Any) -> Mesh:
+def from_faces(vertices: Points, faces: Faces) -> Mesh:
     """A polygon mesh from vertices and faces (lists of vertex indices), checked.
 
     Faces may mix sizes (triangles, quads, n-gons) and list their vertices
@@ -59,10 +59,6 @@ def from_faces(vertices: Points, faces: Any) -> Mesh:
     ``quad: {type: mesh.from_faces, vertices: [[0, 0], [1, 0], [1, 1], [0, 1]],
     faces: [[0, 1, 2, 3]]}``
     """
-    if not isinstance(faces, (list, tuple)):
-        raise InputError(
-            "faces", f"expected a list of faces (lists of vertex indices), got {faces!r}"
-        )
     try:
         fi, fo = meshops.faces_from_lists(faces)
         v, fi, fo = meshops.validate_faces(vertices.xyz, fi, fo)

@@ -54,14 +54,26 @@ def test_from_faces_mixed_sizes():
         ([[0, 1, 2], [1, 0, 3], [0, 1, 2]], r"edge \(0, 1\) is shared by 3 faces"),
         ([[0, 1, 9]], r"face 0 refers to vertex 9, but the mesh has 4 vertices"),
         ([[0, 1]], r"face 0 has 2 vertices; a face needs at least 3"),
-        ([[0, 1, "a"]], r"face 0 must be a list of vertex indices"),
-        ("0 1 2", r"expected a list of faces"),
     ],
 )
 def test_from_faces_rejects_bad_faces(faces, message):
     pts = [[0, 0], [1, 0], [1, 1], [0, 1]]
     with pytest.raises(fg.NodeError, match=r"node 'n', input 'faces'.*" + message):
         run("mesh.from_faces", vertices=pts, faces=faces)
+
+
+@pytest.mark.parametrize(
+    "faces, message",
+    [
+        ([[0, 1, "a"]], r"face 0 must be a list of vertex indices"),
+        ("0 1 2", r"expected a list of faces"),
+    ],
+)
+def test_from_faces_checks_the_faces_before_running(faces, message):
+    g = fg.Graph()
+    g.add("n", "mesh.from_faces", vertices=[[0, 0], [1, 0], [1, 1]], faces=faces)
+    with pytest.raises(fg.GraphError, match=r"node 'n', input 'faces': " + message):
+        g.check()
 
 
 def test_catmull_clark_node():
