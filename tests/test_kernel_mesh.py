@@ -327,6 +327,16 @@ def test_semi_sharp_creases_blend_to_smooth():
     np.testing.assert_allclose(half, 0.5 * (lo + hi), atol=1e-15)
 
 
+def test_crease_meeting_the_boundary_pins_it():
+    rng = np.random.default_rng(7)
+    v, fi, fo = grid(4, 3, rng.normal(size=(4, 3)))
+    # edge 3-4 runs from boundary vertex 3 (i=1, j=0) inward: three sharp edges meet at 3
+    for sharpness in (None, 0.5, 2.0):
+        sv, _, _ = catmull_clark(v, fi, fo, 1, creases=[[3, 4]], sharpness=sharpness)
+        np.testing.assert_array_equal(sv[3], v[3])
+        assert np.isfinite(sv).all()
+
+
 def test_crease_must_be_an_edge():
     with pytest.raises(ValueError, match=r"crease \(0, 3\) is not an edge of the mesh"):
         catmull_clark(*cube(), creases=[[0, 1], [0, 3]])

@@ -167,11 +167,13 @@ def _catmull_clark_step(
         ends = ev[se].ravel()
         n_sharp = np.bincount(ends, minlength=n)
         s_e = np.where(boundary_edge[se], np.inf, sharp[se])
-        s_v = np.bincount(ends, np.repeat(np.minimum(s_e, 1.0), 2), minlength=n)
+        s_v = np.bincount(ends, np.repeat(np.minimum(s_e, 1e300), 2), minlength=n)
         s_v /= np.maximum(n_sharp, 1)  # vertex sharpness: mean over its sharp edges
         nb = _scatter(ends, np.stack([vb[se], va[se]], axis=1).reshape(-1, 3), n)
         crease_v = n_sharp == 2
         on_boundary = np.bincount(ev[boundary_edge].ravel(), minlength=n) > 0
+        s_v[on_boundary] = 1.0  # the smooth rule does not hold on a boundary
+        s_v = np.minimum(s_v, 1.0)
         corner_v = (n_sharp > 2) | (crease_v & on_boundary & (k == 1))
         crease_v &= ~corner_v
         target = v.copy()
