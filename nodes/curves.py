@@ -208,20 +208,10 @@ def parametric(
     if len(t) != 2 or not t[0] < t[1]:
         raise InputError("t", f"t must be [start, end] with start < end, got {list(t)}")
     ctx.guard(samples, "samples")
-    fx, fy, fz = (_expression(e, "t") for e in (x, y, z))
+    fx, fy, fz = x, y, z
     curve = ParametricCurve(fx, fy, fz, (float(t[0]), float(t[1])), samples)
     curve.sample(samples)  # raises, naming the expression and t, if anything is not finite
     return curve
-
-
-def _expression(e: Any, *variables: str) -> Any:
-    """An expression port's value: a bound, compiled expression; a default given as text
-    (which arrives uncompiled) is compiled here, with no params."""
-    if not isinstance(e, str):
-        return e
-    from formgraph.expr import Bound, compile_expression
-
-    return Bound(compile_expression(e, set(variables)), {})
 
 
 @node("curves.resample", version=1)
