@@ -146,7 +146,7 @@ def triangle_normals(vertices: np.ndarray, triangles: np.ndarray) -> np.ndarray:
 # STL
 
 _BLOCK = 1 << 14
-_STL_HEADER = b"formgraph binary STL".ljust(80, b" ")  # must not start with "solid"
+_STL_HEADER = b"formgraph binary STL".ljust(80, b"\0")  # must not start with "solid"
 _STL_RECORD = np.dtype(
     [("normal", "<f4", (3,)), ("vertices", "<f4", (3, 3)), ("attribute", "<u2")]
 )  # 50 bytes, packed
