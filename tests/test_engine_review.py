@@ -298,3 +298,27 @@ def test_cli_set_parses_exponent_floats(tmp_path, capsys):
     code = main(["run", str(graph), "--no-cache", "--out", str(tmp_path / "out"), "--set", "r=1e3"])
     assert code == 0, capsys.readouterr().err
     assert "a: 1000.0" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    "inputs",
+    [
+        "{type: stub.value, x: BIG}",
+        "{type: mesh.box, center: [BIG, 0, 0]}",
+        "{type: points.list, points: [[BIG, 0, 0]]}",
+    ],
+)
+def test_huge_integer_literal_is_a_graph_error(inputs):
+    # Defect: float(int) raises OverflowError for a 400-digit integer; types._coerce_kind,
+    # _vec3 and as_xyz catch only TypeError/ValueError, so a raw OverflowError escapes
+    # load() (CLI: "internal error") instead of a GraphError naming node and input.
+    text = "formgraph: 1\nnodes:\n  a: " + inputs.replace("BIG", "1" + "0" * 400) + "\n"
+    with pytest.raises(fg.GraphError, match="node 'a', input"):
+        fg.Graph.from_text(text)
+
+
+def test_huge_integer_param_override_is_a_param_error():
+    # Defect: the same OverflowError escapes Graph.evaluate(..., r=10**400).
+    g = fg.Graph.from_text("formgraph: 1\nparams:\n  r: 1.0\nnodes:\n  a: {type: stub.value}\n")
+    with pytest.raises(fg.ParamError, match="param 'r'"):
+        g.evaluate("a", r=10**400)
