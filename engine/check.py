@@ -16,7 +16,7 @@ import networkx as nx
 from . import safety
 from .errors import ExpressionError, Problem, Where
 from .expr import compile_expression
-from .model import Expr, Input, Literal, NodeDef, ParamDef, Wire
+from .model import Expr, Input, Items, Literal, NodeDef, ParamDef, Wire
 from .registry import NodeSpec, node_types
 from .types import Kind, PortType, TypeMismatch, describe
 
@@ -226,6 +226,8 @@ class _Unknown(Exception):
 def _static_value(g: Graph, item: Input) -> Any:
     if isinstance(item, Literal):
         return item.value
+    if isinstance(item, Items):
+        return [_static_value(g, i) for i in item.items]
     if isinstance(item, Expr):
         msg = _expr_names_problem(g, item)
         if msg:
