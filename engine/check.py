@@ -155,9 +155,14 @@ def _check_input(
     if not list_kinds:
         return [f"expected {pt.name}, got a list of wires"]
     item_type = PortType(tuple(Kind(k.base) for k in list_kinds), range=pt.range)
+    list_type = PortType(tuple(list_kinds), range=pt.range)
     problems: list[str] = []
     for item in value.items:
-        problems.extend(_check_input(g, nd, item_type, item, registry))
+        # a wire carrying a list joins the list (flattened): ["@paths", "@outline"]
+        as_item = _check_input(g, nd, item_type, item, registry)
+        if as_item and isinstance(item, Wire) and not _check_wire(g, list_type, item, registry):
+            continue
+        problems.extend(as_item)
     return problems
 
 

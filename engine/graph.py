@@ -469,7 +469,14 @@ class _Run:
                 return self.g._expr_value(value, self.values)
             except (ValueError, TypeError, ZeroDivisionError, ExpressionError) as exc:
                 raise GraphError([Problem(self.where(name, port), str(exc))]) from None
-        return [self.resolve(name, port, i) for i in value.items]
+        out: list[Any] = []
+        for item in value.items:
+            v = self.resolve(name, port, item)
+            if isinstance(item, Wire) and isinstance(v, list):
+                out.extend(v)  # a list from a wire joins the list (checked at load)
+            else:
+                out.append(v)
+        return out
 
     def fetch(self, target: str) -> Any:
         """The value of ``target``: from a cache, or computed after its inputs (no recursion)."""

@@ -118,7 +118,7 @@ def parse(text: str, file: str = "<graph>") -> Document:
     else:
         k, v = top["formgraph"]
         version = _value(v, problem, None, None)
-        if version != FORMAT_VERSION:
+        if isinstance(version, bool) or version != FORMAT_VERSION:
             problem(
                 f"format version {version!r} is not supported (this formgraph reads "
                 f"{FORMAT_VERSION})",
