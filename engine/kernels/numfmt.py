@@ -260,6 +260,7 @@ def _drop_digits(
 
 _U = np.uint64
 _ZEROS8 = _U(0x3030303030303030)  # "00000000"
+_DOTS8 = _U(0x2E2E2E2E2E2E2E2E)  # "........"
 _MASKS = np.array([(1 << (8 * k)) - 1 for k in range(9)], dtype=_U)  # the low k bytes
 REPR_WIDTH = 24  # bytes: the longest repr of a double, "-1.2345678901234567e-308", fits
 
@@ -269,10 +270,12 @@ def _swar8(v: np.ndarray) -> np.ndarray:
 
     SIMD-within-a-register conversion: split into two 4-digit lanes, each into two 2-digit
     lanes, each into two digits, with multiply-shift divisions exact on these ranges
-    (x // 100 == (x * 5243) >> 19 for x < 10**4, x // 10 == (x * 103) >> 10 for x < 100).
+    (x // 10**4 == (x * 3518437209) >> 45 for x < 2**32, x // 100 == (x * 5243) >> 19 for
+    x < 10**4, x // 10 == (x * 103) >> 10 for x < 100) — no integer division at all.
     """
     v = v.astype(_U)
-    x = (v // _U(10000)) | ((v % _U(10000)) << _U(32))
+    hi = (v * _U(3518437209)) >> _U(45)
+    x = hi | ((v - hi * _U(10000)) << _U(32))
     q = ((x * _U(5243)) >> _U(19)) & _U(0x0000007F0000007F)
     z = q | ((x - q * _U(100)) << _U(16))
     t = ((z * _U(103)) >> _U(10)) & _U(0x000F000F000F000F)
@@ -354,14 +357,14 @@ def _number_words(
     point = np.where(has_point, last + 1, 8 * nwords)
     moved = _shift_up(v, 1)
     text_len = length + has_point
-    dot = _U(ord("."))
     body = []
     for i in range(nwords):
         before, after = _low_bytes(point, i), _low_bytes(point + 1, i)
-        word = (v[i] & before) | (moved[i] & ~after) | (_place(dot, point, i) & after & ~before)
+        # after & ~before is the point's own byte: fill it with "."
+        word = (v[i] & before) | (moved[i] & ~after) | (_DOTS8 & after & ~before)
         body.append(word & _low_bytes(text_len, i))
-    # the lead and the sign in front
-    front = len(lead) + negative
+    # the lead, then a sign slot ("-" or padding, which the squeeze removes)
+    front = len(lead) + 1
     out = _shift_up(body, front)
     out[0] = out[0] | np.where(negative, _U(ord("-")) << _U(8 * len(lead)), _U(0))
     out[0] = out[0] | _lead_word(lead)
@@ -418,7 +421,9 @@ def float_words(x: np.ndarray, *, decimals: int | None = None, lead: bytes = b""
         x = np.round(x, decimals) + 0.0  # + 0.0 turns -0.0 into 0.0
     a = np.abs(x)
     extreme = bool(np.any((a >= 1e100) | ((a < 1e-99) & (a > 0))))
-    nwords = 4 if lead and extreme else 3
+    # the sign slot, up to 23 characters of number, and the lead must fit: a three-digit
+    # exponent with 17 digits is 23, anything else at most 22
+    nwords = 4 if (len(lead) + 1 + (23 if extreme else 22)) > 24 else 3
     out = np.empty((x.size, nwords), dtype=_U)
     for start in range(0, x.size, _BLOCK):  # blocks keep temporaries in cache
         neg, m, nd, e = shortest_decimal(x[start : start + _BLOCK])
