@@ -169,11 +169,16 @@ class DiskCache:
         return self.root / key[:2] / f"{key}.npz"
 
     def get(self, key: str) -> tuple[bool, Any]:
+        hit, value, _ = self.get_entry(key)
+        return hit, value
+
+    def get_entry(self, key: str) -> tuple[bool, Any, str | None]:
+        """(hit, value, identity recorded with it)."""
         path = self._path(key)
         try:
             data = path.read_bytes()
         except OSError:
-            return False, None
+            return False, None, None
         try:
             with np.load(io.BytesIO(data), allow_pickle=False) as z:
                 meta = json.loads(bytes(z["meta"]).decode())
@@ -188,15 +193,15 @@ class DiskCache:
                 raise ValueError("checksum mismatch")
             for a in arrays.values():
                 a.flags.writeable = False
-            return True, _decode(meta["value"], arrays)
+            return True, _decode(meta["value"], arrays), meta.get("identity")
         except (ValueError, KeyError, OSError, EOFError, zipfile.BadZipFile, TypeError):
             try:
                 path.unlink()
             except OSError:
                 pass
-            return False, None
+            return False, None, None
 
-    def put(self, key: str, value: Any) -> bool:
+    def put(self, key: str, value: Any, identity: str | None = None) -> bool:
         arrays: dict[str, np.ndarray] = {}
         try:
             desc = _encode(value, arrays)
@@ -206,7 +211,13 @@ class DiskCache:
         for name in sorted(arrays):
             check.update(name.encode())
             check.update(_hash_bytes(arrays[name]).encode())
-        meta = {"format": FORMAT, "key": key, "check": check.hexdigest(), "value": desc}
+        meta = {
+            "format": FORMAT,
+            "key": key,
+            "check": check.hexdigest(),
+            "value": desc,
+            "identity": identity or key,
+        }
         buf = io.BytesIO()
         meta_bytes = np.frombuffer(json.dumps(meta).encode(), dtype=np.uint8)
         np.savez(buf, meta=meta_bytes, **arrays)

@@ -11,7 +11,7 @@ import enum
 from typing import Any
 
 from .registry import REQUIRED, NodeSpec, Port, node_types
-from .types import Kind, PortType, Vec3
+from .types import Faces, Kind, PortType, Vec3
 
 WIRE = {
     "type": "string",
@@ -47,6 +47,11 @@ def _kind_schema(k: Kind) -> dict[str, Any]:
         item = {"enum": [m.value for m in base]}
     elif isinstance(base, type) and issubclass(base, str):
         item = {"type": "string"}
+    elif base is Faces:
+        item = {
+            "type": "array",
+            "items": {"type": "array", "items": {"type": "integer"}, "minItems": 3},
+        }
     elif getattr(base, "__name__", "") == "Points":
         item = {
             "type": "array",
@@ -218,3 +223,38 @@ def markdown() -> str:
                 lines.append(f"| `{p.name}` | {ty} | {_default_text(p)} | {doc} |")
             lines.append("")
     return "\n".join(lines).rstrip() + "\n"
+
+
+BEGIN = "<!-- catalogue:begin (generated: python -m formgraph.catalogue README.md) -->"
+END = "<!-- catalogue:end -->"
+
+
+def readme_table() -> str:
+    """The compact catalogue the README shows: one row per node type."""
+    rows = ["| node | inputs ([optional]) | output | what it does |", "|---|---|---|---|"]
+    for name, spec in node_types().items():
+        ports = ", ".join(p.name if p.required else f"[{p.name}]" for p in spec.inputs.values())
+        ret = ", ".join(t.name for t in spec.outputs.values())
+        summary = spec.summary.replace("|", "\\|")
+        rows.append(f"| `{name}` | {ports} | {ret} | {summary} |")
+    return "\n".join(rows)
+
+
+def update_readme(path: str) -> bool:
+    """Rewrite the generated catalogue section of ``path``; True when it changed."""
+    from pathlib import Path
+
+    p = Path(path)
+    text = p.read_text(encoding="utf-8")
+    start, end = text.index(BEGIN), text.index(END)
+    new = text[:start] + BEGIN + "\n" + readme_table() + "\n" + text[end:]
+    if new != text:
+        p.write_text(new, encoding="utf-8")
+    return new != text
+
+
+if __name__ == "__main__":  # pragma: no cover
+    import sys
+
+    for arg in sys.argv[1:]:
+        print(f"{arg}: {'updated' if update_readme(arg) else 'current'}")

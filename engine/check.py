@@ -59,7 +59,26 @@ def check_graph(g: Graph, extra: list[Problem] | None = None) -> list[Problem]:
     file = g.file_label
     registry = node_types()
 
+    from .expr import CONSTANTS, FUNCTIONS
+
     for p in g._params.values():
+        if not p.name.isidentifier() or p.name.startswith("_"):
+            problems.append(
+                Problem(
+                    Where(file, p.line),
+                    f"param '{p.name}': a param name is "
+                    f"letters, digits and '_', not starting with a digit or '_'",
+                )
+            )
+        elif p.name in CONSTANTS or p.name in FUNCTIONS:
+            problems.append(
+                Problem(
+                    Where(file, p.line),
+                    f"param '{p.name}' would hide the "
+                    f"expression {'constant' if p.name in CONSTANTS else 'function'}"
+                    f" '{p.name}'; choose another name",
+                )
+            )
         try:
             check_param_value(p, p.default)
         except TypeMismatch as exc:

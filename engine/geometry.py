@@ -58,7 +58,9 @@ def _pad_rows(values: Any, what: str) -> np.ndarray:
         raise ValueError(f"{what} must be a list of [x, y] or [x, y, z] numbers") from None
     for i, r in enumerate(rows):
         if len(r) not in (2, 3):
-            raise ValueError(f"{what}: point {i} has {len(r)} coordinates; give [x, y] or [x, y, z]")
+            raise ValueError(
+                f"{what}: point {i} has {len(r)} coordinates; give [x, y] or [x, y, z]"
+            )
     return np.array([r + [0.0] * (3 - len(r)) for r in rows], dtype=np.float64).reshape(-1, 3)
 
 

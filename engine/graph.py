@@ -2,9 +2,9 @@
 
 Evaluation is pull-based: asking for a node evaluates only its ancestors. Each node's cache
 key hashes its type, implementation version, resolved literal inputs and the identities of
-its wired inputs. A node's identity is the content digest of its output (early cutoff: a
-recomputed node whose output did not change leaves its descendants cached), or its key when
-the output cannot be hashed.
+its wired inputs. A node's identity is its key, except that a node recomputed to an output
+identical to its previous one keeps its previous identity (early cutoff: its descendants stay
+cached). Outputs are hashed only for that comparison, never on a cold run.
 """
 
 from __future__ import annotations
@@ -15,6 +15,8 @@ from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 from . import cache as _cache
 from .check import check_graph, check_param_value
@@ -111,7 +113,9 @@ class Graph:
         self._params: dict[str, ParamDef] = {}
         self._values: dict[str, Any] = {}
         self._nodes: dict[str, NodeDef] = {}
-        self._identity: dict[str, str] = {}
+        self._identity: dict[str, str] = {}  # cache key -> identity seen downstream
+        self._last: dict[str, tuple[str, str]] = {}  # node -> (key, identity) of its last output
+        self._digests: dict[str, str | None] = {}  # cache key -> content digest, when computed
         self._parse_problems: list[Problem] = []
         self._checked = False
         self.stats: dict[str, NodeStat] = {}
@@ -288,9 +292,13 @@ class Graph:
     def _expr_value(self, e: Expr, values: dict[str, Any]) -> Any:
         if e.compiled.is_bare_name:
             return values[e.text.strip()]
-        value = e.compiled(values)
-        if hasattr(value, "ndim") and value.ndim == 0:
-            value = value.item()
+        env = {
+            n: np.asarray(values[n], dtype=np.float64) if isinstance(values[n], list) else values[n]
+            for n in e.compiled.names
+        }  # list params act as vectors
+        value = e.compiled(env)
+        if hasattr(value, "ndim"):
+            value = value.item() if value.ndim == 0 else value.tolist()
         if isinstance(value, float) and value != value:
             raise ValueError(f"'={e.text}' is not a number (NaN)")
         if isinstance(value, float) and value in (float("inf"), float("-inf")):
@@ -331,7 +339,8 @@ class _Run:
         self.keys: dict[str, str] = {}
         self.results: dict[str, Any] = {}
         self.stats: dict[str, NodeStat] = {}
-        self.out_dir = str(g.out_dir.resolve())
+        self.out_path = g.out_dir.resolve()
+        self.out_dir = str(self.out_path)
         self.total = 0
         self.done = 0
 
@@ -340,7 +349,7 @@ class _Run:
         line = nd.input_lines.get(port, nd.line) if port else nd.line
         return Where(self.g.file_label, line, name, port)
 
-    # identity of the value that flows out of a node (content digest, or its key)
+    # identity of the value that flows out of a node: its key, or an earlier identical output's
     def identity(self, name: str) -> str:
         key = self.key(name)
         ident = self.g._identity.get(key)
@@ -421,16 +430,17 @@ class _Run:
 
     def lookup(self, key: str, spec: NodeSpec) -> tuple[bool, Any, str]:
         hit, value = self.g.memory.get(key)
+        identity = None
         source = "memory"
         if not hit and self.g.disk is not None:
-            hit, value = self.g.disk.get(key)
+            hit, value, identity = self.g.disk.get_entry(key)
             source = "disk"
             if hit:
                 self.g.memory.put(key, value)
         if hit and spec.is_export and not (isinstance(value, str) and os.path.isfile(value)):
             hit = False  # the written file is gone: write it again
         if hit and key not in self.g._identity:
-            self.g._identity[key] = _cache.digest(value) or "k:" + key
+            self.g._identity[key] = identity or key
         return hit, value, source
 
     def compute(self, name: str, nd: NodeDef, spec: NodeSpec) -> Any:
@@ -447,7 +457,7 @@ class _Run:
                 kwargs[port] = p.type.coerce(raw)
             except (TypeMismatch, ValueError) as exc:
                 raise GraphError([Problem(self.where(name, port), str(exc))]) from None
-        ctx = Context(name, Path(self.out_dir), self.g.budget)
+        ctx = Context(name, self.out_path, self.g.budget)
         if spec.wants_context:
             kwargs["ctx"] = ctx
         if self.g.progress is not None:
@@ -476,12 +486,33 @@ class _Run:
         seconds = time.perf_counter() - t0
         value = self.check_output(name, nd, spec, value)
         key = self.key(name)
+        identity = self.cutoff_identity(name, key, value)
         self.g.memory.put(key, value)
         if self.g.disk is not None:
-            self.g.disk.put(key, value)
-        self.g._identity[key] = _cache.digest(value) or "k:" + key
+            self.g.disk.put(key, value, identity)
+        if len(self.g._identity) > 1_000_000:  # bounded: forgetting only costs cache hits
+            self.g._identity.clear()
+            self.g._digests.clear()
+        self.g._identity[key] = identity
+        self.g._last[name] = (key, identity)
         self.stats[name] = NodeStat("computed", seconds, _cache.sizeof(value), ctx.warnings)
         return value
+
+    def cutoff_identity(self, name: str, key: str, value: Any) -> str:
+        """The identity of a freshly computed output: the previous one when identical."""
+        prev = self.g._last.get(name)
+        if prev is None or prev[0] == key:
+            return key
+        hit, prev_value = self.g.memory.get(prev[0])
+        if not hit:
+            return key
+        new = self.digest(key, value)
+        return prev[1] if new is not None and new == self.digest(prev[0], prev_value) else key
+
+    def digest(self, key: str, value: Any) -> str | None:
+        if key not in self.g._digests:
+            self.g._digests[key] = _cache.digest(value)
+        return self.g._digests[key]
 
     def bind_expression(self, name: str, port: str, pt: Any, text: Any) -> Any:
         from .expr import Bound, compile_expression

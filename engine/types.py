@@ -33,6 +33,12 @@ class Vec3:
     """A 3-vector port: ``[x, y]`` or ``[x, y, z]``; the node gets a read-only (3,) array."""
 
 
+class Faces(list):
+    """A list of faces, each a list of vertex indices (``list[list[int]]``)."""
+
+    port_name = "list[list[int]]"
+
+
 class Expression(str):
     """An expression port (text in the node's variables and the graph params)."""
 
@@ -90,7 +96,7 @@ class Kind:
 
     @property
     def name(self) -> str:
-        n = getattr(self.base, "__name__", str(self.base))
+        n = getattr(self.base, "port_name", None) or getattr(self.base, "__name__", str(self.base))
         return f"list[{n}]" if self.is_list else n
 
 
@@ -238,6 +244,8 @@ def _coerce_kind(k: Kind, value: Any) -> Any:
         raise TypeMismatch(f"expected {base.__name__}, got {describe(value)}")
     if base is Vec3:
         return _vec3(value)
+    if base is Faces:
+        return _faces(value)
     if isinstance(base, type) and issubclass(base, enum.Enum):
         try:
             return base(value)
@@ -266,6 +274,21 @@ def _vec3(value: Any) -> np.ndarray:
     if a.shape not in ((2,), (3,)) or not np.all(np.isfinite(a)):
         raise TypeMismatch(f"expected [x, y] or [x, y, z], got {describe(value)}")
     return frozen_array(np.append(a, 0.0) if a.size == 2 else a)
+
+
+def _faces(value: Any) -> Faces:
+    if not isinstance(value, (list, tuple)) or not value:
+        raise TypeMismatch(
+            f"expected a list of faces (lists of vertex indices), got {describe(value)}"
+        )
+    out = Faces()
+    for i, face in enumerate(value):
+        if not isinstance(face, (list, tuple)) or not all(
+            isinstance(x, (int, np.integer)) and not isinstance(x, bool) for x in face
+        ):
+            raise TypeMismatch(f"face {i} must be a list of vertex indices, got {describe(face)}")
+        out.append([int(x) for x in face])
+    return out
 
 
 def _vec_list(value: Any) -> np.ndarray:

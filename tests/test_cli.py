@@ -135,3 +135,20 @@ def test_docs_nodes_md_is_current():
     assert r.returncode == 0
     current = (ROOT / "docs" / "nodes.md").read_text()
     assert r.stdout == current, "docs/nodes.md is stale: formgraph nodes --markdown > docs/nodes.md"
+
+
+def test_readme_catalogue_is_current():
+    r = subprocess.run(
+        [
+            sys.executable,
+            "-c",
+            "from formgraph.catalogue import readme_table; print(readme_table())",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    readme = (ROOT / "README.md").read_text()
+    assert r.stdout.strip() in readme, (
+        "README catalogue is stale: python -m formgraph.catalogue README.md"
+    )

@@ -2,10 +2,9 @@
 
 from __future__ import annotations
 
+import formgraph as fg
 import numpy as np
 import pytest
-
-import formgraph as fg
 
 
 def test_points_validation():
@@ -25,8 +24,9 @@ def test_polyline_is_parametrized_by_arc_length():
     c = fg.NurbsCurve.polyline([[0, 0], [3, 0], [3, 4]])
     assert c.domain == (0.0, 7.0)
     np.testing.assert_allclose(c.evaluate(5.0), [3, 2, 0])
-    np.testing.assert_allclose(c.evaluate(np.array([0.0, 3.0, 7.0])),
-                               [[0, 0, 0], [3, 0, 0], [3, 4, 0]])
+    np.testing.assert_allclose(
+        c.evaluate(np.array([0.0, 3.0, 7.0])), [[0, 0, 0], [3, 0, 0], [3, 4, 0]]
+    )
     assert not c.closed
     closed = fg.NurbsCurve.polyline([[0, 0], [1, 0], [0, 1]], closed=True)
     assert closed.closed

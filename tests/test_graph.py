@@ -232,3 +232,23 @@ def test_random_edit_sequences_match_a_fresh_evaluation(edits):
         fresh = fg.Graph.from_text(g.to_yaml())
         fresh.set(**g.params)
         assert fresh.evaluate(["s", "a3"]) == got
+
+
+def test_list_params_act_as_vectors_in_expressions():
+    g = fg.Graph()
+    g.add_param("c", [1.0, 2.0, 0.0])
+    g.add("pts", "points.circle", count=4, radius=1, center="=c * 2")
+    g.add("same", "points.circle", count=4, radius=1, center="=c")
+    np.testing.assert_allclose(g.evaluate("pts").xyz.mean(axis=0), [2, 4, 0], atol=1e-12)
+    np.testing.assert_allclose(g.evaluate("same").xyz.mean(axis=0), [1, 2, 0], atol=1e-12)
+
+
+def test_param_names_may_not_hide_the_language():
+    g = fg.Graph()
+    g.add_param("pi", 3.0)
+    g.add_param("sqrt", 1.0)
+    g.add("v", "stub.value", x=1.0)
+    with pytest.raises(fg.GraphError) as e:
+        g.check()
+    assert "param 'pi' would hide the expression constant 'pi'" in str(e.value)
+    assert "param 'sqrt' would hide the expression function 'sqrt'" in str(e.value)

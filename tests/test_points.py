@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
+import formgraph as fg
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-
-import formgraph as fg
 
 
 def run(node_type: str, **inputs):
@@ -30,15 +29,22 @@ def test_list_rejects_ragged_input():
 
 
 @settings(max_examples=30, deadline=None)
-@given(st.integers(1, 6), st.integers(1, 6), st.integers(1, 4),
-       st.floats(0.1, 5), st.lists(st.floats(-10, 10), min_size=3, max_size=3))
+@given(
+    st.integers(1, 6),
+    st.integers(1, 6),
+    st.integers(1, 4),
+    st.floats(0.1, 5),
+    st.lists(st.floats(-10, 10), min_size=3, max_size=3),
+)
 def test_grid_counts_order_and_spacing(nx, ny, nz, spacing, origin):
     pts = run("points.grid", nx=nx, ny=ny, nz=nz, spacing=spacing, origin=origin).xyz
     assert pts.shape == (nx * ny * nz, 3)
     np.testing.assert_allclose(pts[0], origin)
-    np.testing.assert_allclose(pts.max(axis=0) - pts.min(axis=0),
-                               [(nx - 1) * spacing, (ny - 1) * spacing, (nz - 1) * spacing],
-                               atol=1e-9)
+    np.testing.assert_allclose(
+        pts.max(axis=0) - pts.min(axis=0),
+        [(nx - 1) * spacing, (ny - 1) * spacing, (nz - 1) * spacing],
+        atol=1e-9,
+    )
     if nx > 1:  # x varies fastest
         np.testing.assert_allclose(pts[1] - pts[0], [spacing, 0, 0], atol=1e-12)
 

@@ -127,9 +127,7 @@ def _basis_rows(
     return N
 
 
-def basis_functions(
-    degree: int, knots: np.ndarray, spans: np.ndarray, t: np.ndarray
-) -> np.ndarray:
+def basis_functions(degree: int, knots: np.ndarray, spans: np.ndarray, t: np.ndarray) -> np.ndarray:
     """The p + 1 non-zero B-spline basis functions at every parameter (A2.2).
 
     Parameters

@@ -172,9 +172,7 @@ def clamped_uniform_knots(n: int, degree: int) -> np.ndarray:
     return np.concatenate([np.zeros(degree), inner, np.ones(degree)])
 
 
-def periodic_curve(
-    points: np.ndarray, degree: int
-) -> tuple[np.ndarray, np.ndarray, None]:
+def periodic_curve(points: np.ndarray, degree: int) -> tuple[np.ndarray, np.ndarray, None]:
     """A closed, smooth (C^{degree-1}) uniform B-spline with ``points`` as its control polygon.
 
     The polygon is wrapped: the first ``degree`` points are repeated at the end, and the
@@ -201,8 +199,7 @@ def periodic_curve(
         raise ValueError(f"degree must be at least 1, got {degree}")
     if k < max(3, degree + 1):
         raise ValueError(
-            f"a closed curve of degree {degree} needs at least {max(3, degree + 1)} points, "
-            f"got {k}"
+            f"a closed curve of degree {degree} needs at least {max(3, degree + 1)} points, got {k}"
         )
     cp = np.concatenate([pts, pts[:degree]], axis=0)
     knots = (np.arange(k + 2 * degree + 1) - degree) / k
