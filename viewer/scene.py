@@ -159,13 +159,26 @@ def _mix(color: str, other: str, t: float) -> tuple[float, float, float]:
 def _style(kind: str, color: str) -> dict[str, Any]:
     """add_mesh keywords for one kind of geometry drawn in ``color``."""
     if kind == "points":
-        return dict(color=color, render_points_as_spheres=True, point_size=11, style="points")
+        return dict(color=color, render_points_as_spheres=True, point_size=12, style="points")
     if kind == "curves":
         return dict(color=color, line_width=3.5, render_lines_as_tubes=True)
     if kind == "surfaces":
-        return dict(color=color, smooth_shading=True, specular=0.25, specular_power=20)
+        return dict(
+            color=color,
+            smooth_shading=True,
+            ambient=0.2,
+            diffuse=0.8,
+            specular=0.25,
+            specular_power=20,
+        )
     if kind == "meshes":
-        return dict(color=color, show_edges=True, edge_color=_mix(color, "black", 0.55))
+        return dict(
+            color=color,
+            show_edges=True,
+            edge_color=_mix(color, "black", 0.45),
+            ambient=0.2,
+            diffuse=0.8,
+        )
     # control polygon / net: thin lines in a paler shade, with their control points
     return dict(color=_mix(color, "black", 0.35), line_width=1.2, style="wireframe")
 
