@@ -173,8 +173,10 @@ def test_default_shows_the_inputs_of_exports_else_the_sinks(tmp_path):
     g.add("save_grid", "viewertest.save", points="@grid", path="grid.txt")
     assert viewer.shown_nodes(g) == ["ring", "grid"]
     assert viewer.shown_nodes(g, "outline") == ["outline"]
-    with pytest.raises(fg.GraphError, match="no node 'outlin'.*did you mean 'outline'"):
+    with pytest.raises(fg.GraphError, match="^<graph>: no node 'outlin'.*did you mean 'outline'"):
         viewer.shown_nodes(g, "outlin")
+    with pytest.raises(fg.GraphError, match=r"node 'ring' \(points.circle\) has no output 'xyz'"):
+        viewer.shown_nodes(g, "ring.xyz")
 
 
 def test_each_shown_node_has_its_colour_and_legend_entry(tmp_path, plotter):
@@ -254,6 +256,24 @@ def test_control_polygon_and_net_toggle(plotter):
         scene.toggle("hull")
 
 
+def test_keys_toggle_overlays_and_grid(plotter):
+    session = viewer.Session([circle_curve(), wavy_surface()], plotter=plotter)
+    session.add_keys()
+    part = session.scene.layers[""].parts["polygon"]
+
+    def press(key):
+        for callback in plotter.iren._key_press_event_callbacks[key]:
+            callback()
+
+    press("c")
+    assert part.actor.GetVisibility() and session.scene.show_polygons
+    press("n")
+    assert session.scene.layers[""].parts["net"].actor.GetVisibility()
+    assert plotter.renderer.cube_axes_actor is not None
+    press("g")
+    assert plotter.renderer.cube_axes_actor is None and not session.scene.show_grid
+
+
 # -------------------------------------------------------------------------- sliders
 
 
@@ -265,6 +285,8 @@ def test_sliders_for_ranged_numeric_params(tmp_path, plotter):
     assert (sliders["radius"].min, sliders["radius"].max) == (0.5, 5.0)
     session.add_sliders()
     assert set(session.widgets) == {"count", "radius", "height"}
+    session.add_keys()
+    assert session.scene.texts()["help"].startswith("c control polygons")
     assert session.widgets["count"].GetRepresentation().GetValue() == 6
 
 
@@ -422,7 +444,7 @@ def test_watch_survives_the_file_disappearing(tmp_path, plotter):
 # ------------------------------------------------------------------------ CLI, gallery
 
 
-def test_cli_view_screenshot(tmp_path):
+def test_cli_view_screenshot(tmp_path, capsys):
     from formgraph.cli import main
 
     f = tmp_path / "ring.yaml"
@@ -433,6 +455,17 @@ def test_cli_view_screenshot(tmp_path):
     assert_not_blank(png)
     assert picture(png).shape[:2] == (240, 320)
     assert main(["view", str(f), "nope", "--screenshot", str(png)]) == 1
+    assert capsys.readouterr().err.strip() == f"{f}: no node 'nope'"
+
+
+def test_show_and_watch_entry_points_off_screen(tmp_path):
+    # with pyvista off screen, show() and watch() draw and return instead of blocking
+    f = tmp_path / "ring.yaml"
+    write(f, RING.format(count=7))
+    session = viewer.show(fg.load(f), size=SIZE, count=9)
+    assert session.params == {"count": 9} and set(session.widgets) == {"count"}
+    watcher = viewer.watch(f, "outline", sets=["count=5"], size=SIZE)
+    assert watcher.session.scene.layers["outline"].parts["curves"].data.n_points == 6
 
 
 def test_gallery_renders_every_graph_and_prints_a_table(tmp_path, capsys):

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from formgraph.errors import FormgraphError, GraphError
+from formgraph.errors import FormgraphError, GraphError, Problem, Where
 from formgraph.graph import Graph, load
 from formgraph.model import Items, Wire, parse_input
 from formgraph.registry import node_types
@@ -34,16 +34,12 @@ def shown_nodes(graph: Graph, node: str | Iterable[str] | None = None) -> list[s
     The results are the nodes wired into its export nodes (``@mesh`` feeding
     ``export.stl``), in author order; a graph without exports shows its sinks.
     """
+    registry = node_types()
     if node is not None:
         names = [node] if isinstance(node, str) else list(node)
         for n in names:
-            base = n.split(".", 1)[0] if n not in graph.nodes else n
-            if base not in graph.nodes:
-                from formgraph.check import suggest
-
-                raise GraphError(f"{graph.file_label}: no node '{n}'{suggest(n, graph.nodes)}")
+            _check_target(graph, registry, n)
         return names
-    registry = node_types()
     shown: list[str] = []
     for name, type_name in graph.nodes.items():
         if not registry[type_name].is_export:
@@ -56,6 +52,26 @@ def shown_nodes(graph: Graph, node: str | Iterable[str] | None = None) -> list[s
                 if target not in shown:
                     shown.append(target)
     return shown or graph.sinks()
+
+
+def _check_target(graph: Graph, registry: dict[str, Any], target: str) -> None:
+    from formgraph.check import suggest
+
+    where = Where(graph.file)
+    if target in graph.nodes:
+        return
+    base, _, output = target.partition(".")
+    if base not in graph.nodes:
+        raise GraphError(Problem(where, f"no node '{target}'{suggest(target, graph.nodes)}"))
+    spec = registry[graph.nodes[base]]
+    if not spec.multi_output or output not in spec.outputs:
+        outputs = ", ".join(spec.outputs) if spec.multi_output else "only one, unnamed"
+        raise GraphError(
+            Problem(
+                where,
+                f"node '{base}' ({spec.name}) has no output '{output}'; its outputs: {outputs}",
+            )
+        )
 
 
 def _wires(raw: Any) -> list[Wire]:
@@ -141,10 +157,6 @@ class Session:
             value = outs[base]
             if t != base:
                 output = t[len(base) + 1 :]
-                if not hasattr(value, output):
-                    raise GraphError(
-                        f"{self.graph.file_label}: node '{base}' has no output '{output}'"
-                    )
                 value = getattr(value, output)
             shown.append((t, value))
         return shown
