@@ -215,7 +215,8 @@ class Session:
     def report(self, message: str) -> None:
         """Show an error in the window and on stderr, keeping what is drawn."""
         print(message, file=sys.stderr)
-        self.scene.set_error(message)
+        kept = "\n(the picture is the last version that worked)" if self.scene.layers else ""
+        self.scene.set_error(message + kept)
         self.plotter.render()
 
     def _status(self) -> None:
@@ -272,7 +273,7 @@ class Session:
                 lambda v, name=s.name: self.on_slider(name, v),
                 rng=(s.min, s.max),
                 value=s.value,
-                title=s.name,
+                title=f"{s.name}   ({s.min:g} to {s.max:g})",
                 pointa=(0.76, y),
                 pointb=(0.97, y),
                 color=TEXT_COLOR,

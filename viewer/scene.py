@@ -469,7 +469,7 @@ class Scene:
             return
         lines = []
         for line in message.splitlines()[:12]:
-            lines.extend(textwrap.wrap(line, 110) or [""])
+            lines.extend(textwrap.wrap(line, 90) or [""])
         self.plotter.add_text(
             "\n".join(lines[:16]),
             position="lower_left",
