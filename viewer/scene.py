@@ -244,6 +244,8 @@ class Scene:
         self.show_grid = True
         self.error: str | None = None
         self.view_shift = 0.0  # move the picture left, to leave room for the sliders
+        self._drawn_grid: Any = None  # what the bounds grid and legend show now
+        self._drawn_legend: list[Any] = []
         plotter.set_background(BACKGROUND)
         plotter.enable_anti_aliasing("ssaa")
 
@@ -390,9 +392,12 @@ class Scene:
 
     def _bounds_grid(self) -> None:
         p = self.plotter
+        grid = self.grid_bounds() if self.show_grid else None
+        if grid == self._drawn_grid and (grid is None) == (p.renderer.cube_axes_actor is None):
+            return  # unchanged: rebuilding the axes is most of a slider step's drawing time
+        self._drawn_grid = grid
         p.remove_bounds_axes()
-        grid = self.grid_bounds()
-        if not self.show_grid or grid is None:
+        if grid is None:
             return
         box, (nx, ny, nz) = grid
         axis = view_axis(box)
@@ -421,16 +426,19 @@ class Scene:
 
     def _legend(self) -> None:
         p = self.plotter
-        if p.legend is not None:
-            p.remove_legend(render=False)
-        if not self.layers:
-            return
         entries = []
         for layer in self.layers.values():
             kinds = layer.kinds
             face = LEGEND_FACE[kinds[0]] if kinds else "none"
             text = f"{layer.label} ({layer.summary})" if layer.label else layer.summary
             entries.append([text, layer.color, face])
+        if entries == self._drawn_legend and p.legend is not None:
+            return
+        self._drawn_legend = entries
+        if p.legend is not None:
+            p.remove_legend(render=False)
+        if not entries:
+            return
         # placed by hand: pyvista's loc="upper right" offsets x by the height, not the width
         # about 13-pixel text, whatever the window size
         win_w, win_h = p.window_size
