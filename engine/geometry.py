@@ -203,14 +203,15 @@ class NurbsCurve(Curve):
         The parameter is the cumulative chord length, so t is arc length along it.
         """
         p = as_xyz(points)
-        if closed and len(p) > 1 and not np.array_equal(p[0], p[-1]):
-            p = np.vstack([p, p[:1]])
         if len(p) < 2:
             raise ValueError(f"a polyline needs at least 2 points, got {len(p)}")
-        chord = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))])
-        if chord[-1] == 0.0:
+        # a repeated point adds no segment; dropping it keeps the shape and the knots valid
+        p = p[np.concatenate([[True], np.any(p[1:] != p[:-1], axis=1)])]
+        if len(p) < 2:
             raise ValueError("a polyline needs at least two distinct points")
-        # repeated points give zero-length spans: keep the knots strictly usable
+        if closed and not np.array_equal(p[0], p[-1]):
+            p = np.vstack([p, p[:1]])
+        chord = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))])
         knots = np.concatenate([[chord[0]], chord, [chord[-1]]])
         return cls(p, 1, knots)
 

@@ -9,10 +9,12 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
-from formgraph.kernels.halfedge import build_halfedges
+from formgraph.kernels.halfedge import HalfEdges, build_halfedges
 
 __all__ = [
     "box",
+    "dihedral_angles",
+    "face_normals",
     "faces_from_lists",
     "merge",
     "reverse_faces",
@@ -81,12 +83,11 @@ def faces_from_lists(faces: Sequence[Sequence[int]]) -> tuple[np.ndarray, np.nda
     """
     flat: list[np.ndarray] = []
     for f, face in enumerate(faces):
-        a = np.asarray(face)
-        if a.ndim != 1 or not (
-            np.issubdtype(a.dtype, np.integer) or (a.size and (a == np.round(a)).all())
-        ):
-            raise ValueError(f"face {f} must be a list of vertex indices, got {face!r}")
-        if np.issubdtype(a.dtype, np.floating) and not np.isfinite(a).all():
+        a = np.asarray(face) if isinstance(face, (list, tuple, np.ndarray)) else np.asarray(None)
+        ok = a.ndim == 1 and a.dtype.kind in "iu"
+        if a.ndim == 1 and a.dtype.kind == "f":
+            ok = bool(np.isfinite(a).all() and (a == np.round(a)).all())
+        if not ok:
             raise ValueError(f"face {f} must be a list of vertex indices, got {face!r}")
         flat.append(a.astype(np.int64))
     sizes = np.array([a.size for a in flat], dtype=np.int64)
@@ -214,6 +215,44 @@ def reverse_faces(face_indices: np.ndarray, face_offsets: np.ndarray) -> np.ndar
     start = np.repeat(fo[:-1], sizes)
     j = np.arange(fi.size) - start
     return fi[start + (np.repeat(sizes, sizes) - j) % np.repeat(sizes, sizes)]
+
+
+def face_normals(
+    vertices: np.ndarray, face_indices: np.ndarray, face_offsets: np.ndarray
+) -> np.ndarray:
+    """Unit face normals by Newell's method (exact for planar faces, robust for warped ones).
+
+    Returns
+    -------
+    (n_faces, 3) float64
+        Zero for a face of zero area.
+    """
+    v = np.asarray(vertices, dtype=np.float64)
+    fi = np.asarray(face_indices, dtype=np.int64)
+    fo = np.asarray(face_offsets, dtype=np.int64)
+    if fo.size < 2:
+        return np.zeros((0, 3))
+    nxt = np.arange(1, fi.size + 1)
+    nxt[fo[1:] - 1] = fo[:-1]
+    n = np.add.reduceat(np.cross(v[fi], v[fi[nxt]]), fo[:-1], axis=0)
+    length = np.linalg.norm(n, axis=1, keepdims=True)
+    return np.divide(n, length, out=np.zeros_like(n), where=length > 0)
+
+
+def dihedral_angles(vertices: np.ndarray, he: HalfEdges) -> np.ndarray:
+    """Angle in degrees between the normals of the two faces at each edge.
+
+    Returns
+    -------
+    (n_edges,) float64
+        0 for a flat edge, up to 180 for a folded one; 0 on boundary edges.
+    """
+    normals = face_normals(vertices, he.origin, he.face_offsets)
+    h = np.flatnonzero(he.twin > np.arange(he.n_halfedges))
+    cos = np.einsum("ij,ij->i", normals[he.face[h]], normals[he.face[he.twin[h]]])
+    out = np.zeros(he.n_edges)
+    out[he.edge[h]] = np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))
+    return out
 
 
 def _newell_normals(p: np.ndarray) -> np.ndarray:

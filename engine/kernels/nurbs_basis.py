@@ -81,50 +81,84 @@ def find_spans(degree: int, knots: np.ndarray, t: np.ndarray) -> np.ndarray:
     return np.clip(spans, first, last).astype(np.int64, copy=False)
 
 
-def _span_table(degree: int, knots: np.ndarray) -> tuple[np.ndarray, int]:
-    """Per-span knots used by A2.2: rows ``knots[s+1-j]`` then ``knots[s+j]`` (j = 1..p).
+#: Parameters are processed in blocks of this size so that the dozens of temporaries of
+#: the triangular scheme stay in the CPU cache (about 3x faster than whole arrays at 10^5).
+CHUNK = 4096
 
-    Returns the table as ``(2p, n_spans)`` (rows contiguous, for ``np.take(..., axis=1)``)
-    and the index of the first span it covers.
+
+def _span_table(degree: int, knots: np.ndarray) -> tuple[np.ndarray, int]:
+    """Per-span constants of A2.2, one column per non-empty span of the domain.
+
+    Rows: ``knots[s+1-j]`` (j = 1..p), ``knots[s+j]`` (j = 1..p), then the reciprocals
+    ``1 / (knots[s+r+1] - knots[s+1-j+r])`` of A2.2's denominators for j = 1..p,
+    r = 0..j-1 (they depend on the span only). Rows are contiguous so that a block of
+    parameters picks its columns with one ``np.take(..., axis=1)``.
+
+    Returns
+    -------
+    table : (2p + p(p+1)/2, n_spans) float
+    first : int
+        Span index of column 0.
     """
     p = degree
     first, last = domain_spans(p, knots)
     s = np.arange(first, last + 1)
-    j = np.arange(1, p + 1)
-    left = knots[s[None, :] + 1 - j[:, None]]
-    right = knots[s[None, :] + j[:, None]]
-    return np.ascontiguousarray(np.concatenate([left, right], axis=0)), first
+    rows = [knots[s + 1 - j] for j in range(1, p + 1)]
+    rows += [knots[s + j] for j in range(1, p + 1)]
+    with np.errstate(divide="ignore"):  # empty spans (repeated knots) are never looked up
+        for j in range(1, p + 1):
+            for r in range(j):
+                rows.append(1.0 / (knots[s + r + 1] - knots[s + 1 - j + r]))
+    return np.ascontiguousarray(np.array(rows).reshape(len(rows), len(s))), first
+
+
+def _basis_from_table(degree: int, k: np.ndarray, t: np.ndarray) -> list[np.ndarray]:
+    """A2.2 on a block: ``k`` holds the block's columns of :func:`_span_table`.
+
+    The loops run over the degree only; each step is one array operation over the block.
+    Returns ``p + 1`` arrays of shape (m,).
+    """
+    p = degree
+    if p == 0:
+        return [np.ones_like(t)]
+    left = [None] + [t - k[j - 1] for j in range(1, p + 1)]
+    right = [None] + [k[p + j - 1] - t for j in range(1, p + 1)]
+    inv = 2 * p
+    # level 1 (N_0 = 1)
+    N = [right[1] * k[inv], left[1] * k[inv]]
+    inv += 1
+    for j in range(2, p + 1):
+        new = []
+        saved = None
+        for r in range(j):
+            temp = N[r] * k[inv]
+            inv += 1
+            term = right[r + 1] * temp
+            if saved is not None:
+                term += saved
+            new.append(term)
+            saved = left[j - r] * temp
+        new.append(saved)
+        N = new
+    return N
 
 
 def _basis_rows(
     degree: int, knots: np.ndarray, spans: np.ndarray, t: np.ndarray
 ) -> list[np.ndarray]:
-    """A2.2 for all parameters at once; returns ``p + 1`` arrays of shape (m,).
-
-    The loops run over the degree only; each step is one array operation over all m
-    parameters. ``left[j] = t - knots[s+1-j]`` and ``right[j] = knots[s+j] - t`` are taken
-    from a per-span table in one gather.
-    """
+    """A2.2 for all parameters; returns ``p + 1`` arrays of shape (m,)."""
     p = degree
     t = np.asarray(t, dtype=np.float64)
     if p == 0:
         return [np.ones_like(t)]
     table, first = _span_table(p, knots)
-    k = np.take(table, spans - first, axis=1)  # (2p, m)
-    left = [None] + [t - k[j - 1] for j in range(1, p + 1)]
-    right = [None] + [k[p + j - 1] - t for j in range(1, p + 1)]
-    N = [np.ones_like(t)]
-    for j in range(1, p + 1):
-        saved = None
-        new = []
-        for r in range(j):
-            temp = N[r] / (right[r + 1] + left[j - r])
-            term = right[r + 1] * temp
-            new.append(term if saved is None else saved + term)
-            saved = left[j - r] * temp
-        new.append(saved)
-        N = new
-    return N
+    out = np.empty((p + 1, t.shape[0]))
+    for s0 in range(0, t.shape[0], CHUNK):
+        sl = slice(s0, s0 + CHUNK)
+        k = np.take(table, spans[sl] - first, axis=1)
+        for r, row in enumerate(_basis_from_table(p, k, t[sl])):
+            out[r, sl] = row
+    return list(out)
 
 
 def basis_functions(degree: int, knots: np.ndarray, spans: np.ndarray, t: np.ndarray) -> np.ndarray:

@@ -11,7 +11,14 @@ import math
 
 import numpy as np
 
-from .nurbs_basis import _basis_rows, basis_function_derivatives, find_spans
+from .nurbs_basis import (
+    CHUNK,
+    _basis_from_table,
+    _span_table,
+    basis_function_derivatives,
+    domain_spans,
+    find_spans,
+)
 
 __all__ = [
     "arc",
@@ -19,6 +26,7 @@ __all__ = [
     "clamped_uniform_knots",
     "curve_derivatives",
     "curve_evaluate",
+    "evaluate_homogeneous",
     "homogeneous",
     "periodic_curve",
     "plane_frame",
@@ -53,12 +61,51 @@ def project(pw: np.ndarray, rational: bool) -> tuple[np.ndarray, np.ndarray | No
     return pw[..., :3] / w[..., None], w
 
 
-def _combine(rows: list[np.ndarray], pw: np.ndarray, spans: np.ndarray, p: int) -> np.ndarray:
-    """``sum_r rows[r][:, None] * pw[spans - p + r]`` for all parameters at once."""
-    base = spans - p
-    out = rows[0][:, None] * pw[base]
-    for r in range(1, p + 1):
-        out += rows[r][:, None] * pw[base + r]
+def evaluate_homogeneous(
+    degree: int, knots: np.ndarray, pw: np.ndarray, t: np.ndarray
+) -> np.ndarray:
+    """``sum_r N_{s-p+r}(t) pw[s-p+r]`` for all parameters: A3.1 on (homogeneous) points.
+
+    Each span's constants (A2.2's knots and reciprocal denominators, and its ``p + 1``
+    control points) are tabulated once per span; each block of parameters takes its
+    columns with one gather, then runs the triangular scheme and the weighted sum as array
+    operations over the block.
+
+    Parameters
+    ----------
+    degree : int
+    knots : (n + p + 1,) float
+    pw : (n, d) float
+        Control points (d = 3) or weighted control points (d = 4).
+    t : (m,) float
+
+    Returns
+    -------
+    (d, m) float
+    """
+    p = degree
+    knots = np.asarray(knots, dtype=np.float64)
+    d = pw.shape[1]
+    basis, first = _span_table(p, knots)
+    _, last = domain_spans(p, knots)
+    s = np.arange(first, last + 1)
+    local = pw[s[None, :] - p + np.arange(p + 1)[:, None]]  # (p+1, n_spans, d)
+    local = np.moveaxis(local, 2, 1).reshape((p + 1) * d, len(s))  # row r*d + c
+    table = np.concatenate([basis, local])
+    base = basis.shape[0]
+    out = np.empty((d, t.shape[0]))
+    for s0 in range(0, t.shape[0], CHUNK):
+        tt = t[s0 : s0 + CHUNK]
+        spans = np.searchsorted(knots, tt, side="right") - 1
+        np.clip(spans, first, last, out=spans)
+        k = np.take(table, spans - first, axis=1)
+        N = _basis_from_table(p, k, tt)
+        block = out[:, s0 : s0 + CHUNK]
+        for c in range(d):
+            acc = N[0] * k[base + c]
+            for r in range(1, p + 1):
+                acc += N[r] * k[base + r * d + c]
+            block[c] = acc
     return out
 
 
@@ -95,14 +142,11 @@ def curve_evaluate(
     knots = np.asarray(knots, dtype=np.float64)
     tt = np.asarray(t, dtype=np.float64)
     flat = tt.reshape(-1)
-    spans = find_spans(degree, knots, flat)
-    rows = _basis_rows(degree, knots, spans, flat)
-    rational = weights is not None
     pw = homogeneous(control_points, weights)
-    out = _combine(rows, pw, spans, degree)
-    if rational:
-        out = out[:, :3] / out[:, 3:]
-    return out.reshape(tt.shape + (3,))
+    out = evaluate_homogeneous(degree, knots, pw, flat)
+    if weights is not None:
+        out = out[:3] / out[3]
+    return out.T.reshape(tt.shape + (3,))
 
 
 def curve_derivatives(

@@ -167,11 +167,13 @@ def _catmull_clark_step(
         ends = ev[se].ravel()
         n_sharp = np.bincount(ends, minlength=n)
         s_e = np.where(boundary_edge[se], np.inf, sharp[se])
-        s_v = np.bincount(ends, np.repeat(np.minimum(s_e, 1.0), 2), minlength=n)
+        s_v = np.bincount(ends, np.repeat(np.minimum(s_e, 1e300), 2), minlength=n)
         s_v /= np.maximum(n_sharp, 1)  # vertex sharpness: mean over its sharp edges
         nb = _scatter(ends, np.stack([vb[se], va[se]], axis=1).reshape(-1, 3), n)
         crease_v = n_sharp == 2
         on_boundary = np.bincount(ev[boundary_edge].ravel(), minlength=n) > 0
+        s_v[on_boundary] = 1.0  # the smooth rule does not hold on a boundary
+        s_v = np.minimum(s_v, 1.0)
         corner_v = (n_sharp > 2) | (crease_v & on_boundary & (k == 1))
         crease_v &= ~corner_v
         target = v.copy()
@@ -370,12 +372,16 @@ def _doo_sabin_step(v: np.ndarray, he: HalfEdges) -> tuple[np.ndarray, np.ndarra
     # V-faces: the corner points around each vertex, counter-clockwise; an open fan is
     # closed by the Chaikin points on its two boundary edges (and a corner by the vertex)
     out_size = fan_size + 2 * fan_open + corner_fan
+    # an interior vertex of valence 2 would give a 2-gon: leave it out (the two E-faces at
+    # the vertex then share that edge directly)
+    out_size[fans.closed & (fan_size == 2)] = 0
     out_off = np.zeros(fan_size.size + 1, dtype=np.int64)
     np.cumsum(out_size, out=out_off[1:])
     vface = np.empty(out_off[-1], dtype=np.int64)
     fan_of = np.repeat(np.arange(fan_size.size), fan_size)
     rank = np.arange(m) - fans.offsets[fan_of]
-    vface[out_off[fan_of] + fan_open[fan_of] + rank] = fans.halfedges
+    placed = out_size[fan_of] > 0
+    vface[(out_off[fan_of] + fan_open[fan_of] + rank)[placed]] = fans.halfedges[placed]
     op = np.flatnonzero(fan_open)
     head = fans.halfedges[fans.offsets[op]]
     tail = fans.halfedges[fans.offsets[op + 1] - 1]
@@ -384,7 +390,7 @@ def _doo_sabin_step(v: np.ndarray, he: HalfEdges) -> tuple[np.ndarray, np.ndarra
     cf = np.flatnonzero(corner_fan)
     vface[out_off[cf] + 3] = m + 2 * nb + np.arange(cf.size)
     parts.append(vface)
-    part_sizes.append(out_size)
+    part_sizes.append(out_size[out_size > 0])
 
     face_indices = np.concatenate(parts)
     all_sizes = np.concatenate(part_sizes)
@@ -404,7 +410,8 @@ def doo_sabin(
 
     - an F-face per face: its new corner points (a shrunken copy, ``k`` sides);
     - an E-face per interior edge: the quad of the four corner points at its ends;
-    - a V-face per interior vertex: the corner points around it (``valence`` sides).
+    - a V-face per interior vertex: the corner points around it (``valence`` sides; none
+      for an interior vertex of valence 2).
 
     Boundaries: each boundary edge ``a -> b`` gets two new points ``3/4 a + 1/4 b`` and
     ``1/4 a + 3/4 b`` (Chaikin's corner cutting, the boundary case of the same quadratic
@@ -415,8 +422,12 @@ def doo_sabin(
     in a single face, valence 2) is kept in its V-face and stays put, as Catmull-Clark
     keeps it.
 
+    Two sheets that touch at a vertex (a non-manifold vertex) get a V-face each and come
+    apart, so the output is always manifold.
+
     Counts per level: ``V' = H + 2B + C`` (``H`` the sum of face sizes, ``B`` boundary edges,
-    ``C`` corners), ``F' = F + E + V`` (vertices used by faces).
+    ``C`` corners), ``F' = F + E + V`` (vertices used by faces, less interior ones of
+    valence 2).
 
     Parameters
     ----------
@@ -455,14 +466,16 @@ def doo_sabin(
 def doo_sabin_counts(he: HalfEdges, levels: int) -> list[tuple[int, int, int]]:
     """(vertices, edges, faces) after each of ``levels`` Doo-Sabin steps, in closed form.
 
-    With ``H`` half-edges, ``B`` boundary edges, ``C`` kept corners and ``P`` vertex fans:
-    ``V' = H + 2B + C``, ``F' = F + E + P``, ``H' = 2H + 4E + 2B + C``, ``B' = 2B + C``,
-    ``E' = (H' + B') / 2``; after the first level every vertex is manifold and used, so
-    ``P = V``, and the corners stay corners.
+    With ``H`` half-edges, ``B`` boundary edges, ``C`` kept corners, ``P`` vertex fans and
+    ``D`` interior vertices of valence 2 (no V-face): ``V' = H + 2B + C``,
+    ``F' = F + E + P - D``, ``H' = 2H + 4E + 2B + C - 2D``, ``B' = 2B + C``,
+    ``E' = (H' + B') / 2``; after the first level every vertex is manifold, used and of
+    valence 3 or more, so ``P = V`` and ``D = 0``, and the corners stay corners.
     """
     fans = he.fans
+    two = int((fans.closed & (fans.sizes == 2)).sum())
     corners = int((~fans.closed & (fans.sizes == 1) & he.is_manifold_vertex[fans.vertex]).sum())
-    n_fans = int(fans.vertex.size)
+    n_fans = int(fans.vertex.size) - two
     v, e, f, h = he.n_vertices, he.n_edges, he.n_faces, he.n_halfedges
     b = int(he.boundary_halfedges.size)
     out = []
@@ -470,10 +483,10 @@ def doo_sabin_counts(he: HalfEdges, levels: int) -> list[tuple[int, int, int]]:
         v, f, h, b = (
             h + 2 * b + corners,
             f + e + n_fans,
-            2 * h + 4 * e + 2 * b + corners,
-            (2 * b + corners),
+            2 * h + 4 * e + 2 * b + corners - 2 * two,
+            2 * b + corners,
         )
         e = (h + b) // 2
-        n_fans = v
+        n_fans, two = v, 0
         out.append((v, e, f))
     return out
