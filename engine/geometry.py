@@ -205,13 +205,15 @@ class NurbsCurve(Curve):
         p = as_xyz(points)
         if len(p) < 2:
             raise ValueError(f"a polyline needs at least 2 points, got {len(p)}")
-        # a repeated point adds no segment; dropping it keeps the shape and the knots valid
-        p = p[np.concatenate([[True], np.any(p[1:] != p[:-1], axis=1)])]
-        if len(p) < 2:
-            raise ValueError("a polyline needs at least two distinct points")
         if closed and not np.array_equal(p[0], p[-1]):
             p = np.vstack([p, p[:1]])
+        # a repeated point (or one so close that the running length does not grow) adds no
+        # segment; dropping it keeps the shape and the knots valid
         chord = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))])
+        keep = np.concatenate([[True], np.diff(chord) > 0])
+        p, chord = p[keep], chord[keep]
+        if len(p) < 2:
+            raise ValueError("a polyline needs at least two distinct points")
         knots = np.concatenate([[chord[0]], chord, [chord[-1]]])
         return cls(p, 1, knots)
 

@@ -446,8 +446,11 @@ class _Run:
     def compute(self, name: str, nd: NodeDef, spec: NodeSpec) -> Any:
         kwargs: dict[str, Any] = {}
         for port, p in spec.inputs.items():
-            if port not in nd.inputs:
-                kwargs[port] = p.type.coerce(p.default)  # defaults reach the node as typed
+            if port not in nd.inputs:  # defaults reach the node typed like any input
+                if p.type.is_expression and p.default is not None:
+                    kwargs[port] = self.bind_expression(name, port, p.type, p.default)
+                else:
+                    kwargs[port] = p.type.coerce(p.default)
                 continue
             raw = self.resolve(name, port, nd.inputs[port])
             if p.type.is_expression:

@@ -176,7 +176,7 @@ class Context:
         """Refuse, before allocating, an output of more than the element budget."""
         if elements > self.budget:
             raise BudgetError(
-                f"node '{self.node}': would make {int(elements):,} {what}, over the budget of "
+                f"would make {int(elements):,} {what}, over the budget of "
                 f"{self.budget:,} (raise it with budget= or --budget if you mean it)"
             )
 

@@ -142,7 +142,8 @@ def interpolate(
     ----------
     points : (k, 3) float
         At least 2 (open) or 3 (closed) points, consecutive points distinct. For a closed
-        curve a last point equal to the first is dropped (the curve closes by itself).
+        curve a last point equal to the first (within 1e-12 of the extent) is dropped: the
+        curve closes by itself.
     degree : int
         Requested degree; it is capped at ``k - 1`` (the most k points determine), so 2
         points give a line and 3 points a parabola.
@@ -170,8 +171,10 @@ def interpolate(
         raise ValueError("points must be finite numbers")
     if isinstance(degree, bool) or int(degree) != degree or degree < 1:
         raise ValueError(f"degree must be a whole number >= 1, got {degree!r}")
-    if closed and len(pts) > 1 and np.array_equal(pts[0], pts[-1]):
-        pts = pts[:-1]
+    if closed and len(pts) > 1:
+        extent = float(np.ptp(pts, axis=0).max())
+        if np.linalg.norm(pts[0] - pts[-1]) <= 1e-12 * extent:
+            pts = pts[:-1]  # the closing point repeats the first (up to rounding)
     need = 3 if closed else 2
     if len(pts) < need:
         kind = "a closed" if closed else "an open"
