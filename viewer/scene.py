@@ -496,20 +496,32 @@ class Scene:
         return out
 
 
-def nice_range(lo: float, hi: float, size: float, target: int = 4) -> tuple[float, float, int]:
-    """``[lo, hi]`` widened to multiples of a round step (1, 2, 2.5 or 5 times a power of
-    ten) about ``size / target`` long, and the number of ticks on it.
+def nice_range(lo: float, hi: float, size: float, max_ticks: int = 7) -> tuple[float, float, int]:
+    """``[lo, hi]`` widened to the nearest multiples of a round step, and the tick count.
 
-    A flat axis (``hi - lo`` tiny next to ``size``) stays as it is, with one tick.
+    The step is 1, 2, 2.5 or 5 times a power of ten, at least ``size / 12`` (so labels on a
+    short axis do not crowd), with at most ``max_ticks`` ticks; of those, the one that widens
+    the range least (then the one with nearer five ticks). A thin axis (under ``size / 12``)
+    keeps its ends, with two ticks; a flat one (``hi - lo`` tiny next to ``size``) one.
     """
     if size <= 0 or hi - lo <= 1e-9 * size:
         return lo, hi, 1
-    raw = max(hi - lo, size / 2) / target
-    power = 10.0 ** np.floor(np.log10(raw))
-    step = power * next(m for m in (1.0, 2.0, 2.5, 5.0, 10.0) if m * power >= raw * (1 - 1e-9))
-    lo2 = step * np.floor(lo / step + 1e-9)
-    hi2 = step * np.ceil(hi / step - 1e-9)
-    return float(lo2), float(hi2), int(round((hi2 - lo2) / step)) + 1
+    if hi - lo < size / 12:  # a thin axis: widening it to a round step would swamp it
+        return lo, hi, 2
+    best: tuple[tuple[float, int], float, float, int] | None = None
+    for power in range(int(np.floor(np.log10(hi - lo))) - 1, int(np.floor(np.log10(size))) + 2):
+        for m in (1.0, 2.0, 2.5, 5.0):
+            step = m * 10.0**power
+            if step < size / 12:
+                continue
+            lo2 = step * np.floor(lo / step + 1e-9)
+            hi2 = step * np.ceil(hi / step - 1e-9)
+            n = int(round((hi2 - lo2) / step)) + 1
+            key = (round(float(hi2 - lo2) / size, 9), abs(n - 5))
+            if n <= max_ticks and (best is None or key < best[0]):
+                best = (key, float(lo2), float(hi2), n)
+    assert best is not None  # the largest step always fits in two or three ticks
+    return best[1], best[2], best[3]
 
 
 def _vertices(data: Any) -> Any:
