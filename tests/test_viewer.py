@@ -233,7 +233,7 @@ def test_view_axis_and_round_grid_ticks():
     assert nice_range(-0.439, 0.878, 1.7) == (-0.5, 1.0, 4)
     assert nice_range(-2.6, 2.6, 6.0) == (-3.0, 3.0, 7)  # widened least
     assert nice_range(2.0, 2.0, 5.0) == (2.0, 2.0, 1)
-    assert nice_range(0.0, 0.001, 10.0) == (0.0, 0.001, 2)  # thin: kept as it is
+    assert nice_range(0.0, 0.001, 10.0) == (0.0, 0.001, 0)  # thin: kept, no labels
 
 
 # ------------------------------------------------------------------------- overlays

@@ -357,24 +357,36 @@ class Scene:
         bounds = grid[0] if self.show_grid else self.bounds()
         axis = view_axis(bounds)
         p = self.plotter
-        # sliders take the right quarter: centre the picture in what is left, a bit smaller
+        # sliders take the right of the window: centre the picture in what is left
         p.camera.SetWindowCenter(self.view_shift, 0.0)
-        room = 1.0 - self.view_shift / 2
-        if axis is None:
-            p.camera.parallel_projection = False
-            p.view_isometric(render=False)
-            p.reset_camera(render=False, bounds=_padded(bounds, 0.02))
-            if self.view_shift:
-                p.camera.zoom(0.8)
-            return
-        # a flat drawing: look straight at it, without perspective, filling the window
-        p.camera.parallel_projection = True
-        {2: p.view_xy, 1: p.view_xz, 0: p.view_yz}[axis](render=False)
+        # flat geometry is a drawing: look straight at it, without perspective
+        p.camera.parallel_projection = axis is not None
+        {None: p.view_isometric, 2: p.view_xy, 1: p.view_xz, 0: p.view_yz}[axis](render=False)
         p.reset_camera(render=False, bounds=bounds)
-        extent = np.delete(np.diff(np.asarray(bounds).reshape(3, 2), axis=1).ravel(), axis)
-        width, height = p.window_size
-        # room around it for the axis labels and the legend
-        p.camera.parallel_scale = 0.7 * max(extent[1], extent[0] * height / width / room, 1e-12)
+        # leave room for the axis labels (and, on a drawing, the legend above it)
+        self._zoom_to_fit(bounds, fill=0.8 if axis is None else 0.7)
+
+    def _zoom_to_fit(self, bounds: Sequence[float], fill: float) -> None:
+        """Zoom until the box's projection fills ``fill`` of the free part of the window.
+
+        reset_camera frames the bounding sphere, which leaves a flat or long box small.
+        """
+        ren = self.plotter.renderer
+        width, height = self.plotter.window_size
+        free_w = width * (1.0 - self.view_shift)
+        corners = np.array(np.meshgrid(*np.asarray(bounds).reshape(3, 2), indexing="ij"))
+        corners = corners.reshape(3, -1).T
+        for _ in range(2):  # perspective: the second pass corrects the first
+            xy = np.empty((len(corners), 2))
+            for k, c in enumerate(corners):  # eight corners
+                ren.SetWorldPoint(*c, 1.0)
+                ren.WorldToDisplay()
+                xy[k] = ren.GetDisplayPoint()[:2]
+            w, h = np.ptp(xy, axis=0)
+            if w <= 0 and h <= 0:
+                return
+            factor = fill * min(free_w / max(w, 1e-9), height / max(h, 1e-9))
+            self.plotter.camera.zoom(float(factor))
 
     def grid_bounds(self) -> tuple[tuple[float, ...], tuple[int, int, int]] | None:
         """The bounds grid's box, widened to round tick values, and its label counts."""
@@ -415,9 +427,12 @@ class Scene:
             show_xaxis=axis != 0,
             show_yaxis=axis != 1,
             show_zaxis=axis != 2,
-            n_xlabels=nx,
-            n_ylabels=ny,
-            n_zlabels=nz,
+            show_xlabels=nx > 0,
+            show_ylabels=ny > 0,
+            show_zlabels=nz > 0,
+            n_xlabels=max(nx, 2),
+            n_ylabels=max(ny, 2),
+            n_zlabels=max(nz, 2),
             fmt="%.4g",
             render=False,
         )
@@ -496,18 +511,19 @@ class Scene:
         return out
 
 
-def nice_range(lo: float, hi: float, size: float, max_ticks: int = 7) -> tuple[float, float, int]:
+def nice_range(lo: float, hi: float, size: float, max_ticks: int = 9) -> tuple[float, float, int]:
     """``[lo, hi]`` widened to the nearest multiples of a round step, and the tick count.
 
     The step is 1, 2, 2.5 or 5 times a power of ten, at least ``size / 12`` (so labels on a
     short axis do not crowd), with at most ``max_ticks`` ticks; of those, the one that widens
     the range least (then the one with nearer five ticks). A thin axis (under ``size / 12``)
-    keeps its ends, with two ticks; a flat one (``hi - lo`` tiny next to ``size``) one.
+    keeps its ends and gets no labels (0: they would overlap); a flat one (``hi - lo`` tiny
+    next to ``size``) gets one tick.
     """
     if size <= 0 or hi - lo <= 1e-9 * size:
         return lo, hi, 1
     if hi - lo < size / 12:  # a thin axis: widening it to a round step would swamp it
-        return lo, hi, 2
+        return lo, hi, 0
     best: tuple[tuple[float, int], float, float, int] | None = None
     for power in range(int(np.floor(np.log10(hi - lo))) - 1, int(np.floor(np.log10(size))) + 2):
         for m in (1.0, 2.0, 2.5, 5.0):
