@@ -131,7 +131,9 @@ def surface_evaluate_grid(
     nu, nv, d = pw.shape
     bu = basis_matrix(degree_u, knots_u, u, nu)
     bv = basis_matrix(degree_v, knots_v, v, nv)
-    # (d, nu, nv) -> Bu @ . @ Bv^T per coordinate, then coordinates last
+    # coordinates first, (d, nu, nv): two BLAS products per coordinate, and the rational
+    # division then runs along contiguous rows (a trailing axis of 3 or 4 would make
+    # numpy's inner loops 3 elements long)
     per_coord = np.ascontiguousarray(np.moveaxis(pw, -1, 0))
     out = bu @ per_coord @ bv.T  # (d, a, b)
     if weights is not None:
