@@ -391,10 +391,9 @@ def test_interpolation_passes_through_its_points(closed, degree, parametrization
     cp, p, knots, w = K.interpolate(pts, degree, closed, parametrization)
     K.validate_curve(cp, p, knots, w)
     u = K.interpolation_parameters(pts, closed, parametrization)
-    if closed and p % 2 == 0:
-        u = np.where(u < knots[p], u + 1, u)
     np.testing.assert_allclose(K.curve_evaluate(cp, p, knots, w, u), pts, atol=1e-12)
     t0, t1 = knots[p], knots[len(cp)]
+    assert (t0, t1) == (0.0, 1.0)  # open or closed, even or odd: starts at the first point
     ders = K.curve_derivatives(cp, p, knots, w, np.array([t0, t1]), min(p - 1, 2))
     if closed:  # closes with the continuity of the degree
         np.testing.assert_allclose(ders[:, 0], ders[:, 1], atol=1e-9 * np.abs(ders).max())
@@ -479,13 +478,18 @@ def test_loft_of_two_curves_is_ruled_and_closed_loft_wraps():
         K.circle(1.0, (3 * math.cos(x), 3 * math.sin(x), 0), (-math.sin(x), math.cos(x), 0))
         for x in np.linspace(0, 2 * np.pi, 6, endpoint=False)
     ]
-    torus = K.loft(rings, closed=True)
-    cp, pu, pv, ku, kv, w = torus
-    np.testing.assert_allclose(
-        K.surface_evaluate(*torus, T, kv[pv]),
-        K.surface_evaluate(*torus, T, kv[cp.shape[1]]),
-        atol=1e-12,
-    )
+    v = np.linspace(0, 1, 6, endpoint=False)  # equal spacing: the rings are congruent
+    for degree_v in (2, 3, 4):
+        torus = K.loft(rings, degree_v=degree_v, closed=True)
+        cp, pu, pv, ku, kv, w = torus
+        assert pv == degree_v and (kv[pv], kv[cp.shape[1]]) == (0.0, 1.0)
+        np.testing.assert_allclose(
+            K.surface_evaluate(*torus, T, 0.0), K.surface_evaluate(*torus, T, 1.0), atol=1e-12
+        )
+        for ring, vk in zip(rings, v, strict=True):
+            np.testing.assert_allclose(
+                K.surface_evaluate(*torus, T, vk), K.curve_evaluate(*ring, T), atol=1e-12
+            )
 
 
 def test_extrude_is_a_ruled_surface():
