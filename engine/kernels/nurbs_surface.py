@@ -15,6 +15,7 @@ from .nurbs_basis import (
     _basis_rows,
     _span_table,
     basis_function_derivatives,
+    basis_workspace,
     domain_spans,
     find_spans,
 )
@@ -119,6 +120,8 @@ def _tensor_sums(
     last_v = domain_spans(pv, kv)[1]
     m = u.shape[0]
     outs = [np.empty((d, m)) for _ in range(3 if derivatives else 1)]
+    work_u = basis_workspace(pu, min(CHUNK, m))
+    work_v = basis_workspace(pv, min(CHUNK, m))
     for s0 in range(0, m, CHUNK):
         sl = slice(s0, s0 + CHUNK)
         uc, vc = u[sl], v[sl]
@@ -129,8 +132,8 @@ def _tensor_sums(
             dv = basis_function_derivatives(pv, kv, sv, vc, 1).transpose(0, 2, 1)
             Nu, dNu, Nv, dNv = du[0], du[1], dv[0], dv[1]
         else:
-            Nu = _basis_from_table(pu, np.take(tab_u, su - first_u, axis=1), uc)
-            Nv = _basis_from_table(pv, np.take(tab_v, sv - first_v, axis=1), vc)
+            Nu = _basis_from_table(pu, np.take(tab_u, su - first_u, axis=1), uc, work_u)
+            Nv = _basis_from_table(pv, np.take(tab_v, sv - first_v, axis=1), vc, work_v)
         base = (su - pu) * nv + (sv - pv)
         for c in range(d):
             P = coords[c]
