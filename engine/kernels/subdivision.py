@@ -54,7 +54,8 @@ def _scatter(index: np.ndarray, values: np.ndarray, size: int) -> np.ndarray:
 
 def _face_sums(vertices: np.ndarray, fi: np.ndarray, fo: np.ndarray, quads: bool) -> np.ndarray:
     if quads:
-        return vertices[fi].reshape(-1, 4, 3).sum(axis=1)
+        q = fi.reshape(-1, 4)
+        return vertices[q[:, 0]] + vertices[q[:, 1]] + vertices[q[:, 2]] + vertices[q[:, 3]]
     if fi.size == 0:
         return np.zeros((0, 3))
     return np.add.reduceat(vertices[fi], fo[:-1], axis=0)
@@ -98,15 +99,16 @@ class _Level:
 
 def _edge_sharpness(
     he: HalfEdges, creases: np.ndarray | None, sharpness: np.ndarray | float | None
-) -> np.ndarray:
-    s = np.zeros(he.n_edges)
+) -> np.ndarray | None:
+    """Sharpness per edge, or None when nothing is creased."""
     if creases is None:
         if sharpness is not None:
             raise ValueError("sharpness was given without creases")
-        return s
+        return None
     c = np.asarray(creases)
     if c.size == 0:
-        return s
+        return None
+    s = np.zeros(he.n_edges)
     if c.ndim != 2 or c.shape[1] != 2 or not np.issubdtype(c.dtype, np.integer):
         raise ValueError(f"creases must be an (k, 2) array of vertex pairs, got shape {c.shape}")
     val = np.broadcast_to(np.inf if sharpness is None else np.asarray(sharpness, float), len(c))
@@ -126,8 +128,9 @@ def _edge_sharpness(
 
 
 def _catmull_clark_step(
-    v: np.ndarray, lv: _Level, sharp: np.ndarray
-) -> tuple[np.ndarray, _Level, np.ndarray]:
+    v: np.ndarray, lv: _Level, sharp: np.ndarray | None, last: bool
+) -> tuple[np.ndarray, _Level, np.ndarray | None]:
+    """One level; on the ``last`` one only the faces of the result are built."""
     n = v.shape[0]
     fi, fo, face, edge, ev = lv.face_indices, lv.face_offsets, lv.face, lv.edge, lv.edge_vertices
     n_edges = ev.shape[0]
@@ -146,7 +149,7 @@ def _catmull_clark_step(
     ep = 0.5 * mid + 0.25 * _scatter(edge, fp_h, n_edges)
     boundary_edge = n_side == 1
     ep[boundary_edge] = mid[boundary_edge]
-    creased = sharp > 0
+    creased = np.zeros(n_edges, dtype=bool) if sharp is None else sharp > 0
     if creased.any():
         w = np.minimum(sharp[creased], 1.0)[:, None]  # semi-sharp: blend (DeRose et al. 1998)
         ep[creased] = (1.0 - w) * ep[creased] + w * mid[creased]
@@ -155,7 +158,9 @@ def _catmull_clark_step(
     # = (sum of face points + sum of edge neighbours) / n^2 + (n - 2) / n * S
     k = np.bincount(fi, minlength=n).astype(np.float64)
     ring = _scatter(fi, fp_h, n)
-    ring += _scatter(ev.ravel(), np.stack([vb, va], axis=1).reshape(-1, 3), n)
+    for c in range(3):  # edge neighbours: each edge adds its other end to both ends
+        ring[:, c] += np.bincount(ev[:, 0], vb[:, c], minlength=n)
+        ring[:, c] += np.bincount(ev[:, 1], va[:, c], minlength=n)
     kk = np.maximum(k, 1.0)[:, None]
     vp = ring / kk**2 + (kk - 2.0) / kk * v
     # sharp rules: a vertex on two sharp edges (boundary or crease) follows the cubic
@@ -166,8 +171,9 @@ def _catmull_clark_step(
         se = np.flatnonzero(sharp_edge)
         ends = ev[se].ravel()
         n_sharp = np.bincount(ends, minlength=n)
-        s_e = np.where(boundary_edge[se], np.inf, sharp[se])
-        s_v = np.bincount(ends, np.repeat(np.minimum(s_e, 1e300), 2), minlength=n)
+        s_e = np.inf if sharp is None else np.where(boundary_edge[se], np.inf, sharp[se])
+        s_e = np.broadcast_to(np.minimum(s_e, 1e300), se.shape)
+        s_v = np.bincount(ends, np.repeat(s_e, 2), minlength=n)
         s_v /= np.maximum(n_sharp, 1)  # vertex sharpness: mean over its sharp edges
         nb = _scatter(ends, np.stack([vb[se], va[se]], axis=1).reshape(-1, 3), n)
         crease_v = n_sharp == 2
@@ -189,33 +195,35 @@ def _catmull_clark_step(
     h = np.arange(m, dtype=np.int64)
     pe = edge[lv.prev]
     quad = np.stack([fi, n + edge, n + n_edges + face, n + pe], axis=1)
+    m4 = 4 * m
+    face_offsets = np.arange(0, m4 + 1, 4, dtype=np.int64)
+    if last:
+        done = _Level(quad.reshape(-1), face_offsets, *(np.empty(0, np.int64),) * 4, True)
+        return new_v, done, None
     # edges: old edge e splits into 2e (at ev[e, 0]) and 2e + 1 (at ev[e, 1]); the edge
     # from the edge point of h to the face point is 2E + h
     child = 2 * edge + (fi == ev[edge, 1])
     child_prev = 2 * pe + (fi == ev[pe, 1])
     new_edge = np.stack([child, 2 * n_edges + h, 2 * n_edges + lv.prev, child_prev], axis=1)
-    new_ev = np.concatenate(
-        [
-            np.stack(
-                [ev, np.broadcast_to(n + np.arange(n_edges)[:, None], ev.shape)], axis=2
-            ).reshape(-1, 2),
-            np.stack([n + edge, n + n_edges + face], axis=1),
-        ]
-    )
-    m4 = 4 * m
+    new_ev = np.empty((2 * n_edges + m, 2), dtype=np.int64)
+    new_ev[: 2 * n_edges, 0] = ev.ravel()
+    new_ev[: 2 * n_edges, 1] = np.repeat(n + np.arange(n_edges), 2)
+    new_ev[2 * n_edges :, 0] = n + edge
+    new_ev[2 * n_edges :, 1] = n + n_edges + face
     prev4 = np.arange(m4, dtype=np.int64) - 1
     prev4[::4] += 4
     nxt = _Level(
         face_indices=quad.reshape(-1),
-        face_offsets=np.arange(0, m4 + 1, 4, dtype=np.int64),
+        face_offsets=face_offsets,
         face=np.repeat(h, 4),
         edge=new_edge.reshape(-1),
         prev=prev4,
         edge_vertices=new_ev,
         quads=True,
     )
-    new_sharp = np.concatenate([np.repeat(np.maximum(sharp - 1.0, 0.0), 2), np.zeros(m)])
-    return new_v, nxt, new_sharp
+    if sharp is None or not (sharp > 1.0).any():
+        return new_v, nxt, None
+    return new_v, nxt, np.concatenate([np.repeat(np.maximum(sharp - 1.0, 0.0), 2), np.zeros(m)])
 
 
 def catmull_clark(
@@ -292,8 +300,8 @@ def catmull_clark(
     if levels == 0:
         return v.copy(), np.array(he.origin), np.array(he.face_offsets)
     lv = _Level.from_halfedges(he)
-    for _ in range(levels):
-        v, lv, sharp = _catmull_clark_step(v, lv, sharp)
+    for level in range(levels):
+        v, lv, sharp = _catmull_clark_step(v, lv, sharp, last=level == levels - 1)
     return v, lv.face_indices, lv.face_offsets
 
 

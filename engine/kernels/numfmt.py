@@ -1,0 +1,642 @@
+"""Numbers to ASCII text in bulk, with numpy: the text exporters (STL, OBJ, SVG, PDF) stand on it.
+
+Formatting millions of floats one ``'%r' % x`` at a time costs about half a microsecond each;
+here every number is turned into digits with integer array arithmetic and the characters are
+put in place with table look-ups, so a mesh of a million triangles formats in a fraction of a
+second.
+
+Every formatter returns a *canvas*: a ``(n, width)`` uint8 array holding one number per row,
+padded with NUL bytes (0) that :func:`join_rows` squeezes out when it assembles the text.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from fractions import Fraction
+from functools import cache
+
+import numpy as np
+
+PAD = 0  # filler byte in canvases, removed when the text is assembled
+
+_DIGIT = np.frombuffer(b"0123456789", dtype=np.uint8)
+_POW10_INT = 10 ** np.arange(19, dtype=np.int64)
+# arrays are formatted in blocks of this many values so the temporaries stay in cache
+_BLOCK = 1 << 15
+
+
+def _check_finite(values: np.ndarray, what: str) -> None:
+    if not np.all(np.isfinite(values)):
+        bad = values[~np.isfinite(values)][0]
+        raise ValueError(f"{what} must be finite numbers to be written as text, got {bad}")
+
+
+# --------------------------------------------------------------------------------------------
+# shortest round-trip decimal digits (the digits Python's repr prints), vectorized
+
+
+@cache
+def _pow10_double_double() -> tuple[np.ndarray, np.ndarray]:
+    """``10**k`` for k in [-300, 308] as unevaluated sums hi + lo of two doubles (exact to 2^-106).
+
+    Index with ``k + 300``. Python's Fraction -> float conversion is correctly rounded.
+    """
+    ks = range(-300, 309)
+    hi = np.empty(len(ks))
+    lo = np.empty(len(ks))
+    for i, k in enumerate(ks):
+        exact = Fraction(10) ** k
+        hi[i] = float(exact)
+        lo[i] = float(exact - Fraction(hi[i]))
+    return hi, lo
+
+
+def _split(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Veltkamp/Dekker split of doubles into 26- and 27-bit halves (a = h + l exactly)."""
+    c = a * 134217729.0  # 2**27 + 1
+    h = c - (c - a)
+    return h, a - h
+
+
+def _two_prod(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Dekker's exact product: p + e == a * b exactly (T. J. Dekker, 1971)."""
+    p = a * b
+    ah, al = _split(a)
+    bh, bl = _split(b)
+    e = ((ah * bh - p) + ah * bl + al * bh) + al * bl
+    return p, e
+
+
+def _scaled_17(a: np.ndarray, e10: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``a * 10**(16 - e10)`` as an integer part (int64) and a fraction in [0, 1).
+
+    The product is carried in double-double arithmetic, so the integer part is exact and the
+    fraction is good to ~1e-15: enough to round correctly to any number of digits.
+    """
+    hi, lo = _pow10_double_double()
+    k = 16 - e10 + 300
+    p, e = _two_prod(a, hi[k])
+    q = e + a * lo[k]
+    s = p + q
+    t = q - (s - p)  # |p| >= |q|: fast two-sum
+    # s >= 2**53 here, so it holds an integer exactly
+    fl = np.floor(t)
+    return s.astype(np.int64) + fl.astype(np.int64), t - fl
+
+
+def shortest_decimal(
+    x: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The shortest decimal that reads back as the same double, for every element of ``x``.
+
+    The digits Python's ``repr(float)`` prints (shortest, and among the shortest the nearest),
+    found with array arithmetic: the value is scaled to 17 digits in double-double arithmetic
+    (Dekker's exact product), then a search over how many trailing digits can be dropped keeps
+    the decimal inside the rounding interval of the double (half the gap to each neighbour) —
+    the round-trip criterion of Steele & White, "How to print floating-point numbers
+    accurately", PLDI 1990. Integers from 2**53 to 2**63 are done exactly in int64, where a
+    decimal on the boundary reads back when the significand is even (round-half-even), as
+    repr allows. Values beyond (above 2**63 or below 1e-280 in magnitude) go through numpy's
+    own shortest formatting one by one.
+
+    Parameters
+    ----------
+    x : (n,) float64
+        Finite values.
+
+    Returns
+    -------
+    negative : (n,) bool
+        Sign bit (so -0.0 is negative, as repr prints it).
+    mantissa : (n,) int64
+        The digits as an integer, no trailing zeros (0 for zero).
+    ndigits : (n,) int64
+        Number of digits in ``mantissa`` (1 to 19).
+    exp10 : (n,) int64
+        Decimal exponent of the first digit: value = mantissa * 10**(exp10 - ndigits + 1).
+    """
+    x = np.asarray(x, dtype=np.float64).ravel()
+    _check_finite(x, "values")
+    negative = np.signbit(x)
+    a = np.abs(x)
+    n = a.size
+    mantissa = np.zeros(n, dtype=np.int64)
+    ndigits = np.ones(n, dtype=np.int64)
+    exp10 = np.zeros(n, dtype=np.int64)
+
+    scaled = (a >= 1e-280) & (a < 2.0**53)
+    big = (a >= 2.0**53) & (a < 2.0**63)
+    idx = np.flatnonzero(scaled)
+    if idx.size:
+        mantissa[idx], ndigits[idx], exp10[idx] = _shortest_scaled(a[idx])
+    idx = np.flatnonzero(big)
+    if idx.size:
+        mantissa[idx], ndigits[idx], exp10[idx] = _shortest_big(a[idx])
+    for i in np.flatnonzero((a != 0) & ~scaled & ~big):  # beyond the ranges above: rare
+        digits, exponent = np.format_float_scientific(a[i], unique=True, trim="-").split("e")
+        digits = digits.replace(".", "")
+        mantissa[i], ndigits[i], exp10[i] = int(digits), len(digits), int(exponent)
+    return negative, mantissa, ndigits, exp10
+
+
+def _shortest_scaled(a: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`shortest_decimal` for 1e-280 <= a < 2**53 (positive)."""
+    e10 = np.floor(np.log10(a)).astype(np.int64)
+    vint, frac = _scaled_17(a, e10)
+    # log10 may be one off next to a power of ten: settle the exponent so round(T) has 17 digits
+    for _ in range(3):
+        r17 = vint + (frac >= 0.5)
+        low, high = r17 < 10**16, r17 >= 10**17
+        fix = np.flatnonzero(low | high)
+        if fix.size == 0:
+            break
+        e10[fix] += np.where(high[fix], 1, -1)
+        vint[fix], frac[fix] = _scaled_17(a[fix], e10[fix])
+    # half the gap to each neighbouring double in units of the scaled value, with a margin far
+    # above the ~1e-15 error of the scaling so that an accepted decimal always reads back. A
+    # decimal of at most 16 digits never sits exactly on the boundary below 2**53 (the midpoint
+    # of two such doubles needs 17 digits), so no tie rule is needed here.
+    hi, _ = _pow10_double_double()
+    scale = hi[16 - e10 + 300] * (0.5 * (1.0 - 2.0**-40))
+    bound_up = np.spacing(a) * scale
+    bound_down = (a - np.nextafter(a, 0.0)) * scale
+    even = np.zeros(a.size, dtype=bool)
+    mantissa, dropped = _drop_digits(vint, frac, bound_down, bound_up, even, np.full(a.size, 16))
+    return _carry(mantissa, 17 - dropped, e10)
+
+
+def _shortest_big(a: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`shortest_decimal` for integers 2**53 <= a < 2**63, exactly in int64."""
+    vint = a.astype(np.int64)
+    total = np.searchsorted(_POW10_INT, vint, side="right")  # number of digits
+    gap = np.spacing(a)
+    bound_up = 0.5 * gap
+    bound_down = 0.5 * (a - np.nextafter(a, 0.0))
+    even = (vint // gap.astype(np.int64)) % 2 == 0
+    frac = np.zeros(a.size)
+    mantissa, dropped = _drop_digits(vint, frac, bound_down, bound_up, even, total - 1)
+    return _carry(mantissa, total - dropped, total - 1)
+
+
+def _carry(
+    mantissa: np.ndarray, ndigits: np.ndarray, e10: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Rounding up may carry into a new digit (9.99... -> 10): the value is then 10**(e10+1)."""
+    carry = mantissa == _POW10_INT[ndigits]
+    return (
+        np.where(carry, 1, mantissa),
+        np.where(carry, 1, ndigits),
+        e10 + carry,
+    )
+
+
+def _drop_digits(
+    vint: np.ndarray,
+    frac: np.ndarray,
+    bound_down: np.ndarray,
+    bound_up: np.ndarray,
+    even: np.ndarray,
+    max_drop: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Most trailing digits of ``vint + frac`` that can be dropped with rounding still reading back.
+
+    A decimal below the value reads back when its distance is under ``bound_down`` (under or,
+    with ``even``, equal), one above under ``bound_up``. Dropping more digits only moves the
+    nearest candidate further away, so the answer is found by search: dropping 1 and then 2
+    digits is tried first (most doubles need 16 or 17 digits), the rest by bisection over the
+    values still undecided.
+
+    Returns
+    -------
+    mantissa : (n,) int64
+        The kept digits, rounded.
+    dropped : (n,) int64
+    """
+    arrays = (vint, frac, bound_down, bound_up, even)
+
+    def trial(j, v, f, bd, bu, ev):
+        div = _POW10_INT[j]
+        q = v // div
+        rem = v - q * div
+        dist_down = rem + f  # distance to q * div
+        dist_up = (div - rem).astype(np.float64) - f  # distance to (q + 1) * div
+        ok_down = (dist_down < bd) | (ev & (dist_down == bd))
+        ok_up = (dist_up < bu) | (ev & (dist_up == bu))
+        # the nearest wins; an exact tie goes to the even digit, as repr does
+        up = ok_up & (~ok_down | (dist_up < dist_down) | ((dist_up == dist_down) & (q % 2 == 1)))
+        return ok_down | ok_up, q, up
+
+    n = vint.size
+    dropped = np.zeros(n, dtype=np.int64)  # dropping nothing always reads back
+    idx = np.arange(n)
+    sub = arrays
+    for step in (1, 2):  # max_drop >= 15 always, so both steps are allowed
+        ok, _, _ = trial(step, *sub)
+        idx = idx[ok]
+        dropped[idx] = step
+        sub = tuple(arr[ok] for arr in sub)
+    lo = np.full(idx.size, 2, dtype=np.int64)
+    hi = max_drop[idx]
+    while True:
+        active = lo < hi
+        if not active.any():
+            break
+        mid = np.where(active, (lo + hi + 1) // 2, lo)
+        ok, _, _ = trial(mid, *sub)
+        lo = np.where(active & ok, mid, lo)
+        hi = np.where(active & ~ok, mid - 1, hi)
+    dropped[idx] = lo
+    _, q, up = trial(dropped, *arrays)
+    return q + up, dropped
+
+
+# --------------------------------------------------------------------------------------------
+# text from digits, eight characters at a time
+#
+# A number's text is held in uint64 words (the first character in the lowest byte of the first
+# word), so moving characters is shifting words: a handful of whole-array integer operations
+# instead of per-character shuffles. Unused bytes stay 0 (PAD). numpy defines shifts of 64
+# bits or more to give 0, which the shifts and masks below rely on.
+
+_U = np.uint64
+_ZEROS8 = _U(0x3030303030303030)  # "00000000"
+_DOTS8 = _U(0x2E2E2E2E2E2E2E2E)  # "........"
+_MASKS = np.array([(1 << (8 * k)) - 1 for k in range(9)], dtype=_U)  # the low k bytes
+REPR_WIDTH = 24  # bytes: the longest repr of a double, "-1.2345678901234567e-308", fits
+
+
+def _swar8(v: np.ndarray) -> np.ndarray:
+    """Integers below 10**8 as eight ASCII digits packed in a uint64, leading zeros included.
+
+    SIMD-within-a-register conversion: split into two 4-digit lanes, each into two 2-digit
+    lanes, each into two digits, with multiply-shift divisions exact on these ranges
+    (x // 10**4 == (x * 3518437209) >> 45 for x < 2**32, x // 100 == (x * 5243) >> 19 for
+    x < 10**4, x // 10 == (x * 103) >> 10 for x < 100) — no integer division at all.
+    """
+    v = v.astype(_U)
+    hi = (v * _U(3518437209)) >> _U(45)
+    x = hi | ((v - hi * _U(10000)) << _U(32))
+    q = ((x * _U(5243)) >> _U(19)) & _U(0x0000007F0000007F)
+    z = q | ((x - q * _U(100)) << _U(16))
+    t = ((z * _U(103)) >> _U(10)) & _U(0x000F000F000F000F)
+    return (t | ((z - t * _U(10)) << _U(8))) + _ZEROS8
+
+
+def _low_bytes(k: np.ndarray, word: int) -> np.ndarray:
+    """Mask of the bytes of word ``word`` that lie below byte ``k`` of the string."""
+    return _MASKS[np.clip(k - 8 * word, 0, 8)]
+
+
+def _shift_up(words: list[np.ndarray], nbytes: np.ndarray | int) -> list[np.ndarray]:
+    """Move the string ``nbytes`` (0 to 8) bytes further on; bytes pushed past the end are lost."""
+    bits = (np.asarray(nbytes) * 8).astype(_U)
+    back = _U(64) - bits
+    out = [words[0] << bits]
+    for i in range(1, len(words)):
+        out.append((words[i] << bits) | (words[i - 1] >> back))
+    return out
+
+
+def _place(text: np.ndarray | np.uint64, pos: np.ndarray, word: int) -> np.ndarray:
+    """Word ``word`` of a string holding the (up to 8-byte) ``text`` at byte ``pos``, else 0."""
+    off = pos - 8 * word
+    bits = (np.abs(off) * 8).astype(_U)
+    return np.where(off >= 0, text << bits, text >> bits)
+
+
+def _lead_word(lead: bytes) -> np.uint64:
+    if len(lead) > 8:
+        raise ValueError(f"a lead of at most 8 bytes fits a word, got {lead!r}")
+    return _U(int.from_bytes(lead, "little"))
+
+
+def _number_words(
+    negative: np.ndarray,
+    mantissa: np.ndarray,
+    ndigits: np.ndarray,
+    exp10: np.ndarray,
+    positional: np.ndarray,
+    point_zero: bool,
+    lead: bytes,
+    nwords: int,
+) -> np.ndarray:
+    """Text of ``(-1)**negative * mantissa * 10**(exp10 - ndigits + 1)`` as (n, nwords) words.
+
+    ``lead`` first (a separator), then the sign where negative, then the number: positional
+    where ``positional`` (``12.5``, ``0.001``; integers as ``3.0`` with ``point_zero`` else
+    ``3``), else scientific as repr writes it (``1.5e+16``, ``1e-05``). At most 7 zeros may
+    follow the point, and the whole must fit ``nwords`` words.
+    """
+    left = mantissa * _POW10_INT[17 - ndigits]  # the 17 digits, left-aligned
+    d0 = left // 10**16
+    rest = left - d0 * 10**16
+    h = _swar8(rest // 10**8)
+    l = _swar8(rest % 10**8)
+    v = [
+        (d0.astype(_U) + _U(ord("0"))) | (h << _U(8)),
+        (h >> _U(56)) | (l << _U(8)),
+        (l >> _U(56)) | (_ZEROS8 << _U(8)),
+    ] + [np.full(d0.size, _ZEROS8)] * (nwords - 3)
+    # "0.001" is the digits after z = 3 zeros, "0001", with the point after the first
+    small = positional & (exp10 < 0)
+    if small.any():
+        z = np.where(small, -exp10, 0)
+        v = _shift_up(v, z)
+        v[0] = v[0] | (_ZEROS8 & _low_bytes(z, 0))
+    else:
+        z = 0
+    integer = positional & (exp10 >= ndigits - 1)
+    last = np.where(positional, np.maximum(exp10, 0), 0)  # the digit before the point
+    has_point = np.where(positional, point_zero | ~integer, ndigits > 1)
+    length = np.where(
+        positional,
+        np.where(integer & ~has_point, exp10 + 1, np.maximum(ndigits + z, last + 2)),
+        ndigits,
+    )
+    # insert the point: the digits after it move one byte on
+    point = np.where(has_point, last + 1, 8 * nwords)
+    moved = _shift_up(v, 1)
+    text_len = length + has_point
+    body = []
+    for i in range(nwords):
+        before, after = _low_bytes(point, i), _low_bytes(point + 1, i)
+        # after & ~before is the point's own byte: fill it with "."
+        word = (v[i] & before) | (moved[i] & ~after) | (_DOTS8 & after & ~before)
+        body.append(word & _low_bytes(text_len, i))
+    # the lead, then a sign slot ("-" or padding, which the squeeze removes)
+    front = len(lead) + 1
+    out = _shift_up(body, front)
+    out[0] = out[0] | np.where(negative, _U(ord("-")) << _U(8 * len(lead)), _U(0))
+    out[0] = out[0] | _lead_word(lead)
+    # scientific: "e", sign, (hundreds), tens, units right after the mantissa
+    sci = ~positional
+    if sci.any():
+        eabs = np.abs(exp10)
+        units = ((eabs % 10).astype(_U) + _U(ord("0"))) << _U(8)
+        tens = ((eabs // 10) % 10).astype(_U) + _U(ord("0"))
+        hund = (eabs // 100).astype(_U) + _U(ord("0"))
+        digits_e = np.where(eabs >= 100, hund | ((tens | units) << _U(8)), tens | units)
+        sign_e = np.where(exp10 < 0, _U(ord("-")), _U(ord("+")))
+        exp = np.where(sci, _U(ord("e")) | (sign_e << _U(8)) | (digits_e << _U(16)), _U(0))
+        at = front + text_len
+        for i in range(nwords):
+            out[i] = out[i] | _place(exp, at, i)
+    return np.stack(out, axis=1)
+
+
+def float_words(x: np.ndarray, *, decimals: int | None = None, lead: bytes = b"") -> np.ndarray:
+    """Text of every value, ``lead`` first, as rows of uint64 words (NUL-padded).
+
+    With ``decimals=None`` the text is Python's ``repr(float(value))``: the shortest that
+    reads back to the same double (:func:`shortest_decimal`), positional for exponents -4..15
+    (``0.0001``, ``12.5``, ``3.0``), scientific otherwise (``1e-05``, ``1.5e+16``). With
+    ``decimals=d`` (0 to 7) the value is rounded to ``d`` places and written positionally
+    without trailing zeros (``1.5``, ``3``, ``0``; never ``-0``, never an exponent).
+
+    Parameters
+    ----------
+    x : (n,) float64
+        Finite values; below 1e15 in magnitude with ``decimals``.
+    decimals : int, optional
+    lead : bytes
+        Up to 2 bytes put before each number (e.g. a space separator).
+
+    Returns
+    -------
+    (n, w) uint64
+        ``w`` is 3 or, when ``lead`` and some value has a three-digit exponent, 4.
+    """
+    x = np.asarray(x, dtype=np.float64).ravel()
+    _check_finite(x, "values")
+    if len(lead) > 2:
+        raise ValueError(f"lead must be at most 2 bytes, got {lead!r}")
+    if decimals is not None:
+        if not 0 <= decimals <= 7:
+            raise ValueError(f"decimals must be between 0 and 7, got {decimals}")
+        if x.size and np.abs(x).max() >= 1e15:
+            raise ValueError(
+                "values must be below 1e15 in magnitude to be written positionally, got "
+                f"{np.abs(x).max():g}"
+            )
+        x = np.round(x, decimals) + 0.0  # + 0.0 turns -0.0 into 0.0
+    a = np.abs(x)
+    extreme = bool(np.any((a >= 1e100) | ((a < 1e-99) & (a > 0))))
+    # the sign slot, up to 23 characters of number, and the lead must fit: a three-digit
+    # exponent with 17 digits is 23, anything else at most 22
+    nwords = 4 if (len(lead) + 1 + (23 if extreme else 22)) > 24 else 3
+    out = np.empty((x.size, nwords), dtype=_U)
+    for start in range(0, x.size, _BLOCK):  # blocks keep temporaries in cache
+        neg, m, nd, e = shortest_decimal(x[start : start + _BLOCK])
+        positional = (e >= -4) & (e <= 15) if decimals is None else np.ones(e.size, dtype=bool)
+        out[start : start + _BLOCK] = _number_words(
+            neg, m, nd, e, positional, decimals is None, lead, nwords
+        )
+    return out
+
+
+def format_shortest(x: np.ndarray) -> np.ndarray:
+    """Each value as Python's ``repr(float(value))`` prints it, in bulk: ``float(text) == value``.
+
+    Parameters
+    ----------
+    x : (n,) float64
+        Finite values.
+
+    Returns
+    -------
+    (n, 24) uint8
+        Canvas, NUL-padded.
+
+    Example
+    -------
+    >>> join_rows([format_shortest(np.array([0.1, -2.0, 1e-7]))], b"\\n")
+    b'0.1\\n-2.0\\n1e-07\\n'
+    """
+    return float_words(x).view(np.uint8)
+
+
+def format_fixed(x: np.ndarray, decimals: int = 6) -> np.ndarray:
+    """Each value rounded to ``decimals`` places, positional, no trailing zeros.
+
+    ``1.5``, ``-0.25``, ``3``, ``0`` — never ``-0`` and never an exponent, so the text is a
+    valid number in SVG path data and in a PDF content stream alike.
+
+    Parameters
+    ----------
+    x : (n,) float64
+        Finite values below 1e15 in magnitude.
+    decimals : int
+        Places after the point, 0 to 7.
+
+    Returns
+    -------
+    (n, 24) uint8
+        Canvas, NUL-padded.
+    """
+    return float_words(x, decimals=decimals).view(np.uint8)
+
+
+def int_words(v: np.ndarray, lead: bytes = b"") -> np.ndarray:
+    """Non-negative integers as right-aligned decimal text after ``lead``, in uint64 words.
+
+    Parameters
+    ----------
+    v : (n,) int
+        Values from 0 to 10**15 - 1.
+    lead : bytes
+        Up to 1 byte (a separator) at the start of each row.
+
+    Returns
+    -------
+    (n, 1) uint64 when every value has at most ``8 - len(lead)`` digits, else (n, 2).
+    """
+    v = np.asarray(v, dtype=np.int64).ravel()
+    if len(lead) > 1:
+        raise ValueError(f"lead must be at most 1 byte, got {lead!r}")
+    if v.size and (v.min() < 0 or v.max() >= 10**15):
+        raise ValueError(f"integers from 0 to 10**15 - 1 expected, got {v.min()} .. {v.max()}")
+    ndig = np.maximum(np.searchsorted(_POW10_INT, v, side="right"), 1)
+    if not v.size or v.max() < 10 ** (8 - len(lead)):
+        words = [_swar8(v) & ~_low_bytes(8 - ndig, 0)]
+    else:
+        blank = 16 - ndig
+        words = [
+            _swar8(v // 10**8) & ~_low_bytes(blank, 0),
+            _swar8(v % 10**8) & ~_low_bytes(blank, 1),
+        ]
+    words[0] = words[0] | _lead_word(lead)
+    return np.stack(words, axis=1)
+
+
+def format_int(v: np.ndarray) -> np.ndarray:
+    """Non-negative integers in decimal, right-aligned in a NUL-padded canvas.
+
+    Parameters
+    ----------
+    v : (n,) int
+        Values from 0 to 10**15 - 1.
+
+    Returns
+    -------
+    (n, 8) uint8 when every value is below 10**8, else (n, 16).
+    """
+    return int_words(v).view(np.uint8)
+
+
+E9_WIDTH = 16  # " -1.23456789e+00"
+
+
+@cache
+def _pow10_float() -> np.ndarray:
+    """Correctly rounded ``10.0**k`` for k in [-60, 60], index ``k + 60``."""
+    return np.array([float(Fraction(10) ** k) for k in range(-60, 61)])
+
+
+def format_e9(x: np.ndarray) -> np.ndarray:
+    """Single-precision values in fixed-width e-format with 9 significant digits.
+
+    ``' -1.23456789e+00'``: a leading space, the sign or a space, nine digits, a two-digit
+    exponent — 16 bytes per value, no padding to remove. Nine digits carry every float32
+    exactly (a reader that parses into float32 gets the same bits back). The digits come
+    from one scaling in double precision: its ~1e-16 error can move the ninth digit only when
+    the value lies within 1e-7 of a rounding tie, and the result still reads back to the same
+    float32. Formats the STL ``facet normal`` and ``vertex`` lines (the ASCII STL layout asks
+    for sign-mantissa-'e'-sign-exponent numbers).
+
+    Parameters
+    ----------
+    x : (n,) float32 or float64
+        Finite values; rounded to float32 first.
+
+    Returns
+    -------
+    (n, 16) uint8
+    """
+    x = np.asarray(x).ravel()
+    if x.dtype != np.float32:
+        with np.errstate(over="ignore"):
+            x32 = x.astype(np.float32)
+        _check_finite(x32, "values (as 32-bit floats)")
+        x = x32
+    else:
+        _check_finite(x, "values")
+    out = np.empty((x.size, 2), dtype=_U)
+    for start in range(0, x.size, _BLOCK):  # blocks keep temporaries in cache
+        out[start : start + _BLOCK] = _e9_block(x[start : start + _BLOCK])
+    return out.view(np.uint8)
+
+
+def _e9_block(x: np.ndarray) -> np.ndarray:
+    a = np.abs(x).astype(np.float64)
+    neg = np.signbit(x)
+    nonzero = a != 0
+    with np.errstate(divide="ignore"):
+        e = np.floor(np.log10(np.where(nonzero, a, 1.0))).astype(np.int64)
+    pw = _pow10_float()
+    m = np.rint(a * pw[8 - e + 60]).astype(np.int64)
+    for _ in range(2):  # log10 may be one off next to a power of ten
+        fix = (m >= 10**9) | ((m < 10**8) & nonzero)
+        if not fix.any():
+            break
+        e = np.where(fix, e + np.where(m >= 10**9, 1, -1), e)
+        m = np.where(fix, np.rint(a * pw[8 - e + 60]).astype(np.int64), m)
+    m = np.where(nonzero, m, 0)
+    e = np.where(nonzero, e, 0)
+    d0 = m // 10**8
+    digits = _swar8(m - d0 * 10**8)
+    eabs = np.abs(e).astype(_U)
+    c = {ch: _U(ord(ch)) for ch in " -.e+0"}
+    out = np.empty((x.size, 2), dtype=_U)
+    out[:, 0] = (
+        c[" "]
+        | (np.where(neg, c["-"], c[" "]) << _U(8))
+        | ((d0.astype(_U) + c["0"]) << _U(16))
+        | (c["."] << _U(24))
+        | (digits << _U(32))
+    )
+    out[:, 1] = (
+        (digits >> _U(32))
+        | (c["e"] << _U(32))
+        | (np.where(e < 0, c["-"], c["+"]) << _U(40))
+        | ((eabs // _U(10) + c["0"]) << _U(48))
+        | ((eabs % _U(10) + c["0"]) << _U(56))
+    )
+    return out
+
+
+# --------------------------------------------------------------------------------------------
+# assembling text
+
+
+def join_rows(parts: Sequence[bytes | np.ndarray], end: bytes = b"") -> bytes:
+    """Rows of text: each row is the concatenation of ``parts``, then ``end``; NULs dropped.
+
+    Parameters
+    ----------
+    parts : sequence of bytes or (n, w) uint8
+        Constant text shared by every row, or a canvas with one row per line.
+    end : bytes
+        Appended to every row (e.g. ``b"\\n"``).
+
+    Returns
+    -------
+    bytes
+    """
+    parts = list(parts) + ([end] if end else [])
+    rows = {p.shape[0] for p in parts if isinstance(p, np.ndarray)}
+    if len(rows) != 1:
+        raise ValueError(f"join_rows needs canvases with one common row count, got {sorted(rows)}")
+    (n,) = rows
+    widths = [p.shape[1] if isinstance(p, np.ndarray) else len(p) for p in parts]
+    canvas = np.empty((n, sum(widths)), dtype=np.uint8)
+    col = 0
+    for p, w in zip(parts, widths, strict=True):
+        canvas[:, col : col + w] = p if isinstance(p, np.ndarray) else np.frombuffer(p, np.uint8)
+        col += w
+    return squeeze(canvas)
+
+
+def squeeze(canvas: np.ndarray) -> bytes:
+    """The bytes of a canvas in row order with the NUL padding removed."""
+    flat = canvas.reshape(-1)
+    return np.compress(flat != PAD, flat).tobytes()
