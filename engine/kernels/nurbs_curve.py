@@ -232,8 +232,8 @@ def periodic_curve(points: np.ndarray, degree: int) -> tuple[np.ndarray, np.ndar
     Parameters
     ----------
     points : (k, 3) float
-        The closed control polygon (the last point is not a repeat of the first); k must
-        be at least degree + 1... the degree is not capped here.
+        The closed control polygon (the last point is not a repeat of the first);
+        k >= max(3, degree + 1).
     degree : int
 
     Returns
