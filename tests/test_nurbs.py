@@ -225,7 +225,7 @@ def test_tessellate_a_parametric_surface():
     [
         ("canopy", {"rise": 4.0}, {"front", "canopy", "mesh"}),
         ("vase", {"angle": 270}, {"vase", "mesh"}),
-        ("spiral_tube", {"thickness": 0.2}, {"section", "tube", "mesh"}),
+        ("spiral_tube", {"thickness": 0.2}, {"section", "tube", "mesh", "print"}),
     ],
 )
 def test_example_graphs_recompute_only_what_a_param_reaches(name, change, recomputed, tmp_path):
