@@ -12,6 +12,18 @@ pyvista is imported only when something is drawn, so importing this package is c
 
 from __future__ import annotations
 
+import os
+import sys
+
+# With no display (CI, a server, a container) VTK would first try X, print a warning and
+# only then fall back; EGL renders off screen directly.
+if (
+    sys.platform.startswith("linux")
+    and not os.environ.get("DISPLAY")
+    and not os.environ.get("WAYLAND_DISPLAY")
+):
+    os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+
 from .app import Session, screenshot, show, shown_nodes
 from .scene import Scene
 from .watch import Watcher, watch
