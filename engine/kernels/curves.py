@@ -19,6 +19,7 @@ import math
 
 import numpy as np
 
+from .nurbs_construct import CurveTuple, SurfaceTuple
 from .polylines import (
     arc_length_table,
     as_points,
@@ -54,8 +55,6 @@ __all__ = [
     "drop_repeats",
 ]
 
-CurveTuple = tuple[np.ndarray, int, np.ndarray, "np.ndarray | None"]
-SurfaceTuple = tuple[np.ndarray, int, int, np.ndarray, np.ndarray, "np.ndarray | None"]
 
 #: knot-interval exponent alpha of each Catmull-Rom spacing: interval = |P[i+1] - P[i]| ** alpha
 SPACINGS = {"uniform": 0.0, "centripetal": 0.5, "chordal": 1.0}
