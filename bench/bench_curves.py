@@ -9,6 +9,7 @@ a linear solve) is shown as context. Resampling and offsetting have shapely coun
 from __future__ import annotations
 
 import numpy as np
+
 from formgraph.kernels.curves import (
     bisector_offset,
     catmull_rom,

@@ -8,8 +8,9 @@ are evaluated cold, fully cached, and after changing one param at the top or at 
 
 from __future__ import annotations
 
-import formgraph as fg
 import numpy as np
+
+import formgraph as fg
 from formgraph.geometry import Points
 from formgraph.registry import node
 

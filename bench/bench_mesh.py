@@ -8,6 +8,7 @@ and pymeshlab when it imports (it is optional and usually not installed).
 from __future__ import annotations
 
 import numpy as np
+
 from formgraph.kernels.grid import grid_faces
 from formgraph.kernels.subdivision import catmull_clark, doo_sabin
 

@@ -17,6 +17,7 @@ from __future__ import annotations
 import copy
 
 import numpy as np
+
 from formgraph.kernels import nurbs as K
 
 N_CP, DEGREE, N_PARAMS = 100, 3, 100_000

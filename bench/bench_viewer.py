@@ -23,6 +23,7 @@ def _graph() -> fg.Graph:
 
 def run(table) -> None:
     import pyvista as pv
+
     from formgraph.viewer import Session
 
     pv.OFF_SCREEN = True

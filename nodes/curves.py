@@ -6,6 +6,7 @@ from enum import Enum
 from typing import Annotated, Any
 
 import numpy as np
+
 from formgraph.errors import InputError
 from formgraph.geometry import Curve, NurbsCurve, ParametricCurve, Points
 from formgraph.kernels import curves as kc

@@ -11,6 +11,7 @@ from __future__ import annotations
 from typing import Annotated
 
 import numpy as np
+
 from formgraph.errors import InputError
 from formgraph.geometry import Mesh, Points
 from formgraph.kernels import meshops, subdivision

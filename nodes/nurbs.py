@@ -11,6 +11,7 @@ from enum import Enum
 from typing import Annotated, Any
 
 import numpy as np
+
 from formgraph.errors import InputError
 from formgraph.geometry import (
     Curve,

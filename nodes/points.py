@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import Annotated
 
 import numpy as np
+
 from formgraph.geometry import Points
 from formgraph.registry import Context, Range, node
 from formgraph.types import Vec3

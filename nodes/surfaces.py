@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import Annotated
 
 import numpy as np
+
 from formgraph.errors import InputError
 from formgraph.geometry import Mesh, NurbsSurface, ParametricSurface, Points
 from formgraph.kernels import curves as kc

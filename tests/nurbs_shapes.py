@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 import numpy as np
-from formgraph.kernels import nurbs as K
 from geomdl import NURBS, BSpline
+
+from formgraph.kernels import nurbs as K
 
 T = np.linspace(0.0, 1.0, 101)
 

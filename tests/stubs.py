@@ -9,6 +9,7 @@ from __future__ import annotations
 from typing import Annotated
 
 import numpy as np
+
 from formgraph.errors import InputError
 from formgraph.geometry import Points
 from formgraph.registry import Context, Range, node

@@ -6,11 +6,12 @@ import multiprocessing as mp
 import os
 from pathlib import Path
 
-import formgraph as fg
 import numpy as np
 import pytest
-from formgraph.cache import DiskCache, MemoryCache, key_of
 from stubs import CALLS
+
+import formgraph as fg
+from formgraph.cache import DiskCache, MemoryCache, key_of
 
 
 def graph(cache_dir: Path) -> fg.Graph:

@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
-import formgraph as fg
 import numpy as np
 import pytest
 import shapely
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.interpolate import BSpline
+
+import formgraph as fg
 
 RNG = np.random.default_rng(7)
 BLOB = [[0, 0], [4, -1], [6, 2], [3, 5], [-1, 3]]

@@ -11,9 +11,10 @@ import json
 import tracemalloc
 from typing import NamedTuple
 
-import formgraph as fg
 import numpy as np
 import pytest
+
+import formgraph as fg
 from formgraph.cache import FORMAT, DiskCache
 from formgraph.cli import main
 from formgraph.expr import compile_expression

@@ -6,10 +6,11 @@ import time
 
 import numpy as np
 import pytest
-from formgraph.errors import ExpressionError
-from formgraph.expr import Bound, compile_expression
 from hypothesis import given
 from hypothesis import strategies as st
+
+from formgraph.errors import ExpressionError
+from formgraph.expr import Bound, compile_expression
 
 
 @pytest.mark.parametrize(

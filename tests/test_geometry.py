@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
-import formgraph as fg
 import numpy as np
 import pytest
+
+import formgraph as fg
 
 
 def test_points_validation():

@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
-import formgraph as fg
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from stubs import CALLS
+
+import formgraph as fg
 
 
 def chain(n: int = 3) -> fg.Graph:

@@ -4,8 +4,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import formgraph as fg
 import pytest
+
+import formgraph as fg
 
 GRAPHS = sorted((Path(__file__).resolve().parents[1] / "graphs").glob("*.yaml"))
 

@@ -7,6 +7,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import shapely
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
+from scipy.interpolate import BSpline
+
 from formgraph.kernels.curves import (
     bezier_chain,
     bisector_offset,
@@ -18,10 +23,6 @@ from formgraph.kernels.curves import (
     subdivide_polygon,
     subdivided_count,
 )
-from hypothesis import assume, given, settings
-from hypothesis import strategies as st
-from hypothesis.extra.numpy import arrays
-from scipy.interpolate import BSpline
 
 RNG = np.random.default_rng(20240601)
 SPACINGS = ["uniform", "centripetal", "chordal"]

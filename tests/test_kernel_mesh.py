@@ -4,19 +4,6 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from formgraph.kernels.halfedge import MeshTopologyError, build_halfedges
-from formgraph.kernels.meshops import (
-    reverse_faces,
-    triangulate,
-    validate_faces,
-)
-from formgraph.kernels.subdivision import (
-    catmull_clark,
-    catmull_clark_counts,
-    doo_sabin,
-    doo_sabin_counts,
-    doo_sabin_weights,
-)
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from mesh_shapes import (
@@ -33,6 +20,20 @@ from mesh_shapes import (
 )
 from scipy.interpolate import BSpline
 from scipy.spatial import cKDTree
+
+from formgraph.kernels.halfedge import MeshTopologyError, build_halfedges
+from formgraph.kernels.meshops import (
+    reverse_faces,
+    triangulate,
+    validate_faces,
+)
+from formgraph.kernels.subdivision import (
+    catmull_clark,
+    catmull_clark_counts,
+    doo_sabin,
+    doo_sabin_counts,
+    doo_sabin_weights,
+)
 
 CLOSED = {
     "cube": cube(),

@@ -4,6 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from mesh_shapes import cube, flat, prism, tetrahedron
+
 from formgraph.kernels.halfedge import build_halfedges
 from formgraph.kernels.meshops import (
     box,
@@ -17,9 +21,6 @@ from formgraph.kernels.meshops import (
     validate_faces,
 )
 from formgraph.kernels.subdivision import catmull_clark, doo_sabin
-from hypothesis import given, settings
-from hypothesis import strategies as st
-from mesh_shapes import cube, flat, prism, tetrahedron
 
 
 def signed_volume(v, fi, fo):

@@ -8,11 +8,12 @@ import math
 
 import numpy as np
 import pytest
-from formgraph.kernels import nurbs as K
 from geomdl import helpers, operations
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from nurbs_shapes import T, geomdl_curve, geomdl_surface, random_curve, shape_error
+
+from formgraph.kernels import nurbs as K
 
 # ------------------------------------------------------------------------- basis, spans
 

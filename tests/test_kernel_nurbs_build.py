@@ -8,12 +8,13 @@ import math
 
 import numpy as np
 import pytest
-from formgraph.kernels import nurbs as K
-from formgraph.kernels.nurbs_construct import _reflection_steps
 from geomdl import fitting
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from nurbs_shapes import T, random_curve
+
+from formgraph.kernels import nurbs as K
+from formgraph.kernels.nurbs_construct import _reflection_steps
 
 # ------------------------------------------------------------------ circles and arcs
 

@@ -4,11 +4,12 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import formgraph as fg
 import numpy as np
 import pytest
-from formgraph.kernels.meshops import triangulate
 from scipy.spatial.transform import Rotation
+
+import formgraph as fg
+from formgraph.kernels.meshops import triangulate
 
 GRAPHS = Path(__file__).resolve().parents[1] / "graphs"
 

@@ -6,9 +6,10 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-import formgraph as fg
 import numpy as np
 import pytest
+
+import formgraph as fg
 from formgraph.kernels import nurbs as K
 
 RNG = np.random.default_rng(3)

@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import os
 
-import formgraph as fg
 import pytest
+
+import formgraph as fg
 from formgraph.safety import path_problem, write_atomic
 
 

@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
-import formgraph as fg
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+
+import formgraph as fg
 
 RNG = np.random.default_rng(11)
 

@@ -7,9 +7,10 @@ import os
 from collections import namedtuple
 from pathlib import Path
 
-import formgraph as fg
 import numpy as np
 import pytest
+
+import formgraph as fg
 from formgraph.geometry import (
     Mesh,
     NurbsCurve,

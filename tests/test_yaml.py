@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import textwrap
 
-import formgraph as fg
 import pytest
+
+import formgraph as fg
 
 
 def write(tmp_path, text: str, name: str = "g.yaml"):

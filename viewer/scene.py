@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+
 from formgraph.geometry import Curve, Geometry, Mesh, NurbsCurve, NurbsSurface, Points, Surface
 
 __all__ = ["PALETTE", "Layer", "Scene", "expand", "geometry_items", "view_axis"]

@@ -17,6 +17,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+
 from formgraph.kernels.halfedge import HalfEdges, build_halfedges
 
 __all__ = [
