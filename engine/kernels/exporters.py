@@ -178,13 +178,31 @@ def stl_binary(vertices: np.ndarray, face_indices: np.ndarray, face_offsets: np.
     """
     v, tris = _stl_input(vertices, face_indices, face_offsets)
     v32 = v.astype(np.float32)
-    records = np.empty(len(tris), dtype=_STL_RECORD)
+    records = np.empty((len(tris), 50), dtype=np.uint8)
+    normal, corners = records[:, :12].view("V12")[:, 0], records[:, 12:48].view("V36")[:, 0]
+    records[:, 48:] = 0  # the attribute byte count
     for s in _blocks(len(tris)):
-        block = records[s]
-        block["normal"] = triangle_normals(v, tris[s])
-        block["vertices"] = v32[tris[s]]
-        block["attribute"] = 0
+        c = np.take(v32, tris[s], axis=0)  # (b, 3, 3) float32, the stored corners
+        corners[s] = c.reshape(-1, 9).view("V36")[:, 0]
+        normal[s] = _facet_normals(c).view("V12")[:, 0]
     return b"".join([_STL_HEADER, struct.pack("<I", len(tris)), records.data])
+
+
+def _facet_normals(corners: np.ndarray) -> np.ndarray:
+    """Unit normals (b, 3) float32 of triangles given by their float32 corners (b, 3, 3).
+
+    Computed in double precision from the corners as the file stores them, so binary and
+    ASCII STL carry the same normals; (0, 0, 0) for zero-area triangles.
+    """
+    c = corners.astype(np.float64)
+    e1, e2 = c[:, 1] - c[:, 0], c[:, 2] - c[:, 0]
+    n = np.empty_like(e1)
+    n[:, 0] = e1[:, 1] * e2[:, 2] - e1[:, 2] * e2[:, 1]
+    n[:, 1] = e1[:, 2] * e2[:, 0] - e1[:, 0] * e2[:, 2]
+    n[:, 2] = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
+    length = np.sqrt(np.einsum("ij,ij->i", n, n))
+    length[length == 0] = np.inf  # zero-area: a zero normal
+    return (n / length[:, None]).astype(np.float32)
 
 
 def stl_ascii(
@@ -240,14 +258,16 @@ def stl_ascii(
     out[len(out) - len(tail) :] = np.frombuffer(tail, dtype=np.uint8)
     facets = out[len(head) : len(out) - len(tail)].reshape(len(tris), width)
     fields = [int(at) + len(w) for w, at in zip(words[:-1], starts[:-1], strict=True)]
+    v32 = v.astype(np.float32)
     for s in _blocks(len(tris)):
         t = tris[s]
         rec = template[: len(t)]
-        normal_text = format_e9(triangle_normals(v, t).ravel()).reshape(-1, field).view(item)[:, 0]
+        normals = _facet_normals(np.take(v32, t, axis=0))
+        normal_text = format_e9(normals.ravel()).reshape(-1, field).view(item)[:, 0]
         rec[:, fields[0] : fields[0] + field].view(item)[:, 0] = normal_text
         for corner in range(3):
             at = fields[corner + 1]
-            rec[:, at : at + field].view(item)[:, 0] = vertex_text[t[:, corner]]
+            rec[:, at : at + field].view(item)[:, 0] = np.take(vertex_text, t[:, corner])
         facets[s] = rec
     return out.tobytes()
 
@@ -458,9 +478,18 @@ def _face_lines(fi: np.ndarray, fo: np.ndarray, with_normals: bool) -> bytes:
     n_faces = fo.size - 1
     if n_faces == 0:
         return b""
+    sizes = np.diff(fo)
+    uniform = bool(np.all(sizes == sizes[0]))
     pieces = []
     for s in _blocks(n_faces):
         lo, hi = fo[s.start], fo[s.stop]
+        if uniform and not with_normals:  # one face size: rows of "\nf" and k index words
+            token = int_words(fi[lo:hi] + 1, lead=b" ")
+            rows = np.empty((s.stop - s.start, 1 + token.size // (s.stop - s.start)), np.uint64)
+            rows[:, 0] = _word(b"\nf")
+            rows[:, 1:] = token.reshape(len(rows), -1)
+            pieces.append(squeeze(rows.view(np.uint8)))
+            continue
         offsets = fo[s.start : s.stop + 1] - lo
         n = s.stop - s.start
         token = int_words(fi[lo:hi] + 1, lead=b" ")

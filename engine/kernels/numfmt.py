@@ -125,6 +125,10 @@ def shortest_decimal(
     exp10 = np.zeros(n, dtype=np.int64)
 
     scaled = (a >= 1e-280) & (a < 2.0**53)
+    zero = a == 0
+    if np.all(scaled | zero):  # the usual case: no gathering and scattering
+        m, d, e = _shortest_scaled(np.where(zero, 1.0, a))
+        return negative, np.where(zero, 0, m), np.where(zero, 1, d), np.where(zero, 0, e)
     big = (a >= 2.0**53) & (a < 2.0**63)
     idx = np.flatnonzero(scaled)
     if idx.size:
@@ -227,27 +231,33 @@ def _drop_digits(
         return ok_down | ok_up, q, up
 
     n = vint.size
-    dropped = np.zeros(n, dtype=np.int64)  # dropping nothing always reads back
+    # dropping nothing always reads back: round the 17 digits half to even
+    half = (frac > 0.5) | ((frac == 0.5) & (vint % 2 == 1))
+    mantissa = vint + half
+    dropped = np.zeros(n, dtype=np.int64)
     idx = np.arange(n)
     sub = arrays
     for step in (1, 2):  # max_drop >= 15 always, so both steps are allowed
-        ok, _, _ = trial(step, *sub)
+        ok, q, up = trial(step, *sub)
         idx = idx[ok]
         dropped[idx] = step
+        mantissa[idx] = (q + up)[ok]
         sub = tuple(arr[ok] for arr in sub)
     lo = np.full(idx.size, 2, dtype=np.int64)
     hi = max_drop[idx]
-    while True:
-        active = lo < hi
-        if not active.any():
-            break
-        mid = np.where(active, (lo + hi + 1) // 2, lo)
-        ok, _, _ = trial(mid, *sub)
-        lo = np.where(active & ok, mid, lo)
-        hi = np.where(active & ~ok, mid - 1, hi)
-    dropped[idx] = lo
-    _, q, up = trial(dropped, *arrays)
-    return q + up, dropped
+    if np.any(lo < hi):  # the rest (values with 15 digits or fewer) by bisection
+        while True:
+            active = lo < hi
+            if not active.any():
+                break
+            mid = np.where(active, (lo + hi + 1) // 2, lo)
+            ok, _, _ = trial(mid, *sub)
+            lo = np.where(active & ok, mid, lo)
+            hi = np.where(active & ~ok, mid - 1, hi)
+        _, q, up = trial(lo, *sub)
+        dropped[idx] = lo
+        mantissa[idx] = q + up
+    return mantissa, dropped
 
 
 # --------------------------------------------------------------------------------------------
