@@ -105,6 +105,6 @@ def run(table) -> None:
             repeat=1,
         )
 
-        table.time(f"{case}: OBJ", "pyvista (VTK)", lambda: pm.save(p("v.obj")), repeat=1)
+        table.time(f"{case}: OBJ", "pyvista (VTK)", lambda: pm.save(p("v.obj")))
         table.time(f"{case}: OBJ", "trimesh", lambda: tm.export(p("t.obj")), repeat=1)
         table.time(f"{case}: OBJ", "meshio", lambda: meshio.write(p("m.obj"), mm), repeat=1)

@@ -181,28 +181,33 @@ def stl_binary(vertices: np.ndarray, face_indices: np.ndarray, face_offsets: np.
     records = np.empty((len(tris), 50), dtype=np.uint8)
     normal, corners = records[:, :12].view("V12")[:, 0], records[:, 12:48].view("V36")[:, 0]
     records[:, 48:] = 0  # the attribute byte count
+    columns = [np.ascontiguousarray(v32[:, k]) for k in range(3)]
     for s in _blocks(len(tris)):
         c = np.take(v32, tris[s], axis=0)  # (b, 3, 3) float32, the stored corners
         corners[s] = c.reshape(-1, 9).view("V36")[:, 0]
-        normal[s] = _facet_normals(c).view("V12")[:, 0]
+        normal[s] = _facet_normals(columns, tris[s]).view("V12")[:, 0]
     return b"".join([_STL_HEADER, struct.pack("<I", len(tris)), records.data])
 
 
-def _facet_normals(corners: np.ndarray) -> np.ndarray:
-    """Unit normals (b, 3) float32 of triangles given by their float32 corners (b, 3, 3).
+def _facet_normals(columns: list[np.ndarray], tris: np.ndarray) -> np.ndarray:
+    """Unit normals (t, 3) float32 of triangles over float32 vertex ``columns`` (x, y, z).
 
-    Computed in double precision from the corners as the file stores them, so binary and
-    ASCII STL carry the same normals; (0, 0, 0) for zero-area triangles.
+    Computed in double precision from the corners as the file stores them (float32), so
+    binary and ASCII STL carry the same normals; (0, 0, 0) for zero-area triangles. The
+    arithmetic runs on one contiguous array per coordinate, which vectorizes far better
+    than (t, 3) rows.
     """
-    c = corners.astype(np.float64)
-    e1, e2 = c[:, 1] - c[:, 0], c[:, 2] - c[:, 0]
-    n = np.empty_like(e1)
-    n[:, 0] = e1[:, 1] * e2[:, 2] - e1[:, 2] * e2[:, 1]
-    n[:, 1] = e1[:, 2] * e2[:, 0] - e1[:, 0] * e2[:, 2]
-    n[:, 2] = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
-    length = np.sqrt(np.einsum("ij,ij->i", n, n))
-    length[length == 0] = np.inf  # zero-area: a zero normal
-    return (n / length[:, None]).astype(np.float32)
+    a = [np.take(col, tris[:, 0]).astype(np.float64) for col in columns]
+    e1 = [np.take(col, tris[:, 1]) - ak for col, ak in zip(columns, a, strict=True)]
+    e2 = [np.take(col, tris[:, 2]) - ak for col, ak in zip(columns, a, strict=True)]
+    nx = e1[1] * e2[2] - e1[2] * e2[1]
+    ny = e1[2] * e2[0] - e1[0] * e2[2]
+    nz = e1[0] * e2[1] - e1[1] * e2[0]
+    length = np.sqrt(nx * nx + ny * ny + nz * nz)
+    length[length == 0] = np.inf  # zero area: a zero normal
+    out = np.empty((len(tris), 3), dtype=np.float32)
+    out[:, 0], out[:, 1], out[:, 2] = nx / length, ny / length, nz / length
+    return out
 
 
 def stl_ascii(
@@ -259,10 +264,11 @@ def stl_ascii(
     facets = out[len(head) : len(out) - len(tail)].reshape(len(tris), width)
     fields = [int(at) + len(w) for w, at in zip(words[:-1], starts[:-1], strict=True)]
     v32 = v.astype(np.float32)
+    columns = [np.ascontiguousarray(v32[:, k]) for k in range(3)]
     for s in _blocks(len(tris)):
         t = tris[s]
         rec = template[: len(t)]
-        normals = _facet_normals(np.take(v32, t, axis=0))
+        normals = _facet_normals(columns, t)
         normal_text = format_e9(normals.ravel()).reshape(-1, field).view(item)[:, 0]
         rec[:, fields[0] : fields[0] + field].view(item)[:, 0] = normal_text
         for corner in range(3):
