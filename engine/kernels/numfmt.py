@@ -85,6 +85,22 @@ def _lead_word(lead: bytes) -> np.uint64:
     return _U(int.from_bytes(lead, "little"))
 
 
+@cache
+def _prefix_masks(nwords: int) -> np.ndarray:
+    """(nwords, 8 * nwords + 2) uint64: column k masks the first k bytes of the string."""
+    k = np.arange(8 * nwords + 2)
+    kb = np.clip(k[None, :] - 8 * np.arange(nwords)[:, None], 0, 8)
+    return _MASKS[kb]
+
+
+def _shift_rows(w: np.ndarray, nbytes: np.ndarray | int) -> np.ndarray:
+    """:func:`_shift_up` for a string held as rows of a (nwords, n) array."""
+    bits = (np.asarray(nbytes) * 8).astype(_U)
+    out = w << bits
+    out[1:] |= w[:-1] >> (_U(64) - bits)
+    return out
+
+
 def _number_words(
     negative: np.ndarray,
     mantissa: np.ndarray,
@@ -100,24 +116,26 @@ def _number_words(
     ``lead`` first (a separator), then the sign where negative, then the number: positional
     where ``positional`` (``12.5``, ``0.001``; integers as ``3.0`` with ``point_zero`` else
     ``3``), else scientific as repr writes it (``1.5e+16``, ``1e-05``). At most 7 zeros may
-    follow the point, and the whole must fit ``nwords`` words.
+    follow the point, and the whole must fit ``nwords`` words. The words of all values are
+    rows of one (nwords, n) array, so every step is one operation over all of them.
     """
+    n = mantissa.size
     left = mantissa * POW10_INT[17 - ndigits]  # the 17 digits, left-aligned
     d0 = left // 10**16
     rest = left - d0 * 10**16
     h = _swar8(rest // 10**8)
     l = _swar8(rest % 10**8)
-    v = [
-        (d0.astype(_U) + _U(ord("0"))) | (h << _U(8)),
-        (h >> _U(56)) | (l << _U(8)),
-        (l >> _U(56)) | (_ZEROS8 << _U(8)),
-    ] + [np.full(d0.size, _ZEROS8)] * (nwords - 3)
+    v = np.empty((nwords, n), dtype=_U)
+    v[0] = (d0.astype(_U) + _U(ord("0"))) | (h << _U(8))
+    v[1] = (h >> _U(56)) | (l << _U(8))
+    v[2] = (l >> _U(56)) | (_ZEROS8 << _U(8))
+    v[3:] = _ZEROS8
     # "0.001" is the digits after z = 3 zeros, "0001", with the point after the first
     small = positional & (exp10 < 0)
     if small.any():
         z = np.where(small, -exp10, 0)
-        v = _shift_up(v, z)
-        v[0] = v[0] | (_ZEROS8 & _low_bytes(z, 0))
+        v = _shift_rows(v, z)
+        v[0] |= _ZEROS8 & _MASKS[z]
     else:
         z = 0
     integer = positional & (exp10 >= ndigits - 1)
@@ -128,21 +146,18 @@ def _number_words(
         np.where(integer & ~has_point, exp10 + 1, np.maximum(ndigits + z, last + 2)),
         ndigits,
     )
-    # insert the point: the digits after it move one byte on
+    # insert the point: the digits after it move one byte on; after & ~before is its byte
+    masks = _prefix_masks(nwords)
     point = np.where(has_point, last + 1, 8 * nwords)
-    moved = _shift_up(v, 1)
+    before = np.take(masks, point, axis=1)
+    after = np.take(masks, point + 1, axis=1)
+    body = (v & before) | (_shift_rows(v, 1) & ~after) | (_DOTS8 & after & ~before)
     text_len = length + has_point
-    body = []
-    for i in range(nwords):
-        before, after = _low_bytes(point, i), _low_bytes(point + 1, i)
-        # after & ~before is the point's own byte: fill it with "."
-        word = (v[i] & before) | (moved[i] & ~after) | (_DOTS8 & after & ~before)
-        body.append(word & _low_bytes(text_len, i))
+    body &= np.take(masks, text_len, axis=1)
     # the lead, then a sign slot ("-" or padding, which the squeeze removes)
     front = len(lead) + 1
-    out = _shift_up(body, front)
-    out[0] = out[0] | np.where(negative, _U(ord("-")) << _U(8 * len(lead)), _U(0))
-    out[0] = out[0] | _lead_word(lead)
+    out = _shift_rows(body, front)
+    out[0] |= np.where(negative, _U(ord("-")) << _U(8 * len(lead)), _U(0)) | _lead_word(lead)
     # scientific: "e", sign, (hundreds), tens, units right after the mantissa
     sci = ~positional
     if sci.any():
@@ -155,8 +170,8 @@ def _number_words(
         exp = np.where(sci, _U(ord("e")) | (sign_e << _U(8)) | (digits_e << _U(16)), _U(0))
         at = front + text_len
         for i in range(nwords):
-            out[i] = out[i] | _place(exp, at, i)
-    return np.stack(out, axis=1)
+            out[i] |= _place(exp, at, i)
+    return out.T
 
 
 def float_words(x: np.ndarray, *, decimals: int | None = None, lead: bytes = b"") -> np.ndarray:
