@@ -159,18 +159,19 @@ def _number_words(
     out = _shift_rows(body, front)
     out[0] |= np.where(negative, _U(ord("-")) << _U(8 * len(lead)), _U(0)) | _lead_word(lead)
     # scientific: "e", sign, (hundreds), tens, units right after the mantissa
-    sci = ~positional
-    if sci.any():
-        eabs = np.abs(exp10)
+    sci = np.flatnonzero(~positional)
+    if sci.size:
+        e = exp10[sci]
+        eabs = np.abs(e)
         units = ((eabs % 10).astype(_U) + _U(ord("0"))) << _U(8)
         tens = ((eabs // 10) % 10).astype(_U) + _U(ord("0"))
         hund = (eabs // 100).astype(_U) + _U(ord("0"))
         digits_e = np.where(eabs >= 100, hund | ((tens | units) << _U(8)), tens | units)
-        sign_e = np.where(exp10 < 0, _U(ord("-")), _U(ord("+")))
-        exp = np.where(sci, _U(ord("e")) | (sign_e << _U(8)) | (digits_e << _U(16)), _U(0))
-        at = front + text_len
+        sign_e = np.where(e < 0, _U(ord("-")), _U(ord("+")))
+        exp = _U(ord("e")) | (sign_e << _U(8)) | (digits_e << _U(16))
+        at = front + text_len[sci]
         for i in range(nwords):
-            out[i] |= _place(exp, at, i)
+            out[i, sci] |= _place(exp, at, i)
     return out.T
 
 

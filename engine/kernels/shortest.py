@@ -153,8 +153,7 @@ def _shortest_scaled(a: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]
     scale = hi[16 - e10 + 300] * (0.5 * (1.0 - 2.0**-40))
     bound_up = np.spacing(a) * scale
     bound_down = (a - np.nextafter(a, 0.0)) * scale
-    even = np.zeros(a.size, dtype=bool)
-    mantissa, dropped = _drop_digits(vint, frac, bound_down, bound_up, even, np.full(a.size, 16))
+    mantissa, dropped = _drop_digits(vint, frac, bound_down, bound_up, None, np.full(a.size, 16))
     return _carry(mantissa, 17 - dropped, e10)
 
 
@@ -188,7 +187,7 @@ def _drop_digits(
     frac: np.ndarray,
     bound_down: np.ndarray,
     bound_up: np.ndarray,
-    even: np.ndarray,
+    even: np.ndarray | None,
     max_drop: np.ndarray,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Most trailing digits of ``vint + frac`` that can be dropped with rounding still reading back.
@@ -213,8 +212,11 @@ def _drop_digits(
         rem = v - q * div
         dist_down = rem + f  # distance to q * div
         dist_up = (div - rem).astype(np.float64) - f  # distance to (q + 1) * div
-        ok_down = (dist_down < bd) | (ev & (dist_down == bd))
-        ok_up = (dist_up < bu) | (ev & (dist_up == bu))
+        ok_down = dist_down < bd
+        ok_up = dist_up < bu
+        if ev is not None:  # on the boundary, an even significand reads back (half-even)
+            ok_down |= ev & (dist_down == bd)
+            ok_up |= ev & (dist_up == bu)
         # the nearest wins; an exact tie goes to the even digit, as repr does
         up = ok_up & (~ok_down | (dist_up < dist_down) | ((dist_up == dist_down) & (q % 2 == 1)))
         return ok_down | ok_up, q, up
@@ -231,7 +233,7 @@ def _drop_digits(
         idx = idx[ok]
         dropped[idx] = step
         mantissa[idx] = (q + up)[ok]
-        sub = tuple(arr[ok] for arr in sub)
+        sub = tuple(None if arr is None else arr[ok] for arr in sub)
     lo = np.full(idx.size, 2, dtype=np.int64)
     hi = max_drop[idx]
     if np.any(lo < hi):  # the rest (values with 15 digits or fewer) by bisection
