@@ -365,8 +365,8 @@ def mesh_report(
 
     Every face contributes its directed edges (a -> b around its winding). An undirected edge
     seen once is a boundary, more than twice non-manifold; a directed edge seen twice means
-    two faces cross it the same way, so their orientations disagree. Sorting the edge keys
-    does the counting for all edges at once.
+    two faces cross it the same way, so their orientations disagree. One sort of the edge
+    keys (undirected edge, then direction) does the counting for all edges at once.
 
     Parameters
     ----------
@@ -383,13 +383,14 @@ def mesh_report(
     nxt = np.arange(1, fi.size + 1)
     nxt[fo[1:] - 1] = fo[:-1]  # the last corner of each face wraps to its first
     a, b = fi, fi[nxt]
-    directed = a * nv + b
-    undirected = np.minimum(a, b) * nv + np.maximum(a, b)
-    _, counts = np.unique(undirected, return_counts=True)
-    directed_sorted = np.sort(directed)
-    repeated = directed_sorted[1:] == directed_sorted[:-1]
-    # a directed edge repeated k times is k - 1 extra traversals; count distinct edges instead
-    misoriented = int(np.count_nonzero(repeated & ~np.r_[False, repeated[:-1]]))
+    # one sort does it all: the key is the undirected edge, then its direction as a last bit
+    key = np.sort((np.minimum(a, b) * nv + np.maximum(a, b)) * 2 + (a > b))
+    edge = key >> 1
+    starts = np.flatnonzero(np.r_[True, edge[1:] != edge[:-1]])
+    counts = np.diff(np.r_[starts, edge.size])
+    # equal neighbours are the same directed edge twice: count each such edge once
+    same = key[1:] == key[:-1]
+    misoriented = int(np.count_nonzero(same & ~np.r_[False, same[:-1]]))
     tris = fan_triangles(fi, fo)
     p0, p1, p2 = v[tris[:, 0]], v[tris[:, 1]], v[tris[:, 2]]
     cross = np.cross(p1 - p0, p2 - p0)
@@ -401,7 +402,7 @@ def mesh_report(
         n_vertices=len(v),
         n_faces=fo.size - 1,
         n_triangles=len(tris),
-        n_edges=int(counts.size),
+        n_edges=int(starts.size),
         boundary_edges=int(np.count_nonzero(counts == 1)),
         nonmanifold_edges=int(np.count_nonzero(counts > 2)),
         misoriented_edges=misoriented,
