@@ -596,3 +596,15 @@ def test_random_polylines_in_svg_and_pdf(n, seed, closed):
             if ln.endswith((" m", " l"))]  # fmt: skip
     lo, _ = drawing_bounds([path])
     assert np.allclose(np.array(nums).reshape(-1, 2) * 25.4 / 72 + lo - 1, pts, atol=2e-5)
+
+
+def test_empty_mesh_writes_empty_files():
+    v, fi, fo = np.zeros((0, 3)), np.zeros(0, dtype=int), np.zeros(1, dtype=int)
+    assert stl_binary(v, fi, fo) == b"formgraph binary STL".ljust(80, b"\0") + b"\0\0\0\0"
+    assert stl_ascii(v, fi, fo) == b"solid formgraph\nendsolid formgraph\n"
+    assert obj_bytes(v, fi, fo) == b"# formgraph\n"
+    assert b"element face 0\n" in ply_binary(v, fi, fo)
+    r = mesh_report(v, fi, fo)
+    assert (r.n_edges, r.n_triangles, r.watertight) == (0, 0, True)
+    tri = mesh_report(np.eye(3), np.arange(3), np.array([0, 3]))
+    assert (tri.n_edges, tri.boundary_edges) == (3, 3)

@@ -386,7 +386,7 @@ def mesh_report(
     # one sort does it all: the key is the undirected edge, then its direction as a last bit
     key = np.sort((np.minimum(a, b) * nv + np.maximum(a, b)) * 2 + (a > b))
     edge = key >> 1
-    starts = np.flatnonzero(np.r_[True, edge[1:] != edge[:-1]])
+    starts = np.flatnonzero(np.r_[edge.size > 0, edge[1:] != edge[:-1]])
     counts = np.diff(np.r_[starts, edge.size])
     # equal neighbours are the same directed edge twice: count each such edge once
     same = key[1:] == key[:-1]
