@@ -14,6 +14,8 @@ import io
 import json
 import os
 import tempfile
+import uuid
+import weakref
 import zipfile
 from collections import OrderedDict
 from pathlib import Path
@@ -43,8 +45,19 @@ def canonical(value: Any) -> Any:
     if isinstance(value, dict):
         return {str(k): canonical(v) for k, v in sorted(value.items())}
     if isinstance(value, Geometry):
-        return {"g": type(value).__name__, "h": digest(value)}
+        h = digest(value)
+        return {"g": type(value).__name__, "h": h if h is not None else _token(value)}
     raise TypeError(f"cannot make a cache key of {type(value).__name__}")
+
+
+_TOKENS: weakref.WeakKeyDictionary[Any, str] = weakref.WeakKeyDictionary()
+
+
+def _token(value: Any) -> str:
+    """A unique, never reused name for a value whose content cannot be hashed."""
+    if value not in _TOKENS:
+        _TOKENS[value] = "obj:" + uuid.uuid4().hex
+    return _TOKENS[value]
 
 
 def key_of(parts: Any) -> str:
@@ -63,8 +76,7 @@ def digest(value: Any) -> str | None:
     """A cheap content hash of a node output (for early cutoff); None when not hashable."""
     try:
         if isinstance(value, Geometry):
-            state = value.state()
-            return key_of({"type": type(value).__name__, "state": state})
+            return key_of({"type": type(value).__name__, "state": value.fingerprint()})
         return key_of(value)
     except (TypeError, NotImplementedError):
         return None
@@ -194,7 +206,15 @@ class DiskCache:
             for a in arrays.values():
                 a.flags.writeable = False
             return True, _decode(meta["value"], arrays), meta.get("identity")
-        except (ValueError, KeyError, OSError, EOFError, zipfile.BadZipFile, TypeError):
+        except (
+            ValueError,
+            KeyError,
+            OSError,
+            EOFError,
+            zipfile.BadZipFile,
+            TypeError,
+            AttributeError,
+        ):
             try:
                 path.unlink()
             except OSError:

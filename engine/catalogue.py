@@ -53,10 +53,9 @@ def _kind_schema(k: Kind) -> dict[str, Any]:
             "items": {"type": "array", "items": {"type": "integer"}, "minItems": 3},
         }
     elif getattr(base, "__name__", "") == "Points":
-        item = {
-            "type": "array",
-            "items": {"type": "array", "items": {"type": "number"}, "minItems": 2, "maxItems": 3},
-        }
+        coordinate = {"anyOf": [{"type": "number"}, EXPR]}
+        point = {"type": "array", "items": coordinate, "minItems": 2, "maxItems": 3}
+        item = {"type": "array", "items": {"anyOf": [point, EXPR]}}
     else:
         item = {}  # geometry: only through a wire or a param
     if k.is_list:

@@ -16,7 +16,7 @@ import networkx as nx
 from . import safety
 from .errors import ExpressionError, Problem, Where
 from .expr import compile_expression
-from .model import Expr, Input, Literal, NodeDef, ParamDef, Wire
+from .model import Expr, Input, Items, Literal, NodeDef, ParamDef, Wire
 from .registry import NodeSpec, node_types
 from .types import Kind, PortType, TypeMismatch, describe
 
@@ -155,9 +155,14 @@ def _check_input(
     if not list_kinds:
         return [f"expected {pt.name}, got a list of wires"]
     item_type = PortType(tuple(Kind(k.base) for k in list_kinds), range=pt.range)
+    list_type = PortType(tuple(list_kinds), range=pt.range)
     problems: list[str] = []
     for item in value.items:
-        problems.extend(_check_input(g, nd, item_type, item, registry))
+        # a wire carrying a list joins the list (flattened): ["@paths", "@outline"]
+        as_item = _check_input(g, nd, item_type, item, registry)
+        if as_item and isinstance(item, Wire) and not _check_wire(g, list_type, item, registry):
+            continue
+        problems.extend(as_item)
     return problems
 
 
@@ -226,6 +231,8 @@ class _Unknown(Exception):
 def _static_value(g: Graph, item: Input) -> Any:
     if isinstance(item, Literal):
         return item.value
+    if isinstance(item, Items):
+        return [_static_value(g, i) for i in item.items]
     if isinstance(item, Expr):
         msg = _expr_names_problem(g, item)
         if msg:

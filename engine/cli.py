@@ -112,6 +112,8 @@ def parse_sets(graph: Any, items: Sequence[str]) -> dict[str, Any]:
         default = defs[name].default
         if isinstance(default, str):
             value: Any = text
+        elif isinstance(default, (int, float)) and not isinstance(default, bool):
+            value = _number(text)
         else:
             try:
                 value = yaml.safe_load(text)
@@ -125,6 +127,19 @@ def parse_sets(graph: Any, items: Sequence[str]) -> dict[str, Any]:
                 value = float(value)
         out[name] = value
     return out
+
+
+def _number(text: str) -> Any:
+    """A number as people type it: 3, -2.5, 1e3, 0x10 (YAML 1.1 would read 1e3 as text)."""
+    for parse in (int, float):
+        try:
+            return parse(text.strip().replace("_", ""))
+        except ValueError:
+            pass
+    try:
+        return int(text.strip(), 0)
+    except ValueError:
+        return text  # the param's check then says what was expected
 
 
 class _ProgressLine:

@@ -40,7 +40,10 @@ class Problem:
     message: str
 
     def __str__(self) -> str:
-        return f"{self.where.prefix()}: {self.message}"
+        w = self.where
+        if w.file is None and w.line is None and w.node is None and w.input is None:
+            return self.message  # nothing to locate: the message says it all
+        return f"{w.prefix()}: {self.message}"
 
 
 class FormgraphError(Exception):

@@ -27,6 +27,19 @@ from .errors import ExpressionError
 
 MAX_LENGTH = 4000
 MAX_NODES = 2000
+MAX_DEPTH = 64
+
+
+def _depth(tree: ast.AST) -> int:
+    """Nesting depth of a syntax tree, measured without recursion."""
+    deepest = 0
+    stack = [(tree, 1)]
+    while stack:
+        node, d = stack.pop()
+        deepest = max(deepest, d)
+        stack.extend((child, d + 1) for child in ast.iter_child_nodes(node))
+    return deepest
+
 
 CONSTANTS: dict[str, float] = {"pi": math.pi, "e": math.e, "tau": math.tau}
 
@@ -167,10 +180,18 @@ def compile_expression(text: str, allowed: set[str] | frozenset[str] | None = No
         tree = ast.parse(text.strip(), mode="eval")
     except SyntaxError as exc:
         raise ExpressionError(f"expression {text!r} is not valid: {exc.msg}") from None
+    except (RecursionError, MemoryError):
+        raise ExpressionError(f"expression {text[:40]!r}... is nested too deeply") from None
     count = sum(1 for _ in ast.walk(tree))
     if count > MAX_NODES:
         raise ExpressionError(
             f"expression {text!r} is too large ({count} parts; limit {MAX_NODES})"
+        )
+    depth = _depth(tree.body)
+    if depth > MAX_DEPTH:
+        raise ExpressionError(
+            f"expression {text[:40]!r}{'...' if len(text) > 40 else ''} is nested too deeply "
+            f"({depth} levels; limit {MAX_DEPTH})"
         )
     names: set[str] = set()
     fn = _Compiler(text, allowed, names).visit(tree.body)

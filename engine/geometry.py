@@ -30,8 +30,11 @@ def frozen_array(values: Any, dtype: Any = np.float64) -> np.ndarray:
 def as_xyz(values: Any, what: str = "points") -> np.ndarray:
     """``(n, 2)`` or ``(n, 3)`` coordinates as a read-only ``(n, 3)`` float64 array (z = 0)."""
     try:
-        a = np.asarray(values, dtype=np.float64)
-    except (TypeError, ValueError):
+        raw = np.asarray(values)
+        if raw.dtype.kind not in "biuf":
+            raise TypeError  # strings, objects: not coordinates
+        a = raw.astype(np.float64)
+    except (TypeError, ValueError, OverflowError):
         a = _pad_rows(values, what)
     if a.ndim == 1 and a.size in (2, 3):
         a = a[None, :]
@@ -50,11 +53,17 @@ def as_xyz(values: Any, what: str = "points") -> np.ndarray:
     return frozen_array(a)
 
 
+def _number(x: Any) -> float:
+    if isinstance(x, (str, bytes, bool)) or not isinstance(x, (int, float, np.number)):
+        raise TypeError(f"{x!r} is not a number")
+    return float(x)
+
+
 def _pad_rows(values: Any, what: str) -> np.ndarray:
     """Mixed [x, y] and [x, y, z] rows (z = 0 where it is missing)."""
     try:
-        rows = [list(map(float, r)) for r in values]
-    except (TypeError, ValueError):
+        rows = [[_number(x) for x in r] for r in values]
+    except (TypeError, ValueError, OverflowError):
         raise ValueError(f"{what} must be a list of [x, y] or [x, y, z] numbers") from None
     for i, r in enumerate(rows):
         if len(r) not in (2, 3):
@@ -77,6 +86,10 @@ class Geometry:
     def state(self) -> dict[str, Any]:
         """Arrays and JSON-able scalars that rebuild this value with :func:`from_state`."""
         raise NotImplementedError(f"{type(self).__name__} cannot be stored on disk")
+
+    def fingerprint(self) -> Any:
+        """What determines this value, for content hashes (its state, by default)."""
+        return self.state()
 
 
 # ---------------------------------------------------------------------------------- points
@@ -122,6 +135,7 @@ def _is_frozen_xyz(a: Any) -> bool:
         and a.ndim == 2
         and a.shape[1] == 3
         and not a.flags.writeable
+        and a.flags.owndata  # a read-only view of someone's writable array is not enough
     )
 
 
@@ -205,13 +219,15 @@ class NurbsCurve(Curve):
         p = as_xyz(points)
         if len(p) < 2:
             raise ValueError(f"a polyline needs at least 2 points, got {len(p)}")
-        # a repeated point adds no segment; dropping it keeps the shape and the knots valid
-        p = p[np.concatenate([[True], np.any(p[1:] != p[:-1], axis=1)])]
-        if len(p) < 2:
-            raise ValueError("a polyline needs at least two distinct points")
         if closed and not np.array_equal(p[0], p[-1]):
             p = np.vstack([p, p[:1]])
+        # a repeated point (or one so close that the running length does not grow) adds no
+        # segment; dropping it keeps the shape and the knots valid
         chord = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))])
+        keep = np.concatenate([[True], np.diff(chord) > 0])
+        p, chord = p[keep], chord[keep]
+        if len(p) < 2:
+            raise ValueError("a polyline needs at least two distinct points")
         knots = np.concatenate([[chord[0]], chord, [chord[-1]]])
         return cls(p, 1, knots)
 
@@ -302,6 +318,13 @@ class ParametricCurve(Curve):
     def __repr__(self) -> str:
         return f"ParametricCurve(domain={self.domain})"
 
+    def fingerprint(self) -> Any:
+        return {
+            "f": [_expression_fingerprint(f) for f in (self.fx, self.fy, self.fz)],
+            "domain": list(self.domain),
+            "samples": self.samples,
+        }
+
     @property
     def nbytes(self) -> int:
         return 256
@@ -341,6 +364,15 @@ class Surface(Geometry):
 
     def to_pyvista(self) -> Any:
         return self.tessellate(64, 64).to_pyvista()
+
+
+def _expression_fingerprint(f: Any) -> Any:
+    """A bound expression is its text and the param values it reads; any other callable
+    cannot be hashed (its content is code), and says so."""
+    text, params = getattr(f, "text", None), getattr(f, "params", None)
+    if isinstance(text, str) and params is not None:
+        return {"text": text, "params": dict(params)}
+    raise TypeError("a curve or surface of plain Python callables has no content hash")
 
 
 def _scale(pts: np.ndarray) -> float:
@@ -464,6 +496,12 @@ class ParametricSurface(Surface):
     def __repr__(self) -> str:
         return f"ParametricSurface(u={self.domain_u}, v={self.domain_v})"
 
+    def fingerprint(self) -> Any:
+        return {
+            "f": [_expression_fingerprint(f) for f in (self.fx, self.fy, self.fz)],
+            "domain": [list(self.domain_u), list(self.domain_v)],
+        }
+
     @property
     def nbytes(self) -> int:
         return 256
@@ -500,8 +538,8 @@ class Mesh(Geometry):
             fi = np.concatenate(faces) if faces else np.zeros(0, np.int64)
             fo = np.concatenate([[0], np.cumsum(sizes)])
         else:
-            fi = np.asarray(face_indices, dtype=np.int64).ravel()
-            fo = np.asarray(face_offsets, dtype=np.int64).ravel()
+            fi = _indices(face_indices, "face_indices")
+            fo = _indices(face_offsets, "face_offsets")
         if fo.size == 0 or fo[0] != 0 or fo[-1] != fi.size or np.any(np.diff(fo) < 0):
             raise ValueError(
                 "face_offsets must start at 0, never decrease and end at len(face_indices)"
@@ -535,6 +573,8 @@ class Mesh(Geometry):
     @property
     def faces(self) -> list[np.ndarray]:
         """Each face's vertex indices (a convenience; kernels use the flat arrays)."""
+        if self.n_faces == 0:
+            return []
         return np.split(self.face_indices, self.face_offsets[1:-1])
 
     @functools.cached_property
@@ -564,6 +604,15 @@ class Mesh(Geometry):
             "face_indices": self.face_indices,
             "face_offsets": self.face_offsets,
         }
+
+
+def _indices(values: Any, what: str) -> np.ndarray:
+    a = np.asarray(values)
+    if a.size and a.dtype.kind == "f" and not np.all(a == np.round(a)):
+        raise ValueError(f"{what} must be whole numbers")
+    if a.size and a.dtype.kind not in "iuf":
+        raise ValueError(f"{what} must be whole numbers, got {a.dtype}")
+    return a.astype(np.int64).ravel()
 
 
 STORABLE: dict[str, type[Geometry]] = {

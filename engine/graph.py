@@ -34,7 +34,7 @@ from .errors import (
 from .model import Expr, Input, Items, Literal, NodeDef, ParamDef, Wire, parse_input
 from .registry import DEFAULT_BUDGET, Context, NodeSpec, node_types
 from .types import TypeMismatch, type_by_name
-from .yamlio import dump, parse
+from .yamlio import MAX_BYTES, dump, parse
 
 __all__ = ["Graph", "NodeStat", "load"]
 
@@ -70,9 +70,17 @@ def load(
     """
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        with open(path, "rb") as fh:  # never read more than the format allows
+            data = fh.read(MAX_BYTES + 1)
+        if len(data) > MAX_BYTES:
+            raise GraphError(
+                Problem(
+                    Where(str(path)), f"the file is larger than {MAX_BYTES // (1024 * 1024)} MiB"
+                )
+            )
+        text = data.decode("utf-8")
     except (OSError, UnicodeDecodeError) as exc:
-        raise GraphError(f"{path}: cannot read the graph file: {exc}") from None
+        raise GraphError(Problem(Where(str(path)), f"cannot read the graph file: {exc}")) from None
     return Graph.from_text(
         text,
         file=str(path),
@@ -116,6 +124,7 @@ class Graph:
         self._identity: dict[str, str] = {}  # cache key -> identity seen downstream
         self._last: dict[str, tuple[str, str]] = {}  # node -> (key, identity) of its last output
         self._digests: dict[str, str | None] = {}  # cache key -> content digest, when computed
+        self._written: dict[str, tuple[int, int] | None] = {}  # export key -> file stamp
         self._parse_problems: list[Problem] = []
         self._checked = False
         self.stats: dict[str, NodeStat] = {}
@@ -153,6 +162,7 @@ class Graph:
     ) -> None:
         """Declare a graph param (``type`` names a geometry type for a Python input slot)."""
         long_form = any(x is not None for x in (min, max, type)) or bool(doc)
+        default = _plain(default)
         p = ParamDef(name, default, None, type, min, max, doc, None, long_form)
         if type is not None:
             p.type = type_by_name(type)
@@ -162,7 +172,7 @@ class Graph:
 
     def add(self, name: str, type: str, **inputs: Any) -> None:
         """Add (or replace) node ``name`` of node type ``type`` with its inputs."""
-        self._nodes[name] = NodeDef.make(name, type, inputs)
+        self._nodes[name] = NodeDef.make(name, type, {k: _plain(v) for k, v in inputs.items()})
         self._checked = False
 
     def remove(self, name: str) -> None:
@@ -181,6 +191,7 @@ class Graph:
     def set_input(self, node: str, port: str, value: Any) -> None:
         """Change one input of a node as authored (a literal, wire or expression)."""
         nd = self._nodes[node]
+        value = _plain(value)
         nd.raw[port] = value
         nd.parse_errors.pop(port, None)
         try:
@@ -261,7 +272,8 @@ class Graph:
                 raise GraphError(f"{self.file_label}: no node '{n}'{suggest(n, self._nodes)}")
         run = _Run(self, values)
         self.stats = run.stats
-        outs = {n: run.value(n) for n in names}
+        run.run(names)
+        outs = {n: run.results[n] for n in names}
         return outs[names[0]] if isinstance(nodes, str) else outs
 
     def sinks(self) -> list[str]:
@@ -275,18 +287,27 @@ class Graph:
 
     def upstream(self, name: str) -> list[str]:
         """All ancestors of ``name`` and itself, in evaluation order."""
+        return self._order([name])
+
+    def _order(self, targets: list[str]) -> list[str]:
+        """Ancestors of ``targets`` (and themselves) in topological order, without recursion
+        (a chain of thousands of nodes is fine)."""
         order: list[str] = []
         seen: set[str] = set()
-
-        def visit(n: str) -> None:
-            if n in seen or n not in self._nodes:
-                return
-            seen.add(n)
-            for up in self._nodes[n].upstream():
-                visit(up)
-            order.append(n)
-
-        visit(name)
+        for target in targets:
+            stack = [(target, False)]
+            while stack:
+                n, finished = stack.pop()
+                if finished:
+                    order.append(n)
+                    continue
+                if n in seen or n not in self._nodes:
+                    continue
+                seen.add(n)
+                stack.append((n, True))
+                stack.extend(
+                    (u, False) for u in reversed(self._nodes[n].upstream()) if u not in seen
+                )
         return order
 
     def _expr_value(self, e: Expr, values: dict[str, Any]) -> Any:
@@ -329,6 +350,29 @@ class Graph:
         return f"Graph({self.file_label!r}, {len(self._nodes)} nodes, params={self._values})"
 
 
+def _plain(value: Any) -> Any:
+    """Inputs given from Python as the YAML they save to: tuples and arrays become lists,
+    numpy numbers Python numbers (geometry objects stay as they are)."""
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if isinstance(value, dict):
+        return {k: _plain(v) for k, v in value.items()}
+    return value
+
+
+def _file_stamp(path: Any) -> tuple[int, int] | None:
+    """(size, mtime in ns) of a written file, or None when it is gone."""
+    try:
+        st = os.stat(path)
+    except (OSError, TypeError, ValueError):
+        return None
+    return st.st_size, st.st_mtime_ns
+
+
 class _Run:
     """One evaluation call: memoized keys, identities and values, and the run record."""
 
@@ -349,17 +393,27 @@ class _Run:
         line = nd.input_lines.get(port, nd.line) if port else nd.line
         return Where(self.g.file_label, line, name, port)
 
-    # identity of the value that flows out of a node: its key, or an earlier identical output's
+    def run(self, targets: list[str]) -> None:
+        """Key every ancestor in topological order, then fetch the targets' values.
+
+        A node whose key already has an identity (from an earlier run) is not even fetched
+        unless a node that must compute needs its value.
+        """
+        order = self.g._order(targets)
+        self.total = len(order)
+        for n in order:
+            key = self.key(n)
+            if key in self.g._identity and not self.registry[self.g._nodes[n].type].is_export:
+                self.stats.setdefault(n, NodeStat("cached", 0.0, source="identity"))
+            else:
+                self.fetch(n)
+        for t in targets:
+            self.fetch(t)
+
     def identity(self, name: str) -> str:
-        key = self.key(name)
-        ident = self.g._identity.get(key)
-        if ident is None:
-            self.value(name)
-            ident = self.g._identity[key]
-        elif name not in self.stats:
-            # known from an earlier run: its value is not even fetched unless needed
-            self.stats[name] = NodeStat("cached", 0.0, source="identity")
-        return ident
+        # identity of the value that flows out of a node: its key, or an earlier identical
+        # output's (early cutoff); known for every upstream node by the time it is asked
+        return self.g._identity[self.keys[name]]
 
     def key(self, name: str) -> str:
         if name in self.keys:
@@ -380,18 +434,24 @@ class _Run:
         if isinstance(value, Items):
             return [self.key_part(name, port, spec, i) for i in value.items]
         pt = spec.inputs[port].type
-        if pt.is_expression and isinstance(value, Literal):
+        if pt.is_expression:  # the text, and the values of the params the text reads
             from .expr import compile_expression
 
-            names = compile_expression(value.value).names & set(self.values)
-            return {"expr": value.value, "params": {n: self.values[n] for n in sorted(names)}}
+            text = self.resolve(name, port, value)
+            try:
+                names = compile_expression(text).names & set(self.values)
+            except ExpressionError as exc:
+                raise GraphError(
+                    [Problem(self.where(name, port), exc.problems[0].message)]
+                ) from None
+            return {"expr": text, "params": {n: self.values[n] for n in sorted(names)}}
         return self.resolve(name, port, value)
 
     def resolve(self, name: str, port: str, value: Input) -> Any:
         if isinstance(value, Literal):
             return value.value
         if isinstance(value, Wire):
-            out = self.value(value.node)
+            out = self.results[value.node]
             return getattr(out, value.output) if value.output else out
         if isinstance(value, Expr):
             missing = [n for n in value.compiled.names if self.values.get(n) is None]
@@ -409,24 +469,44 @@ class _Run:
                 return self.g._expr_value(value, self.values)
             except (ValueError, TypeError, ZeroDivisionError, ExpressionError) as exc:
                 raise GraphError([Problem(self.where(name, port), str(exc))]) from None
-        return [self.resolve(name, port, i) for i in value.items]
+        out: list[Any] = []
+        for item in value.items:
+            v = self.resolve(name, port, item)
+            if isinstance(item, Wire) and isinstance(v, list):
+                out.extend(v)  # a list from a wire joins the list (checked at load)
+            else:
+                out.append(v)
+        return out
 
-    def value(self, name: str) -> Any:
-        if name in self.results:
-            return self.results[name]
-        nd = self.g._nodes[name]
-        spec = self.registry[nd.type]
-        key = self.key(name)
-        t0 = time.perf_counter()
-        hit, value, source = self.lookup(key, spec)
-        if hit:
-            self.stats[name] = NodeStat(
-                "cached", time.perf_counter() - t0, _cache.sizeof(value), source=source
-            )
-        else:
-            value = self.compute(name, nd, spec)
-        self.results[name] = value
-        return value
+    def fetch(self, target: str) -> Any:
+        """The value of ``target``: from a cache, or computed after its inputs (no recursion)."""
+        stack = [target]
+        missed: set[str] = set()
+        while stack:
+            n = stack[-1]
+            if n in self.results:
+                stack.pop()
+                continue
+            nd = self.g._nodes[n]
+            spec = self.registry[nd.type]
+            if n not in missed:
+                t0 = time.perf_counter()
+                hit, value, source = self.lookup(self.keys[n], spec)
+                if hit:
+                    self.results[n] = value
+                    self.stats[n] = NodeStat(
+                        "cached", time.perf_counter() - t0, _cache.sizeof(value), source=source
+                    )
+                    stack.pop()
+                    continue
+                missed.add(n)
+            pending = [u for u in dict.fromkeys(nd.upstream()) if u not in self.results]
+            if pending:
+                stack.extend(pending)
+                continue
+            self.results[n] = self.compute(n, nd, spec)
+            stack.pop()
+        return self.results[target]
 
     def lookup(self, key: str, spec: NodeSpec) -> tuple[bool, Any, str]:
         hit, value = self.g.memory.get(key)
@@ -437,8 +517,10 @@ class _Run:
             source = "disk"
             if hit:
                 self.g.memory.put(key, value)
-        if hit and spec.is_export and not (isinstance(value, str) and os.path.isfile(value)):
-            hit = False  # the written file is gone: write it again
+        if hit and spec.is_export and self.g._written.get(key) != _file_stamp(value):
+            hit = False  # the file is gone or holds something else now: write it again
+        if hit and spec.multi_output and not isinstance(value, spec.output_class):
+            value = spec.output_class(*value)  # the disk cache stores the outputs as a list
         if hit and key not in self.g._identity:
             self.g._identity[key] = identity or key
         return hit, value, source
@@ -446,8 +528,11 @@ class _Run:
     def compute(self, name: str, nd: NodeDef, spec: NodeSpec) -> Any:
         kwargs: dict[str, Any] = {}
         for port, p in spec.inputs.items():
-            if port not in nd.inputs:
-                kwargs[port] = p.type.coerce(p.default)  # defaults reach the node as typed
+            if port not in nd.inputs:  # defaults reach the node typed like any input
+                if p.type.is_expression and p.default is not None:
+                    kwargs[port] = self.bind_expression(name, port, p.type, p.default)
+                else:
+                    kwargs[port] = p.type.coerce(p.default)
                 continue
             raw = self.resolve(name, port, nd.inputs[port])
             if p.type.is_expression:
@@ -462,7 +547,7 @@ class _Run:
             kwargs["ctx"] = ctx
         if self.g.progress is not None:
             computed = sum(1 for s in self.stats.values() if s.status == "computed")
-            self.g.progress(name, computed, len(self.g._nodes))
+            self.g.progress(name, computed, self.total)
         t0 = time.perf_counter()
         try:
             value = spec.func(**kwargs)
@@ -495,6 +580,8 @@ class _Run:
             self.g._digests.clear()
         self.g._identity[key] = identity
         self.g._last[name] = (key, identity)
+        if spec.is_export:
+            self.g._written[key] = _file_stamp(value)
         self.stats[name] = NodeStat("computed", seconds, _cache.sizeof(value), ctx.warnings)
         return value
 

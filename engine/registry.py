@@ -60,6 +60,7 @@ class NodeSpec:
     doc: str
     wants_context: bool
     multi_output: bool = False
+    output_class: Any = None  # the NamedTuple of a node with several outputs
 
     @property
     def family(self) -> str:
@@ -127,7 +128,18 @@ def _spec_from_function(name: str, version: int, func: Callable[..., Any]) -> No
         outputs = {"out": port_type(ret)}
     doc = inspect.cleandoc(func.__doc__ or "")
     summary = doc.split("\n\n", 1)[0].replace("\n", " ").strip()
-    return NodeSpec(name, func, version, inputs, outputs, summary, doc, wants_context, multi)
+    return NodeSpec(
+        name,
+        func,
+        version,
+        inputs,
+        outputs,
+        summary,
+        doc,
+        wants_context,
+        multi,
+        ret if multi else None,
+    )
 
 
 def parse_param_docs(doc: str) -> dict[str, str]:

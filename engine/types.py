@@ -234,7 +234,12 @@ def _coerce_kind(k: Kind, value: Any) -> Any:
     if base is float:
         if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.number)):
             raise TypeMismatch(f"expected float, got {describe(value)}")
-        f = float(value)
+        try:
+            f = float(value)
+        except OverflowError:
+            raise TypeMismatch(
+                f"expected a float, got a number too large ({describe(value)[:40]})"
+            ) from None
         if not np.isfinite(f):
             raise TypeMismatch(f"expected a finite float, got {f}")
         return f
@@ -267,9 +272,11 @@ def _coerce_kind(k: Kind, value: Any) -> Any:
 
 
 def _vec3(value: Any) -> np.ndarray:
+    if isinstance(value, (list, tuple)) and any(isinstance(v, (str, bool)) for v in value):
+        raise TypeMismatch(f"expected [x, y] or [x, y, z] numbers, got {describe(value)}")
     try:
         a = np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise TypeMismatch(f"expected [x, y] or [x, y, z], got {describe(value)}") from None
     if a.shape not in ((2,), (3,)) or not np.all(np.isfinite(a)):
         raise TypeMismatch(f"expected [x, y] or [x, y, z], got {describe(value)}")

@@ -19,6 +19,8 @@ from .types import TypeMismatch, type_by_name
 
 FORMAT_VERSION = 1
 MAX_BYTES = 16 * 1024 * 1024
+MAX_VALUES = 2_000_000  # scalars and collections, with aliases expanded
+MAX_DEPTH = 64
 TOP_KEYS = ("formgraph", "description", "params", "nodes")
 
 
@@ -28,6 +30,37 @@ class Document:
     params: dict[str, ParamDef] = field(default_factory=dict)
     nodes: dict[str, NodeDef] = field(default_factory=dict)
     problems: list[Problem] = field(default_factory=list)
+
+
+def _expansion_problem(root: yaml.Node | None) -> str | None:
+    """Why the composed tree is too big to read (an alias bomb, absurd nesting), or None.
+
+    Walks the tree without recursion, counting every node as often as aliases repeat it.
+    """
+    if root is None:
+        return None
+    count = 0
+    distinct: set[int] = set()
+    stack: list[tuple[yaml.Node, int]] = [(root, 0)]
+    while stack:
+        node, depth = stack.pop()
+        count += 1
+        distinct.add(id(node))
+        # text cannot hold more values than it has characters; only aliases multiply them
+        if count > MAX_VALUES or (count > 100_000 and count > 4 * len(distinct)):
+            return (
+                f"the YAML's aliases expand to more than {min(count, MAX_VALUES):,} values "
+                f"(aliases of aliases?); refusing to read it"
+            )
+        if depth > MAX_DEPTH:
+            return f"the YAML is nested too deeply (more than {MAX_DEPTH} levels)"
+        if isinstance(node, yaml.SequenceNode):
+            stack.extend((v, depth + 1) for v in node.value)
+        elif isinstance(node, yaml.MappingNode):
+            for k, v in node.value:
+                stack.append((k, depth + 1))
+                stack.append((v, depth + 1))
+    return None
 
 
 def _line(node: yaml.Node) -> int:
@@ -60,6 +93,13 @@ def parse(text: str, file: str = "<graph>") -> Document:
             mark.line + 1 if mark else None,
         )
         return doc
+    except RecursionError:
+        problem(f"the YAML is nested too deeply (more than {MAX_DEPTH} levels)")
+        return doc
+    too_big = _expansion_problem(root)
+    if too_big:
+        problem(too_big)
+        return doc
     if root is None or not isinstance(root, yaml.MappingNode):
         problem("a graph file is a mapping with 'formgraph: 1' and 'nodes:'", 1)
         return doc
@@ -78,7 +118,7 @@ def parse(text: str, file: str = "<graph>") -> Document:
     else:
         k, v = top["formgraph"]
         version = _value(v, problem, None, None)
-        if version != FORMAT_VERSION:
+        if isinstance(version, bool) or version != FORMAT_VERSION:
             problem(
                 f"format version {version!r} is not supported (this formgraph reads "
                 f"{FORMAT_VERSION})",

@@ -44,6 +44,25 @@ class Ends(str, Enum):
     clamped = "clamped"  # the curve passes through them too
 
 
+def _polyline(points: np.ndarray, closed: bool) -> NurbsCurve:
+    """A degree-1 curve through ``points``, merging repeated consecutive points (a
+    subdivided or offset polygon can repeat a point; a polyline needs no zero spans)."""
+    p = kc.drop_repeats(points, closed)
+    for _ in range(3):  # NurbsCurve.polyline's knots are cumulative chords: keep them distinct
+        ring = np.vstack([p, p[:1]]) if closed else p
+        cum = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(ring, axis=0), axis=1))])
+        grows = np.diff(cum) > 0.0
+        keep = np.concatenate([[True], grows[: len(p) - 1]])
+        if closed and not grows[-1]:
+            keep[-1] = False
+        if keep.all():
+            break
+        p = p[keep]
+    if len(p) < 2:
+        raise ValueError("the result has fewer than two distinct points")
+    return NurbsCurve.polyline(p, closed=closed)
+
+
 def _kernel(port: str, fn: Any, *args: Any, **kwargs: Any) -> Any:
     """Call a kernel; its ValueError names the node input it is about."""
     try:
@@ -151,7 +170,7 @@ def subdivide(
     p, closed = _control_polygon(curve)
     ctx.guard(kc.subdivided_count(len(p), closed, iterations), "points")
     out = _kernel("curve", kc.subdivide_polygon, p, closed=closed, iterations=iterations)
-    return NurbsCurve.polyline(out, closed=closed)
+    return _polyline(out, closed=closed)
 
 
 @node("curves.parametric", version=1)
@@ -189,20 +208,10 @@ def parametric(
     if len(t) != 2 or not t[0] < t[1]:
         raise InputError("t", f"t must be [start, end] with start < end, got {list(t)}")
     ctx.guard(samples, "samples")
-    fx, fy, fz = (_expression(e, "t") for e in (x, y, z))
+    fx, fy, fz = x, y, z
     curve = ParametricCurve(fx, fy, fz, (float(t[0]), float(t[1])), samples)
     curve.sample(samples)  # raises, naming the expression and t, if anything is not finite
     return curve
-
-
-def _expression(e: Any, *variables: str) -> Any:
-    """An expression port's value: a bound, compiled expression; a default given as text
-    (which arrives uncompiled) is compiled here, with no params."""
-    if not isinstance(e, str):
-        return e
-    from formgraph.expr import Bound, compile_expression
-
-    return Bound(compile_expression(e, set(variables)), {})
 
 
 @node("curves.resample", version=1)
@@ -242,7 +251,7 @@ def resample(
         )
         ctx.guard(n, "points")
         out = _kernel("curve", kc.resample_polyline, p, count=n, closed=closed)
-        return NurbsCurve.polyline(out, closed=closed)
+        return _polyline(out, closed=closed)
 
     def speed(tt: np.ndarray) -> np.ndarray:
         return np.linalg.norm(curve.derivative(tt), axis=-1)
@@ -265,7 +274,7 @@ def resample(
     ctx.guard(n, "points")
     s = np.arange(n) * (length / n) if closed else np.linspace(0.0, length, n)
     t = kc.parameters_at_lengths(speed, edges, cum, s)
-    return NurbsCurve.polyline(curve.evaluate(t), closed=closed)
+    return _polyline(curve.evaluate(t), closed=closed)
 
 
 @node("curves.offset", version=1)
@@ -304,4 +313,4 @@ def offset(
     out = _kernel(
         "curve", kc.bisector_offset, p, closed=closed, distance=distance, miter_limit=miter_limit
     )
-    return NurbsCurve.polyline(out, closed=closed)
+    return _polyline(out, closed=closed)

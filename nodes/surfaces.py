@@ -9,7 +9,6 @@ from formgraph.errors import InputError
 from formgraph.geometry import Mesh, NurbsSurface, ParametricSurface, Points
 from formgraph.kernels import curves as kc
 from formgraph.kernels.grid import grid_faces
-from formgraph.nodes.curves import _expression
 from formgraph.registry import Context, node
 from formgraph.types import Expression, Variables
 
@@ -97,7 +96,7 @@ def parametric(
     for name, r in (("u", u), ("v", v)):
         if len(r) != 2 or not r[0] < r[1]:
             raise InputError(name, f"{name} must be [start, end] with start < end, got {list(r)}")
-    fx, fy, fz = (_expression(e, "u", "v") for e in (x, y, z))
+    fx, fy, fz = x, y, z
     surface = ParametricSurface(fx, fy, fz, (float(u[0]), float(u[1])), (float(v[0]), float(v[1])))
     probe = np.linspace(0.0, 1.0, 33)
     surface.evaluate_grid(u[0] + (u[1] - u[0]) * probe, v[0] + (v[1] - v[0]) * probe)

@@ -129,3 +129,16 @@ def write(text: str, path: OutputPath, *, ctx: Context) -> str:
     """
     CALLS.append("write")
     return str(ctx.write(path, text.encode()))
+
+
+@node("stub.pair", version=1)
+def pair(a: float, b: float) -> list[float]:
+    """[a, b].
+
+    Parameters
+    ----------
+    a, b : float
+        The two numbers.
+    """
+    CALLS.append("pair")
+    return [a, b]

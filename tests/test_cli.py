@@ -152,3 +152,14 @@ def test_readme_catalogue_is_current():
     assert r.stdout.strip() in readme, (
         "README catalogue is stale: python -m formgraph.catalogue README.md"
     )
+
+
+def test_schema_accepts_expressions_inside_coordinates():
+    jsonschema = pytest.importorskip("jsonschema")
+    schema = json.loads(cli("schema").stdout)
+    graph = {
+        "formgraph": 1,
+        "params": {"h": 2.0},
+        "nodes": {"p": {"type": "points.list", "points": [[0, 0, "=h"], [1, 2]]}},
+    }
+    assert not list(jsonschema.Draft202012Validator(schema).iter_errors(graph))

@@ -308,3 +308,13 @@ def test_random_point_sets_through_the_whole_family(n, closed, spacing, seed):
         assert np.min(np.linalg.norm(got - p, axis=1)) < 1e-9
     for name in ("s", "r"):
         assert np.isfinite(np.asarray(g.evaluate(name).control_points)).all()
+
+
+def test_subdivide_merges_repeated_control_points():
+    # tension 1 puts each Bezier handle on its end point: the control polygon repeats every
+    # through point three times, which a polyline must not keep as zero-length spans
+    g, last = chain(
+        ("curves.catmull_rom", {"points": BLOB, "ends": "clamped", "tension": 1.0}),
+        ("curves.subdivide", {"curve": "@prev", "iterations": 0}),
+    )
+    np.testing.assert_allclose(np.asarray(g.evaluate(last).control_points)[:, :2], BLOB)

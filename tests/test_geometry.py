@@ -63,3 +63,13 @@ def test_to_pyvista_round_trip():
     c = fg.NurbsCurve.polyline([[0, 0], [1, 0], [1, 1]])
     assert c.to_pyvista().n_points == 3
     assert fg.Points([[0, 0, 0], [1, 1, 1]]).to_pyvista().n_points == 2
+
+
+def test_polyline_drops_points_that_add_no_length():
+    c = fg.NurbsCurve.polyline(
+        [[0, 0], [1, 0], [1, 0], [1, 0], [1e3, 0], [1e3 + 1e-14, 0], [1e3, 5]]
+    )
+    assert len(c.control_points) == 4
+    np.testing.assert_allclose(c.evaluate(c.domain[1]), [1e3, 5, 0])
+    with pytest.raises(ValueError, match="two distinct points"):
+        fg.NurbsCurve.polyline([[1, 1], [1, 1], [1, 1]])

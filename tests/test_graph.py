@@ -252,3 +252,16 @@ def test_param_names_may_not_hide_the_language():
         g.check()
     assert "param 'pi' would hide the expression constant 'pi'" in str(e.value)
     assert "param 'sqrt' would hide the expression function 'sqrt'" in str(e.value)
+
+
+def test_a_list_from_a_wire_joins_a_list_port():
+    g = fg.Graph()
+    g.add("a", "stub.value", x=1.0, label="a")
+    g.add("b", "stub.value", x=2.0, label="b")
+    g.add("ab", "stub.pair", a="@a", b="@b")
+    g.add("s", "stub.sum", items=["@ab", "@a", 10.0])
+    assert g.evaluate("s") == 1.0 + 2.0 + 1.0 + 10.0
+    g.add("bad", "stub.sum", items=["@ab", "@p"])
+    g.add("p", "stub.points", n=2)
+    with pytest.raises(fg.GraphError, match="expected float, got Points from '@p'"):
+        g.check()

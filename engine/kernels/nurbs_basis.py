@@ -112,34 +112,51 @@ def _span_table(degree: int, knots: np.ndarray) -> tuple[np.ndarray, int]:
     return np.ascontiguousarray(np.array(rows).reshape(len(rows), len(s))), first
 
 
-def _basis_from_table(degree: int, k: np.ndarray, t: np.ndarray) -> list[np.ndarray]:
+def basis_workspace(degree: int, size: int) -> np.ndarray:
+    """Scratch memory for :func:`_basis_from_table` on blocks of up to ``size`` parameters."""
+    return np.empty((3 * degree + 3, size))
+
+
+def _basis_from_table(
+    degree: int, k: np.ndarray, t: np.ndarray, work: np.ndarray | None = None
+) -> np.ndarray:
     """A2.2 on a block: ``k`` holds the block's columns of :func:`_span_table`.
 
-    The loops run over the degree only; each step is one array operation over the block.
-    Returns ``p + 1`` arrays of shape (m,).
+    The loops run over the degree only; each step is one array operation over the block,
+    written in place into ``work`` (from :func:`basis_workspace`; allocated if None), as
+    A2.2 itself works in place. Returns the basis functions as a ``(p + 1, m)`` view into
+    ``work``: use it before the next block overwrites it.
     """
     p = degree
+    m = t.shape[0]
+    if work is None:
+        work = basis_workspace(p, m)
+    w = work[:, :m]
+    N = w[: p + 1]
     if p == 0:
-        return [np.ones_like(t)]
-    left = [None] + [t - k[j - 1] for j in range(1, p + 1)]
-    right = [None] + [k[p + j - 1] - t for j in range(1, p + 1)]
+        N[0] = 1.0
+        return N
+    left = w[p + 1 : 2 * p + 1]  # left[j - 1] = t - knots[s + 1 - j]
+    right = w[2 * p + 1 : 3 * p + 1]  # right[j - 1] = knots[s + j] - t
+    temp, saved = w[3 * p + 1], w[3 * p + 2]
+    np.subtract(t, k[:p], out=left)
+    np.subtract(k[p : 2 * p], t, out=right)
     inv = 2 * p
     # level 1 (N_0 = 1)
-    N = [right[1] * k[inv], left[1] * k[inv]]
+    np.multiply(right[0], k[inv], out=N[0])
+    np.multiply(left[0], k[inv], out=N[1])
     inv += 1
     for j in range(2, p + 1):
-        new = []
-        saved = None
         for r in range(j):
-            temp = N[r] * k[inv]
+            np.multiply(N[r], k[inv], out=temp)
             inv += 1
-            term = right[r + 1] * temp
-            if saved is not None:
-                term += saved
-            new.append(term)
-            saved = left[j - r] * temp
-        new.append(saved)
-        N = new
+            if r == 0:
+                np.multiply(right[0], temp, out=N[0])
+            else:
+                np.multiply(right[r], temp, out=N[r])
+                N[r] += saved
+            np.multiply(left[j - r - 1], temp, out=saved)
+        N[j] = saved
     return N
 
 
@@ -153,11 +170,11 @@ def _basis_rows(
         return [np.ones_like(t)]
     table, first = _span_table(p, knots)
     out = np.empty((p + 1, t.shape[0]))
+    work = basis_workspace(p, min(CHUNK, t.shape[0]))
     for s0 in range(0, t.shape[0], CHUNK):
         sl = slice(s0, s0 + CHUNK)
         k = np.take(table, spans[sl] - first, axis=1)
-        for r, row in enumerate(_basis_from_table(p, k, t[sl])):
-            out[r, sl] = row
+        out[:, sl] = _basis_from_table(p, k, t[sl], work)
     return list(out)
 
 

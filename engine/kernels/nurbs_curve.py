@@ -16,6 +16,7 @@ from .nurbs_basis import (
     _basis_from_table,
     _span_table,
     basis_function_derivatives,
+    basis_workspace,
     domain_spans,
     find_spans,
 )
@@ -94,18 +95,23 @@ def evaluate_homogeneous(
     table = np.concatenate([basis, local])
     base = basis.shape[0]
     out = np.empty((d, t.shape[0]))
+    size = min(CHUNK, t.shape[0])
+    work = basis_workspace(p, size)
+    temp = np.empty(size)
     for s0 in range(0, t.shape[0], CHUNK):
         tt = t[s0 : s0 + CHUNK]
         spans = np.searchsorted(knots, tt, side="right") - 1
         np.clip(spans, first, last, out=spans)
         k = np.take(table, spans - first, axis=1)
-        N = _basis_from_table(p, k, tt)
+        N = _basis_from_table(p, k, tt, work)
         block = out[:, s0 : s0 + CHUNK]
+        tmp = temp[: len(tt)]
         for c in range(d):
-            acc = N[0] * k[base + c]
+            acc = block[c]
+            np.multiply(N[0], k[base + c], out=acc)
             for r in range(1, p + 1):
-                acc += N[r] * k[base + r * d + c]
-            block[c] = acc
+                np.multiply(N[r], k[base + r * d + c], out=tmp)
+                acc += tmp
     return out
 
 
@@ -226,8 +232,8 @@ def periodic_curve(points: np.ndarray, degree: int) -> tuple[np.ndarray, np.ndar
     Parameters
     ----------
     points : (k, 3) float
-        The closed control polygon (the last point is not a repeat of the first); k must
-        be at least degree + 1... the degree is not capped here.
+        The closed control polygon (the last point is not a repeat of the first);
+        k >= max(3, degree + 1).
     degree : int
 
     Returns

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .nurbs_knots import respace
 from .nurbs_surface import basis_matrix
 
 __all__ = ["fit_columns", "interpolate", "interpolation_parameters"]
@@ -107,10 +108,12 @@ def fit_columns(
 
     Returns
     -------
-    control : (k, ...) float, or (k + degree, ...) when closed
-    knots : (k + degree + 1,) float, or (k + 2 degree + 1,) when closed
-        Domain [0, 1] when open; when closed, [0, 1] for odd degree and shifted by half a
-        parameter step for even degree (the data lie at the given parameters either way).
+    control : (k, ...) float; when closed (k + degree, ...) for odd degree and
+        (k + 1 + degree, ...) for even degree
+    knots : (len(control) + degree + 1,) float
+        Domain [0, 1], with the data at ``params``. Closed even degrees get one knot more
+        per period (the midpoints between the parameters, for Schoenberg-Whitney, plus 0
+        so that the domain starts at the first data point), hence one more control point.
     """
     vals = np.asarray(values, dtype=np.float64)
     k = vals.shape[0]
@@ -126,8 +129,28 @@ def fit_columns(
     A = basis_matrix(p, knots, t, k + p)
     A[:, :p] += A[:, k:]
     ctrl = np.linalg.solve(A[:, :k], flat)
+    if p % 2 == 0:
+        ctrl, knots = _start_at_zero(ctrl, knots[p : p + k], p)
+        k += 1
     ctrl = np.concatenate([ctrl, ctrl[:p]])
     return ctrl.reshape((k + p,) + vals.shape[1:]), knots
+
+
+def _start_at_zero(ctrl: np.ndarray, period: np.ndarray, p: int) -> tuple[np.ndarray, np.ndarray]:
+    """Re-express a periodic spline (k distinct control points, knots ``period`` in one
+    period, the first above 0) on the knots ``{0} + period mod 1``, so that its domain
+    starts at parameter 0, the first data point. Exact: the new periodic knot vector
+    refines the old one (:func:`~.nurbs_knots.respace` on three periods of the old curve).
+    """
+    k = len(period)
+    i = np.arange(-k - p, 2 * k + p + 1)  # domain [period[0] - 1, period[0] + 2]
+    old_knots = period[i % k] + np.floor_divide(i, k)
+    old_ctrl = ctrl[np.arange(3 * k + p) % k]
+    base = np.sort(np.concatenate([[0.0], np.mod(period, 1.0)]))
+    j = np.arange(-p, k + 1 + p + 1)
+    new_knots = base[j % (k + 1)] + np.floor_divide(j, k + 1)
+    new_ctrl = respace(p, old_knots, old_ctrl, new_knots)
+    return new_ctrl[: k + 1], new_knots
 
 
 def interpolate(
@@ -142,7 +165,8 @@ def interpolate(
     ----------
     points : (k, 3) float
         At least 2 (open) or 3 (closed) points, consecutive points distinct. For a closed
-        curve a last point equal to the first is dropped (the curve closes by itself).
+        curve a last point equal to the first (within 1e-12 of the extent) is dropped: the
+        curve closes by itself.
     degree : int
         Requested degree; it is capped at ``k - 1`` (the most k points determine), so 2
         points give a line and 3 points a parabola.
@@ -155,12 +179,12 @@ def interpolate(
 
     Returns
     -------
-    control_points : (k, 3) or (k + degree, 3) float
+    control_points : (k, 3) float, or (k + degree, 3) closed (k + 1 + degree for even degree)
     degree : int
         The degree used (after the cap).
     knots : float array
         Domain [0, 1]; open curves are clamped and pass through the first and last point at
-        0 and 1; closed curves pass through the first point at 0 (odd degree).
+        0 and 1; closed curves start and end at the first point.
     weights : None
     """
     pts = np.asarray(points, dtype=np.float64)
@@ -170,8 +194,10 @@ def interpolate(
         raise ValueError("points must be finite numbers")
     if isinstance(degree, bool) or int(degree) != degree or degree < 1:
         raise ValueError(f"degree must be a whole number >= 1, got {degree!r}")
-    if closed and len(pts) > 1 and np.array_equal(pts[0], pts[-1]):
-        pts = pts[:-1]
+    if closed and len(pts) > 1:
+        extent = float(np.ptp(pts, axis=0).max())
+        if np.linalg.norm(pts[0] - pts[-1]) <= 1e-12 * extent:
+            pts = pts[:-1]  # the closing point repeats the first (up to rounding)
     need = 3 if closed else 2
     if len(pts) < need:
         kind = "a closed" if closed else "an open"

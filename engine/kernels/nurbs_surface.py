@@ -9,7 +9,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from .nurbs_basis import _basis_rows, basis_function_derivatives, find_spans
+from .nurbs_basis import (
+    CHUNK,
+    _basis_from_table,
+    _basis_rows,
+    _span_table,
+    basis_function_derivatives,
+    basis_workspace,
+    domain_spans,
+    find_spans,
+)
 from .nurbs_curve import homogeneous
 
 __all__ = [
@@ -76,25 +85,71 @@ def surface_evaluate(
     """
     uu, vv = np.broadcast_arrays(np.asarray(u, dtype=np.float64), np.asarray(v, dtype=np.float64))
     shape = uu.shape
-    uf, vf = uu.reshape(-1), vv.reshape(-1)
+    pw = homogeneous(control_points, weights)
+    (out,) = _tensor_sums(pw, degree_u, degree_v, knots_u, knots_v, uu.reshape(-1),
+                          vv.reshape(-1), derivatives=False)  # fmt: skip
+    if weights is not None:
+        out = out[:3] / out[3]
+    return out.T.reshape(shape + (3,))
+
+
+def _tensor_sums(
+    pw: np.ndarray,
+    pu: int,
+    pv: int,
+    knots_u: np.ndarray,
+    knots_v: np.ndarray,
+    u: np.ndarray,
+    v: np.ndarray,
+    derivatives: bool,
+) -> tuple[np.ndarray, ...]:
+    """``sum_ab Nu_a(u) Nv_b(v) pw[su-pu+a, sv-pv+b]`` (and with dNu or dNv) for all pairs.
+
+    Blocks of parameters (cache-sized), coordinates first: each coordinate of the control
+    net is a flat array read with 1-D gathers, so every operation is a long, contiguous
+    array operation. Returns ``(d, m)`` arrays: the sum, then (with ``derivatives``) its
+    u and v partials.
+    """
+    nu, nv, d = pw.shape
     ku = np.asarray(knots_u, dtype=np.float64)
     kv = np.asarray(knots_v, dtype=np.float64)
-    su = find_spans(degree_u, ku, uf)
-    sv = find_spans(degree_v, kv, vf)
-    nu_rows = _basis_rows(degree_u, ku, su, uf)
-    nv_rows = _basis_rows(degree_v, kv, sv, vf)
-    pw = homogeneous(control_points, weights)
-    out = np.zeros((uf.shape[0], pw.shape[-1]))
-    iv = sv - degree_v
-    for a in range(degree_u + 1):
-        iu = su - degree_u + a
-        inner = nv_rows[0][:, None] * pw[iu, iv]
-        for b in range(1, degree_v + 1):
-            inner += nv_rows[b][:, None] * pw[iu, iv + b]
-        out += nu_rows[a][:, None] * inner
-    if weights is not None:
-        out = out[:, :3] / out[:, 3:]
-    return out.reshape(shape + (3,))
+    coords = np.ascontiguousarray(np.moveaxis(pw, -1, 0)).reshape(d, nu * nv)
+    tab_u, first_u = _span_table(pu, ku)
+    tab_v, first_v = _span_table(pv, kv)
+    last_u = domain_spans(pu, ku)[1]
+    last_v = domain_spans(pv, kv)[1]
+    m = u.shape[0]
+    outs = [np.empty((d, m)) for _ in range(3 if derivatives else 1)]
+    work_u = basis_workspace(pu, min(CHUNK, m))
+    work_v = basis_workspace(pv, min(CHUNK, m))
+    for s0 in range(0, m, CHUNK):
+        sl = slice(s0, s0 + CHUNK)
+        uc, vc = u[sl], v[sl]
+        su = np.clip(np.searchsorted(ku, uc, side="right") - 1, first_u, last_u)
+        sv = np.clip(np.searchsorted(kv, vc, side="right") - 1, first_v, last_v)
+        if derivatives:
+            du = basis_function_derivatives(pu, ku, su, uc, 1).transpose(0, 2, 1)
+            dv = basis_function_derivatives(pv, kv, sv, vc, 1).transpose(0, 2, 1)
+            Nu, dNu, Nv, dNv = du[0], du[1], dv[0], dv[1]
+        else:
+            Nu = _basis_from_table(pu, np.take(tab_u, su - first_u, axis=1), uc, work_u)
+            Nv = _basis_from_table(pv, np.take(tab_v, sv - first_v, axis=1), vc, work_v)
+        base = (su - pu) * nv + (sv - pv)
+        for c in range(d):
+            P = coords[c]
+            acc = [None] * len(outs)
+            for a in range(pu + 1):
+                row = base + a * nv
+                g = [P.take(row + b) for b in range(pv + 1)]
+                inner = sum(Nv[b] * g[b] for b in range(pv + 1))
+                terms = [Nu[a] * inner]
+                if derivatives:
+                    terms += [dNu[a] * inner, Nu[a] * sum(dNv[b] * g[b] for b in range(pv + 1))]
+                for i, t in enumerate(terms):
+                    acc[i] = t if acc[i] is None else acc[i] + t
+            for i in range(len(outs)):
+                outs[i][c, sl] = acc[i]
+    return tuple(outs)
 
 
 def surface_evaluate_grid(
@@ -131,7 +186,9 @@ def surface_evaluate_grid(
     nu, nv, d = pw.shape
     bu = basis_matrix(degree_u, knots_u, u, nu)
     bv = basis_matrix(degree_v, knots_v, v, nv)
-    # (d, nu, nv) -> Bu @ . @ Bv^T per coordinate, then coordinates last
+    # coordinates first, (d, nu, nv): two BLAS products per coordinate, and the rational
+    # division then runs along contiguous rows (a trailing axis of 3 or 4 would make
+    # numpy's inner loops 3 elements long)
     per_coord = np.ascontiguousarray(np.moveaxis(pw, -1, 0))
     out = bu @ per_coord @ bv.T  # (d, a, b)
     if weights is not None:
@@ -161,25 +218,16 @@ def surface_derivatives(
     uf, vf = uu.reshape(-1), vv.reshape(-1)
     ku = np.asarray(knots_u, dtype=np.float64)
     kv = np.asarray(knots_v, dtype=np.float64)
-    pu, pv = degree_u, degree_v
-    su = find_spans(pu, ku, uf)
-    sv = find_spans(pv, kv, vf)
-    du = basis_function_derivatives(pu, ku, su, uf, 1)  # (2, m, pu+1)
-    dv = basis_function_derivatives(pv, kv, sv, vf, 1)
     pw = homogeneous(control_points, weights)
-    iu = su[:, None] - pu + np.arange(pu + 1)
-    iv = sv[:, None] - pv + np.arange(pv + 1)
-    local = pw[iu[:, :, None], iv[:, None, :]]  # (m, pu+1, pv+1, d)
-    a = np.einsum("ma,mb,mabd->md", du[0], dv[0], local)
-    au = np.einsum("ma,mb,mabd->md", du[1], dv[0], local)
-    av = np.einsum("ma,mb,mabd->md", du[0], dv[1], local)
+    a, au, av = _tensor_sums(pw, degree_u, degree_v, ku, kv, uf, vf, derivatives=True)
     if weights is None:
         s, s_u, s_v = a, au, av
     else:
-        w, wu, wv = a[:, 3:], au[:, 3:], av[:, 3:]
-        s = a[:, :3] / w
-        s_u = (au[:, :3] - wu * s) / w
-        s_v = (av[:, :3] - wv * s) / w
+        w, wu, wv = a[3], au[3], av[3]
+        s = a[:3] / w
+        s_u = (au[:3] - wu * s) / w
+        s_v = (av[:3] - wv * s) / w
+    s, s_u, s_v = s.T, s_u.T, s_v.T
     return s.reshape(shape + (3,)), s_u.reshape(shape + (3,)), s_v.reshape(shape + (3,))
 
 
