@@ -194,7 +194,8 @@ def dxf(
             w = np.asarray(c.weights) if c.rational else None
             splines.append((c.control_points, c.degree, c.knots, w))
         else:
-            polylines.append((c.sample(samples), bool(c.closed)))
+            pts, closed = c.sample(samples), bool(c.closed)
+            polylines.append((pts[:-1] if closed else pts, closed))
     meshes = [] if mesh is None else [(mesh.vertices, mesh.face_indices, mesh.face_offsets)]
     if not splines and not polylines and not meshes:
         raise ValueError("export.dxf needs curves or a mesh to write, got neither")

@@ -230,3 +230,31 @@ def test_stl_ascii_and_binary_agree(tmp_path):
     b = stl_mesh.Mesh.from_file(out["b"], calculate_normals=False)
     assert len(a.vectors) == 2 * 96 and np.array_equal(a.vectors, b.vectors)
     assert io.BytesIO(open(out["a"], "rb").read()).read(6) == b"solid "
+
+
+def test_nurbs_circles_and_arcs_become_svg_arcs_and_dxf_splines(tmp_path):
+    import ezdxf
+
+    g = graph(tmp_path)
+    g.add("c", "nurbs.circle", radius=5, center=[1, 2, 0])
+    g.add("a", "nurbs.arc", radius=3, start=30, end=200)
+    g.add("tilted", "nurbs.circle", radius=2, normal=[1, 0, 1])  # an ellipse seen from +z
+    g.add("svg", "export.svg", curves=["@c", "@a", "@tilted"], path="arcs.svg")
+    g.add("dxf", "export.dxf", curves=["@c", "@a"], path="arcs.dxf")
+    out = g.evaluate(["svg", "dxf"])
+    _, (circle, arc, tilted) = _svg(out["svg"])
+    assert circle.endswith("Z") and " A " in circle
+    args = _numbers(circle)[2:].reshape(-1, 7)
+    assert np.allclose(args[:, :2], 5) and np.allclose(args[-1, 5:], [6, -2])
+    args = _numbers(arc)[2:].reshape(-1, 7)
+    assert np.allclose(args[:, :2], 3) and np.all(args[:, 4] == 1)  # counter-clockwise
+    end = np.radians(200)
+    assert np.allclose(args[-1, 5:], [3 * np.cos(end), -3 * np.sin(end)], atol=1e-6)
+    assert " L " in tilted and " A " not in tilted  # not a circle in the drawing: a polyline
+    doc = ezdxf.readfile(out["dxf"])
+    assert not doc.audit().has_errors
+    for spline, (centre, r) in zip(
+        doc.modelspace().query("SPLINE"), [([1, 2, 0], 5), ([0, 0, 0], 3)], strict=True
+    ):
+        pts = np.array(list(spline.construction_tool().points(np.linspace(0, 1, 501))))
+        assert np.abs(np.linalg.norm(pts - centre, axis=1) - r).max() < 1e-9

@@ -535,3 +535,76 @@ def test_dxf_polylines_and_meshes():
 def test_dxf_bad_splines(spline, match):
     with pytest.raises(ValueError, match=match):
         dxf_bytes(splines=[spline])
+
+
+# --------------------------------------------------------------------------------------------
+# random meshes and drawings
+
+
+@st.composite
+def polygon_meshes(draw):
+    n = draw(st.integers(3, 30))
+    sizes = draw(st.lists(st.integers(3, 7), min_size=1, max_size=12))
+    seed = draw(st.integers(0, 2**32 - 1))
+    rng = np.random.default_rng(seed)
+    v = rng.normal(size=(n, 3)) * 10.0 ** rng.integers(-3, 4)
+    fi = rng.integers(0, n, size=sum(sizes))
+    return v, fi, np.concatenate([[0], np.cumsum(sizes)])
+
+
+@settings(max_examples=30, deadline=None)
+@given(polygon_meshes())
+def test_random_polygon_meshes_round_trip(tmp_path_factory, mesh):
+    import meshio
+    from stl import mesh as stl_mesh
+
+    v, fi, fo = mesh
+    tmp = tmp_path_factory.mktemp("m")
+    tris = fan_triangles(fi, fo)
+    assert len(tris) == int(np.sum(np.diff(fo) - 2))
+    s = stl_mesh.Mesh.from_file(
+        str(write(tmp, "m.stl", stl_binary(v, fi, fo))), calculate_normals=False
+    )
+    assert np.array_equal(s.vectors, v.astype(np.float32)[tris])
+    # OBJ: every face line and every coordinate back exactly
+    text = obj_bytes(v, fi, fo).decode().splitlines()
+    verts = np.array([[float(x) for x in ln.split()[1:]] for ln in text if ln.startswith("v ")])
+    faces = [[int(x) - 1 for x in ln.split()[1:]] for ln in text if ln.startswith("f ")]
+    assert np.array_equal(verts, v)
+    assert faces == [fi[a:b].tolist() for a, b in zip(fo[:-1], fo[1:], strict=True)]
+    # PLY: meshio groups the faces by size; each group is the faces of that size, in order
+    m = meshio.read(write(tmp, "m.ply", ply_binary(v, fi, fo)))
+    assert np.array_equal(m.points, v)
+    got = sorted(tuple(f) for c in m.cells for f in c.data.tolist())
+    want = sorted(tuple(fi[a:b].tolist()) for a, b in zip(fo[:-1], fo[1:], strict=True))
+    assert got == want
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.integers(2, 40), st.integers(0, 2**32 - 1), st.booleans())
+def test_random_polylines_in_svg_and_pdf(n, seed, closed):
+    rng = np.random.default_rng(seed)
+    pts = rng.normal(size=(n, 2)) * 10.0 ** rng.integers(-1, 3)
+    path = Path2D("polyline", pts, closed=closed)
+    _, (d,) = _svg_paths(svg_bytes([path]))
+    back = np.array([x for x in _tokens(d) if not isinstance(x, str)]).reshape(-1, 2)
+    assert np.allclose(back * [1, -1], pts, atol=5.1e-7, rtol=0)
+    objs = _pdf_objects(pdf_bytes([path], compress=False))
+    body = objs[4]
+    content = body[body.index(b"stream\n") + 7 : body.index(b"\nendstream")].decode()
+    nums = [float(x) for ln in content.splitlines()[1:] for x in ln.split()[:2]
+            if ln.endswith((" m", " l"))]  # fmt: skip
+    lo, _ = drawing_bounds([path])
+    assert np.allclose(np.array(nums).reshape(-1, 2) * 25.4 / 72 + lo - 1, pts, atol=2e-5)
+
+
+def test_empty_mesh_writes_empty_files():
+    v, fi, fo = np.zeros((0, 3)), np.zeros(0, dtype=int), np.zeros(1, dtype=int)
+    assert stl_binary(v, fi, fo) == b"formgraph binary STL".ljust(80, b"\0") + b"\0\0\0\0"
+    assert stl_ascii(v, fi, fo) == b"solid formgraph\nendsolid formgraph\n"
+    assert obj_bytes(v, fi, fo) == b"# formgraph\n"
+    assert b"element face 0\n" in ply_binary(v, fi, fo)
+    r = mesh_report(v, fi, fo)
+    assert (r.n_edges, r.n_triangles, r.watertight) == (0, 0, True)
+    tri = mesh_report(np.eye(3), np.arange(3), np.array([0, 3]))
+    assert (tri.n_edges, tri.boundary_edges) == (3, 3)

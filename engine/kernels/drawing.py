@@ -165,12 +165,11 @@ def _command(letter: bytes, nwords: int) -> np.ndarray:
     return row
 
 
-def _path_text(rows_per_item: list[tuple[bytes | None, np.ndarray]]) -> bytes:
-    """Squeeze a sequence of (command letters, number rows) into text."""
+def _path_text(items: list[tuple[bytes, np.ndarray]]) -> bytes:
+    """Squeeze a sequence of (command letters, rows of number words) into path data."""
     blocks = []
-    for letter, rows in rows_per_item:
-        if letter is not None:
-            blocks.append(_command(letter, rows.shape[1] if rows.size else 3))
+    for letter, rows in items:  # a handful of commands per path
+        blocks.append(_command(letter, rows.shape[1] if rows.size else 3))
         if rows.size:
             blocks.append(rows)
     width = max(b.shape[1] for b in blocks)

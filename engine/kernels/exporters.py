@@ -178,13 +178,36 @@ def stl_binary(vertices: np.ndarray, face_indices: np.ndarray, face_offsets: np.
     """
     v, tris = _stl_input(vertices, face_indices, face_offsets)
     v32 = v.astype(np.float32)
-    records = np.empty(len(tris), dtype=_STL_RECORD)
+    records = np.empty((len(tris), 50), dtype=np.uint8)
+    normal, corners = records[:, :12].view("V12")[:, 0], records[:, 12:48].view("V36")[:, 0]
+    records[:, 48:] = 0  # the attribute byte count
+    columns = [np.ascontiguousarray(v32[:, k]) for k in range(3)]
     for s in _blocks(len(tris)):
-        block = records[s]
-        block["normal"] = triangle_normals(v, tris[s])
-        block["vertices"] = v32[tris[s]]
-        block["attribute"] = 0
+        c = np.take(v32, tris[s], axis=0)  # (b, 3, 3) float32, the stored corners
+        corners[s] = c.reshape(-1, 9).view("V36")[:, 0]
+        normal[s] = _facet_normals(columns, tris[s]).view("V12")[:, 0]
     return b"".join([_STL_HEADER, struct.pack("<I", len(tris)), records.data])
+
+
+def _facet_normals(columns: list[np.ndarray], tris: np.ndarray) -> np.ndarray:
+    """Unit normals (t, 3) float32 of triangles over float32 vertex ``columns`` (x, y, z).
+
+    Computed in double precision from the corners as the file stores them (float32), so
+    binary and ASCII STL carry the same normals; (0, 0, 0) for zero-area triangles. The
+    arithmetic runs on one contiguous array per coordinate, which vectorizes far better
+    than (t, 3) rows.
+    """
+    a = [np.take(col, tris[:, 0]).astype(np.float64) for col in columns]
+    e1 = [np.take(col, tris[:, 1]) - ak for col, ak in zip(columns, a, strict=True)]
+    e2 = [np.take(col, tris[:, 2]) - ak for col, ak in zip(columns, a, strict=True)]
+    nx = e1[1] * e2[2] - e1[2] * e2[1]
+    ny = e1[2] * e2[0] - e1[0] * e2[2]
+    nz = e1[0] * e2[1] - e1[1] * e2[0]
+    length = np.sqrt(nx * nx + ny * ny + nz * nz)
+    length[length == 0] = np.inf  # zero area: a zero normal
+    out = np.empty((len(tris), 3), dtype=np.float32)
+    out[:, 0], out[:, 1], out[:, 2] = nx / length, ny / length, nz / length
+    return out
 
 
 def stl_ascii(
@@ -240,14 +263,17 @@ def stl_ascii(
     out[len(out) - len(tail) :] = np.frombuffer(tail, dtype=np.uint8)
     facets = out[len(head) : len(out) - len(tail)].reshape(len(tris), width)
     fields = [int(at) + len(w) for w, at in zip(words[:-1], starts[:-1], strict=True)]
+    v32 = v.astype(np.float32)
+    columns = [np.ascontiguousarray(v32[:, k]) for k in range(3)]
     for s in _blocks(len(tris)):
         t = tris[s]
         rec = template[: len(t)]
-        normal_text = format_e9(triangle_normals(v, t).ravel()).reshape(-1, field).view(item)[:, 0]
+        normals = _facet_normals(columns, t)
+        normal_text = format_e9(normals.ravel()).reshape(-1, field).view(item)[:, 0]
         rec[:, fields[0] : fields[0] + field].view(item)[:, 0] = normal_text
         for corner in range(3):
             at = fields[corner + 1]
-            rec[:, at : at + field].view(item)[:, 0] = vertex_text[t[:, corner]]
+            rec[:, at : at + field].view(item)[:, 0] = np.take(vertex_text, t[:, corner])
         facets[s] = rec
     return out.tobytes()
 
@@ -339,8 +365,8 @@ def mesh_report(
 
     Every face contributes its directed edges (a -> b around its winding). An undirected edge
     seen once is a boundary, more than twice non-manifold; a directed edge seen twice means
-    two faces cross it the same way, so their orientations disagree. Sorting the edge keys
-    does the counting for all edges at once.
+    two faces cross it the same way, so their orientations disagree. One sort of the edge
+    keys (undirected edge, then direction) does the counting for all edges at once.
 
     Parameters
     ----------
@@ -357,13 +383,14 @@ def mesh_report(
     nxt = np.arange(1, fi.size + 1)
     nxt[fo[1:] - 1] = fo[:-1]  # the last corner of each face wraps to its first
     a, b = fi, fi[nxt]
-    directed = a * nv + b
-    undirected = np.minimum(a, b) * nv + np.maximum(a, b)
-    _, counts = np.unique(undirected, return_counts=True)
-    directed_sorted = np.sort(directed)
-    repeated = directed_sorted[1:] == directed_sorted[:-1]
-    # a directed edge repeated k times is k - 1 extra traversals; count distinct edges instead
-    misoriented = int(np.count_nonzero(repeated & ~np.r_[False, repeated[:-1]]))
+    # one sort does it all: the key is the undirected edge, then its direction as a last bit
+    key = np.sort((np.minimum(a, b) * nv + np.maximum(a, b)) * 2 + (a > b))
+    edge = key >> 1
+    starts = np.flatnonzero(np.r_[edge.size > 0, edge[1:] != edge[:-1]])
+    counts = np.diff(np.r_[starts, edge.size])
+    # equal neighbours are the same directed edge twice: count each such edge once
+    same = key[1:] == key[:-1]
+    misoriented = int(np.count_nonzero(same & ~np.r_[False, same[:-1]]))
     tris = fan_triangles(fi, fo)
     p0, p1, p2 = v[tris[:, 0]], v[tris[:, 1]], v[tris[:, 2]]
     cross = np.cross(p1 - p0, p2 - p0)
@@ -375,7 +402,7 @@ def mesh_report(
         n_vertices=len(v),
         n_faces=fo.size - 1,
         n_triangles=len(tris),
-        n_edges=int(counts.size),
+        n_edges=int(starts.size),
         boundary_edges=int(np.count_nonzero(counts == 1)),
         nonmanifold_edges=int(np.count_nonzero(counts > 2)),
         misoriented_edges=misoriented,
@@ -458,9 +485,18 @@ def _face_lines(fi: np.ndarray, fo: np.ndarray, with_normals: bool) -> bytes:
     n_faces = fo.size - 1
     if n_faces == 0:
         return b""
+    sizes = np.diff(fo)
+    uniform = bool(np.all(sizes == sizes[0]))
     pieces = []
     for s in _blocks(n_faces):
         lo, hi = fo[s.start], fo[s.stop]
+        if uniform and not with_normals:  # one face size: rows of "\nf" and k index words
+            token = int_words(fi[lo:hi] + 1, lead=b" ")
+            rows = np.empty((s.stop - s.start, 1 + token.size // (s.stop - s.start)), np.uint64)
+            rows[:, 0] = _word(b"\nf")
+            rows[:, 1:] = token.reshape(len(rows), -1)
+            pieces.append(squeeze(rows.view(np.uint8)))
+            continue
         offsets = fo[s.start : s.stop + 1] - lo
         n = s.stop - s.start
         token = int_words(fi[lo:hi] + 1, lead=b" ")

@@ -1,9 +1,10 @@
 """Numbers to ASCII text in bulk, with numpy: the text exporters (STL, OBJ, SVG, PDF) stand on it.
 
-Formatting millions of floats one ``'%r' % x`` at a time costs about half a microsecond each;
-here every number is turned into digits with integer array arithmetic and the characters are
-put in place with table look-ups, so a mesh of a million triangles formats in a fraction of a
-second.
+Formatting millions of floats one ``repr`` at a time costs about half a microsecond each;
+here every number is turned into digits with integer array arithmetic
+(:mod:`formgraph.kernels.shortest` finds the shortest round-trip digits) and its characters
+are packed eight to a 64-bit word and moved with shifts and masks, so a mesh of a million
+triangles formats in a fraction of a second.
 
 Every formatter returns a *canvas*: a ``(n, width)`` uint8 array holding one number per row,
 padded with NUL bytes (0) that :func:`join_rows` squeezes out when it assembles the text.
@@ -16,238 +17,12 @@ from fractions import Fraction
 from functools import cache
 
 import numpy as np
+from formgraph.kernels.shortest import POW10_INT, check_finite, shortest_decimal
 
 PAD = 0  # filler byte in canvases, removed when the text is assembled
 
-_DIGIT = np.frombuffer(b"0123456789", dtype=np.uint8)
-_POW10_INT = 10 ** np.arange(19, dtype=np.int64)
 # arrays are formatted in blocks of this many values so the temporaries stay in cache
 _BLOCK = 1 << 15
-
-
-def _check_finite(values: np.ndarray, what: str) -> None:
-    if not np.all(np.isfinite(values)):
-        bad = values[~np.isfinite(values)][0]
-        raise ValueError(f"{what} must be finite numbers to be written as text, got {bad}")
-
-
-# --------------------------------------------------------------------------------------------
-# shortest round-trip decimal digits (the digits Python's repr prints), vectorized
-
-
-@cache
-def _pow10_double_double() -> tuple[np.ndarray, np.ndarray]:
-    """``10**k`` for k in [-300, 308] as unevaluated sums hi + lo of two doubles (exact to 2^-106).
-
-    Index with ``k + 300``. Python's Fraction -> float conversion is correctly rounded.
-    """
-    ks = range(-300, 309)
-    hi = np.empty(len(ks))
-    lo = np.empty(len(ks))
-    for i, k in enumerate(ks):
-        exact = Fraction(10) ** k
-        hi[i] = float(exact)
-        lo[i] = float(exact - Fraction(hi[i]))
-    return hi, lo
-
-
-def _split(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Veltkamp/Dekker split of doubles into 26- and 27-bit halves (a = h + l exactly)."""
-    c = a * 134217729.0  # 2**27 + 1
-    h = c - (c - a)
-    return h, a - h
-
-
-def _two_prod(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Dekker's exact product: p + e == a * b exactly (T. J. Dekker, 1971)."""
-    p = a * b
-    ah, al = _split(a)
-    bh, bl = _split(b)
-    e = ((ah * bh - p) + ah * bl + al * bh) + al * bl
-    return p, e
-
-
-def _scaled_17(a: np.ndarray, e10: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``a * 10**(16 - e10)`` as an integer part (int64) and a fraction in [0, 1).
-
-    The product is carried in double-double arithmetic, so the integer part is exact and the
-    fraction is good to ~1e-15: enough to round correctly to any number of digits.
-    """
-    hi, lo = _pow10_double_double()
-    k = 16 - e10 + 300
-    p, e = _two_prod(a, hi[k])
-    q = e + a * lo[k]
-    s = p + q
-    t = q - (s - p)  # |p| >= |q|: fast two-sum
-    # s >= 2**53 here, so it holds an integer exactly
-    fl = np.floor(t)
-    return s.astype(np.int64) + fl.astype(np.int64), t - fl
-
-
-def shortest_decimal(
-    x: np.ndarray,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """The shortest decimal that reads back as the same double, for every element of ``x``.
-
-    The digits Python's ``repr(float)`` prints (shortest, and among the shortest the nearest),
-    found with array arithmetic: the value is scaled to 17 digits in double-double arithmetic
-    (Dekker's exact product), then a search over how many trailing digits can be dropped keeps
-    the decimal inside the rounding interval of the double (half the gap to each neighbour) —
-    the round-trip criterion of Steele & White, "How to print floating-point numbers
-    accurately", PLDI 1990. Integers from 2**53 to 2**63 are done exactly in int64, where a
-    decimal on the boundary reads back when the significand is even (round-half-even), as
-    repr allows. Values beyond (above 2**63 or below 1e-280 in magnitude) go through numpy's
-    own shortest formatting one by one.
-
-    Parameters
-    ----------
-    x : (n,) float64
-        Finite values.
-
-    Returns
-    -------
-    negative : (n,) bool
-        Sign bit (so -0.0 is negative, as repr prints it).
-    mantissa : (n,) int64
-        The digits as an integer, no trailing zeros (0 for zero).
-    ndigits : (n,) int64
-        Number of digits in ``mantissa`` (1 to 19).
-    exp10 : (n,) int64
-        Decimal exponent of the first digit: value = mantissa * 10**(exp10 - ndigits + 1).
-    """
-    x = np.asarray(x, dtype=np.float64).ravel()
-    _check_finite(x, "values")
-    negative = np.signbit(x)
-    a = np.abs(x)
-    n = a.size
-    mantissa = np.zeros(n, dtype=np.int64)
-    ndigits = np.ones(n, dtype=np.int64)
-    exp10 = np.zeros(n, dtype=np.int64)
-
-    scaled = (a >= 1e-280) & (a < 2.0**53)
-    big = (a >= 2.0**53) & (a < 2.0**63)
-    idx = np.flatnonzero(scaled)
-    if idx.size:
-        mantissa[idx], ndigits[idx], exp10[idx] = _shortest_scaled(a[idx])
-    idx = np.flatnonzero(big)
-    if idx.size:
-        mantissa[idx], ndigits[idx], exp10[idx] = _shortest_big(a[idx])
-    for i in np.flatnonzero((a != 0) & ~scaled & ~big):  # beyond the ranges above: rare
-        digits, exponent = np.format_float_scientific(a[i], unique=True, trim="-").split("e")
-        digits = digits.replace(".", "")
-        mantissa[i], ndigits[i], exp10[i] = int(digits), len(digits), int(exponent)
-    return negative, mantissa, ndigits, exp10
-
-
-def _shortest_scaled(a: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """:func:`shortest_decimal` for 1e-280 <= a < 2**53 (positive)."""
-    e10 = np.floor(np.log10(a)).astype(np.int64)
-    vint, frac = _scaled_17(a, e10)
-    # log10 may be one off next to a power of ten: settle the exponent so round(T) has 17 digits
-    for _ in range(3):
-        r17 = vint + (frac >= 0.5)
-        low, high = r17 < 10**16, r17 >= 10**17
-        fix = np.flatnonzero(low | high)
-        if fix.size == 0:
-            break
-        e10[fix] += np.where(high[fix], 1, -1)
-        vint[fix], frac[fix] = _scaled_17(a[fix], e10[fix])
-    # half the gap to each neighbouring double in units of the scaled value, with a margin far
-    # above the ~1e-15 error of the scaling so that an accepted decimal always reads back. A
-    # decimal of at most 16 digits never sits exactly on the boundary below 2**53 (the midpoint
-    # of two such doubles needs 17 digits), so no tie rule is needed here.
-    hi, _ = _pow10_double_double()
-    scale = hi[16 - e10 + 300] * (0.5 * (1.0 - 2.0**-40))
-    bound_up = np.spacing(a) * scale
-    bound_down = (a - np.nextafter(a, 0.0)) * scale
-    even = np.zeros(a.size, dtype=bool)
-    mantissa, dropped = _drop_digits(vint, frac, bound_down, bound_up, even, np.full(a.size, 16))
-    return _carry(mantissa, 17 - dropped, e10)
-
-
-def _shortest_big(a: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """:func:`shortest_decimal` for integers 2**53 <= a < 2**63, exactly in int64."""
-    vint = a.astype(np.int64)
-    total = np.searchsorted(_POW10_INT, vint, side="right")  # number of digits
-    gap = np.spacing(a)
-    bound_up = 0.5 * gap
-    bound_down = 0.5 * (a - np.nextafter(a, 0.0))
-    even = (vint // gap.astype(np.int64)) % 2 == 0
-    frac = np.zeros(a.size)
-    mantissa, dropped = _drop_digits(vint, frac, bound_down, bound_up, even, total - 1)
-    return _carry(mantissa, total - dropped, total - 1)
-
-
-def _carry(
-    mantissa: np.ndarray, ndigits: np.ndarray, e10: np.ndarray
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Rounding up may carry into a new digit (9.99... -> 10): the value is then 10**(e10+1)."""
-    carry = mantissa == _POW10_INT[ndigits]
-    return (
-        np.where(carry, 1, mantissa),
-        np.where(carry, 1, ndigits),
-        e10 + carry,
-    )
-
-
-def _drop_digits(
-    vint: np.ndarray,
-    frac: np.ndarray,
-    bound_down: np.ndarray,
-    bound_up: np.ndarray,
-    even: np.ndarray,
-    max_drop: np.ndarray,
-) -> tuple[np.ndarray, np.ndarray]:
-    """Most trailing digits of ``vint + frac`` that can be dropped with rounding still reading back.
-
-    A decimal below the value reads back when its distance is under ``bound_down`` (under or,
-    with ``even``, equal), one above under ``bound_up``. Dropping more digits only moves the
-    nearest candidate further away, so the answer is found by search: dropping 1 and then 2
-    digits is tried first (most doubles need 16 or 17 digits), the rest by bisection over the
-    values still undecided.
-
-    Returns
-    -------
-    mantissa : (n,) int64
-        The kept digits, rounded.
-    dropped : (n,) int64
-    """
-    arrays = (vint, frac, bound_down, bound_up, even)
-
-    def trial(j, v, f, bd, bu, ev):
-        div = _POW10_INT[j]
-        q = v // div
-        rem = v - q * div
-        dist_down = rem + f  # distance to q * div
-        dist_up = (div - rem).astype(np.float64) - f  # distance to (q + 1) * div
-        ok_down = (dist_down < bd) | (ev & (dist_down == bd))
-        ok_up = (dist_up < bu) | (ev & (dist_up == bu))
-        # the nearest wins; an exact tie goes to the even digit, as repr does
-        up = ok_up & (~ok_down | (dist_up < dist_down) | ((dist_up == dist_down) & (q % 2 == 1)))
-        return ok_down | ok_up, q, up
-
-    n = vint.size
-    dropped = np.zeros(n, dtype=np.int64)  # dropping nothing always reads back
-    idx = np.arange(n)
-    sub = arrays
-    for step in (1, 2):  # max_drop >= 15 always, so both steps are allowed
-        ok, _, _ = trial(step, *sub)
-        idx = idx[ok]
-        dropped[idx] = step
-        sub = tuple(arr[ok] for arr in sub)
-    lo = np.full(idx.size, 2, dtype=np.int64)
-    hi = max_drop[idx]
-    while True:
-        active = lo < hi
-        if not active.any():
-            break
-        mid = np.where(active, (lo + hi + 1) // 2, lo)
-        ok, _, _ = trial(mid, *sub)
-        lo = np.where(active & ok, mid, lo)
-        hi = np.where(active & ~ok, mid - 1, hi)
-    dropped[idx] = lo
-    _, q, up = trial(dropped, *arrays)
-    return q + up, dropped
 
 
 # --------------------------------------------------------------------------------------------
@@ -310,6 +85,22 @@ def _lead_word(lead: bytes) -> np.uint64:
     return _U(int.from_bytes(lead, "little"))
 
 
+@cache
+def _prefix_masks(nwords: int) -> np.ndarray:
+    """(nwords, 8 * nwords + 2) uint64: column k masks the first k bytes of the string."""
+    k = np.arange(8 * nwords + 2)
+    kb = np.clip(k[None, :] - 8 * np.arange(nwords)[:, None], 0, 8)
+    return _MASKS[kb]
+
+
+def _shift_rows(w: np.ndarray, nbytes: np.ndarray | int) -> np.ndarray:
+    """:func:`_shift_up` for a string held as rows of a (nwords, n) array."""
+    bits = (np.asarray(nbytes) * 8).astype(_U)
+    out = w << bits
+    out[1:] |= w[:-1] >> (_U(64) - bits)
+    return out
+
+
 def _number_words(
     negative: np.ndarray,
     mantissa: np.ndarray,
@@ -325,24 +116,26 @@ def _number_words(
     ``lead`` first (a separator), then the sign where negative, then the number: positional
     where ``positional`` (``12.5``, ``0.001``; integers as ``3.0`` with ``point_zero`` else
     ``3``), else scientific as repr writes it (``1.5e+16``, ``1e-05``). At most 7 zeros may
-    follow the point, and the whole must fit ``nwords`` words.
+    follow the point, and the whole must fit ``nwords`` words. The words of all values are
+    rows of one (nwords, n) array, so every step is one operation over all of them.
     """
-    left = mantissa * _POW10_INT[17 - ndigits]  # the 17 digits, left-aligned
+    n = mantissa.size
+    left = mantissa * POW10_INT[17 - ndigits]  # the 17 digits, left-aligned
     d0 = left // 10**16
     rest = left - d0 * 10**16
     h = _swar8(rest // 10**8)
     l = _swar8(rest % 10**8)
-    v = [
-        (d0.astype(_U) + _U(ord("0"))) | (h << _U(8)),
-        (h >> _U(56)) | (l << _U(8)),
-        (l >> _U(56)) | (_ZEROS8 << _U(8)),
-    ] + [np.full(d0.size, _ZEROS8)] * (nwords - 3)
+    v = np.empty((nwords, n), dtype=_U)
+    v[0] = (d0.astype(_U) + _U(ord("0"))) | (h << _U(8))
+    v[1] = (h >> _U(56)) | (l << _U(8))
+    v[2] = (l >> _U(56)) | (_ZEROS8 << _U(8))
+    v[3:] = _ZEROS8
     # "0.001" is the digits after z = 3 zeros, "0001", with the point after the first
     small = positional & (exp10 < 0)
     if small.any():
         z = np.where(small, -exp10, 0)
-        v = _shift_up(v, z)
-        v[0] = v[0] | (_ZEROS8 & _low_bytes(z, 0))
+        v = _shift_rows(v, z)
+        v[0] |= _ZEROS8 & _MASKS[z]
     else:
         z = 0
     integer = positional & (exp10 >= ndigits - 1)
@@ -353,35 +146,33 @@ def _number_words(
         np.where(integer & ~has_point, exp10 + 1, np.maximum(ndigits + z, last + 2)),
         ndigits,
     )
-    # insert the point: the digits after it move one byte on
+    # insert the point: the digits after it move one byte on; after & ~before is its byte
+    masks = _prefix_masks(nwords)
     point = np.where(has_point, last + 1, 8 * nwords)
-    moved = _shift_up(v, 1)
+    before = np.take(masks, point, axis=1)
+    after = np.take(masks, point + 1, axis=1)
+    body = (v & before) | (_shift_rows(v, 1) & ~after) | (_DOTS8 & after & ~before)
     text_len = length + has_point
-    body = []
-    for i in range(nwords):
-        before, after = _low_bytes(point, i), _low_bytes(point + 1, i)
-        # after & ~before is the point's own byte: fill it with "."
-        word = (v[i] & before) | (moved[i] & ~after) | (_DOTS8 & after & ~before)
-        body.append(word & _low_bytes(text_len, i))
+    body &= np.take(masks, text_len, axis=1)
     # the lead, then a sign slot ("-" or padding, which the squeeze removes)
     front = len(lead) + 1
-    out = _shift_up(body, front)
-    out[0] = out[0] | np.where(negative, _U(ord("-")) << _U(8 * len(lead)), _U(0))
-    out[0] = out[0] | _lead_word(lead)
+    out = _shift_rows(body, front)
+    out[0] |= np.where(negative, _U(ord("-")) << _U(8 * len(lead)), _U(0)) | _lead_word(lead)
     # scientific: "e", sign, (hundreds), tens, units right after the mantissa
-    sci = ~positional
-    if sci.any():
-        eabs = np.abs(exp10)
+    sci = np.flatnonzero(~positional)
+    if sci.size:
+        e = exp10[sci]
+        eabs = np.abs(e)
         units = ((eabs % 10).astype(_U) + _U(ord("0"))) << _U(8)
         tens = ((eabs // 10) % 10).astype(_U) + _U(ord("0"))
         hund = (eabs // 100).astype(_U) + _U(ord("0"))
         digits_e = np.where(eabs >= 100, hund | ((tens | units) << _U(8)), tens | units)
-        sign_e = np.where(exp10 < 0, _U(ord("-")), _U(ord("+")))
-        exp = np.where(sci, _U(ord("e")) | (sign_e << _U(8)) | (digits_e << _U(16)), _U(0))
-        at = front + text_len
+        sign_e = np.where(e < 0, _U(ord("-")), _U(ord("+")))
+        exp = _U(ord("e")) | (sign_e << _U(8)) | (digits_e << _U(16))
+        at = front + text_len[sci]
         for i in range(nwords):
-            out[i] = out[i] | _place(exp, at, i)
-    return np.stack(out, axis=1)
+            out[i, sci] |= _place(exp, at, i)
+    return out.T
 
 
 def float_words(x: np.ndarray, *, decimals: int | None = None, lead: bytes = b"") -> np.ndarray:
@@ -407,7 +198,7 @@ def float_words(x: np.ndarray, *, decimals: int | None = None, lead: bytes = b""
         ``w`` is 3 or, when ``lead`` and some value has a three-digit exponent, 4.
     """
     x = np.asarray(x, dtype=np.float64).ravel()
-    _check_finite(x, "values")
+    check_finite(x, "values")
     if len(lead) > 2:
         raise ValueError(f"lead must be at most 2 bytes, got {lead!r}")
     if decimals is not None:
@@ -495,7 +286,7 @@ def int_words(v: np.ndarray, lead: bytes = b"") -> np.ndarray:
         raise ValueError(f"lead must be at most 1 byte, got {lead!r}")
     if v.size and (v.min() < 0 or v.max() >= 10**15):
         raise ValueError(f"integers from 0 to 10**15 - 1 expected, got {v.min()} .. {v.max()}")
-    ndig = np.maximum(np.searchsorted(_POW10_INT, v, side="right"), 1)
+    ndig = np.maximum(np.searchsorted(POW10_INT, v, side="right"), 1)
     if not v.size or v.max() < 10 ** (8 - len(lead)):
         words = [_swar8(v) & ~_low_bytes(8 - ndig, 0)]
     else:
@@ -556,10 +347,10 @@ def format_e9(x: np.ndarray) -> np.ndarray:
     if x.dtype != np.float32:
         with np.errstate(over="ignore"):
             x32 = x.astype(np.float32)
-        _check_finite(x32, "values (as 32-bit floats)")
+        check_finite(x32, "values (as 32-bit floats)")
         x = x32
     else:
-        _check_finite(x, "values")
+        check_finite(x, "values")
     out = np.empty((x.size, 2), dtype=_U)
     for start in range(0, x.size, _BLOCK):  # blocks keep temporaries in cache
         out[start : start + _BLOCK] = _e9_block(x[start : start + _BLOCK])
