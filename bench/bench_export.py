@@ -12,6 +12,7 @@ import os
 import tempfile
 
 import numpy as np
+
 from formgraph.kernels.exporters import obj_bytes, stl_ascii, stl_binary
 from formgraph.kernels.grid import grid_faces
 

@@ -12,6 +12,7 @@ from __future__ import annotations
 from typing import Annotated
 
 import numpy as np
+
 from formgraph.geometry import Curve, Mesh, NurbsCurve
 from formgraph.kernels import nurbs
 from formgraph.kernels.drawing import Path2D, pdf_bytes, svg_bytes

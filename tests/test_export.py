@@ -7,9 +7,10 @@ import os
 import re
 import xml.etree.ElementTree as ET
 
-import formgraph as fg
 import numpy as np
 import pytest
+
+import formgraph as fg
 from formgraph.geometry import Mesh, NurbsCurve
 
 S = np.sqrt(0.5)

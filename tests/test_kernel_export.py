@@ -11,6 +11,9 @@ import zlib
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
 from formgraph.kernels.drawing import Path2D, drawing_bounds, pdf_bytes, svg_bytes
 from formgraph.kernels.dxf import dxf_bytes
 from formgraph.kernels.exporters import (
@@ -29,8 +32,6 @@ from formgraph.kernels.numfmt import (
     format_shortest,
     join_rows,
 )
-from hypothesis import given, settings
-from hypothesis import strategies as st
 
 # --------------------------------------------------------------------------------------------
 # shapes

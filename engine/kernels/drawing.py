@@ -16,6 +16,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+
 from formgraph.kernels.numfmt import float_words, squeeze
 
 __all__ = ["Path2D", "drawing_bounds", "pdf_bytes", "svg_bytes"]

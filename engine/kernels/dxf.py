@@ -12,6 +12,7 @@ import io
 from collections.abc import Sequence
 
 import numpy as np
+
 from formgraph.kernels.exporters import check_mesh
 
 __all__ = ["dxf_bytes"]

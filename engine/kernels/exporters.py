@@ -17,6 +17,7 @@ import struct
 from dataclasses import dataclass
 
 import numpy as np
+
 from formgraph.kernels.numfmt import E9_WIDTH, float_words, format_e9, int_words, squeeze
 
 __all__ = [

@@ -17,6 +17,7 @@ from fractions import Fraction
 from functools import cache
 
 import numpy as np
+
 from formgraph.kernels.shortest import POW10_INT, check_finite, shortest_decimal
 
 PAD = 0  # filler byte in canvases, removed when the text is assembled
