@@ -8,6 +8,7 @@ defaults; the numpydoc ``Parameters`` section documents each port.
 
 from __future__ import annotations
 
+import functools
 import inspect
 import re
 import typing
@@ -66,7 +67,7 @@ class NodeSpec:
     def family(self) -> str:
         return self.name.split(".", 1)[0]
 
-    @property
+    @functools.cached_property
     def is_export(self) -> bool:
         return any(p.type.is_output_path for p in self.inputs.values())
 

@@ -9,6 +9,7 @@ coerce a YAML literal into the value the node function receives (nothing else is
 from __future__ import annotations
 
 import enum
+import functools
 import types as _pytypes
 import typing
 from dataclasses import dataclass
@@ -113,15 +114,15 @@ class PortType:
     def name(self) -> str:
         return " | ".join(k.name for k in self.kinds)
 
-    @property
+    @functools.cached_property
     def is_expression(self) -> bool:
         return any(k.base is Expression for k in self.kinds)
 
-    @property
+    @functools.cached_property
     def is_output_path(self) -> bool:
         return any(k.base is OutputPath for k in self.kinds)
 
-    @property
+    @functools.cached_property
     def is_geometry(self) -> bool:
         return any(_is_geometry(k.base) for k in self.kinds)
 
