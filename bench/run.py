@@ -12,7 +12,7 @@ import sys
 # One BLAS thread: comparisons stay stable on a shared 2-core machine (set it to override).
 for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
-from pathlib import Path
+from pathlib import Path  # noqa: E402  (after the thread settings)
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
