@@ -12,7 +12,13 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 
-def best_time(fn: Callable[[], object], *, repeat: int = 5, min_seconds: float = 0.2) -> float:
+def best_time(
+    fn: Callable[[], object],
+    *,
+    repeat: int = 5,
+    min_seconds: float = 0.2,
+    number: int | None = None,
+) -> float:
     """Best wall time of one call of ``fn`` in seconds.
 
     Calls ``fn`` once to warm up, then takes the best of ``repeat`` rounds, each of which
@@ -22,7 +28,8 @@ def best_time(fn: Callable[[], object], *, repeat: int = 5, min_seconds: float =
     t0 = time.perf_counter()
     fn()
     first = time.perf_counter() - t0
-    number = max(1, int(min_seconds / max(first, 1e-9)))
+    if number is None:
+        number = max(1, int(min_seconds / max(first, 1e-9)))
     if first > 2.0:  # slow reference: one more call is enough
         repeat, number = 1, 1
     best = float("inf")
@@ -47,11 +54,18 @@ class Table:
     rows: list[Row] = field(default_factory=list)
 
     def time(
-        self, case: str, impl: str, fn: Callable[[], object], *, repeat: int = 5, note: str = ""
+        self,
+        case: str,
+        impl: str,
+        fn: Callable[[], object],
+        *,
+        repeat: int = 5,
+        note: str = "",
+        number: int | None = None,
     ) -> float | None:
         """Time ``fn`` and record it; a reference that fails to import or run is noted."""
         try:
-            seconds = best_time(fn, repeat=repeat)
+            seconds = best_time(fn, repeat=repeat, number=number)
         except ImportError as exc:
             self.rows.append(Row(case, impl, None, f"not installed ({exc.name})"))
             return None

@@ -6,8 +6,13 @@ The "vs ours" column is the reference's time divided by ours: above 1x we are fa
 from __future__ import annotations
 
 import importlib
+import os
 import sys
-from pathlib import Path
+
+# One BLAS thread: comparisons stay stable on a shared 2-core machine (set it to override).
+for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
+from pathlib import Path  # noqa: E402  (after the thread settings)
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))

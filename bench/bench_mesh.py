@@ -1,0 +1,66 @@
+"""Subdivision benchmark: Catmull-Clark and Doo-Sabin of a 10,000-quad torus.
+
+References, timed in the same run: pyopensubdiv (OpenSubdiv 3.4.4 through ctypes; its
+Python wrapper converts the mesh to and from lists, which is part of what a caller pays)
+and pymeshlab when it imports (it is optional and usually not installed).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from formgraph.kernels.grid import grid_faces
+from formgraph.kernels.subdivision import catmull_clark, doo_sabin
+
+
+def torus(nu: int = 100, nv: int = 100, r_major: float = 3.0, r_minor: float = 1.0):
+    """An (nu x nv)-quad torus: vertices (nu*nv, 3), flat faces, offsets."""
+    u = np.linspace(0, 2 * np.pi, nu, endpoint=False)[:, None]
+    v = np.linspace(0, 2 * np.pi, nv, endpoint=False)[None, :]
+    ring = r_major + r_minor * np.cos(v)
+    xyz = np.stack(
+        np.broadcast_arrays(ring * np.cos(u), ring * np.sin(u), r_minor * np.sin(v)), axis=-1
+    ).reshape(-1, 3)
+    fi, fo = grid_faces(nu, nv, closed_u=True, closed_v=True)
+    return xyz, fi, fo
+
+
+def _opensubdiv(levels: int, verts: list, faces: list, flat: list, sizes: list):
+    from pyOpenSubdiv.pysubdivision import pysubdivide
+
+    return pysubdivide(levels, verts, faces, flat, sizes)
+
+
+def _pymeshlab(v: np.ndarray, fi: np.ndarray, filter_name: str, levels: int):
+    import pymeshlab
+
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=v, face_list_of_indices=fi.reshape(-1, 4)))
+    for _ in range(levels):
+        ms.apply_filter(filter_name)
+    return ms.current_mesh().face_number()
+
+
+def run(table) -> None:
+    v, fi, fo = torus()
+    verts = v.tolist()
+    faces = fi.reshape(-1, 4).tolist()
+    flat = fi.tolist()
+    sizes = np.diff(fo).tolist()
+    for levels in (1, 2):
+        n_faces = 10_000 * 4**levels
+        case = f"catmull_clark 10k-quad torus, {levels} lvl -> {n_faces // 1000}k quads"
+        table.time(case, "formgraph", lambda lv=levels: catmull_clark(v, fi, fo, lv))
+        table.time(
+            case, "pyopensubdiv", lambda lv=levels: _opensubdiv(lv, verts, faces, flat, sizes)
+        )
+        table.time(
+            case,
+            "pymeshlab",
+            lambda lv=levels: _pymeshlab(v, fi, "meshing_surface_subdivision_catmull_clark", lv),
+        )
+    case = "doo_sabin 10k-quad torus, 1 lvl -> 30k faces"
+    table.time(case, "formgraph", lambda: doo_sabin(v, fi, fo, 1))
+    table.time(
+        case, "pymeshlab", lambda: _pymeshlab(v, fi, "meshing_surface_subdivision_doo_sabin", 1)
+    )

@@ -1,0 +1,265 @@
+"""Caches of node results: in memory (LRU bounded by bytes) and on disk (content addressed).
+
+Keys are computed from what went into a node (its type, implementation version, canonical
+literal inputs and the keys of its wired inputs), never from the data. Values on disk are
+plain ``.npz`` archives (``allow_pickle=False``) with a JSON description and a checksum, so
+a truncated, corrupt or foreign entry is detected and recomputed, never trusted.
+"""
+
+from __future__ import annotations
+
+import enum
+import hashlib
+import io
+import json
+import os
+import tempfile
+import uuid
+import weakref
+import zipfile
+from collections import OrderedDict
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .geometry import STORABLE, Geometry, from_state
+
+FORMAT = 1
+
+
+def canonical(value: Any) -> Any:
+    """A JSON-able, order-stable form of a literal input (for cache keys)."""
+    if isinstance(value, enum.Enum):
+        return {"enum": str(value.value)}
+    if isinstance(value, (bool, int, str)) or value is None:
+        return value
+    if isinstance(value, float):
+        return {"f": value.hex()}
+    if isinstance(value, np.generic):
+        return canonical(value.item())
+    if isinstance(value, np.ndarray):
+        return {"a": str(value.dtype), "s": list(value.shape), "h": _hash_bytes(value)}
+    if isinstance(value, (list, tuple)):
+        return [canonical(v) for v in value]
+    if isinstance(value, dict):
+        return {str(k): canonical(v) for k, v in sorted(value.items())}
+    if isinstance(value, Geometry):
+        h = digest(value)
+        return {"g": type(value).__name__, "h": h if h is not None else _token(value)}
+    raise TypeError(f"cannot make a cache key of {type(value).__name__}")
+
+
+_TOKENS: weakref.WeakKeyDictionary[Any, str] = weakref.WeakKeyDictionary()
+
+
+def _token(value: Any) -> str:
+    """A unique, never reused name for a value whose content cannot be hashed."""
+    if value not in _TOKENS:
+        _TOKENS[value] = "obj:" + uuid.uuid4().hex
+    return _TOKENS[value]
+
+
+def key_of(parts: Any) -> str:
+    text = json.dumps(canonical(parts), sort_keys=True, separators=(",", ":"))
+    return hashlib.blake2b(text.encode(), digest_size=20).hexdigest()
+
+
+def _hash_bytes(a: np.ndarray) -> str:
+    h = hashlib.blake2b(digest_size=16)
+    h.update(str(a.dtype).encode() + str(a.shape).encode())
+    h.update(np.ascontiguousarray(a).view(np.uint8).reshape(-1))
+    return h.hexdigest()
+
+
+def digest(value: Any) -> str | None:
+    """A cheap content hash of a node output (for early cutoff); None when not hashable."""
+    try:
+        if isinstance(value, Geometry):
+            return key_of({"type": type(value).__name__, "state": value.fingerprint()})
+        return key_of(value)
+    except (TypeError, NotImplementedError):
+        return None
+
+
+def sizeof(value: Any) -> int:
+    if isinstance(value, Geometry):
+        return value.nbytes + 200
+    if isinstance(value, np.ndarray):
+        return value.nbytes + 100
+    if isinstance(value, (list, tuple)):
+        return 64 + sum(sizeof(v) for v in value)
+    return 64
+
+
+class MemoryCache:
+    """Least-recently-used cache of node outputs, bounded by their size in bytes."""
+
+    def __init__(self, max_bytes: int = 1 << 30):
+        self.max_bytes = max_bytes
+        self._items: OrderedDict[str, tuple[Any, int]] = OrderedDict()
+        self.bytes = 0
+
+    def get(self, key: str) -> tuple[bool, Any]:
+        item = self._items.get(key)
+        if item is None:
+            return False, None
+        self._items.move_to_end(key)
+        return True, item[0]
+
+    def put(self, key: str, value: Any) -> None:
+        size = sizeof(value)
+        if key in self._items:
+            self.bytes -= self._items.pop(key)[1]
+        if size > self.max_bytes:
+            return
+        self._items[key] = (value, size)
+        self.bytes += size
+        while self.bytes > self.max_bytes:
+            _, (_, s) = self._items.popitem(last=False)
+            self.bytes -= s
+
+    def __contains__(self, key: str) -> bool:
+        return key in self._items
+
+    def __len__(self) -> int:
+        return len(self._items)
+
+    def clear(self) -> None:
+        self._items.clear()
+        self.bytes = 0
+
+
+class Unstorable(Exception):
+    """A value the disk cache cannot hold (it is then simply not stored)."""
+
+
+def _encode(value: Any, arrays: dict[str, np.ndarray]) -> Any:
+    if isinstance(value, Geometry):
+        name = type(value).__name__
+        if name not in STORABLE:
+            raise Unstorable(name)
+        return {"geom": name, "state": {k: _encode(v, arrays) for k, v in value.state().items()}}
+    if isinstance(value, np.ndarray):
+        ref = f"a{len(arrays)}"
+        arrays[ref] = value
+        return {"array": ref}
+    if isinstance(value, (list, tuple)):
+        return {"list": [_encode(v, arrays) for v in value]}
+    if isinstance(value, (bool, int, str)) or value is None:
+        return {"v": value}
+    if isinstance(value, float):
+        return {"f": value.hex()}
+    raise Unstorable(type(value).__name__)
+
+
+def _decode(desc: Any, arrays: Any) -> Any:
+    if "geom" in desc:
+        state = {k: _decode(v, arrays) for k, v in desc["state"].items()}
+        return from_state(desc["geom"], state)
+    if "array" in desc:
+        return arrays[desc["array"]]
+    if "list" in desc:
+        return [_decode(v, arrays) for v in desc["list"]]
+    if "f" in desc:
+        return float.fromhex(desc["f"])
+    return desc["v"]
+
+
+class DiskCache:
+    """A content-addressed store of node outputs in a folder, shared between processes.
+
+    Entries are written to a temp file and renamed into place, so concurrent writers of the
+    same key each leave a whole file; a reader that finds a bad entry (truncated, corrupt,
+    wrong checksum, unknown format) deletes it and reports a miss.
+    """
+
+    def __init__(self, root: str | os.PathLike[str]):
+        self.root = Path(root)
+
+    def _path(self, key: str) -> Path:
+        return self.root / key[:2] / f"{key}.npz"
+
+    def get(self, key: str) -> tuple[bool, Any]:
+        hit, value, _ = self.get_entry(key)
+        return hit, value
+
+    def get_entry(self, key: str) -> tuple[bool, Any, str | None]:
+        """(hit, value, identity recorded with it)."""
+        path = self._path(key)
+        try:
+            data = path.read_bytes()
+        except OSError:
+            return False, None, None
+        try:
+            with np.load(io.BytesIO(data), allow_pickle=False) as z:
+                meta = json.loads(bytes(z["meta"]).decode())
+                if meta.get("format") != FORMAT or meta.get("key") != key:
+                    raise ValueError("foreign entry")
+                arrays = {name: z[name] for name in z.files if name != "meta"}
+            check = hashlib.blake2b(digest_size=16)
+            for name in sorted(arrays):
+                check.update(name.encode())
+                check.update(_hash_bytes(arrays[name]).encode())
+            if check.hexdigest() != meta.get("check"):
+                raise ValueError("checksum mismatch")
+            for a in arrays.values():
+                a.flags.writeable = False
+            return True, _decode(meta["value"], arrays), meta.get("identity")
+        except (
+            ValueError,
+            KeyError,
+            OSError,
+            EOFError,
+            zipfile.BadZipFile,
+            TypeError,
+            AttributeError,
+        ):
+            try:
+                path.unlink()
+            except OSError:
+                pass
+            return False, None, None
+
+    def put(self, key: str, value: Any, identity: str | None = None) -> bool:
+        arrays: dict[str, np.ndarray] = {}
+        try:
+            desc = _encode(value, arrays)
+        except Unstorable:
+            return False
+        check = hashlib.blake2b(digest_size=16)
+        for name in sorted(arrays):
+            check.update(name.encode())
+            check.update(_hash_bytes(arrays[name]).encode())
+        meta = {
+            "format": FORMAT,
+            "key": key,
+            "check": check.hexdigest(),
+            "value": desc,
+            "identity": identity or key,
+        }
+        buf = io.BytesIO()
+        meta_bytes = np.frombuffer(json.dumps(meta).encode(), dtype=np.uint8)
+        np.savez(buf, meta=meta_bytes, **arrays)
+        path = self._path(key)
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            fd, tmp = tempfile.mkstemp(prefix=".", suffix=".tmp", dir=path.parent)
+            try:
+                with os.fdopen(fd, "wb") as fh:
+                    fh.write(buf.getvalue())
+                os.replace(tmp, path)
+            except BaseException:
+                try:
+                    os.unlink(tmp)
+                except OSError:
+                    pass
+                raise
+        except OSError:
+            return False  # a cache that cannot be written is only slower, never wrong
+        return True
+
+
+def default_cache_dir() -> Path:
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return Path(base) / "formgraph"

@@ -1,0 +1,302 @@
+"""Checking a graph whole, before anything runs.
+
+Every problem is collected (unknown types with a suggestion, unknown and missing inputs,
+wires to missing nodes or outputs, type mismatches, expressions outside the language or
+naming unknown params, values out of range, output paths that escape, cycles) so a user
+fixes a graph in one pass.
+"""
+
+from __future__ import annotations
+
+import difflib
+from typing import TYPE_CHECKING, Any
+
+import networkx as nx
+
+from . import safety
+from .errors import ExpressionError, Problem, Where
+from .expr import compile_expression
+from .model import Expr, Input, Items, Literal, NodeDef, ParamDef, Wire
+from .registry import NodeSpec, node_types
+from .types import Kind, PortType, TypeMismatch, describe
+
+if TYPE_CHECKING:
+    from .graph import Graph
+
+
+def suggest(name: str, options: Any) -> str:
+    close = difflib.get_close_matches(name, list(options), n=1, cutoff=0.6)
+    return f" (did you mean '{close[0]}'?)" if close else ""
+
+
+def check_param_value(p: ParamDef, value: Any) -> Any:
+    """The value of param ``p`` as the graph uses it, or TypeMismatch."""
+    if p.type is not None:
+        if value is None:
+            return None
+        out = p.type.coerce(value)
+    elif isinstance(p.default, bool):
+        out = PortType((Kind(bool),)).coerce(value)
+    elif isinstance(p.default, int):
+        out = PortType((Kind(int),)).coerce(value)
+    elif isinstance(p.default, float):
+        out = PortType((Kind(float),)).coerce(value)
+    elif isinstance(p.default, str):
+        out = PortType((Kind(str),)).coerce(value)
+    else:
+        out = value
+    if isinstance(out, (int, float)) and not isinstance(out, bool):
+        if p.min is not None and out < p.min:
+            raise TypeMismatch(f"must be >= {p.min:g}, got {out:g}")
+        if p.max is not None and out > p.max:
+            raise TypeMismatch(f"must be <= {p.max:g}, got {out:g}")
+    return out
+
+
+def check_graph(g: Graph, extra: list[Problem] | None = None) -> list[Problem]:
+    """Every problem of graph ``g`` (an empty list when it can run)."""
+    problems = list(extra or [])
+    file = g.file_label
+    registry = node_types()
+
+    from .expr import CONSTANTS, FUNCTIONS
+
+    for p in g._params.values():
+        if not p.name.isidentifier() or p.name.startswith("_"):
+            problems.append(
+                Problem(
+                    Where(file, p.line),
+                    f"param '{p.name}': a param name is "
+                    f"letters, digits and '_', not starting with a digit or '_'",
+                )
+            )
+        elif p.name in CONSTANTS or p.name in FUNCTIONS:
+            problems.append(
+                Problem(
+                    Where(file, p.line),
+                    f"param '{p.name}' would hide the "
+                    f"expression {'constant' if p.name in CONSTANTS else 'function'}"
+                    f" '{p.name}'; choose another name",
+                )
+            )
+        try:
+            check_param_value(p, p.default)
+        except TypeMismatch as exc:
+            problems.append(Problem(Where(file, p.line), f"param '{p.name}': default {exc}"))
+
+    for nd in g._nodes.values():
+        spec = registry.get(nd.type)
+        if spec is None:
+            if nd.type:
+                # the SPEC's form: file:line, then the type (the node is named after it)
+                problems.append(
+                    Problem(
+                        Where(file, nd.line),
+                        f"unknown node type '{nd.type}'{suggest(nd.type, registry)}"
+                        f" in node '{nd.name}'",
+                    )
+                )
+            continue
+        problems.extend(_check_node(g, nd, spec, registry))
+
+    problems.extend(_check_cycles(g))
+    return problems
+
+
+def _check_node(
+    g: Graph, nd: NodeDef, spec: NodeSpec, registry: dict[str, NodeSpec]
+) -> list[Problem]:
+    out: list[Problem] = []
+    file = g.file_label
+
+    def add(message: str, port: str | None) -> None:
+        line = nd.input_lines.get(port, nd.line) if port else nd.line
+        out.append(Problem(Where(file, line, nd.name, port), message))
+
+    for port, message in nd.parse_errors.items():
+        add(message, port)
+    for port in nd.raw:
+        if port not in spec.inputs:
+            add(
+                f"'{nd.type}' has no input '{port}'{suggest(port, spec.inputs)}; its inputs are "
+                f"{', '.join(spec.inputs) or 'none'}",
+                port,
+            )
+    for port, p in spec.inputs.items():
+        if port not in nd.raw:
+            if p.required:
+                add(f"missing required input ({p.type.name})", port)
+            continue
+        if port in nd.parse_errors:
+            continue
+        for message in _check_input(g, nd, p.type, nd.inputs[port], registry):
+            add(message, port)
+    return out
+
+
+def _check_input(
+    g: Graph, nd: NodeDef, pt: PortType, value: Input, registry: dict[str, NodeSpec]
+) -> list[str]:
+    if isinstance(value, Wire):
+        return _check_wire(g, pt, value, registry)
+    if isinstance(value, Literal):
+        return _check_literal(g, pt, value.value)
+    if isinstance(value, Expr):
+        return _check_expr(g, pt, value)
+    # Items: a list holding wires and/or expressions
+    wires = [i for i in value.items if isinstance(i, Wire)]
+    if not wires:
+        try:
+            resolved = [_static_value(g, i) for i in value.items]
+        except _Unknown as exc:
+            return [str(exc)] if str(exc) else []
+        return _coerce_problems(pt, resolved)
+    list_kinds = [k for k in pt.kinds if k.is_list]
+    if not list_kinds:
+        return [f"expected {pt.name}, got a list of wires"]
+    item_type = PortType(tuple(Kind(k.base) for k in list_kinds), range=pt.range)
+    list_type = PortType(tuple(list_kinds), range=pt.range)
+    problems: list[str] = []
+    for item in value.items:
+        # a wire carrying a list joins the list (flattened): ["@paths", "@outline"]
+        as_item = _check_input(g, nd, item_type, item, registry)
+        if as_item and isinstance(item, Wire) and not _check_wire(g, list_type, item, registry):
+            continue
+        problems.extend(as_item)
+    return problems
+
+
+def _check_wire(g: Graph, pt: PortType, wire: Wire, registry: dict[str, NodeSpec]) -> list[str]:
+    target = g._nodes.get(wire.node)
+    if target is None:
+        if wire.node in g._params:
+            return [
+                f"'@{wire.node}' wires to a node, but '{wire.node}' is a param: write "
+                f"'={wire.node}'"
+            ]
+        return [f"wire to missing node '@{wire.node}'{suggest(wire.node, g._nodes)}"]
+    spec = registry.get(target.type)
+    if spec is None:
+        return []  # reported on the target itself
+    if wire.output is not None and wire.output not in spec.outputs:
+        if not spec.multi_output:
+            return [f"'{target.type}' has a single output: write '@{wire.node}', not '{wire}'"]
+        return [
+            f"'{target.type}' has no output '{wire.output}'; its outputs are "
+            f"{', '.join(spec.outputs)}"
+        ]
+    if wire.output is None and spec.multi_output:
+        return [
+            f"'{target.type}' has several outputs; pick one: "
+            f"{', '.join('@' + wire.node + '.' + o for o in spec.outputs)}"
+        ]
+    produced = spec.output_type(wire.output)
+    if not pt.accepts(produced):
+        return [f"expected {pt.name}, got {produced.name} from '{wire}'"]
+    return []
+
+
+def _check_literal(g: Graph, pt: PortType, value: Any) -> list[str]:
+    if pt.is_expression:
+        if not isinstance(value, str):
+            return [f"expected an expression (text), got {describe(value)}"]
+        allowed = set(g._params) | set(pt.variables)
+        try:
+            compile_expression(value, allowed)
+        except ExpressionError as exc:
+            return [exc.problems[0].message]
+        return []
+    problems = _coerce_problems(pt, value)
+    if not problems and pt.is_output_path and isinstance(value, str):
+        why = safety.path_problem(value)
+        if why:
+            problems.append(why)
+    return problems
+
+
+def _coerce_problems(pt: PortType, value: Any) -> list[str]:
+    try:
+        pt.coerce(value)
+    except TypeMismatch as exc:
+        return [str(exc)]
+    except ValueError as exc:
+        return [str(exc)]
+    return []
+
+
+class _Unknown(Exception):
+    """A value that cannot be known before running (a geometry param with no default)."""
+
+
+def _static_value(g: Graph, item: Input) -> Any:
+    if isinstance(item, Literal):
+        return item.value
+    if isinstance(item, Items):
+        return [_static_value(g, i) for i in item.items]
+    if isinstance(item, Expr):
+        msg = _expr_names_problem(g, item)
+        if msg:
+            raise _Unknown(msg)
+        if any(g._params[n].default is None for n in item.compiled.names):
+            raise _Unknown("")
+        return g._expr_value(item, {n: p.default for n, p in g._params.items()})
+    raise _Unknown("")
+
+
+def _expr_names_problem(g: Graph, e: Expr) -> str | None:
+    unknown = sorted(e.compiled.names - set(g._params))
+    if unknown:
+        return (
+            f"expression '={e.text}' names unknown param '{unknown[0]}'"
+            f"{suggest(unknown[0], g._params)}; params are {', '.join(g._params) or 'none'}"
+        )
+    return None
+
+
+def _check_expr(g: Graph, pt: PortType, e: Expr) -> list[str]:
+    msg = _expr_names_problem(g, e)
+    if msg:
+        return [msg]
+    if e.compiled.is_bare_name:
+        p = g._params[e.text.strip()]
+        if p.type is not None:
+            if not pt.accepts(p.type):
+                return [f"expected {pt.name}, got {p.type.name} from param '{p.name}'"]
+            return []
+    try:
+        value = _static_value(g, e)
+    except _Unknown as exc:
+        return [str(exc)] if str(exc) else []
+    except (ExpressionError, ValueError, TypeError, ZeroDivisionError) as exc:
+        return [f"expression '={e.text}' fails with the param defaults: {exc}"]
+    if pt.is_expression:
+        return (
+            []
+            if isinstance(value, str)
+            else [f"expected an expression (text), got {describe(value)}"]
+        )
+    return [f"{m} (from '={e.text}')" for m in _coerce_problems(pt, value)]
+
+
+def _check_cycles(g: Graph) -> list[Problem]:
+    dag = nx.DiGraph()
+    for nd in g._nodes.values():
+        dag.add_node(nd.name)
+        for up in nd.upstream():
+            if up in g._nodes:
+                dag.add_edge(up, nd.name)
+    problems = []
+    seen: set[frozenset[str]] = set()
+    for cycle in nx.simple_cycles(dag):
+        key = frozenset(cycle)
+        if key in seen:
+            continue
+        seen.add(key)
+        # start the path at the node written first in the file
+        order = list(g._nodes)
+        start = min(range(len(cycle)), key=lambda i: order.index(cycle[i]))
+        path = cycle[start:] + cycle[:start]
+        problems.append(Problem(Where(g.file_label), "cycle: " + " -> ".join(path + [path[0]])))
+        if len(problems) >= 10:
+            break
+    return problems

@@ -1,0 +1,341 @@
+"""The ``formgraph`` command line.
+
+Exit codes: 0 ok, 1 a graph or node error (the message on stderr), 2 a usage error.
+No Python traceback reaches the user unless ``--debug``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import time
+import traceback
+from collections.abc import Sequence
+from typing import Any
+
+import yaml
+
+from .errors import FormgraphError, GraphError
+from .registry import DEFAULT_BUDGET
+
+
+class UsageError(Exception):
+    """A command line that does not make sense (exit code 2)."""
+
+
+def _parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(
+        prog="formgraph", description="Evaluate, check, view and document formgraph graphs."
+    )
+    ap.add_argument("--debug", action="store_true", help="show Python tracebacks")
+    sub = ap.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    def graph_options(p: argparse.ArgumentParser) -> None:
+        p.add_argument(
+            "--set",
+            action="append",
+            default=[],
+            metavar="NAME=VALUE",
+            help="override a graph param (parsed by the param's type)",
+        )
+        p.add_argument(
+            "--budget",
+            type=int,
+            default=DEFAULT_BUDGET,
+            help=f"element budget per node (default {DEFAULT_BUDGET:,})",
+        )
+        p.add_argument(
+            "--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS
+        )
+
+    run = sub.add_parser("run", help="evaluate nodes (default: every sink) and write exports")
+    run.add_argument("graph")
+    run.add_argument("nodes", nargs="*", metavar="NODE")
+    graph_options(run)
+    run.add_argument("--out", default="out", metavar="DIR", help="output directory (./out)")
+    run.add_argument("--no-cache", action="store_true", help="do not use the on-disk cache")
+    run.add_argument("--cache-dir", default=None, help=argparse.SUPPRESS)
+    run.add_argument("--profile", action="store_true", help="print a table of node timings")
+
+    chk = sub.add_parser("check", help="validate a graph; exit 1 with every problem")
+    chk.add_argument("graph")
+    chk.add_argument(
+        "--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS
+    )
+
+    view = sub.add_parser("view", help="show a node's output (window, or PNG with --screenshot)")
+    view.add_argument("graph")
+    view.add_argument("node", nargs="?")
+    graph_options(view)
+    view.add_argument("--screenshot", metavar="FILE.png")
+    view.add_argument("--size", default="1024x768", metavar="WxH")
+    view.add_argument("--out", default="out", metavar="DIR", help=argparse.SUPPRESS)
+
+    watch = sub.add_parser("watch", help="re-evaluate and redraw when the file changes")
+    watch.add_argument("graph")
+    watch.add_argument("node", nargs="?")
+    graph_options(watch)
+    watch.add_argument("--out", default="out", metavar="DIR", help=argparse.SUPPRESS)
+
+    nodes = sub.add_parser("nodes", help="the node catalogue, or one node type's ports")
+    nodes.add_argument("type", nargs="?")
+    nodes.add_argument("--markdown", action="store_true", help="the catalogue as Markdown")
+    nodes.add_argument(
+        "--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS
+    )
+
+    schema = sub.add_parser("schema", help="JSON Schema of the YAML format")
+    schema.add_argument(
+        "--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS
+    )
+    return ap
+
+
+def parse_sets(graph: Any, items: Sequence[str]) -> dict[str, Any]:
+    """``NAME=VALUE`` pairs parsed by each param's type (YAML scalars, lists allowed)."""
+    out: dict[str, Any] = {}
+    defs = graph.param_defs
+    for item in items:
+        name, sep, text = item.partition("=")
+        name = name.strip()
+        if not sep or not name:
+            raise UsageError(f"--set takes NAME=VALUE, got {item!r}")
+        if name not in defs:
+            from .check import suggest
+
+            raise GraphError(
+                f"--set {name}: unknown param{suggest(name, defs)}; params are "
+                f"{', '.join(defs) or 'none'}"
+            )
+        default = defs[name].default
+        if isinstance(default, str):
+            value: Any = text
+        elif isinstance(default, (int, float)) and not isinstance(default, bool):
+            value = _number(text)
+        else:
+            try:
+                value = yaml.safe_load(text)
+            except yaml.YAMLError:
+                raise UsageError(f"--set {name}: cannot read {text!r}") from None
+            if (
+                isinstance(default, float)
+                and isinstance(value, int)
+                and not isinstance(value, bool)
+            ):
+                value = float(value)
+        out[name] = value
+    return out
+
+
+def _number(text: str) -> Any:
+    """A number as people type it: 3, -2.5, 1e3, 0x10 (YAML 1.1 would read 1e3 as text)."""
+    for parse in (int, float):
+        try:
+            return parse(text.strip().replace("_", ""))
+        except ValueError:
+            pass
+    try:
+        return int(text.strip(), 0)
+    except ValueError:
+        return text  # the param's check then says what was expected
+
+
+class _ProgressLine:
+    """'cooking node (k/n)' on a terminal, for runs that take more than a moment."""
+
+    def __init__(self, stream: Any):
+        self.stream = stream
+        self.enabled = hasattr(stream, "isatty") and stream.isatty()
+        self.start = time.perf_counter()
+        self.shown = False
+
+    def __call__(self, node: str, done: int, total: int) -> None:
+        if not self.enabled or time.perf_counter() - self.start < 0.5:
+            return
+        self.stream.write(f"\r\x1b[Kcooking '{node}' ({done + 1}/{total} nodes)")
+        self.stream.flush()
+        self.shown = True
+
+    def clear(self) -> None:
+        if self.shown:
+            self.stream.write("\r\x1b[K")
+            self.stream.flush()
+
+
+def _profile_table(stats: dict[str, Any], nodes: dict[str, str]) -> str:
+    from .cache import sizeof  # noqa: F401  (sizes come with the stats)
+
+    rows = [f"{'node':<24} {'type':<24} {'status':<9} {'seconds':>9} {'size':>10}  warnings"]
+    total = 0.0
+    for name, st in stats.items():
+        total += st.seconds
+        size = _size(st.nbytes)
+        rows.append(
+            f"{name:<24} {nodes.get(name, ''):<24} {st.status:<9} {st.seconds:>9.4f} "
+            f"{size:>10}  {'; '.join(st.warnings)}"
+        )
+    rows.append(f"{'total':<24} {'':<24} {'':<9} {total:>9.4f}")
+    return "\n".join(rows)
+
+
+def _size(n: int) -> str:
+    for unit in ("B", "KiB", "MiB", "GiB"):
+        if n < 1024 or unit == "GiB":
+            return f"{n:.0f} {unit}" if unit == "B" else f"{n:.1f} {unit}"
+        n /= 1024
+    return str(n)
+
+
+def _describe(value: Any) -> str:
+    if isinstance(value, str) and os.path.isabs(value):
+        return f"wrote {os.path.relpath(value)}"
+    return repr(value)
+
+
+def cmd_run(args: argparse.Namespace) -> int:
+    from .cache import default_cache_dir
+    from .graph import load
+
+    cache_dir = None if args.no_cache else (args.cache_dir or default_cache_dir())
+    g = load(args.graph, out_dir=args.out, cache_dir=cache_dir, budget=args.budget)
+    params = parse_sets(g, args.set)
+    progress = _ProgressLine(sys.stderr)
+    g.progress = progress
+    try:
+        outs = g.evaluate(args.nodes, **params) if args.nodes else g.evaluate_all(**params)
+    finally:
+        progress.clear()
+    for name, value in outs.items():
+        print(f"{name}: {_describe(value)}")
+        for w in g.stats.get(name).warnings if name in g.stats else []:
+            print(f"  warning: {w}", file=sys.stderr)
+    for name, st in g.stats.items():
+        if name not in outs:
+            for w in st.warnings:
+                print(f"{name}: warning: {w}", file=sys.stderr)
+    if args.profile:
+        print(_profile_table(g.stats, g.nodes))
+    return 0
+
+
+def cmd_check(args: argparse.Namespace) -> int:
+    from .graph import load
+
+    g = load(args.graph)
+    print(f"{args.graph}: ok ({len(g.nodes)} nodes, {len(g.params)} params)")
+    return 0
+
+
+def _size_arg(text: str) -> tuple[int, int]:
+    try:
+        w, h = (int(x) for x in text.lower().split("x"))
+    except ValueError:
+        raise UsageError(f"--size takes WIDTHxHEIGHT, e.g. 1024x768, got {text!r}") from None
+    if not (16 <= w <= 8192 and 16 <= h <= 8192):
+        raise UsageError(f"--size {text}: each side must be 16 to 8192 pixels")
+    return w, h
+
+
+def cmd_view(args: argparse.Namespace) -> int:
+    from . import graph as _graph
+
+    try:
+        from formgraph import viewer
+    except ImportError as exc:  # pragma: no cover - pyvista is a dependency
+        raise GraphError(f"the viewer needs pyvista: {exc}") from None
+    size = _size_arg(args.size)
+    g = _graph.load(args.graph, out_dir=args.out, budget=args.budget)
+    params = parse_sets(g, args.set)
+    if args.screenshot:
+        path = viewer.screenshot(g, args.screenshot, node=args.node, size=size, **params)
+        print(f"wrote {path}")
+        return 0
+    viewer.show(g, node=args.node, size=size, **params)
+    return 0
+
+
+def cmd_watch(args: argparse.Namespace) -> int:
+    from formgraph import viewer
+
+    viewer.watch(args.graph, node=args.node, sets=args.set, out_dir=args.out, budget=args.budget)
+    return 0
+
+
+def cmd_nodes(args: argparse.Namespace) -> int:
+    from .catalogue import catalogue_text, markdown, node_text
+    from .check import suggest
+    from .registry import node_types
+
+    if args.markdown:
+        sys.stdout.write(markdown())
+        return 0
+    if args.type:
+        registry = node_types()
+        if args.type not in registry:
+            raise GraphError(f"unknown node type '{args.type}'{suggest(args.type, registry)}")
+        print(node_text(registry[args.type]))
+        return 0
+    print(catalogue_text())
+    return 0
+
+
+def cmd_schema(args: argparse.Namespace) -> int:
+    from .catalogue import json_schema
+
+    json.dump(json_schema(), sys.stdout, indent=2)
+    sys.stdout.write("\n")
+    return 0
+
+
+COMMANDS = {
+    "run": cmd_run,
+    "check": cmd_check,
+    "view": cmd_view,
+    "watch": cmd_watch,
+    "nodes": cmd_nodes,
+    "schema": cmd_schema,
+}
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    ap = _parser()
+    args = ap.parse_args(argv)  # exits 2 on a usage error
+    try:
+        return COMMANDS[args.command](args)
+    except UsageError as exc:
+        print(f"formgraph: {exc}", file=sys.stderr)
+        return 2
+    except FormgraphError as exc:
+        if args.debug:
+            traceback.print_exc()
+        else:
+            print(str(exc), file=sys.stderr)
+            if exc.__cause__ is not None:
+                print("(run with --debug for the Python traceback)", file=sys.stderr)
+        return 1
+    except BrokenPipeError:
+        return 0
+    except OSError as exc:
+        if args.debug:
+            traceback.print_exc()
+        print(f"formgraph: {exc}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        print("interrupted", file=sys.stderr)
+        return 130
+    except Exception as exc:  # a bug of ours: still no traceback without --debug
+        if args.debug:
+            traceback.print_exc()
+        else:
+            print(
+                f"formgraph: internal error: {type(exc).__name__}: {exc} (run with --debug "
+                f"for the traceback, and please report it)",
+                file=sys.stderr,
+            )
+        return 1
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,572 @@
+"""Mesh file writers as pure functions: arrays in, the file's bytes out.
+
+STL (binary and ASCII), OBJ and PLY. Every writer builds its output with whole-array numpy
+operations — binary records through structured dtypes, text through the bulk number
+formatting of :mod:`formgraph.kernels.numfmt` — and never loops over faces or vertices in
+Python. Writing the bytes to disk (atomically, inside the output directory) is the engine's
+job, not these functions'.
+
+Meshes come as ``vertices`` (n, 3) float64, ``face_indices`` (flat int) and ``face_offsets``
+(n_faces + 1,): face ``k`` is ``face_indices[face_offsets[k]:face_offsets[k + 1]]``, with
+any mix of face sizes.
+"""
+
+from __future__ import annotations
+
+import struct
+from dataclasses import dataclass
+
+import numpy as np
+
+from formgraph.kernels.numfmt import E9_WIDTH, float_words, format_e9, int_words, squeeze
+
+__all__ = [
+    "MeshReport",
+    "check_mesh",
+    "fan_triangles",
+    "mesh_report",
+    "obj_bytes",
+    "ply_binary",
+    "stl_ascii",
+    "stl_binary",
+    "triangle_normals",
+]
+
+
+def check_mesh(
+    vertices: np.ndarray,
+    face_indices: np.ndarray,
+    face_offsets: np.ndarray,
+    *,
+    min_face: int = 3,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Validate a flat polygon mesh and return it as contiguous float64 / int64 arrays.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+        Finite coordinates.
+    face_indices : (m,) int
+        Vertex indices, each in ``[0, n)``.
+    face_offsets : (n_faces + 1,) int
+        Starts at 0, ends at ``m``, each face at least ``min_face`` long.
+
+    Raises
+    ------
+    ValueError
+        With a sentence naming what was expected and what came.
+    """
+    v = np.asarray(vertices, dtype=np.float64)
+    if v.ndim != 2 or v.shape[1] != 3:
+        raise ValueError(f"vertices must be an (n, 3) array, got shape {v.shape}")
+    if not np.all(np.isfinite(v)):
+        raise ValueError("vertices must be finite; found NaN or infinity")
+    fi = np.asarray(face_indices)
+    fo = np.asarray(face_offsets)
+    if fi.ndim != 1 or fo.ndim != 1:
+        raise ValueError(
+            f"face_indices and face_offsets must be flat arrays, got shapes {fi.shape} and "
+            f"{fo.shape}"
+        )
+    if fi.size and not np.issubdtype(fi.dtype, np.integer):
+        raise ValueError(f"face_indices must be integers, got dtype {fi.dtype}")
+    if not np.issubdtype(fo.dtype, np.integer) and fo.size:
+        raise ValueError(f"face_offsets must be integers, got dtype {fo.dtype}")
+    fi = fi.astype(np.int64, copy=False)
+    fo = fo.astype(np.int64, copy=False)
+    if fo.size == 0 or fo[0] != 0 or fo[-1] != fi.size:
+        raise ValueError(
+            f"face_offsets must start at 0 and end at len(face_indices) = {fi.size}, got "
+            f"{fo[:1].tolist()} ... {fo[-1:].tolist()}"
+        )
+    sizes = np.diff(fo)
+    if sizes.size and sizes.min() < min_face:
+        k = int(np.argmin(sizes))
+        raise ValueError(
+            f"every face needs at least {min_face} vertices, face {k} has {int(sizes[k])}"
+        )
+    if fi.size and (fi.min() < 0 or fi.max() >= len(v)):
+        bad = int(fi[(fi < 0) | (fi >= len(v))][0])
+        raise ValueError(f"face index {bad} is out of range for {len(v)} vertices")
+    return np.ascontiguousarray(v), np.ascontiguousarray(fi), np.ascontiguousarray(fo)
+
+
+def fan_triangles(face_indices: np.ndarray, face_offsets: np.ndarray) -> np.ndarray:
+    """Triangulate every polygon as a fan from its first vertex, keeping the winding.
+
+    A face ``(a, b, c, d, ...)`` becomes ``(a, b, c), (a, c, d), ...``. Exact for convex
+    faces (and for any triangle or planar convex quad); all faces at once, whatever their
+    sizes, without grouping by size.
+
+    Parameters
+    ----------
+    face_indices : (m,) int64
+    face_offsets : (n_faces + 1,) int64
+        Faces of at least 3 vertices.
+
+    Returns
+    -------
+    (sum(size - 2), 3) int64
+        Triangles in face order.
+    """
+    sizes = np.diff(face_offsets)
+    per_face = sizes - 2
+    if np.all(per_face == 1):  # already triangles: nothing to fan
+        return face_indices.reshape(-1, 3)
+    face = np.repeat(np.arange(sizes.size), per_face)
+    first = face_offsets[:-1][face]
+    tri_start = np.cumsum(per_face) - per_face
+    j = np.arange(face.size) - tri_start[face]  # triangle number within its face
+    return np.stack(
+        [face_indices[first], face_indices[first + j + 1], face_indices[first + j + 2]], axis=1
+    )
+
+
+def triangle_normals(vertices: np.ndarray, triangles: np.ndarray) -> np.ndarray:
+    """Unit normals from the winding (right-hand rule); (0, 0, 0) for zero-area triangles.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float64
+    triangles : (t, 3) int
+
+    Returns
+    -------
+    (t, 3) float64
+    """
+    a = vertices[triangles[:, 0]]
+    n = np.cross(vertices[triangles[:, 1]] - a, vertices[triangles[:, 2]] - a)
+    length = np.sqrt(np.einsum("ij,ij->i", n, n))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        n /= length[:, None]
+    n[length == 0] = 0.0
+    return n
+
+
+# --------------------------------------------------------------------------------------------
+# STL
+
+_BLOCK = 1 << 14
+_STL_HEADER = b"formgraph binary STL".ljust(80, b"\0")  # must not start with "solid"
+_STL_RECORD = np.dtype(
+    [("normal", "<f4", (3,)), ("vertices", "<f4", (3, 3)), ("attribute", "<u2")]
+)  # 50 bytes, packed
+
+
+def _blocks(n: int, size: int = _BLOCK) -> list[slice]:
+    """Consecutive slices covering ``range(n)``: big outputs are filled a cache-sized block at
+    a time, so the temporaries of the arithmetic stay small."""
+    return [slice(i, min(i + size, n)) for i in range(0, n, size)]
+
+
+def stl_binary(vertices: np.ndarray, face_indices: np.ndarray, face_offsets: np.ndarray) -> bytes:
+    """Binary STL: an 80-byte header, the triangle count, then 50 bytes per triangle.
+
+    Polygons are fan-triangulated; each facet's normal comes from its winding (counter-
+    clockwise seen from outside), as the format asks. Coordinates are stored as float32
+    (the format's only precision). The records are one packed structured array.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float64
+    face_indices : (m,) int
+    face_offsets : (n_faces + 1,) int
+
+    Returns
+    -------
+    bytes
+        ``84 + 50 * n_triangles`` bytes.
+    """
+    v, tris = _stl_input(vertices, face_indices, face_offsets)
+    v32 = v.astype(np.float32)
+    records = np.empty((len(tris), 50), dtype=np.uint8)
+    normal, corners = records[:, :12].view("V12")[:, 0], records[:, 12:48].view("V36")[:, 0]
+    records[:, 48:] = 0  # the attribute byte count
+    columns = [np.ascontiguousarray(v32[:, k]) for k in range(3)]
+    for s in _blocks(len(tris)):
+        c = np.take(v32, tris[s], axis=0)  # (b, 3, 3) float32, the stored corners
+        corners[s] = c.reshape(-1, 9).view("V36")[:, 0]
+        normal[s] = _facet_normals(columns, tris[s]).view("V12")[:, 0]
+    return b"".join([_STL_HEADER, struct.pack("<I", len(tris)), records.data])
+
+
+def _facet_normals(columns: list[np.ndarray], tris: np.ndarray) -> np.ndarray:
+    """Unit normals (t, 3) float32 of triangles over float32 vertex ``columns`` (x, y, z).
+
+    Computed in double precision from the corners as the file stores them (float32), so
+    binary and ASCII STL carry the same normals; (0, 0, 0) for zero-area triangles. The
+    arithmetic runs on one contiguous array per coordinate, which vectorizes far better
+    than (t, 3) rows.
+    """
+    a = [np.take(col, tris[:, 0]).astype(np.float64) for col in columns]
+    e1 = [np.take(col, tris[:, 1]) - ak for col, ak in zip(columns, a, strict=True)]
+    e2 = [np.take(col, tris[:, 2]) - ak for col, ak in zip(columns, a, strict=True)]
+    nx = e1[1] * e2[2] - e1[2] * e2[1]
+    ny = e1[2] * e2[0] - e1[0] * e2[2]
+    nz = e1[0] * e2[1] - e1[1] * e2[0]
+    length = np.sqrt(nx * nx + ny * ny + nz * nz)
+    length[length == 0] = np.inf  # zero area: a zero normal
+    out = np.empty((len(tris), 3), dtype=np.float32)
+    out[:, 0], out[:, 1], out[:, 2] = nx / length, ny / length, nz / length
+    return out
+
+
+def stl_ascii(
+    vertices: np.ndarray,
+    face_indices: np.ndarray,
+    face_offsets: np.ndarray,
+    name: str = "formgraph",
+) -> bytes:
+    """ASCII STL in the classic ``facet normal ... endfacet`` layout.
+
+    Numbers are written in sign-mantissa-e-sign-exponent form with nine significant digits —
+    exactly the float32 values a binary STL of the same mesh holds. Every facet is a
+    fixed-width record: the constant words are laid down once in a block-sized template, each
+    distinct vertex is formatted once and its 48 bytes of text copied (as one item) into every
+    facet that uses it.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float64
+    face_indices : (m,) int
+    face_offsets : (n_faces + 1,) int
+    name : str
+        The solid's name, written after ``solid`` and ``endsolid`` (ASCII, no line breaks).
+
+    Returns
+    -------
+    bytes
+    """
+    if not name.isascii() or not name.isprintable():
+        raise ValueError(f"the solid name must be printable ASCII, got {name!r}")
+    v, tris = _stl_input(vertices, face_indices, face_offsets)
+    field = 3 * E9_WIDTH
+    item = np.dtype(f"V{field}")
+    vertex_text = (
+        format_e9(v.ravel()).reshape(-1, field).view(item)[:, 0] if len(v) else np.empty(0, item)
+    )
+    words = [
+        b"  facet normal",
+        b"\n    outer loop\n      vertex",
+        b"\n      vertex",
+        b"\n      vertex",
+        b"\n    endloop\n  endfacet\n",
+    ]
+    starts = np.cumsum([0] + [len(w) + field for w in words[:-1]])  # where each word begins
+    width = int(starts[-1]) + len(words[-1])
+    template = np.empty((min(len(tris), _BLOCK), width), dtype=np.uint8)
+    for w, at in zip(words, starts, strict=True):
+        template[:, at : at + len(w)] = np.frombuffer(w, dtype=np.uint8)
+    head = f"solid {name}\n".encode()
+    tail = f"endsolid {name}\n".encode()
+    out = np.empty(len(head) + len(tris) * width + len(tail), dtype=np.uint8)
+    out[: len(head)] = np.frombuffer(head, dtype=np.uint8)
+    out[len(out) - len(tail) :] = np.frombuffer(tail, dtype=np.uint8)
+    facets = out[len(head) : len(out) - len(tail)].reshape(len(tris), width)
+    fields = [int(at) + len(w) for w, at in zip(words[:-1], starts[:-1], strict=True)]
+    v32 = v.astype(np.float32)
+    columns = [np.ascontiguousarray(v32[:, k]) for k in range(3)]
+    for s in _blocks(len(tris)):
+        t = tris[s]
+        rec = template[: len(t)]
+        normals = _facet_normals(columns, t)
+        normal_text = format_e9(normals.ravel()).reshape(-1, field).view(item)[:, 0]
+        rec[:, fields[0] : fields[0] + field].view(item)[:, 0] = normal_text
+        for corner in range(3):
+            at = fields[corner + 1]
+            rec[:, at : at + field].view(item)[:, 0] = np.take(vertex_text, t[:, corner])
+        facets[s] = rec
+    return out.tobytes()
+
+
+def _stl_input(
+    vertices: np.ndarray, face_indices: np.ndarray, face_offsets: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    v, fi, fo = check_mesh(vertices, face_indices, face_offsets)
+    if np.abs(v).max(initial=0.0) > np.finfo(np.float32).max:
+        raise ValueError("STL stores 32-bit floats; vertex coordinates beyond 3.4e38 do not fit")
+    return v, fan_triangles(fi, fo)
+
+
+# --------------------------------------------------------------------------------------------
+# watertightness and orientation
+
+
+@dataclass(frozen=True)
+class MeshReport:
+    """What a 3-D printer's slicer will think of a mesh.
+
+    Attributes
+    ----------
+    n_vertices, n_faces, n_triangles, n_edges : int
+        Counts (triangles after fan triangulation; edges undirected).
+    boundary_edges : int
+        Edges used by one face only (holes).
+    nonmanifold_edges : int
+        Edges shared by more than two faces.
+    misoriented_edges : int
+        Edges two faces run through in the same direction (their windings disagree).
+    degenerate_triangles : int
+        Triangles of zero area (they get a zero normal).
+    volume : float
+        Signed volume by the divergence theorem; positive when closed and wound outward.
+        Meaningful only when the mesh is watertight and consistently oriented.
+    """
+
+    n_vertices: int
+    n_faces: int
+    n_triangles: int
+    n_edges: int
+    boundary_edges: int
+    nonmanifold_edges: int
+    misoriented_edges: int
+    degenerate_triangles: int
+    volume: float
+
+    @property
+    def watertight(self) -> bool:
+        """Every edge shared by exactly two faces."""
+        return self.boundary_edges == 0 and self.nonmanifold_edges == 0
+
+    @property
+    def consistently_oriented(self) -> bool:
+        """No edge is run through twice in the same direction."""
+        return self.misoriented_edges == 0
+
+    def warnings(self) -> list[str]:
+        """Sentences about each problem found (empty for a clean, closed, outward mesh)."""
+        out = []
+        if self.boundary_edges:
+            out.append(
+                f"mesh is not watertight: {self.boundary_edges} boundary edges "
+                "(edges of only one face)"
+            )
+        if self.nonmanifold_edges:
+            out.append(f"mesh has {self.nonmanifold_edges} non-manifold edges (shared by 3+ faces)")
+        if self.misoriented_edges:
+            out.append(
+                f"faces are not consistently oriented: {self.misoriented_edges} edges are run "
+                "through in the same direction by two faces"
+            )
+        elif self.watertight and self.volume < 0:
+            out.append(
+                f"mesh is inside out: its faces wind inward (signed volume {self.volume:.6g})"
+            )
+        if self.degenerate_triangles:
+            out.append(
+                f"{self.degenerate_triangles} triangles have zero area and get a zero normal"
+            )
+        return out
+
+
+def mesh_report(
+    vertices: np.ndarray, face_indices: np.ndarray, face_offsets: np.ndarray
+) -> MeshReport:
+    """Count boundary, non-manifold and misoriented edges, degenerate triangles, and the volume.
+
+    Every face contributes its directed edges (a -> b around its winding). An undirected edge
+    seen once is a boundary, more than twice non-manifold; a directed edge seen twice means
+    two faces cross it the same way, so their orientations disagree. One sort of the edge
+    keys (undirected edge, then direction) does the counting for all edges at once.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float64
+    face_indices : (m,) int
+    face_offsets : (n_faces + 1,) int
+
+    Returns
+    -------
+    MeshReport
+    """
+    v, fi, fo = check_mesh(vertices, face_indices, face_offsets)
+    nv = max(len(v), 1)
+    nxt = np.arange(1, fi.size + 1)
+    nxt[fo[1:] - 1] = fo[:-1]  # the last corner of each face wraps to its first
+    a, b = fi, fi[nxt]
+    # one sort does it all: the key is the undirected edge, then its direction as a last bit
+    key = np.sort((np.minimum(a, b) * nv + np.maximum(a, b)) * 2 + (a > b))
+    edge = key >> 1
+    starts = np.flatnonzero(np.r_[edge.size > 0, edge[1:] != edge[:-1]])
+    counts = np.diff(np.r_[starts, edge.size])
+    # equal neighbours are the same directed edge twice: count each such edge once
+    same = key[1:] == key[:-1]
+    misoriented = int(np.count_nonzero(same & ~np.r_[False, same[:-1]]))
+    tris = fan_triangles(fi, fo)
+    p0, p1, p2 = v[tris[:, 0]], v[tris[:, 1]], v[tris[:, 2]]
+    cross = np.cross(p1 - p0, p2 - p0)
+    degenerate = int(np.count_nonzero(~np.any(cross, axis=1)))
+    # divergence theorem, with the centroid as origin to keep the sum well conditioned
+    c = v.mean(axis=0) if len(v) else np.zeros(3)
+    volume = float(np.einsum("ij,ij->", p0 - c, np.cross(p1 - c, p2 - c)) / 6.0)
+    return MeshReport(
+        n_vertices=len(v),
+        n_faces=fo.size - 1,
+        n_triangles=len(tris),
+        n_edges=int(starts.size),
+        boundary_edges=int(np.count_nonzero(counts == 1)),
+        nonmanifold_edges=int(np.count_nonzero(counts > 2)),
+        misoriented_edges=misoriented,
+        degenerate_triangles=degenerate,
+        volume=volume,
+    )
+
+
+# --------------------------------------------------------------------------------------------
+# OBJ
+
+
+def obj_bytes(
+    vertices: np.ndarray,
+    face_indices: np.ndarray,
+    face_offsets: np.ndarray,
+    normals: np.ndarray | None = None,
+) -> bytes:
+    """Wavefront OBJ: ``v`` lines, optional ``vn`` lines, ``f`` lines with 1-based indices.
+
+    Polygons are kept as they are (a quad stays one ``f`` line of four indices). Coordinates
+    are written as Python's ``repr`` writes them — the shortest text that reads back to the
+    same double — so the file holds the mesh exactly.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float64
+    face_indices : (m,) int
+    face_offsets : (n_faces + 1,) int
+    normals : (n, 3) float64, optional
+        One normal per vertex; faces then read ``f a//a b//b c//c``.
+
+    Returns
+    -------
+    bytes
+    """
+    v, fi, fo = check_mesh(vertices, face_indices, face_offsets)
+    parts = [b"# formgraph\n"]
+    parts.append(_vector_lines(b"v", v))
+    if normals is not None:
+        vn = np.asarray(normals, dtype=np.float64)
+        if vn.shape != v.shape:
+            raise ValueError(
+                f"normals must be one per vertex, shape {v.shape}, got shape {vn.shape}"
+            )
+        parts.append(_vector_lines(b"vn", vn))
+    parts.append(_face_lines(fi, fo, with_normals=normals is not None))
+    return b"".join(parts)
+
+
+def _word(text: bytes) -> np.uint64:
+    return np.uint64(int.from_bytes(text, "little"))
+
+
+def _vector_lines(prefix: bytes, xyz: np.ndarray) -> bytes:
+    """``prefix x y z`` lines: per row a word with ``"\\n" + prefix`` and three numbers.
+
+    Every line starts with the previous line's end; the first newline is dropped and one
+    is added at the end.
+    """
+    if not len(xyz):
+        return b""
+    pieces = []
+    for s in _blocks(len(xyz)):
+        text = float_words(xyz[s].ravel(), lead=b" ").reshape(s.stop - s.start, -1)
+        rows = np.empty((len(text), 1 + text.shape[1]), dtype=np.uint64)
+        rows[:, 0] = _word(b"\n" + prefix)
+        rows[:, 1:] = text
+        pieces.append(squeeze(rows.view(np.uint8)))
+    return b"".join(pieces)[1:] + b"\n"
+
+
+def _face_lines(fi: np.ndarray, fo: np.ndarray, with_normals: bool) -> bytes:
+    """``f`` lines for faces of any sizes, as rows of word tokens squeezed together.
+
+    In a block of faces, row ``offsets[k] + k`` holds face k's ``"\\nf"`` and the rows after
+    it its 1-based indices, ``" 12"`` or ``" 12//12"``: one scatter places them all, whatever
+    the face sizes. The first newline is dropped and one is added at the end.
+    """
+    n_faces = fo.size - 1
+    if n_faces == 0:
+        return b""
+    sizes = np.diff(fo)
+    uniform = bool(np.all(sizes == sizes[0]))
+    pieces = []
+    for s in _blocks(n_faces):
+        lo, hi = fo[s.start], fo[s.stop]
+        if uniform and not with_normals:  # one face size: rows of "\nf" and k index words
+            token = int_words(fi[lo:hi] + 1, lead=b" ")
+            rows = np.empty((s.stop - s.start, 1 + token.size // (s.stop - s.start)), np.uint64)
+            rows[:, 0] = _word(b"\nf")
+            rows[:, 1:] = token.reshape(len(rows), -1)
+            pieces.append(squeeze(rows.view(np.uint8)))
+            continue
+        offsets = fo[s.start : s.stop + 1] - lo
+        n = s.stop - s.start
+        token = int_words(fi[lo:hi] + 1, lead=b" ")
+        if with_normals:
+            slashes = np.full((hi - lo, 1), _word(b"//"))
+            token = np.concatenate([token, slashes, int_words(fi[lo:hi] + 1)], axis=1)
+        rows = np.zeros((hi - lo + n, token.shape[1]), dtype=np.uint64)
+        rows[np.arange(hi - lo) + np.repeat(np.arange(1, n + 1), np.diff(offsets))] = token
+        rows[offsets[:-1] + np.arange(n), 0] = _word(b"\nf")
+        pieces.append(squeeze(rows.view(np.uint8)))
+    return b"".join(pieces)[1:] + b"\n"
+
+
+# --------------------------------------------------------------------------------------------
+# PLY
+
+
+def ply_binary(vertices: np.ndarray, face_indices: np.ndarray, face_offsets: np.ndarray) -> bytes:
+    """Binary little-endian PLY: double x, y, z per vertex; faces as lists of int indices.
+
+    Each face record is a count (``uchar``, or ``uint`` when some face has more than 255
+    vertices) followed by that many ``int`` indices; polygons are kept as they are. The face
+    records have different lengths, so they are laid out by computing every record's byte
+    offset and placing counts and indices with one scatter each.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float64
+    face_indices : (m,) int
+    face_offsets : (n_faces + 1,) int
+
+    Returns
+    -------
+    bytes
+    """
+    v, fi, fo = check_mesh(vertices, face_indices, face_offsets)
+    if len(v) >= 2**31:
+        raise ValueError(f"PLY int indices hold at most 2**31 - 1 vertices, got {len(v)}")
+    sizes = np.diff(fo)
+    n_faces = sizes.size
+    wide = bool(sizes.size and sizes.max() > 255)
+    count_type, count_dtype = ("uint", np.dtype("<u4")) if wide else ("uchar", np.dtype("u1"))
+    header = (
+        "ply\n"
+        "format binary_little_endian 1.0\n"
+        "comment formgraph\n"
+        f"element vertex {len(v)}\n"
+        "property double x\n"
+        "property double y\n"
+        "property double z\n"
+        f"element face {n_faces}\n"
+        f"property list {count_type} int vertex_indices\n"
+        "end_header\n"
+    ).encode()
+    cw = count_dtype.itemsize
+    if n_faces and np.all(sizes == sizes[0]):  # one face size: a packed structured array
+        record = np.dtype([("count", count_dtype), ("indices", "<i4", (int(sizes[0]),))])
+        faces = np.empty(n_faces, dtype=record)
+        faces["count"] = sizes[0]
+        faces["indices"] = fi.reshape(n_faces, -1)
+        face_bytes = faces.data
+    else:
+        face_of = np.repeat(np.arange(n_faces), sizes)
+        starts = fo[:-1] * 4 + np.arange(n_faces) * cw  # byte offset of each record
+        buf = np.empty(fi.size * 4 + n_faces * cw, dtype=np.uint8)
+        buf[starts[:, None] + np.arange(cw)] = (
+            sizes.astype(count_dtype).view(np.uint8).reshape(-1, cw)
+        )
+        pos = np.arange(fi.size) * 4 + (face_of + 1) * cw
+        buf[pos[:, None] + np.arange(4)] = fi.astype("<i4").view(np.uint8).reshape(-1, 4)
+        face_bytes = buf.data
+    return b"".join([header, v.astype("<f8").data, face_bytes])

@@ -1,0 +1,112 @@
+"""NURBS kernel: the exact curves and surfaces every curve and surface node stands on.
+
+Pure numpy array functions, vectorized over parameters, following L. Piegl and W. Tiller,
+*The NURBS Book* (2nd ed., 1997); algorithm numbers are cited in each docstring. This
+module gathers the family's public names; the code lives in
+
+- ``nurbs_basis``: knot spans, basis functions and their derivatives, blossoms, validation;
+- ``nurbs_curve``: curve points and derivatives, knot vectors, periodic curves, circles, arcs;
+- ``nurbs_surface``: surface points, grids, partial derivatives and normals;
+- ``nurbs_knots``: knot insertion and refinement, degree elevation, Bezier decomposition,
+  reparametrization, compatibility;
+- ``nurbs_fit``: global interpolation, open and closed;
+- ``nurbs_construct``: loft, extrusion, revolution, rotation-minimizing frames, sweep.
+
+Curves are ``(control_points (n, 3), degree, knots (n + degree + 1,), weights (n,) | None)``;
+surfaces ``(control_points (nu, nv, 3), degree_u, degree_v, knots_u, knots_v,
+weights (nu, nv) | None)`` with u along the first axis. ``weights=None`` is non-rational.
+"""
+
+from __future__ import annotations
+
+from .nurbs_basis import (
+    basis_function_derivatives,
+    basis_functions,
+    blossom_basis,
+    domain_spans,
+    find_spans,
+    validate_curve,
+    validate_surface,
+)
+from .nurbs_construct import (
+    extrude,
+    loft,
+    revolve,
+    rotation_minimizing_frames,
+    skin,
+    sweep,
+)
+from .nurbs_curve import (
+    arc,
+    circle,
+    clamped_uniform_knots,
+    curve_derivatives,
+    curve_evaluate,
+    evaluate_homogeneous,
+    homogeneous,
+    periodic_curve,
+    plane_frame,
+    project,
+)
+from .nurbs_fit import fit_columns, interpolate, interpolation_parameters
+from .nurbs_knots import (
+    clamp,
+    decompose_bezier,
+    elevate_degree,
+    insert_knot,
+    is_clamped,
+    make_compatible,
+    refine_knots,
+    reparametrize,
+    respace,
+)
+from .nurbs_surface import (
+    basis_matrix,
+    surface_derivatives,
+    surface_evaluate,
+    surface_evaluate_grid,
+    surface_normals,
+)
+
+__all__ = [
+    "arc",
+    "basis_function_derivatives",
+    "basis_functions",
+    "basis_matrix",
+    "blossom_basis",
+    "circle",
+    "clamp",
+    "clamped_uniform_knots",
+    "curve_derivatives",
+    "curve_evaluate",
+    "decompose_bezier",
+    "domain_spans",
+    "elevate_degree",
+    "evaluate_homogeneous",
+    "extrude",
+    "find_spans",
+    "fit_columns",
+    "homogeneous",
+    "insert_knot",
+    "interpolate",
+    "interpolation_parameters",
+    "is_clamped",
+    "loft",
+    "make_compatible",
+    "periodic_curve",
+    "plane_frame",
+    "project",
+    "refine_knots",
+    "reparametrize",
+    "respace",
+    "revolve",
+    "rotation_minimizing_frames",
+    "skin",
+    "surface_derivatives",
+    "surface_evaluate",
+    "surface_evaluate_grid",
+    "surface_normals",
+    "sweep",
+    "validate_curve",
+    "validate_surface",
+]

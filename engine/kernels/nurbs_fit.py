@@ -1,0 +1,208 @@
+"""Global interpolation: B-spline curves (and columns of control nets) through given points.
+
+Open interpolation is The NURBS Book's A9.1: parameters by chord length or centripetal
+spacing (Eq. 9.4-9.6), knots by averaging (Eq. 9.8), and one linear system for all
+coordinates. Closed interpolation is its periodic counterpart: a periodic knot vector
+(knots at the parameters for odd degree, at their midpoints for even degree, so that the
+Schoenberg-Whitney conditions hold) and a cyclic collocation system.
+
+The systems are dense and solved with LAPACK through ``numpy.linalg.solve``: collocation
+matrices of B-splines are totally positive, so elimination is stable. The cost grows as
+the cube of the point count; a few thousand points take well under a second.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .nurbs_knots import respace
+from .nurbs_surface import basis_matrix
+
+__all__ = ["fit_columns", "interpolate", "interpolation_parameters"]
+
+_PARAMETRIZATIONS = ("chord", "centripetal", "uniform")
+
+
+def interpolation_parameters(
+    points: np.ndarray, closed: bool = False, parametrization: str = "chord"
+) -> np.ndarray:
+    """Parameters of the data points on [0, 1] (Eq. 9.4-9.6 of The NURBS Book).
+
+    Parameters
+    ----------
+    points : (k, d) float
+        Data points (or stacked rows of them: the distance between rows is the mean over
+        the trailing axes, as for the sections of a loft, Eq. 10.8).
+    closed : bool
+        Include the closing segment from the last point back to the first; the k
+        parameters then lie in [0, 1) and 1 stands for the first point again.
+    parametrization : {"chord", "centripetal", "uniform"}
+
+    Returns
+    -------
+    (k,) float
+    """
+    if parametrization not in _PARAMETRIZATIONS:
+        raise ValueError(
+            f"parametrization must be one of {', '.join(_PARAMETRIZATIONS)}, got "
+            f"{parametrization!r}"
+        )
+    pts = np.asarray(points, dtype=np.float64)
+    k = pts.shape[0]
+    seq = np.concatenate([pts, pts[:1]]) if closed else pts
+    steps = seq[1:] - seq[:-1]
+    dist = np.linalg.norm(steps.reshape(len(steps), -1, steps.shape[-1]), axis=-1).mean(axis=1)
+    if parametrization == "uniform":
+        dist = np.ones_like(dist)
+    elif parametrization == "centripetal":
+        dist = np.sqrt(dist)
+    if np.any(dist == 0):
+        i = int(np.argmax(dist == 0))
+        j = (i + 1) % k
+        raise ValueError(
+            f"points {i} and {j} coincide; interpolation needs consecutive points to differ"
+        )
+    u = np.concatenate([[0.0], np.cumsum(dist)])
+    u /= u[-1]
+    return u[:k] if closed else u
+
+
+def _averaged_knots(u: np.ndarray, degree: int) -> np.ndarray:
+    """Clamped knots by averaging the parameters (Eq. 9.8)."""
+    p = degree
+    k = len(u)
+    inner = (
+        np.lib.stride_tricks.sliding_window_view(u[1:-1], p).mean(axis=1)[: k - p - 1]
+        if k - p - 1 > 0
+        else np.empty(0)
+    )
+    return np.concatenate([np.zeros(p + 1), inner, np.ones(p + 1)])
+
+
+def _periodic_knots(u: np.ndarray, degree: int) -> np.ndarray:
+    """Periodic knot vector of period 1 with k knots per period (k + 2p + 1 knots)."""
+    p = degree
+    k = len(u)
+    ext = np.concatenate([u, [1.0]])
+    base = u if p % 2 == 1 else 0.5 * (ext[:-1] + ext[1:])
+    i = np.arange(-p, k + p + 1)
+    return base[i % k] + np.floor_divide(i, k)
+
+
+def fit_columns(
+    values: np.ndarray, params: np.ndarray, degree: int, closed: bool = False
+) -> tuple[np.ndarray, np.ndarray]:
+    """Interpolating B-spline coefficients of many columns at once (A9.1, open or periodic).
+
+    Parameters
+    ----------
+    values : (k, ...) float
+        Data at the k parameters; trailing axes are independent right-hand sides (the
+        control points of loft sections, in homogeneous coordinates).
+    params : (k,) float
+        Increasing, in [0, 1] (open: from 0 to 1; closed: from 0, below 1).
+    degree : int
+        1 <= degree <= k - 1.
+    closed : bool
+        Periodic: the result's first ``degree`` control points are repeated at its end.
+
+    Returns
+    -------
+    control : (k, ...) float; when closed (k + degree, ...) for odd degree and
+        (k + 1 + degree, ...) for even degree
+    knots : (len(control) + degree + 1,) float
+        Domain [0, 1], with the data at ``params``. Closed even degrees get one knot more
+        per period (the midpoints between the parameters, for Schoenberg-Whitney, plus 0
+        so that the domain starts at the first data point), hence one more control point.
+    """
+    vals = np.asarray(values, dtype=np.float64)
+    k = vals.shape[0]
+    flat = vals.reshape(k, -1)
+    p = degree
+    if not closed:
+        knots = _averaged_knots(params, p)
+        A = basis_matrix(p, knots, params, k)
+        ctrl = np.linalg.solve(A, flat)
+        return ctrl.reshape(vals.shape), knots
+    knots = _periodic_knots(params, p)
+    t = params if p % 2 == 1 else np.where(params < knots[p], params + 1.0, params)
+    A = basis_matrix(p, knots, t, k + p)
+    A[:, :p] += A[:, k:]
+    ctrl = np.linalg.solve(A[:, :k], flat)
+    if p % 2 == 0:
+        ctrl, knots = _start_at_zero(ctrl, knots[p : p + k], p)
+        k += 1
+    ctrl = np.concatenate([ctrl, ctrl[:p]])
+    return ctrl.reshape((k + p,) + vals.shape[1:]), knots
+
+
+def _start_at_zero(ctrl: np.ndarray, period: np.ndarray, p: int) -> tuple[np.ndarray, np.ndarray]:
+    """Re-express a periodic spline (k distinct control points, knots ``period`` in one
+    period, the first above 0) on the knots ``{0} + period mod 1``, so that its domain
+    starts at parameter 0, the first data point. Exact: the new periodic knot vector
+    refines the old one (:func:`~.nurbs_knots.respace` on three periods of the old curve).
+    """
+    k = len(period)
+    i = np.arange(-k - p, 2 * k + p + 1)  # domain [period[0] - 1, period[0] + 2]
+    old_knots = period[i % k] + np.floor_divide(i, k)
+    old_ctrl = ctrl[np.arange(3 * k + p) % k]
+    base = np.sort(np.concatenate([[0.0], np.mod(period, 1.0)]))
+    j = np.arange(-p, k + 1 + p + 1)
+    new_knots = base[j % (k + 1)] + np.floor_divide(j, k + 1)
+    new_ctrl = respace(p, old_knots, old_ctrl, new_knots)
+    return new_ctrl[: k + 1], new_knots
+
+
+def interpolate(
+    points: np.ndarray,
+    degree: int = 3,
+    closed: bool = False,
+    parametrization: str = "chord",
+) -> tuple[np.ndarray, int, np.ndarray, None]:
+    """A B-spline curve through every point, in order (global interpolation, A9.1).
+
+    Parameters
+    ----------
+    points : (k, 3) float
+        At least 2 (open) or 3 (closed) points, consecutive points distinct. For a closed
+        curve a last point equal to the first (within 1e-12 of the extent) is dropped: the
+        curve closes by itself.
+    degree : int
+        Requested degree; it is capped at ``k - 1`` (the most k points determine), so 2
+        points give a line and 3 points a parabola.
+    closed : bool
+        A periodic curve: it passes through every point and closes with the continuity of
+        its degree (no corner at the first point).
+    parametrization : {"chord", "centripetal", "uniform"}
+        Spacing of the parameters: chord length, square root of chord length (fewer loops
+        and cusps on uneven data), or equal.
+
+    Returns
+    -------
+    control_points : (k, 3) float, or (k + degree, 3) closed (k + 1 + degree for even degree)
+    degree : int
+        The degree used (after the cap).
+    knots : float array
+        Domain [0, 1]; open curves are clamped and pass through the first and last point at
+        0 and 1; closed curves start and end at the first point.
+    weights : None
+    """
+    pts = np.asarray(points, dtype=np.float64)
+    if pts.ndim != 2 or pts.shape[1] != 3:
+        raise ValueError(f"points must be an (n, 3) array, got shape {pts.shape}")
+    if not np.all(np.isfinite(pts)):
+        raise ValueError("points must be finite numbers")
+    if isinstance(degree, bool) or int(degree) != degree or degree < 1:
+        raise ValueError(f"degree must be a whole number >= 1, got {degree!r}")
+    if closed and len(pts) > 1:
+        extent = float(np.ptp(pts, axis=0).max())
+        if np.linalg.norm(pts[0] - pts[-1]) <= 1e-12 * extent:
+            pts = pts[:-1]  # the closing point repeats the first (up to rounding)
+    need = 3 if closed else 2
+    if len(pts) < need:
+        kind = "a closed" if closed else "an open"
+        raise ValueError(f"{kind} interpolating curve needs at least {need} points, got {len(pts)}")
+    p = min(int(degree), len(pts) - 1)
+    u = interpolation_parameters(pts, closed, parametrization)
+    cp, knots = fit_columns(pts, u, p, closed)
+    return cp, p, knots, None

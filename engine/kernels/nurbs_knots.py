@@ -1,0 +1,431 @@
+"""Knot operations on NURBS curves: insertion, refinement, degree elevation, Bezier
+decomposition, reparametrization and the compatibility step used by lofting.
+
+Every operation keeps the curve's shape exactly (up to rounding). Rational curves are
+processed in homogeneous coordinates. Apart from A5.1, the operations are written with
+one tool, the blossom of the basis functions (:func:`~.nurbs_basis.blossom_basis`): a
+control point of the same curve on a new knot vector is the curve's blossom at that knot
+vector's p consecutive interior knots (de Boor's dual functionals). This is the Oslo
+algorithm for refinement and Ramshaw's blossoming principle for elevation and Bezier
+extraction, and it vectorizes over all new control points at once.
+
+References: L. Piegl and W. Tiller, *The NURBS Book*, 2nd ed. (A5.1, A5.4, A5.6, A5.9);
+E. Cohen, T. Lyche and R. Riesenfeld, "Discrete B-splines and subdivision techniques in
+computer-aided geometric design", CGIP 14 (1980); L. Ramshaw, "Blossoms are polar forms",
+CAGD 6 (1989).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from .nurbs_basis import blossom_basis, domain_spans, find_spans, validate_curve
+from .nurbs_curve import homogeneous, project
+
+__all__ = [
+    "clamp",
+    "decompose_bezier",
+    "elevate_degree",
+    "insert_knot",
+    "is_clamped",
+    "make_compatible",
+    "refine_knots",
+    "reparametrize",
+    "respace",
+]
+
+Curve = tuple[np.ndarray, int, np.ndarray, "np.ndarray | None"]
+
+
+def _flat(pw: np.ndarray) -> tuple[np.ndarray, tuple[int, ...]]:
+    return pw.reshape(pw.shape[0], -1), pw.shape[1:]
+
+
+def respace(degree: int, knots: np.ndarray, pw: np.ndarray, new_knots: np.ndarray) -> np.ndarray:
+    """Control points of the same spline on another knot vector of the same degree.
+
+    Row i is the blossom of the polynomial piece under the start of new basis function
+    i's support, at ``new_knots[i+1 .. i+p]`` (dual functionals; the Oslo algorithm when
+    ``new_knots`` refines ``knots``). Exact whenever the new knot vector's spline space
+    contains the curve on the new domain, which must lie inside the old one: refinement,
+    clamping an unclamped vector, or restricting to a sub-domain.
+
+    Parameters
+    ----------
+    degree : int
+    knots : (n + p + 1,) float
+    pw : (n, ...) float
+        Control points (homogeneous for a rational curve); trailing axes are carried
+        along, so a surface's control net is respaced along its first axis.
+    new_knots : (n' + p + 1,) float
+
+    Returns
+    -------
+    (n', ...) float
+    """
+    p = degree
+    knots = np.asarray(knots, dtype=np.float64)
+    tau = np.asarray(new_knots, dtype=np.float64)
+    flat, tail = _flat(np.asarray(pw, dtype=np.float64))
+    n_new = len(tau) - p - 1
+    a = knots[p]
+    lo = np.maximum(tau[:n_new], a)
+    mu = find_spans(p, knots, lo)
+    args = (
+        np.lib.stride_tricks.sliding_window_view(tau[1:], p)[:n_new] if p else np.empty((n_new, 0))
+    )
+    alpha = blossom_basis(p, knots, mu, args)
+    idx = mu[:, None] - p + np.arange(p + 1)
+    out = np.einsum("ir,ird->id", alpha, flat[idx])
+    return out.reshape((n_new,) + tail)
+
+
+def is_clamped(degree: int, knots: np.ndarray) -> bool:
+    """True when the first and last ``degree + 1`` knots are equal (the curve's ends are
+    its end control points)."""
+    k = np.asarray(knots)
+    p = degree
+    return bool(np.all(k[: p + 1] == k[0]) and np.all(k[-p - 1 :] == k[-1]))
+
+
+def clamp(
+    control_points: np.ndarray, degree: int, knots: np.ndarray, weights: np.ndarray | None
+) -> Curve:
+    """The same curve on a clamped knot vector over the same domain (no-op if clamped).
+
+    The knots inside the domain are kept; the ``p`` knots outside each end are replaced by
+    the domain's ends (:func:`respace`).
+
+    Returns
+    -------
+    (control_points, degree, knots, weights)
+    """
+    p = degree
+    knots = np.asarray(knots, dtype=np.float64)
+    if is_clamped(p, knots):
+        return np.array(control_points, dtype=np.float64), p, knots.copy(), _copy(weights)
+    n = len(knots) - p - 1
+    a, b = knots[p], knots[n]
+    inner = knots[(knots > a) & (knots < b)]
+    tau = np.concatenate([[a] * (p + 1), inner, [b] * (p + 1)])
+    pw = respace(p, knots, homogeneous(control_points, weights), tau)
+    cp, w = project(pw, weights is not None)
+    return cp, p, tau, w
+
+
+def _copy(w: np.ndarray | None) -> np.ndarray | None:
+    return None if w is None else np.array(w, dtype=np.float64)
+
+
+def _multiplicity(knots: np.ndarray, t: float) -> int:
+    return int(np.count_nonzero(knots == t))
+
+
+def _snap(knots: np.ndarray, t: np.ndarray, scale: float) -> np.ndarray:
+    """Parameters within 1e-12 of the domain size from an existing knot become that knot."""
+    i = np.clip(np.searchsorted(knots, t), 1, len(knots) - 1)
+    near = np.where(np.abs(knots[i - 1] - t) <= np.abs(knots[i] - t), knots[i - 1], knots[i])
+    return np.where(np.abs(near - t) <= 1e-12 * scale, near, t)
+
+
+def _check_in_domain(t: np.ndarray, a: float, b: float, what: str) -> None:
+    if not np.all(np.isfinite(t)):
+        raise ValueError(f"{what} must be finite numbers")
+    out = (t < a) | (t > b)
+    if np.any(out):
+        raise ValueError(
+            f"{what} {float(t[out][0]):g} is outside the curve's domain [{a:g}, {b:g}]"
+        )
+
+
+def insert_knot(
+    control_points: np.ndarray,
+    degree: int,
+    knots: np.ndarray,
+    weights: np.ndarray | None,
+    t: float,
+    times: int = 1,
+) -> Curve:
+    """Insert the knot ``t`` ``times`` times without changing the curve (Boehm, A5.1).
+
+    The knot's multiplicity may not exceed the degree (a multiplicity of p already puts
+    a control point on the curve at t; more would only split it).
+
+    Parameters
+    ----------
+    control_points : (n, 3) float
+    degree : int
+    knots : (n + p + 1,) float
+    weights : (n,) float or None
+    t : float
+        In the domain ``[knots[p], knots[n]]``.
+    times : int
+        How many times to insert it (>= 0).
+
+    Returns
+    -------
+    control_points : (n + times, 3), degree, knots (n + p + 1 + times,), weights or None
+        New arrays; the inputs are not modified.
+
+    Raises
+    ------
+    ValueError
+        If t is outside the domain or the multiplicity would exceed the degree.
+    """
+    validate_curve(control_points, degree, knots, weights)
+    p = degree
+    U = np.asarray(knots, dtype=np.float64)
+    n = len(U) - p - 1
+    if isinstance(times, bool) or int(times) != times or times < 0:
+        raise ValueError(f"times must be a whole number >= 0, got {times!r}")
+    times = int(times)
+    a, b = U[p], U[n]
+    tv = np.asarray([t], dtype=np.float64)
+    _check_in_domain(tv, a, b, "knot")
+    t = float(_snap(U, tv, b - a)[0])
+    s = _multiplicity(U, t)
+    if s + times > p:
+        raise ValueError(
+            f"knot {t:g} has multiplicity {s}; inserting it {times} more time(s) would exceed "
+            f"the degree {p}"
+        )
+    Pw = homogeneous(control_points, weights)
+    if times == 0:
+        return np.array(control_points, dtype=np.float64), p, U.copy(), _copy(weights)
+    r = times
+    k = int(np.searchsorted(U, t, side="right")) - 1
+    Qw = np.empty((n + r, Pw.shape[1]))
+    Qw[: k - p + 1] = Pw[: k - p + 1]
+    Qw[k - s + r :] = Pw[k - s :]
+    Rw = Pw[k - p : k - s + 1].copy()
+    L = k - p
+    for j in range(1, r + 1):  # loops over the inserted copies and the degree only
+        L = k - p + j
+        i = np.arange(p - j - s + 1)
+        alpha = ((t - U[L + i]) / (U[i + k + 1] - U[L + i]))[:, None]
+        Rw[: len(i)] = alpha * Rw[1 : len(i) + 1] + (1.0 - alpha) * Rw[: len(i)]
+        Qw[L] = Rw[0]
+        Qw[k + r - j - s] = Rw[p - j - s]
+    Qw[L + 1 : k - s] = Rw[1 : k - s - L]
+    UQ = np.concatenate([U[: k + 1], np.full(r, t), U[k + 1 :]])
+    cp, w = project(Qw, weights is not None)
+    return cp, p, UQ, w
+
+
+def refine_knots(
+    control_points: np.ndarray,
+    degree: int,
+    knots: np.ndarray,
+    weights: np.ndarray | None,
+    new_knots: np.ndarray,
+) -> Curve:
+    """Insert many knots at once without changing the curve (knot refinement).
+
+    The result is the one of The NURBS Book's A5.4, computed row by row with the Oslo
+    algorithm (:func:`respace`), vectorized over all new control points.
+
+    Parameters
+    ----------
+    control_points : (n, 3) float
+    degree : int
+    knots : (n + p + 1,) float
+    weights : (n,) float or None
+    new_knots : (r,) float
+        Knots to insert (any order, repeats allowed), each in the domain; no knot may end
+        up with a multiplicity above the degree.
+
+    Returns
+    -------
+    control_points : (n + r, 3), degree, knots (n + p + 1 + r,), weights or None
+    """
+    validate_curve(control_points, degree, knots, weights)
+    p = degree
+    U = np.asarray(knots, dtype=np.float64)
+    n = len(U) - p - 1
+    X = np.sort(np.asarray(new_knots, dtype=np.float64).reshape(-1))
+    if X.size == 0:
+        return np.array(control_points, dtype=np.float64), p, U.copy(), _copy(weights)
+    a, b = U[p], U[n]
+    _check_in_domain(X, a, b, "knot")
+    X = _snap(U, X, b - a)
+    values, counts = np.unique(X, return_counts=True)
+    existing = np.array([_multiplicity(U, v) for v in values])
+    over = existing + counts > p
+    if np.any(over):
+        i = int(np.argmax(over))
+        raise ValueError(
+            f"knot {values[i]:g} has multiplicity {existing[i]}; inserting it {counts[i]} more "
+            f"time(s) would exceed the degree {p}"
+        )
+    tau = np.sort(np.concatenate([U, X]))
+    pw = respace(p, U, homogeneous(control_points, weights), tau)
+    cp, w = project(pw, weights is not None)
+    return cp, p, tau, w
+
+
+def elevate_degree(
+    control_points: np.ndarray,
+    degree: int,
+    knots: np.ndarray,
+    weights: np.ndarray | None,
+    times: int = 1,
+) -> Curve:
+    """Raise the degree by ``times`` without changing the curve.
+
+    Each step raises the degree by one and every distinct knot's multiplicity by one, so
+    the continuity is kept (the result of A5.9). The new control points are the
+    symmetric blossoms (Ramshaw): for degree q = p + 1, row i is the average over the
+    q arguments ``new_knots[i+1 .. i+q]`` left out one at a time of the degree-p
+    blossom, vectorized over all rows. An unclamped (periodic) curve is clamped first
+    (same shape and domain).
+
+    Returns
+    -------
+    control_points (n', 3), degree + times, knots, weights or None
+    """
+    validate_curve(control_points, degree, knots, weights)
+    if isinstance(times, bool) or int(times) != times or times < 0:
+        raise ValueError(f"times must be a whole number >= 0, got {times!r}")
+    cp, p, U, w = clamp(control_points, degree, knots, weights)
+    pw = homogeneous(cp, w)
+    for _ in range(int(times)):
+        values, counts = np.unique(U, return_counts=True)
+        tau = np.repeat(values, counts + 1)
+        q = p + 1
+        n_new = len(tau) - q - 1
+        lo = tau[:n_new]
+        mu = find_spans(p, U, lo)
+        args = np.lib.stride_tricks.sliding_window_view(tau[1:], q)[:n_new]
+        alpha = np.zeros((n_new, p + 1))
+        for leave in range(q):
+            alpha += blossom_basis(p, U, mu, np.delete(args, leave, axis=1))
+        alpha /= q
+        idx = mu[:, None] - p + np.arange(p + 1)
+        pw = np.einsum("ir,ird->id", alpha, pw[idx])
+        p, U = q, tau
+    cp, w = project(pw, weights is not None)
+    return cp, p, U, w
+
+
+def decompose_bezier(
+    control_points: np.ndarray, degree: int, knots: np.ndarray, weights: np.ndarray | None
+) -> tuple[np.ndarray, np.ndarray | None]:
+    """Split the curve into its Bezier pieces, one per non-empty knot span (A5.6).
+
+    Bezier point k of the piece on ``[a, b]`` is the blossom of that piece at
+    ``(a, .., a, b, .., b)`` (p - k times a, k times b): the result of inserting every
+    knot up to multiplicity p, computed for all pieces at once. Works for unclamped
+    curves too (only the domain's pieces).
+
+    Returns
+    -------
+    segments : (k, p + 1, 3) float
+    segment_weights : (k, p + 1) float, or None for a non-rational curve
+    """
+    validate_curve(control_points, degree, knots, weights)
+    p = degree
+    U = np.asarray(knots, dtype=np.float64)
+    first, last = domain_spans(p, U)
+    spans = np.arange(first, last + 1)
+    spans = spans[U[spans + 1] > U[spans]]
+    a, b = U[spans], U[spans + 1]
+    kk = np.arange(p + 1)
+    # argument j of Bezier point k is b when j < k, else a
+    args = np.where(
+        np.arange(p)[None, None, :] < kk[None, :, None], b[:, None, None], a[:, None, None]
+    )  # (segments, p+1, p)
+    mu = np.repeat(spans, p + 1)
+    alpha = blossom_basis(p, U, mu, args.reshape(-1, p))
+    pw = homogeneous(control_points, weights)
+    idx = mu[:, None] - p + kk
+    seg = np.einsum("ir,ird->id", alpha, pw[idx]).reshape(len(spans), p + 1, -1)
+    cp, w = project(seg, weights is not None)
+    return cp, w
+
+
+def reparametrize(knots: np.ndarray, t0: float, t1: float, degree: int | None = None) -> np.ndarray:
+    """Map a knot vector affinely so that the domain becomes ``[t0, t1]``.
+
+    Parameters
+    ----------
+    knots : (k,) float
+    t0, t1 : float
+        New domain, ``t0 < t1``.
+    degree : int, optional
+        With the degree, the domain ``[knots[p], knots[-p-1]]`` is mapped (right for
+        unclamped knots); without it the first and last knots are (right when clamped).
+
+    Returns
+    -------
+    (k,) float
+    """
+    k = np.asarray(knots, dtype=np.float64)
+    if not (np.isfinite(t0) and np.isfinite(t1) and t0 < t1):
+        raise ValueError(f"the new domain must have t0 < t1, got [{t0:g}, {t1:g}]")
+    a, b = (k[0], k[-1]) if degree is None else (k[degree], k[len(k) - degree - 1])
+    if not a < b:
+        raise ValueError(f"cannot reparametrize an empty domain [{a:g}, {b:g}]")
+    out = t0 + (k - a) * ((t1 - t0) / (b - a))
+    out[k == a] = t0  # the domain's ends exactly, whatever the rounding
+    out[k == b] = t1
+    return out
+
+
+def _merge_knots(vectors: Sequence[np.ndarray], tol: float = 1e-10) -> list[np.ndarray]:
+    """Snap nearly equal knots of several vectors on [0, 1] to one value, per vector."""
+    allk = np.unique(np.concatenate(vectors))
+    if allk.size == 0:
+        return list(vectors)
+    starts = np.concatenate([[True], np.diff(allk) > tol])
+    reps = allk[starts][np.cumsum(starts) - 1]
+    return [reps[np.searchsorted(allk, v)] for v in vectors]
+
+
+def make_compatible(curves: Sequence[Curve]) -> list[Curve]:
+    """Give several curves one degree and one knot vector, each keeping its shape.
+
+    Each curve is clamped, reparametrized to [0, 1], elevated to the highest degree
+    among them, and refined to the union of all knot vectors (each value with the highest
+    multiplicity it has in any of them; knots closer than 1e-10 are merged). If any curve
+    is rational, all get weights. This is the first step of skinning (The NURBS Book
+    section 10.3).
+
+    Parameters
+    ----------
+    curves : sequence of (control_points, degree, knots, weights)
+
+    Returns
+    -------
+    list of (control_points (n, 3), degree, knots (n + degree + 1,), weights (n,) or None)
+        All with the same n, degree and knots.
+    """
+    curves = list(curves)
+    if not curves:
+        raise ValueError("make_compatible needs at least one curve, got none")
+    rational = any(c[3] is not None for c in curves)
+    q = max(int(c[1]) for c in curves)
+    work = []
+    for cp, p, U, w in curves:
+        validate_curve(cp, p, U, w)
+        cp, p, U, w = clamp(cp, p, U, w)
+        U = reparametrize(U, 0.0, 1.0)
+        if rational and w is None:
+            w = np.ones(len(cp))
+        cp, p, U, w = elevate_degree(cp, p, U, w, q - p)
+        work.append((cp, U, w))
+    snapped = _merge_knots([U for _, U, _ in work])
+    values = np.unique(np.concatenate(snapped))
+    mult = np.zeros(len(values), dtype=np.int64)
+    for U in snapped:
+        v, c = np.unique(U, return_counts=True)
+        i = np.searchsorted(values, v)
+        mult[i] = np.maximum(mult[i], c)
+    target = np.repeat(values, mult)
+    out = []
+    for (cp, _, w), U in zip(work, snapped, strict=True):
+        pw = respace(q, U, homogeneous(cp, w), target)
+        cpn, wn = project(pw, w is not None)
+        out.append((cpn, q, target.copy(), wn))
+    return out

@@ -1,0 +1,501 @@
+"""Subdivision surfaces on flat polygon meshes: Catmull-Clark and Doo-Sabin.
+
+Both schemes come from the same 1978 issue of Computer-Aided Design:
+
+- E. Catmull, J. Clark, "Recursively generated B-spline surfaces on arbitrary topological
+  meshes", CAD 10(6), 350-355 -- generalises uniform bicubic B-splines;
+- D. Doo, M. Sabin, "Behaviour of recursive division surfaces near extraordinary points",
+  CAD 10(6), 356-360 -- generalises uniform biquadratic B-splines.
+
+Each level is a handful of gathers and ``np.bincount`` scatter-adds over the half-edges (no
+Python loop per face, edge or vertex). Catmull-Clark builds the half-edge structure once;
+the connectivity of every later level follows in closed form from the previous one.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from formgraph.kernels.halfedge import HalfEdges, build_halfedges
+
+__all__ = [
+    "catmull_clark",
+    "catmull_clark_counts",
+    "doo_sabin",
+    "doo_sabin_counts",
+    "doo_sabin_weights",
+]
+
+
+def _as_vertices(vertices: np.ndarray) -> np.ndarray:
+    v = np.asarray(vertices, dtype=np.float64)
+    if v.ndim != 2 or v.shape[1] != 3:
+        raise ValueError(f"vertices must be an (n, 3) array, got shape {v.shape}")
+    if not np.isfinite(v).all():
+        i = int(np.flatnonzero(~np.isfinite(v).all(axis=1))[0])
+        raise ValueError(f"vertex {i} is not finite: {v[i].tolist()}")
+    return v
+
+
+def _check_levels(levels: int) -> int:
+    if isinstance(levels, bool) or int(levels) != levels or levels < 0:
+        raise ValueError(f"levels must be a whole number >= 0, got {levels!r}")
+    return int(levels)
+
+
+def _scatter(index: np.ndarray, values: np.ndarray, size: int) -> np.ndarray:
+    """Sum the rows of ``values`` (m, 3) into ``size`` bins: one bincount per coordinate."""
+    out = np.empty((size, 3))
+    for k in range(3):
+        out[:, k] = np.bincount(index, values[:, k], minlength=size)
+    return out
+
+
+def _face_sums(vertices: np.ndarray, fi: np.ndarray, fo: np.ndarray, quads: bool) -> np.ndarray:
+    if quads:
+        q = fi.reshape(-1, 4)
+        return vertices[q[:, 0]] + vertices[q[:, 1]] + vertices[q[:, 2]] + vertices[q[:, 3]]
+    if fi.size == 0:
+        return np.zeros((0, 3))
+    return np.add.reduceat(vertices[fi], fo[:-1], axis=0)
+
+
+# --------------------------------------------------------------------------------------
+# Catmull-Clark
+# --------------------------------------------------------------------------------------
+
+
+@dataclass
+class _Level:
+    """Connectivity of one level, as much as the Catmull-Clark rules need.
+
+    Half-edge ``h`` is corner ``h`` of the flat face list; ``edge`` is its undirected edge,
+    ``prev`` the half-edge before it in its face; ``edge_vertices`` the two ends of each
+    edge (not sorted after the first level).
+    """
+
+    face_indices: np.ndarray
+    face_offsets: np.ndarray
+    face: np.ndarray
+    edge: np.ndarray
+    prev: np.ndarray
+    edge_vertices: np.ndarray
+    quads: bool
+
+    @classmethod
+    def from_halfedges(cls, he: HalfEdges) -> _Level:
+        sizes = he.face_sizes
+        return cls(
+            face_indices=he.origin,
+            face_offsets=he.face_offsets,
+            face=he.face,
+            edge=he.edge,
+            prev=he.prev,
+            edge_vertices=he.edge_vertices,
+            quads=bool(sizes.size and (sizes == 4).all()),
+        )
+
+
+def _edge_sharpness(
+    he: HalfEdges, creases: np.ndarray | None, sharpness: np.ndarray | float | None
+) -> np.ndarray | None:
+    """Sharpness per edge, or None when nothing is creased."""
+    if creases is None:
+        if sharpness is not None:
+            raise ValueError("sharpness was given without creases")
+        return None
+    c = np.asarray(creases)
+    if c.size == 0:
+        return None
+    s = np.zeros(he.n_edges)
+    if c.ndim != 2 or c.shape[1] != 2 or not np.issubdtype(c.dtype, np.integer):
+        raise ValueError(f"creases must be an (k, 2) array of vertex pairs, got shape {c.shape}")
+    val = np.broadcast_to(np.inf if sharpness is None else np.asarray(sharpness, float), len(c))
+    if (val < 0).any() or np.isnan(val).any():
+        raise ValueError("crease sharpness must be >= 0 (inf for an infinitely sharp crease)")
+    n = max(he.n_vertices, 1)
+    lo, hi = np.minimum(c[:, 0], c[:, 1]), np.maximum(c[:, 0], c[:, 1])
+    ekey = he.edge_vertices[:, 0] * n + he.edge_vertices[:, 1]
+    ckey = lo * n + hi
+    i = np.minimum(np.searchsorted(ekey, ckey), ekey.size - 1)
+    missing = np.flatnonzero((ekey.size == 0) | (ekey[i] != ckey) | (lo < 0) | (hi >= n))
+    if missing.size:
+        a, b = c[missing[0]]
+        raise ValueError(f"crease ({a}, {b}) is not an edge of the mesh")
+    s[i] = np.maximum(s[i], val)
+    return s
+
+
+def _catmull_clark_step(
+    v: np.ndarray, lv: _Level, sharp: np.ndarray | None, last: bool
+) -> tuple[np.ndarray, _Level, np.ndarray | None]:
+    """One level; on the ``last`` one only the faces of the result are built."""
+    n = v.shape[0]
+    fi, fo, face, edge, ev = lv.face_indices, lv.face_offsets, lv.face, lv.edge, lv.edge_vertices
+    n_edges = ev.shape[0]
+    m = fi.size
+    sizes = np.diff(fo)
+
+    # face points: centroids
+    fp = _face_sums(v, fi, fo, lv.quads)
+    fp /= 4.0 if lv.quads else sizes[:, None]
+    fp_h = fp[face]
+
+    # edge points: (v0 + v1 + f0 + f1) / 4 inside, the midpoint on a boundary or crease
+    n_side = np.bincount(edge, minlength=n_edges)
+    va, vb = v[ev[:, 0]], v[ev[:, 1]]
+    mid = 0.5 * (va + vb)
+    ep = 0.5 * mid + 0.25 * _scatter(edge, fp_h, n_edges)
+    boundary_edge = n_side == 1
+    ep[boundary_edge] = mid[boundary_edge]
+    creased = np.zeros(n_edges, dtype=bool) if sharp is None else sharp > 0
+    if creased.any():
+        w = np.minimum(sharp[creased], 1.0)[:, None]  # semi-sharp: blend (DeRose et al. 1998)
+        ep[creased] = (1.0 - w) * ep[creased] + w * mid[creased]
+
+    # vertex points, smooth rule (Q + 2R + (n - 3) S) / n with n the valence:
+    # = (sum of face points + sum of edge neighbours) / n^2 + (n - 2) / n * S
+    k = np.bincount(fi, minlength=n).astype(np.float64)
+    ring = _scatter(fi, fp_h, n)
+    for c in range(3):  # edge neighbours: each edge adds its other end to both ends
+        ring[:, c] += np.bincount(ev[:, 0], vb[:, c], minlength=n)
+        ring[:, c] += np.bincount(ev[:, 1], va[:, c], minlength=n)
+    kk = np.maximum(k, 1.0)[:, None]
+    vp = ring / kk**2 + (kk - 2.0) / kk * v
+    # sharp rules: a vertex on two sharp edges (boundary or crease) follows the cubic
+    # B-spline curve rule 1/8, 6/8, 1/8; on more than two, or a boundary corner in a single
+    # face (valence 2), it stays put
+    sharp_edge = boundary_edge | creased
+    if sharp_edge.any():
+        se = np.flatnonzero(sharp_edge)
+        ends = ev[se].ravel()
+        n_sharp = np.bincount(ends, minlength=n)
+        s_e = np.inf if sharp is None else np.where(boundary_edge[se], np.inf, sharp[se])
+        s_e = np.broadcast_to(np.minimum(s_e, 1e300), se.shape)
+        s_v = np.bincount(ends, np.repeat(s_e, 2), minlength=n)
+        s_v /= np.maximum(n_sharp, 1)  # vertex sharpness: mean over its sharp edges
+        nb = _scatter(ends, np.stack([vb[se], va[se]], axis=1).reshape(-1, 3), n)
+        crease_v = n_sharp == 2
+        on_boundary = np.bincount(ev[boundary_edge].ravel(), minlength=n) > 0
+        s_v[on_boundary] = 1.0  # the smooth rule does not hold on a boundary
+        s_v = np.minimum(s_v, 1.0)
+        corner_v = (n_sharp > 2) | (crease_v & on_boundary & (k == 1))
+        crease_v &= ~corner_v
+        target = v.copy()
+        target[crease_v] = 0.125 * nb[crease_v] + 0.75 * v[crease_v]
+        hard = crease_v | corner_v
+        w = s_v[hard][:, None]
+        vp[hard] = (1.0 - w) * vp[hard] + w * target[hard]
+    vp[k == 0] = v[k == 0]  # vertices no face uses are carried along
+
+    new_v = np.concatenate([vp, ep, fp])
+
+    # connectivity: one quad per half-edge h = (vertex, edge point, face point, edge point)
+    h = np.arange(m, dtype=np.int64)
+    pe = edge[lv.prev]
+    quad = np.stack([fi, n + edge, n + n_edges + face, n + pe], axis=1)
+    m4 = 4 * m
+    face_offsets = np.arange(0, m4 + 1, 4, dtype=np.int64)
+    if last:
+        done = _Level(quad.reshape(-1), face_offsets, *(np.empty(0, np.int64),) * 4, True)
+        return new_v, done, None
+    # edges: old edge e splits into 2e (at ev[e, 0]) and 2e + 1 (at ev[e, 1]); the edge
+    # from the edge point of h to the face point is 2E + h
+    child = 2 * edge + (fi == ev[edge, 1])
+    child_prev = 2 * pe + (fi == ev[pe, 1])
+    new_edge = np.stack([child, 2 * n_edges + h, 2 * n_edges + lv.prev, child_prev], axis=1)
+    new_ev = np.empty((2 * n_edges + m, 2), dtype=np.int64)
+    new_ev[: 2 * n_edges, 0] = ev.ravel()
+    new_ev[: 2 * n_edges, 1] = np.repeat(n + np.arange(n_edges), 2)
+    new_ev[2 * n_edges :, 0] = n + edge
+    new_ev[2 * n_edges :, 1] = n + n_edges + face
+    prev4 = np.arange(m4, dtype=np.int64) - 1
+    prev4[::4] += 4
+    nxt = _Level(
+        face_indices=quad.reshape(-1),
+        face_offsets=face_offsets,
+        face=np.repeat(h, 4),
+        edge=new_edge.reshape(-1),
+        prev=prev4,
+        edge_vertices=new_ev,
+        quads=True,
+    )
+    if sharp is None or not (sharp > 1.0).any():
+        return new_v, nxt, None
+    return new_v, nxt, np.concatenate([np.repeat(np.maximum(sharp - 1.0, 0.0), 2), np.zeros(m)])
+
+
+def catmull_clark(
+    vertices: np.ndarray,
+    face_indices: np.ndarray,
+    face_offsets: np.ndarray,
+    levels: int = 1,
+    creases: np.ndarray | None = None,
+    sharpness: np.ndarray | float | None = None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Catmull-Clark subdivision of a polygon mesh (Catmull & Clark 1978).
+
+    Per level, on any polygons (after one level every face is a quad):
+
+    - face point: the centroid of the face;
+    - edge point: ``(v0 + v1 + f0 + f1) / 4``, the ends and the two face points;
+    - vertex point: ``(Q + 2R + (n - 3) S) / n`` with ``n`` the valence, ``Q`` the mean of
+      the adjacent face points, ``R`` the mean of the incident edge midpoints, ``S`` the
+      vertex;
+    - open boundaries follow the cubic B-spline curve rule: a boundary edge point is the
+      midpoint, a boundary vertex moves to ``1/8 a + 6/8 S + 1/8 b`` with ``a``, ``b`` its
+      boundary neighbours, and a corner (a boundary vertex in a single face, valence 2) or
+      a vertex on more than two boundary edges (non-manifold) stays where it is.
+
+    Each face of ``k`` corners becomes ``k`` quads (vertex, edge point, face point, edge
+    point), so ``F' = sum of face sizes``; ``V' = V + E + F``; the Euler characteristic is
+    kept.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+    face_indices : (m,) int
+    face_offsets : (n_faces + 1,) int
+        The mesh, faces counter-clockwise seen from outside.
+    levels : int
+        Number of subdivision steps (0 returns a copy).
+    creases : (k, 2) int, optional
+        Edges (vertex pairs) to keep sharp. A crease edge uses the boundary rules: its edge
+        point is the midpoint; a vertex on two creases follows the crease as a cubic
+        B-spline curve, a vertex on three or more stays put (a dart, on one, stays smooth).
+    sharpness : float or (k,) float, optional
+        Sharpness of each crease, ``inf`` by default. Semi-sharp creases (DeRose, Kass &
+        Truong 1998, "Subdivision surfaces in character animation"): an edge of sharpness
+        ``s`` uses the sharp rules for ``floor(s)`` levels, blends sharp and smooth by the
+        fractional part on the next, and is smooth afterwards; a vertex takes the mean
+        sharpness of its sharp edges.
+
+    Returns
+    -------
+    vertices : (n', 3) float64
+        The original vertices' new positions first (same indices), then one edge point per
+        edge, then one face point per face.
+    face_indices : (4 * n_faces',) int64
+    face_offsets : (n_faces' + 1,) int64
+        All quads.
+
+    Raises
+    ------
+    MeshTopologyError
+        When the faces are not an oriented manifold (see ``build_halfedges``).
+    ValueError
+        Bad vertex array, levels or creases.
+
+    Example
+    -------
+    >>> v, fi, fo = catmull_clark(np.eye(3), [0, 1, 2], [0, 3])
+    >>> v.shape, fo.size - 1
+    ((7, 3), 3)
+    """
+    v = _as_vertices(vertices)
+    levels = _check_levels(levels)
+    he = build_halfedges(face_indices, face_offsets, v.shape[0])
+    sharp = _edge_sharpness(he, creases, sharpness)
+    if levels == 0:
+        return v.copy(), np.array(he.origin), np.array(he.face_offsets)
+    lv = _Level.from_halfedges(he)
+    for level in range(levels):
+        v, lv, sharp = _catmull_clark_step(v, lv, sharp, last=level == levels - 1)
+    return v, lv.face_indices, lv.face_offsets
+
+
+def catmull_clark_counts(
+    n_vertices: int, n_edges: int, n_faces: int, n_halfedges: int, levels: int
+) -> list[tuple[int, int, int]]:
+    """(vertices, edges, faces) after each of ``levels`` Catmull-Clark steps, in closed form.
+
+    ``V' = V + E + F``, ``E' = 2E + H``, ``F' = H`` and ``H' = 4H``, with ``H`` the sum of
+    the face sizes.
+    """
+    out = []
+    v, e, f, h = n_vertices, n_edges, n_faces, n_halfedges
+    for _ in range(_check_levels(levels)):
+        v, e, f, h = v + e + f, 2 * e + h, h, 4 * h
+        out.append((v, e, f))
+    return out
+
+
+# --------------------------------------------------------------------------------------
+# Doo-Sabin
+# --------------------------------------------------------------------------------------
+
+
+def doo_sabin_weights(k: int) -> np.ndarray:
+    """Doo-Sabin weights of a ``k``-sided face: ``a0 = 1/4 + 5/(4k)``,
+    ``ai = (3 + 2 cos(2 pi i / k)) / (4k)``; they sum to 1.
+
+    Returns
+    -------
+    (k, k) float64
+        Circulant matrix: row ``i`` gives the new point of corner ``i`` from the corners.
+    """
+    i = np.arange(k)
+    a = (3.0 + 2.0 * np.cos(2.0 * np.pi * i / k)) / (4.0 * k)
+    a[0] = 0.25 + 5.0 / (4.0 * k)
+    return a[(i[None, :] - i[:, None]) % k]
+
+
+def _doo_sabin_step(v: np.ndarray, he: HalfEdges) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    fi, fo = he.origin, he.face_offsets
+    m = fi.size
+    sizes = he.face_sizes
+
+    # one new point per corner (half-edge), by the weights of its face's size
+    corner = np.empty((m, 3))
+    for k in np.unique(sizes):
+        faces = np.flatnonzero(sizes == k)
+        idx = fo[faces][:, None] + np.arange(k)
+        corner[idx] = np.einsum("ij,fjd->fid", doo_sabin_weights(int(k)), v[fi[idx]])
+
+    # boundary edges get two points at 1/4 and 3/4 (Chaikin), boundary corners keep theirs
+    b = he.boundary_halfedges
+    nb = b.size
+    a_b, z_b = v[he.origin[b]], v[he.vertex[b]]
+    chaikin = np.stack([0.75 * a_b + 0.25 * z_b, 0.25 * a_b + 0.75 * z_b], axis=1).reshape(-1, 3)
+    c_first = np.full(m, -1, dtype=np.int64)  # new id of the Chaikin point near origin(h)
+    c_first[b] = m + 2 * np.arange(nb)
+
+    fans = he.fans
+    fan_size = fans.sizes
+    fan_open = ~fans.closed
+    corner_fan = fan_open & (fan_size == 1) & he.is_manifold_vertex[fans.vertex]
+    kept = fans.vertex[corner_fan]
+    new_v = np.concatenate([corner, chaikin, v[kept]])
+
+    # F-faces: the corner points of each face, in the face's order
+    parts = [np.arange(m, dtype=np.int64)]
+    part_sizes = [sizes]
+    # E-faces: one quad per interior edge (h < twin) and per boundary edge
+    h = np.flatnonzero(he.twin > np.arange(m))
+    t = he.twin[h]
+    parts.append(np.stack([he.next[t], t, he.next[h], h], axis=1).reshape(-1))
+    parts.append(np.stack([c_first[b], c_first[b] + 1, he.next[b], b], axis=1).reshape(-1))
+    part_sizes.append(np.full(h.size + nb, 4, dtype=np.int64))
+    # V-faces: the corner points around each vertex, counter-clockwise; an open fan is
+    # closed by the Chaikin points on its two boundary edges (and a corner by the vertex)
+    out_size = fan_size + 2 * fan_open + corner_fan
+    # an interior vertex of valence 2 would give a 2-gon: leave it out (the two E-faces at
+    # the vertex then share that edge directly)
+    out_size[fans.closed & (fan_size == 2)] = 0
+    out_off = np.zeros(fan_size.size + 1, dtype=np.int64)
+    np.cumsum(out_size, out=out_off[1:])
+    vface = np.empty(out_off[-1], dtype=np.int64)
+    fan_of = np.repeat(np.arange(fan_size.size), fan_size)
+    rank = np.arange(m) - fans.offsets[fan_of]
+    placed = out_size[fan_of] > 0
+    vface[(out_off[fan_of] + fan_open[fan_of] + rank)[placed]] = fans.halfedges[placed]
+    op = np.flatnonzero(fan_open)
+    head = fans.halfedges[fans.offsets[op]]
+    tail = fans.halfedges[fans.offsets[op + 1] - 1]
+    vface[out_off[op]] = c_first[head]
+    vface[out_off[op] + 1 + fan_size[op]] = c_first[he.prev[tail]] + 1
+    cf = np.flatnonzero(corner_fan)
+    vface[out_off[cf] + 3] = m + 2 * nb + np.arange(cf.size)
+    parts.append(vface)
+    part_sizes.append(out_size[out_size > 0])
+
+    face_indices = np.concatenate(parts)
+    all_sizes = np.concatenate(part_sizes)
+    face_offsets = np.zeros(all_sizes.size + 1, dtype=np.int64)
+    np.cumsum(all_sizes, out=face_offsets[1:])
+    return new_v, face_indices, face_offsets
+
+
+def doo_sabin(
+    vertices: np.ndarray, face_indices: np.ndarray, face_offsets: np.ndarray, levels: int = 1
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Doo-Sabin subdivision of a polygon mesh (Doo & Sabin 1978).
+
+    Per level, every corner ``i`` of every ``k``-sided face gets a new point
+    ``sum_j a_|i-j| v_j`` with ``a0 = 1/4 + 5/(4k)``, ``ai = (3 + 2 cos(2 pi i/k)) / (4k)``
+    (:func:`doo_sabin_weights`), and the new mesh has
+
+    - an F-face per face: its new corner points (a shrunken copy, ``k`` sides);
+    - an E-face per interior edge: the quad of the four corner points at its ends;
+    - a V-face per interior vertex: the corner points around it (``valence`` sides; none
+      for an interior vertex of valence 2).
+
+    Boundaries: each boundary edge ``a -> b`` gets two new points ``3/4 a + 1/4 b`` and
+    ``1/4 a + 3/4 b`` (Chaikin's corner cutting, the boundary case of the same quadratic
+    B-spline scheme) and its E-face is the quad of those two points and the two corner
+    points beside it; a boundary vertex's V-face is its corner points closed by the Chaikin
+    points on its two boundary edges. So each boundary polygon is refined by Chaikin's rule
+    and converges to its uniform quadratic B-spline, except that a corner (a boundary vertex
+    in a single face, valence 2) is kept in its V-face and stays put, as Catmull-Clark
+    keeps it.
+
+    Two sheets that touch at a vertex (a non-manifold vertex) get a V-face each and come
+    apart, so the output is always manifold.
+
+    Counts per level: ``V' = H + 2B + C`` (``H`` the sum of face sizes, ``B`` boundary edges,
+    ``C`` corners), ``F' = F + E + V`` (vertices used by faces, less interior ones of
+    valence 2).
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+    face_indices : (m,) int
+    face_offsets : (n_faces + 1,) int
+        The mesh, faces counter-clockwise seen from outside.
+    levels : int
+        Number of subdivision steps (0 returns a copy).
+
+    Returns
+    -------
+    vertices : (n', 3) float64
+        Corner points (one per half-edge of the input, in face order), then the boundary
+        Chaikin points (two per boundary edge), then the kept corners.
+    face_indices : (m',) int64
+    face_offsets : (n_faces' + 1,) int64
+        F-faces, then E-faces (interior, then boundary), then V-faces.
+
+    Raises
+    ------
+    MeshTopologyError
+        When the faces are not an oriented manifold (see ``build_halfedges``).
+    """
+    v = _as_vertices(vertices)
+    levels = _check_levels(levels)
+    he = build_halfedges(face_indices, face_offsets, v.shape[0])
+    if levels == 0:
+        return v.copy(), np.array(he.origin), np.array(he.face_offsets)
+    v, fi, fo = _doo_sabin_step(v, he)
+    for _ in range(levels - 1):
+        v, fi, fo = _doo_sabin_step(v, build_halfedges(fi, fo, v.shape[0]))
+    return v, fi, fo
+
+
+def doo_sabin_counts(he: HalfEdges, levels: int) -> list[tuple[int, int, int]]:
+    """(vertices, edges, faces) after each of ``levels`` Doo-Sabin steps, in closed form.
+
+    With ``H`` half-edges, ``B`` boundary edges, ``C`` kept corners, ``P`` vertex fans and
+    ``D`` interior vertices of valence 2 (no V-face): ``V' = H + 2B + C``,
+    ``F' = F + E + P - D``, ``H' = 2H + 4E + 2B + C - 2D``, ``B' = 2B + C``,
+    ``E' = (H' + B') / 2``; after the first level every vertex is manifold, used and of
+    valence 3 or more, so ``P = V`` and ``D = 0``, and the corners stay corners.
+    """
+    fans = he.fans
+    two = int((fans.closed & (fans.sizes == 2)).sum())
+    corners = int((~fans.closed & (fans.sizes == 1) & he.is_manifold_vertex[fans.vertex]).sum())
+    n_fans = int(fans.vertex.size) - two
+    v, e, f, h = he.n_vertices, he.n_edges, he.n_faces, he.n_halfedges
+    b = int(he.boundary_halfedges.size)
+    out = []
+    for _ in range(_check_levels(levels)):
+        v, f, h, b = (
+            h + 2 * b + corners,
+            f + e + n_fans,
+            2 * h + 4 * e + 2 * b + corners - 2 * two,
+            2 * b + corners,
+        )
+        e = (h + b) // 2
+        n_fans, two = v, 0
+        out.append((v, e, f))
+    return out

@@ -1,0 +1,168 @@
+"""The graph as authored: params, nodes and their inputs, with the lines they came from.
+
+An input's authored value is parsed once into one of :class:`Literal`, :class:`Wire`,
+:class:`Expr` or :class:`Items` (a list holding wires or expressions), while the raw value
+is kept so that ``save()`` writes back exactly what the author wrote.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Union
+
+from .errors import ExpressionError
+from .expr import Compiled, compile_expression
+from .types import PortType
+
+
+@dataclass(frozen=True)
+class Literal:
+    value: Any
+
+
+@dataclass(frozen=True)
+class Wire:
+    node: str
+    output: str | None = None
+
+    def __str__(self) -> str:
+        return f"@{self.node}" + (f".{self.output}" if self.output else "")
+
+
+@dataclass(frozen=True)
+class Expr:
+    compiled: Compiled
+
+    @property
+    def text(self) -> str:
+        return self.compiled.text
+
+
+@dataclass(frozen=True)
+class Items:
+    items: tuple[Input, ...]
+
+
+Input = Union[Literal, Wire, Expr, Items]  # noqa: UP007 (a runtime alias)
+
+
+def parse_input(raw: Any) -> Input:
+    """Parse an authored input value.
+
+    ``"@node"`` / ``"@node.output"`` is a wire, ``"=..."`` an expression over the params,
+    ``{value: ...}`` an escaped literal; a list holding wires or expressions becomes
+    :class:`Items`; anything else is a literal.
+
+    Raises
+    ------
+    ExpressionError
+        For a malformed wire or expression.
+    """
+    if isinstance(raw, str):
+        if raw.startswith("@"):
+            target = raw[1:]
+            name, _, output = target.partition(".")
+            if not name or not _is_name(name) or (output and not _is_name(output)):
+                raise ExpressionError(
+                    f"{raw!r} is not a wire; write '@node' or '@node.output' (escape a literal "
+                    f"string starting with '@' as {{value: {raw!r}}})"
+                )
+            return Wire(name, output or None)
+        if raw.startswith("="):
+            return Expr(compile_expression(raw[1:]))
+        return Literal(raw)
+    if isinstance(raw, dict) and set(raw) == {"value"}:
+        return Literal(raw["value"])
+    if isinstance(raw, list):
+        items = tuple(parse_input(v) for v in raw)
+        if any(not isinstance(i, Literal) for i in items):
+            return Items(items)
+        return Literal([i.value for i in items])
+    return Literal(raw)
+
+
+def _is_name(text: str) -> bool:
+    return text.replace("-", "_").isidentifier()
+
+
+def wires_of(value: Input) -> list[Wire]:
+    if isinstance(value, Wire):
+        return [value]
+    if isinstance(value, Items):
+        return [w for i in value.items for w in wires_of(i)]
+    return []
+
+
+def exprs_of(value: Input) -> list[Expr]:
+    if isinstance(value, Expr):
+        return [value]
+    if isinstance(value, Items):
+        return [e for i in value.items for e in exprs_of(i)]
+    return []
+
+
+@dataclass
+class ParamDef:
+    """A graph parameter: default, optional declared type, range and doc."""
+
+    name: str
+    default: Any = None
+    type: PortType | None = None
+    type_name: str | None = None
+    min: float | None = None
+    max: float | None = None
+    doc: str = ""
+    line: int | None = None
+    long_form: bool = False
+
+    def to_yaml(self) -> Any:
+        if not self.long_form:
+            return self.default
+        out: dict[str, Any] = {}
+        if self.type_name is not None:
+            out["type"] = self.type_name
+        if self.default is not None or self.type_name is None:
+            out["default"] = self.default
+        if self.min is not None:
+            out["min"] = self.min
+        if self.max is not None:
+            out["max"] = self.max
+        if self.doc:
+            out["doc"] = self.doc
+        return out
+
+
+@dataclass
+class NodeDef:
+    """A node as authored: its name, type, raw inputs (in author order) and lines."""
+
+    name: str
+    type: str
+    raw: dict[str, Any] = field(default_factory=dict)
+    inputs: dict[str, Input] = field(default_factory=dict)
+    line: int | None = None
+    input_lines: dict[str, int] = field(default_factory=dict)
+    parse_errors: dict[str, str] = field(default_factory=dict)
+
+    @classmethod
+    def make(
+        cls,
+        name: str,
+        type_: str,
+        raw: dict[str, Any],
+        line: int | None = None,
+        input_lines: dict[str, int] | None = None,
+    ) -> NodeDef:
+        nd = cls(name, type_, dict(raw), {}, line, dict(input_lines or {}))
+        for port, value in raw.items():
+            try:
+                nd.inputs[port] = parse_input(value)
+            except ExpressionError as exc:
+                nd.parse_errors[port] = str(exc.problems[0].message)
+        return nd
+
+    def upstream(self) -> list[str]:
+        return [w.node for v in self.inputs.values() for w in wires_of(v)]
+
+    def to_yaml(self) -> dict[str, Any]:
+        return {"type": self.type, **self.raw}

@@ -1,0 +1,204 @@
+"""The node registry: one decorated, typed, documented function per node type.
+
+The registry is the single source of the YAML validation, the catalogue (``formgraph
+nodes``), the JSON Schema (``formgraph schema``) and ``docs/nodes.md``. A node is declared
+by its signature: parameter names are the ports, hints their types, defaults their
+defaults; the numpydoc ``Parameters`` section documents each port.
+"""
+
+from __future__ import annotations
+
+import functools
+import inspect
+import re
+import typing
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from . import safety
+from .errors import BudgetError
+from .types import PortType, Range, Variables, port_type
+
+__all__ = ["Context", "NodeSpec", "Port", "Range", "Variables", "node", "node_types", "REQUIRED"]
+
+DEFAULT_BUDGET = 50_000_000
+
+
+class _Required:
+    def __repr__(self) -> str:
+        return "REQUIRED"
+
+
+REQUIRED: Any = _Required()
+
+
+@dataclass(frozen=True)
+class Port:
+    """One input of a node type."""
+
+    name: str
+    type: PortType
+    default: Any = REQUIRED
+    doc: str = ""
+
+    @property
+    def required(self) -> bool:
+        return self.default is REQUIRED
+
+
+@dataclass(frozen=True)
+class NodeSpec:
+    """A registered node type: its function, ports, outputs and documentation."""
+
+    name: str
+    func: Callable[..., Any]
+    version: int
+    inputs: dict[str, Port]
+    outputs: dict[str, PortType]
+    summary: str
+    doc: str
+    wants_context: bool
+    multi_output: bool = False
+    output_class: Any = None  # the NamedTuple of a node with several outputs
+
+    @property
+    def family(self) -> str:
+        return self.name.split(".", 1)[0]
+
+    @functools.cached_property
+    def is_export(self) -> bool:
+        return any(p.type.is_output_path for p in self.inputs.values())
+
+    def output_type(self, output: str | None) -> PortType:
+        if output is None:
+            return next(iter(self.outputs.values()))
+        return self.outputs[output]
+
+
+_REGISTRY: dict[str, NodeSpec] = {}
+
+
+def node(name: str, *, version: int = 1) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
+    """Register a function as the node type ``name`` (e.g. ``"points.circle"``).
+
+    ``version`` is part of every cache key: bump it when the node's results change.
+    """
+    if not re.fullmatch(r"[a-z][a-z0-9_]*\.[a-z][a-z0-9_]*", name):
+        raise ValueError(f"node type names are 'family.name' in lower case, got {name!r}")
+
+    def register(func: Callable[..., Any]) -> Callable[..., Any]:
+        if name in _REGISTRY and _REGISTRY[name].func.__qualname__ != func.__qualname__:
+            raise ValueError(f"node type {name!r} is registered twice")
+        _REGISTRY[name] = _spec_from_function(name, version, func)
+        return func
+
+    return register
+
+
+def node_types() -> dict[str, NodeSpec]:
+    """Every registered node type, by name (importing the node families first)."""
+    import formgraph.nodes  # noqa: F401  (registers the families on import)
+
+    return dict(sorted(_REGISTRY.items()))
+
+
+def _spec_from_function(name: str, version: int, func: Callable[..., Any]) -> NodeSpec:
+    hints = typing.get_type_hints(func, include_extras=True)
+    sig = inspect.signature(func)
+    docs = parse_param_docs(func.__doc__ or "")
+    inputs: dict[str, Port] = {}
+    wants_context = False
+    for pname, p in sig.parameters.items():
+        hint = hints.get(pname)
+        if hint is Context:
+            wants_context = True
+            continue
+        if hint is None:
+            raise TypeError(f"node {name!r}: port {pname!r} has no type hint")
+        default = REQUIRED if p.default is inspect.Parameter.empty else p.default
+        inputs[pname] = Port(pname, port_type(hint), default, docs.get(pname, ""))
+    ret = hints.get("return")
+    if ret is None:
+        raise TypeError(f"node {name!r} has no return type hint")
+    multi = isinstance(ret, type) and issubclass(ret, tuple) and hasattr(ret, "_fields")
+    if multi:
+        outputs = {f: port_type(t) for f, t in typing.get_type_hints(ret).items()}
+    else:
+        outputs = {"out": port_type(ret)}
+    doc = inspect.cleandoc(func.__doc__ or "")
+    summary = doc.split("\n\n", 1)[0].replace("\n", " ").strip()
+    return NodeSpec(
+        name,
+        func,
+        version,
+        inputs,
+        outputs,
+        summary,
+        doc,
+        wants_context,
+        multi,
+        ret if multi else None,
+    )
+
+
+def parse_param_docs(doc: str) -> dict[str, str]:
+    """Port descriptions from a numpydoc ``Parameters`` section."""
+    lines = inspect.cleandoc(doc).splitlines()
+    out: dict[str, str] = {}
+    try:
+        start = next(i for i, ln in enumerate(lines) if ln.strip() == "Parameters")
+    except StopIteration:
+        return out
+    current: str | None = None
+    for ln in lines[start + 2 :]:
+        if ln.strip() and not ln.startswith(" ") and not re.match(r"^[\w, ]+ ?:", ln):
+            break  # next section title
+        if re.match(r"^---", ln.strip()):
+            break
+        m = re.match(r"^([\w, ]+?)\s*:", ln)
+        if m and not ln.startswith(" "):
+            names = [n.strip() for n in m.group(1).split(",")]
+            current = ",".join(names)
+            for n in names:
+                out[n] = ""
+        elif current and ln.strip():
+            for n in current.split(","):
+                out[n] = (out[n] + " " + ln.strip()).strip()
+        elif not ln.strip() and current is None:
+            continue
+    # a section header that follows (e.g. 'Returns' then '-----') ends the list
+    return {k: v for k, v in out.items() if k not in ("Returns", "Raises", "Example", "Examples")}
+
+
+@dataclass
+class Context:
+    """What a running node may use besides its inputs: budget, output directory, warnings.
+
+    Passed to node functions that declare a keyword-only ``ctx: Context`` parameter.
+    """
+
+    node: str
+    out_dir: Path
+    budget: int = DEFAULT_BUDGET
+    warnings: list[str] = field(default_factory=list)
+    written: list[Path] = field(default_factory=list)
+
+    def guard(self, elements: int | float, what: str = "elements") -> None:
+        """Refuse, before allocating, an output of more than the element budget."""
+        if elements > self.budget:
+            raise BudgetError(
+                f"would make {int(elements):,} {what}, over the budget of "
+                f"{self.budget:,} (raise it with budget= or --budget if you mean it)"
+            )
+
+    def write(self, path: str, data: bytes) -> Path:
+        """Write ``data`` atomically to ``path`` inside the output directory."""
+        target = safety.write_atomic(self.out_dir, path, data)
+        self.written.append(target)
+        return target
+
+    def warn(self, message: str) -> None:
+        """Record a warning in this node's stats (shown by the CLI)."""
+        self.warnings.append(message)

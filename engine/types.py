@@ -1,0 +1,362 @@
+"""Port types: the Python classes that type node inputs and outputs.
+
+A port's type hint (``int``, ``Vec3``, ``list[Curve]``, ``Mesh | None``,
+``Annotated[int, Range(min=1)]``, an ``Enum``) becomes a :class:`PortType`, which knows
+how to check a wire (subtypes accepted, a single item where a list is asked) and how to
+coerce a YAML literal into the value the node function receives (nothing else is coerced).
+"""
+
+from __future__ import annotations
+
+import enum
+import functools
+import types as _pytypes
+import typing
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from .geometry import (
+    Curve,
+    Geometry,
+    Mesh,
+    NurbsCurve,
+    NurbsSurface,
+    Points,
+    Surface,
+    as_xyz,
+    frozen_array,
+)
+
+
+class Vec3:
+    """A 3-vector port: ``[x, y]`` or ``[x, y, z]``; the node gets a read-only (3,) array."""
+
+
+class Faces(list):
+    """A list of faces, each a list of vertex indices (``list[list[int]]``)."""
+
+    port_name = "list[list[int]]"
+
+
+class Expression(str):
+    """An expression port (text in the node's variables and the graph params)."""
+
+
+class OutputPath(str):
+    """A relative output path, checked not to leave the output directory."""
+
+
+@dataclass(frozen=True)
+class Range:
+    """Inclusive bounds of a numeric port, checked at load."""
+
+    min: float | None = None
+    max: float | None = None
+
+    def check(self, value: float) -> str | None:
+        if self.min is not None and value < self.min:
+            return f"must be >= {self.min:g}, got {value:g}"
+        if self.max is not None and value > self.max:
+            return f"must be <= {self.max:g}, got {value:g}"
+        return None
+
+
+@dataclass(frozen=True)
+class Variables:
+    """The variables an :class:`Expression` port's text may use besides the params."""
+
+    names: tuple[str, ...]
+
+    def __init__(self, *names: str):
+        object.__setattr__(self, "names", tuple(names))
+
+
+class TypeMismatch(ValueError):
+    """A literal or wire that does not fit a port."""
+
+
+GEOMETRY_TYPES: dict[str, type] = {
+    "Points": Points,
+    "Curve": Curve,
+    "NurbsCurve": NurbsCurve,
+    "Surface": Surface,
+    "NurbsSurface": NurbsSurface,
+    "Mesh": Mesh,
+}
+SCALARS: dict[str, type] = {"int": int, "float": float, "bool": bool, "str": str}
+
+
+@dataclass(frozen=True)
+class Kind:
+    """One alternative of a port type: a base class, as an item or as a list of items."""
+
+    base: Any
+    is_list: bool = False
+
+    @property
+    def name(self) -> str:
+        n = getattr(self.base, "port_name", None) or getattr(self.base, "__name__", str(self.base))
+        return f"list[{n}]" if self.is_list else n
+
+
+@dataclass(frozen=True)
+class PortType:
+    """The type of a port: one or more :class:`Kind` alternatives, maybe optional."""
+
+    kinds: tuple[Kind, ...]
+    optional: bool = False
+    range: Range | None = None
+    variables: tuple[str, ...] = ()
+
+    @property
+    def name(self) -> str:
+        return " | ".join(k.name for k in self.kinds)
+
+    @functools.cached_property
+    def is_expression(self) -> bool:
+        return any(k.base is Expression for k in self.kinds)
+
+    @functools.cached_property
+    def is_output_path(self) -> bool:
+        return any(k.base is OutputPath for k in self.kinds)
+
+    @functools.cached_property
+    def is_geometry(self) -> bool:
+        return any(_is_geometry(k.base) for k in self.kinds)
+
+    @property
+    def enum(self) -> type[enum.Enum] | None:
+        for k in self.kinds:
+            if isinstance(k.base, type) and issubclass(k.base, enum.Enum):
+                return k.base
+        return None
+
+    def accepts(self, other: PortType) -> bool:
+        """Whether a wire carrying ``other`` may feed this port."""
+        if any(k.base is Any for k in self.kinds):
+            return True
+        return all(any(_kind_accepts(k, o) for k in self.kinds) for o in other.kinds)
+
+    def coerce(self, value: Any) -> Any:
+        """The value a node function receives for the literal ``value``.
+
+        Raises
+        ------
+        TypeMismatch
+            With a sentence saying what was expected and what came.
+        """
+        if value is None:
+            if self.optional:
+                return None
+            raise TypeMismatch(f"expected {self.name}, got nothing (null)")
+        errors = []
+        for k in self.kinds:
+            try:
+                out = _coerce_kind(k, value)
+            except TypeMismatch as exc:
+                errors.append(str(exc))
+                continue
+            if self.range is not None:
+                for x in _numbers(out):
+                    msg = self.range.check(x)
+                    if msg:
+                        raise TypeMismatch(msg)
+            return out
+        if len(errors) == 1:
+            raise TypeMismatch(errors[0])
+        raise TypeMismatch(f"expected {self.name}, got {describe(value)}")
+
+
+def _is_geometry(base: Any) -> bool:
+    return isinstance(base, type) and issubclass(base, Geometry)
+
+
+def _kind_accepts(k: Kind, o: Kind) -> bool:
+    if not (isinstance(o.base, type) and isinstance(k.base, type)):
+        return k.base is o.base
+    same = issubclass(o.base, k.base) or (k.base is float and o.base is int)
+    if not same:
+        return False
+    return k.is_list or not o.is_list
+
+
+def _numbers(value: Any) -> list[float]:
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        return [value]
+    if isinstance(value, list) and all(isinstance(v, (int, float)) for v in value):
+        return [v for v in value if not isinstance(v, bool)]
+    return []
+
+
+def describe(value: Any) -> str:
+    """A short description of a value for error messages: its type and a glimpse."""
+    if isinstance(value, Geometry):
+        return type(value).__name__
+    if isinstance(value, bool):
+        return f"bool {value}"
+    if isinstance(value, (int, float)):
+        return f"{type(value).__name__} {value!r}"
+    if isinstance(value, str):
+        return f"string {value!r}" if len(value) < 40 else f"string {value[:37]!r}..."
+    if isinstance(value, list):
+        return f"list of {len(value)}"
+    if isinstance(value, dict):
+        return "mapping"
+    return type(value).__name__
+
+
+def _coerce_kind(k: Kind, value: Any) -> Any:
+    if k.is_list:
+        if isinstance(value, (list, tuple)):
+            if k.base is Vec3:
+                return _vec_list(value)
+            return [_coerce_kind(Kind(k.base), v) for v in value]
+        if k.base is Vec3 and isinstance(value, np.ndarray) and value.ndim == 2:
+            return _vec_list(value)
+        # a single item is accepted where a list is asked
+        return [_coerce_kind(Kind(k.base), value)]
+    base = k.base
+    if base is Any:
+        return value
+    if base is bool:
+        if isinstance(value, (bool, np.bool_)):
+            return bool(value)
+        raise TypeMismatch(f"expected bool, got {describe(value)}")
+    if base is int:
+        if isinstance(value, (bool, np.bool_)):
+            raise TypeMismatch(f"expected int, got {describe(value)}")
+        if isinstance(value, (int, np.integer)):
+            return int(value)
+        if isinstance(value, (float, np.floating)) and float(value).is_integer():
+            return int(value)
+        raise TypeMismatch(f"expected int, got {describe(value)}")
+    if base is float:
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.number)):
+            raise TypeMismatch(f"expected float, got {describe(value)}")
+        try:
+            f = float(value)
+        except OverflowError:
+            raise TypeMismatch(
+                f"expected a float, got a number too large ({describe(value)[:40]})"
+            ) from None
+        if not np.isfinite(f):
+            raise TypeMismatch(f"expected a finite float, got {f}")
+        return f
+    if base in (str, Expression, OutputPath):
+        if isinstance(value, str):
+            return value
+        raise TypeMismatch(f"expected {base.__name__}, got {describe(value)}")
+    if base is Vec3:
+        return _vec3(value)
+    if base is Faces:
+        return _faces(value)
+    if isinstance(base, type) and issubclass(base, enum.Enum):
+        try:
+            return base(value)
+        except ValueError:
+            options = ", ".join(repr(m.value) for m in base)
+            raise TypeMismatch(
+                f"{value!r} is not a valid option, must be one of {options}"
+            ) from None
+    if base is Points and not isinstance(value, Geometry):
+        try:
+            return Points(value)
+        except ValueError as exc:
+            raise TypeMismatch(
+                f"expected Points (a list of [x, y, z]), got {describe(value)}: {exc}"
+            ) from None
+    if isinstance(base, type) and isinstance(value, base):
+        return value
+    raise TypeMismatch(f"expected {base.__name__}, got {describe(value)}")
+
+
+def _vec3(value: Any) -> np.ndarray:
+    if isinstance(value, (list, tuple)) and any(isinstance(v, (str, bool)) for v in value):
+        raise TypeMismatch(f"expected [x, y] or [x, y, z] numbers, got {describe(value)}")
+    try:
+        a = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError, OverflowError):
+        raise TypeMismatch(f"expected [x, y] or [x, y, z], got {describe(value)}") from None
+    if a.shape not in ((2,), (3,)) or not np.all(np.isfinite(a)):
+        raise TypeMismatch(f"expected [x, y] or [x, y, z], got {describe(value)}")
+    return frozen_array(np.append(a, 0.0) if a.size == 2 else a)
+
+
+def _faces(value: Any) -> Faces:
+    if not isinstance(value, (list, tuple)) or not value:
+        raise TypeMismatch(
+            f"expected a list of faces (lists of vertex indices), got {describe(value)}"
+        )
+    out = Faces()
+    for i, face in enumerate(value):
+        if not isinstance(face, (list, tuple)) or not all(
+            isinstance(x, (int, np.integer)) and not isinstance(x, bool) for x in face
+        ):
+            raise TypeMismatch(f"face {i} must be a list of vertex indices, got {describe(face)}")
+        out.append([int(x) for x in face])
+    return out
+
+
+def _vec_list(value: Any) -> np.ndarray:
+    try:
+        return as_xyz(value, "coordinates")
+    except ValueError as exc:
+        raise TypeMismatch(str(exc)) from None
+
+
+def port_type(hint: Any) -> PortType:
+    """Turn a type hint into a :class:`PortType`."""
+    rng: Range | None = None
+    variables: tuple[str, ...] = ()
+    if typing.get_origin(hint) is typing.Annotated:
+        hint, *extras = typing.get_args(hint)
+        for x in extras:
+            if isinstance(x, Range):
+                rng = x
+            elif isinstance(x, Variables):
+                variables = x.names
+    optional = False
+    alternatives = [hint]
+    if typing.get_origin(hint) in (typing.Union, _pytypes.UnionType):
+        alternatives = list(typing.get_args(hint))
+    kinds = []
+    for alt in alternatives:
+        if alt is type(None):
+            optional = True
+            continue
+        if typing.get_origin(alt) is list:
+            (item,) = typing.get_args(alt)
+            kinds.append(Kind(item, True))
+        else:
+            kinds.append(Kind(alt, False))
+    return PortType(tuple(kinds), optional, rng, variables)
+
+
+def type_by_name(name: str) -> PortType:
+    """The port type for a name written in YAML (param ``type:``), e.g. ``list[Curve]``."""
+    text = name.strip()
+    is_list = text.startswith("list[") and text.endswith("]")
+    inner = text[5:-1].strip() if is_list else text
+    base = GEOMETRY_TYPES.get(inner) or SCALARS.get(inner) or {"Vec3": Vec3}.get(inner)
+    if base is None:
+        known = ", ".join([*GEOMETRY_TYPES, *SCALARS, "Vec3"])
+        raise TypeMismatch(f"unknown type {name!r} (known: {known}, and list[...] of them)")
+    return PortType((Kind(base, is_list),))
+
+
+def type_of_value(value: Any) -> PortType:
+    """The port type a runtime value has (for params supplied from Python)."""
+    if isinstance(value, list) and value and all(isinstance(v, Geometry) for v in value):
+        return PortType((Kind(_common_base([type(v) for v in value]), True),))
+    if isinstance(value, bool):
+        return PortType((Kind(bool),))
+    return PortType((Kind(type(value)),))
+
+
+def _common_base(classes: list[type]) -> type:
+    for cls in classes[0].__mro__:
+        if all(issubclass(c, cls) for c in classes):
+            return cls
+    return object

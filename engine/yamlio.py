@@ -1,0 +1,256 @@
+"""Reading and writing graph files.
+
+Reading uses PyYAML's safe loader only: the text is composed into a node tree (to keep the
+line of every node and input), then each value is built by the safe constructor, so a
+``!!python/...`` tag is refused with its line. Duplicate keys, which YAML would silently
+resolve to the last one, are reported.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import yaml
+
+from .errors import Problem, Where
+from .model import NodeDef, ParamDef
+from .types import TypeMismatch, type_by_name
+
+FORMAT_VERSION = 1
+MAX_BYTES = 16 * 1024 * 1024
+MAX_VALUES = 2_000_000  # scalars and collections, with aliases expanded
+MAX_DEPTH = 64
+TOP_KEYS = ("formgraph", "description", "params", "nodes")
+
+
+@dataclass
+class Document:
+    description: str = ""
+    params: dict[str, ParamDef] = field(default_factory=dict)
+    nodes: dict[str, NodeDef] = field(default_factory=dict)
+    problems: list[Problem] = field(default_factory=list)
+
+
+def _expansion_problem(root: yaml.Node | None) -> str | None:
+    """Why the composed tree is too big to read (an alias bomb, absurd nesting), or None.
+
+    Walks the tree without recursion, counting every node as often as aliases repeat it.
+    """
+    if root is None:
+        return None
+    count = 0
+    distinct: set[int] = set()
+    stack: list[tuple[yaml.Node, int]] = [(root, 0)]
+    while stack:
+        node, depth = stack.pop()
+        count += 1
+        distinct.add(id(node))
+        # text cannot hold more values than it has characters; only aliases multiply them
+        if count > MAX_VALUES or (count > 100_000 and count > 4 * len(distinct)):
+            return (
+                f"the YAML's aliases expand to more than {min(count, MAX_VALUES):,} values "
+                f"(aliases of aliases?); refusing to read it"
+            )
+        if depth > MAX_DEPTH:
+            return f"the YAML is nested too deeply (more than {MAX_DEPTH} levels)"
+        if isinstance(node, yaml.SequenceNode):
+            stack.extend((v, depth + 1) for v in node.value)
+        elif isinstance(node, yaml.MappingNode):
+            for k, v in node.value:
+                stack.append((k, depth + 1))
+                stack.append((v, depth + 1))
+    return None
+
+
+def _line(node: yaml.Node) -> int:
+    return node.start_mark.line + 1
+
+
+def _construct(node: yaml.Node) -> Any:
+    constructor = yaml.constructor.SafeConstructor()
+    return constructor.construct_document(node)
+
+
+def parse(text: str, file: str = "<graph>") -> Document:
+    """Parse graph text into a :class:`Document`; problems are collected, not raised."""
+    doc = Document()
+
+    def problem(
+        message: str, line: int | None = None, node: str | None = None, input: str | None = None
+    ) -> None:
+        doc.problems.append(Problem(Where(file, line, node, input), message))
+
+    if len(text.encode()) > MAX_BYTES:
+        problem(f"the file is larger than {MAX_BYTES // (1024 * 1024)} MiB")
+        return doc
+    try:
+        root = yaml.compose(text, Loader=yaml.SafeLoader)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        problem(
+            f"not valid YAML: {getattr(exc, 'problem', None) or exc}",
+            mark.line + 1 if mark else None,
+        )
+        return doc
+    except RecursionError:
+        problem(f"the YAML is nested too deeply (more than {MAX_DEPTH} levels)")
+        return doc
+    too_big = _expansion_problem(root)
+    if too_big:
+        problem(too_big)
+        return doc
+    if root is None or not isinstance(root, yaml.MappingNode):
+        problem("a graph file is a mapping with 'formgraph: 1' and 'nodes:'", 1)
+        return doc
+
+    top: dict[str, tuple[yaml.Node, yaml.Node]] = {}
+    for k, v in root.value:
+        key = _scalar_key(k)
+        if key in top:
+            problem(f"'{key}' appears twice", _line(k))
+        elif key not in TOP_KEYS:
+            problem(f"unknown top-level key '{key}' (expected {', '.join(TOP_KEYS)})", _line(k))
+        top[key] = (k, v)
+
+    if "formgraph" not in top:
+        problem("missing 'formgraph: 1' (the format version)", 1)
+    else:
+        k, v = top["formgraph"]
+        version = _value(v, problem, None, None)
+        if isinstance(version, bool) or version != FORMAT_VERSION:
+            problem(
+                f"format version {version!r} is not supported (this formgraph reads "
+                f"{FORMAT_VERSION})",
+                _line(k),
+            )
+
+    if "description" in top:
+        desc = _value(top["description"][1], problem, None, None)
+        doc.description = "" if desc is None else str(desc)
+
+    if "params" in top:
+        k, v = top["params"]
+        if isinstance(v, yaml.MappingNode):
+            for pk, pv in v.value:
+                name = _scalar_key(pk)
+                if name in doc.params:
+                    problem(f"param '{name}' is declared twice", _line(pk))
+                    continue
+                param = _param(name, pv, problem)
+                if param is not None:
+                    doc.params[name] = param
+        elif not (isinstance(v, yaml.ScalarNode) and v.value in ("", "null", "~")):
+            problem("'params' must be a mapping of name: default or name: {default: ...}", _line(k))
+
+    if "nodes" not in top:
+        problem("missing 'nodes:' (a mapping of node name to its type and inputs)", 1)
+        return doc
+    k, v = top["nodes"]
+    if not isinstance(v, yaml.MappingNode):
+        problem("'nodes' must be a mapping of node name to {type: ..., inputs...}", _line(k))
+        return doc
+    for nk, nv in v.value:
+        name = _scalar_key(nk)
+        line = _line(nk)
+        if name in doc.nodes:
+            problem("node name appears twice", line, name)
+            continue
+        if not name.replace("-", "_").isidentifier():
+            problem(
+                "node names are letters, digits, '_' and '-', not starting with a digit", line, name
+            )
+        if name in doc.params:
+            problem(f"the name '{name}' is both a param and a node", line, name)
+        if not isinstance(nv, yaml.MappingNode):
+            problem("a node is a mapping with 'type:' and its inputs", line, name)
+            continue
+        raw: dict[str, Any] = {}
+        lines: dict[str, int] = {}
+        unreadable: dict[str, str] = {}
+        node_type = None
+        for ik, iv in nv.value:
+            port = _scalar_key(ik)
+            if port in raw or (port == "type" and node_type is not None):
+                problem("input appears twice", _line(ik), name, port)
+                continue
+            bad: list[str] = []
+            value = _value(iv, lambda msg, *a, bad=bad: bad.append(msg), name, port)
+            if port == "type":
+                node_type = value
+                bad and problem(bad[0], _line(ik), name)
+                continue
+            raw[port] = value
+            lines[port] = _line(ik)
+            if bad:
+                unreadable[port] = bad[0]
+        if not isinstance(node_type, str):
+            problem("missing 'type:' (e.g. type: points.circle)", line, name)
+            node_type = ""
+        nd = NodeDef.make(name, node_type, raw, line, lines)
+        nd.parse_errors.update(unreadable)
+        doc.nodes[name] = nd
+    return doc
+
+
+def _scalar_key(node: yaml.Node) -> str:
+    return str(node.value) if isinstance(node, yaml.ScalarNode) else "<complex key>"
+
+
+def _value(node: yaml.Node, problem: Any, where_node: str | None, port: str | None) -> Any:
+    try:
+        return _construct(node)
+    except yaml.YAMLError as exc:
+        problem(
+            f"cannot read this value: {getattr(exc, 'problem', None) or exc} (only plain "
+            f"YAML data is allowed; no !!python tags)",
+            _line(node),
+            where_node,
+            port,
+        )
+        return None
+
+
+def _param(name: str, node: yaml.Node, problem: Any) -> ParamDef | None:
+    line = _line(node)
+    value = _value(node, problem, None, None)
+    if not isinstance(value, dict):
+        return ParamDef(name, value, line=line)
+    unknown = set(value) - {"default", "min", "max", "doc", "type"}
+    if unknown:
+        problem(
+            f"param '{name}': unknown key(s) {', '.join(sorted(map(str, unknown)))} "
+            f"(expected default, min, max, doc, type)",
+            line,
+        )
+    p = ParamDef(
+        name, value.get("default"), line=line, long_form=True, doc=str(value.get("doc", "") or "")
+    )
+    for bound in ("min", "max"):
+        b = value.get(bound)
+        if b is not None and (isinstance(b, bool) or not isinstance(b, (int, float))):
+            problem(f"param '{name}': {bound} must be a number, got {b!r}", line)
+        else:
+            setattr(p, bound, b)
+    if "type" in value:
+        p.type_name = str(value["type"])
+        try:
+            p.type = type_by_name(p.type_name)
+        except TypeMismatch as exc:
+            problem(f"param '{name}': {exc}", line)
+    elif "default" not in value:
+        problem(f"param '{name}' needs a default (or a type, for geometry given from Python)", line)
+    return p
+
+
+def dump(description: str, params: dict[str, ParamDef], nodes: dict[str, NodeDef]) -> str:
+    """The YAML text of a graph, in author order, that :func:`parse` reads back equal."""
+    data: dict[str, Any] = {"formgraph": FORMAT_VERSION}
+    if description:
+        data["description"] = description
+    if params:
+        data["params"] = {n: p.to_yaml() for n, p in params.items()}
+    data["nodes"] = {n: nd.to_yaml() for n, nd in nodes.items()}
+    return yaml.safe_dump(
+        data, sort_keys=False, default_flow_style=None, allow_unicode=True, width=100
+    )

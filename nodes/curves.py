@@ -1,0 +1,317 @@
+"""Curves from points: polylines, Bezier chains, Catmull-Rom splines, subdivision, offsets."""
+
+from __future__ import annotations
+
+from enum import Enum
+from typing import Annotated, Any
+
+import numpy as np
+
+from formgraph.errors import InputError
+from formgraph.geometry import Curve, NurbsCurve, ParametricCurve, Points
+from formgraph.kernels import curves as kc
+from formgraph.registry import Context, Range, node
+from formgraph.types import Expression, Variables
+
+
+@node("curves.polyline", version=1)
+def polyline(points: Points, closed: bool = False) -> NurbsCurve:
+    """The straight segments through the points, as an exact degree-1 NURBS curve.
+
+    The parameter runs along the arc length (knots are the cumulative chord lengths).
+
+    Parameters
+    ----------
+    points : Points
+        At least two distinct points, in order.
+    closed : bool
+        Join the last point back to the first.
+    """
+    return NurbsCurve.polyline(points.xyz, closed=closed)
+
+
+class Spacing(str, Enum):
+    """Knot spacing of a Catmull-Rom spline: interval |P[i+1] - P[i]| ** alpha."""
+
+    uniform = "uniform"  # alpha = 0
+    centripetal = "centripetal"  # alpha = 1/2: no cusps or self-intersections in a segment
+    chordal = "chordal"  # alpha = 1
+
+
+class Ends(str, Enum):
+    """How an open Catmull-Rom spline treats its first and last points."""
+
+    processing = "processing"  # they only shape the end tangents (curveVertex)
+    clamped = "clamped"  # the curve passes through them too
+
+
+def _polyline(points: np.ndarray, closed: bool) -> NurbsCurve:
+    """A degree-1 curve through ``points``, merging repeated consecutive points (a
+    subdivided or offset polygon can repeat a point; a polyline needs no zero spans)."""
+    p = kc.drop_repeats(points, closed)
+    for _ in range(3):  # NurbsCurve.polyline's knots are cumulative chords: keep them distinct
+        ring = np.vstack([p, p[:1]]) if closed else p
+        cum = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(ring, axis=0), axis=1))])
+        grows = np.diff(cum) > 0.0
+        keep = np.concatenate([[True], grows[: len(p) - 1]])
+        if closed and not grows[-1]:
+            keep[-1] = False
+        if keep.all():
+            break
+        p = p[keep]
+    if len(p) < 2:
+        raise ValueError("the result has fewer than two distinct points")
+    return NurbsCurve.polyline(p, closed=closed)
+
+
+def _kernel(port: str, fn: Any, *args: Any, **kwargs: Any) -> Any:
+    """Call a kernel; its ValueError names the node input it is about."""
+    try:
+        return fn(*args, **kwargs)
+    except ValueError as exc:
+        raise InputError(port, str(exc)) from None
+
+
+@node("curves.bezier", version=1)
+def bezier(points: Points) -> NurbsCurve:
+    """A chain of cubic Bezier segments, laid out as Processing's bezierVertex; exact.
+
+    The first point starts the chain; each segment then takes (control, control, end), so
+    the count is 4, 7, 10, ... Each segment is one span of the cubic NURBS (interior knots
+    of multiplicity 3); the parameter runs 0..1 over the first segment, 1..2 over the
+    second, and so on.
+
+    Parameters
+    ----------
+    points : Points
+        3k + 1 points: start, then control, control, end per segment.
+
+    Example
+    -------
+    ``s: {type: curves.bezier, points: [[0, 0], [1, 2], [3, 2], [4, 0]]}``
+    """
+    return NurbsCurve(*_kernel("points", kc.bezier_chain, points.xyz))
+
+
+@node("curves.catmull_rom", version=1)
+def catmull_rom(
+    points: Points,
+    closed: bool = False,
+    tension: float = 0.0,
+    spacing: Spacing = Spacing.uniform,
+    ends: Ends = Ends.processing,
+) -> NurbsCurve:
+    """A Catmull-Rom spline through the points, converted exactly to a cubic NURBS curve.
+
+    Each segment is one Bezier piece; knots are the spline's own parameter values, so the
+    curve is C1 at every point it passes (and across the seam when closed). Repeated
+    consecutive points are dropped. Centripetal spacing (Yuksel et al. 2011) never makes
+    a cusp or a loop within a segment, whatever the spacing of the points; uniform is
+    Processing's curveVertex.
+
+    Parameters
+    ----------
+    points : Points
+        The points to pass through (at least 2 distinct; 4 with ends: processing).
+    closed : bool
+        Join the last point back to the first, smoothly.
+    tension : float
+        Processing's curveTightness: 0 is Catmull-Rom, 1 straight segments; tangents are
+        scaled by (1 - tension).
+    spacing : Spacing
+        Knot spacing: uniform, centripetal or chordal.
+    ends : Ends
+        Open curves: processing (the first and last points only shape the end tangents) or
+        clamped (the curve passes through every point).
+    """
+    result = _kernel(
+        "points",
+        kc.catmull_rom,
+        points.xyz,
+        closed=closed,
+        tension=tension,
+        spacing=spacing.value,
+        ends=ends.value,
+    )
+    return NurbsCurve(*result)
+
+
+def _control_polygon(curve: Curve) -> tuple[np.ndarray, bool]:
+    """The control polygon of a NURBS curve (or the drawn polyline of any other curve),
+    without the repeated closing point, and whether it is closed."""
+    if isinstance(curve, NurbsCurve):
+        p = np.asarray(curve.control_points)
+    else:
+        p = np.asarray(curve.display_points())
+    closed = curve.closed
+    if closed and len(p) > 1:
+        p = p[:-1]
+    return p, closed
+
+
+@node("curves.subdivide", version=1)
+def subdivide(
+    curve: Curve, iterations: Annotated[int, Range(min=0)] = 3, *, ctx: Context
+) -> NurbsCurve:
+    """Cubic B-spline subdivision of the curve's control polygon, as a polyline.
+
+    Each round inserts edge midpoints and moves every vertex to 1/8, 6/8, 1/8 of its
+    neighbours and itself (Lane-Riesenfeld); the polygon doubles and converges to the
+    uniform cubic B-spline of the control points. Open curves keep their end points; closed
+    ones wrap around. A curve without control points (parametric) subdivides its drawn
+    polyline.
+
+    Parameters
+    ----------
+    curve : Curve
+        The curve whose control polygon is refined.
+    iterations : int
+        Rounds of subdivision; the point count roughly doubles each round.
+    """
+    p, closed = _control_polygon(curve)
+    ctx.guard(kc.subdivided_count(len(p), closed, iterations), "points")
+    out = _kernel("curve", kc.subdivide_polygon, p, closed=closed, iterations=iterations)
+    return _polyline(out, closed=closed)
+
+
+@node("curves.parametric", version=1)
+def parametric(
+    x: Annotated[Expression, Variables("t")],
+    y: Annotated[Expression, Variables("t")],
+    z: Annotated[Expression, Variables("t")] = "0",  # type: ignore[assignment]
+    t: list[float] = (0.0, 1.0),  # type: ignore[assignment]
+    samples: Annotated[int, Range(min=2)] = 256,
+    *,
+    ctx: Context,
+) -> ParametricCurve:
+    """A curve from expressions in t (and the graph params), exact at every t.
+
+    The expressions are evaluated whenever the curve is (vectorized over t); tangents come
+    from central differences. The curve is checked at ``samples`` parameters when the node
+    runs: a NaN or infinity is an error naming the expression and the t where it happened.
+
+    Parameters
+    ----------
+    x, y : Expression
+        Coordinates as expressions in t, e.g. "radius * cos(t)".
+    z : Expression
+        Height as an expression in t.
+    t : list[float]
+        [start, end] of the parameter range, start < end.
+    samples : int
+        How many points draw the curve, and the default resolution of later sampling.
+
+    Example
+    -------
+    ``spiral: {type: curves.parametric, x: "cos(t)", y: "sin(t)", z: "t / 10",
+    t: ["=0", "=2*pi*turns"]}``
+    """
+    if len(t) != 2 or not t[0] < t[1]:
+        raise InputError("t", f"t must be [start, end] with start < end, got {list(t)}")
+    ctx.guard(samples, "samples")
+    fx, fy, fz = x, y, z
+    curve = ParametricCurve(fx, fy, fz, (float(t[0]), float(t[1])), samples)
+    curve.sample(samples)  # raises, naming the expression and t, if anything is not finite
+    return curve
+
+
+@node("curves.resample", version=1)
+def resample(
+    curve: Curve,
+    count: Annotated[int | None, Range(min=2)] = None,
+    spacing: Annotated[float | None, Range(min=0)] = None,
+    *,
+    ctx: Context,
+) -> NurbsCurve:
+    """Points evenly spaced along the curve by arc length, joined as a polyline.
+
+    Give ``count`` or ``spacing``. The points lie exactly on the curve: the arc length is
+    integrated by Gauss-Legendre quadrature and inverted by Newton steps (a polyline is
+    resampled along its straight segments). A closed curve stays closed, its first point
+    not repeated in the count.
+
+    Parameters
+    ----------
+    curve : Curve
+        Any curve.
+    count : int
+        Number of points (open: both ends included; closed: >= 3).
+    spacing : float
+        Distance along the curve between points; rounded so it divides the length evenly.
+    """
+    if (count is None) == (spacing is None):
+        raise InputError("count", "give exactly one of count and spacing")
+    closed = curve.closed
+    if isinstance(curve, NurbsCurve) and curve.degree == 1:
+        p, _ = _control_polygon(curve)
+        length = _kernel("curve", kc.polyline_length, p, closed)
+        n = (
+            count
+            if count is not None
+            else _kernel("spacing", kc.resample_count, length, spacing, closed)
+        )
+        ctx.guard(n, "points")
+        out = _kernel("curve", kc.resample_polyline, p, count=n, closed=closed)
+        return _polyline(out, closed=closed)
+
+    def speed(tt: np.ndarray) -> np.ndarray:
+        return np.linalg.norm(curve.derivative(tt), axis=-1)
+
+    if isinstance(curve, NurbsCurve):
+        breaks, pieces = np.unique(curve.knots[curve.degree : len(curve.control_points) + 1]), 16
+    else:
+        breaks, pieces = np.array(curve.domain), max(64, getattr(curve, "samples", 256))
+    edges, cum = kc.arc_length_table(speed, breaks, pieces)
+    length = float(cum[-1])
+    if not length > 0.0:
+        raise InputError("curve", "cannot resample a curve of zero length")
+    n = (
+        count
+        if count is not None
+        else _kernel("spacing", kc.resample_count, length, spacing, closed)
+    )
+    if closed and n < 3:
+        raise InputError("count", f"resampling a closed curve needs count >= 3, got {n}")
+    ctx.guard(n, "points")
+    s = np.arange(n) * (length / n) if closed else np.linspace(0.0, length, n)
+    t = kc.parameters_at_lengths(speed, edges, cum, s)
+    return _polyline(curve.evaluate(t), closed=closed)
+
+
+@node("curves.offset", version=1)
+def offset(
+    curve: Curve, distance: float, miter_limit: Annotated[float, Range(min=1)] = 4.0
+) -> NurbsCurve:
+    """The bisector offset of a polyline in the XY plane (mitred corners), as a polyline.
+
+    Each vertex moves by distance / sin(a/2) along the bisector of its corner angle a, so
+    every edge ends up at exactly ``distance`` from its original; straight runs move
+    straight. A positive distance grows a closed curve whichever way it runs, and lies to
+    the left of the direction of travel on an open one (as shapely's offset_curve).
+    Convex corners whose mitre would reach past ``miter_limit * distance`` are clipped
+    (bevelled). Curves that are not polylines are offset through their drawn polyline
+    (use curves.resample first to choose the resolution).
+
+    This is a local construction: where the distance exceeds the local size of the shape
+    the result loops over itself; ``offset.marching_squares`` is the node that resolves
+    self-intersections (and islands and holes).
+
+    Parameters
+    ----------
+    curve : Curve
+        The curve to offset; its z is carried along, the offset is in XY.
+    distance : float
+        Offset distance; positive grows closed curves, goes left on open ones.
+    miter_limit : float
+        Longest mitre, as a multiple of the distance, before a corner is bevelled.
+    """
+    if isinstance(curve, NurbsCurve) and curve.degree == 1:
+        p, closed = _control_polygon(curve)
+    else:
+        p, closed = np.asarray(curve.display_points()), curve.closed
+        if closed:
+            p = p[:-1]
+    out = _kernel(
+        "curve", kc.bisector_offset, p, closed=closed, distance=distance, miter_limit=miter_limit
+    )
+    return _polyline(out, closed=closed)

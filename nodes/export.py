@@ -1,0 +1,293 @@
+"""Export: STL, OBJ and PLY meshes; SVG, PDF and DXF drawings.
+
+Each node builds the file's bytes with a kernel (:mod:`formgraph.kernels.exporters`,
+:mod:`~formgraph.kernels.drawing`, :mod:`~formgraph.kernels.dxf`) and hands them to
+``ctx.write``, which writes atomically inside the output directory, creates sub-folders,
+refuses paths that leave it, and leaves a file alone when it already holds these bytes. Each
+returns the written file's path.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+import numpy as np
+
+from formgraph.geometry import Curve, Mesh, NurbsCurve
+from formgraph.kernels import nurbs
+from formgraph.kernels.drawing import Path2D, pdf_bytes, svg_bytes
+from formgraph.kernels.dxf import dxf_bytes
+from formgraph.kernels.exporters import (
+    fan_triangles,
+    mesh_report,
+    obj_bytes,
+    ply_binary,
+    stl_ascii,
+    stl_binary,
+)
+from formgraph.registry import Context, Range, node
+from formgraph.types import OutputPath
+
+_CIRCLE_TOL = 1e-9  # relative: a rational quadratic piece closer than this to a circle is one
+
+
+@node("export.stl", version=1)
+def stl(mesh: Mesh, path: OutputPath, ascii: bool = False, *, ctx: Context) -> str:
+    """Write a mesh as STL (binary, or ASCII), for 3-D printing.
+
+    Polygons are fan-triangulated, each facet's normal comes from its winding. A mesh that is
+    not watertight, not consistently oriented, inside out or has zero-area triangles is
+    still written, with a warning in the node's stats saying what a slicer will find.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        The mesh to write.
+    path : OutputPath
+        File path relative to the output directory, e.g. ``parts/tube.stl``.
+    ascii : bool
+        Write the text layout (``facet normal ... endfacet``) instead of binary.
+    """
+    v, fi, fo = mesh.vertices, mesh.face_indices, mesh.face_offsets
+    ctx.guard(int(np.sum(mesh.face_sizes - 2)), "triangles")
+    for warning in mesh_report(v, fi, fo).warnings():
+        ctx.warn(warning)
+    data = stl_ascii(v, fi, fo) if ascii else stl_binary(v, fi, fo)
+    return str(ctx.write(path, data))
+
+
+@node("export.obj", version=1)
+def obj(mesh: Mesh, path: OutputPath, normals: bool = False, *, ctx: Context) -> str:
+    """Write a mesh as Wavefront OBJ: polygons kept as they are, 1-based indices.
+
+    Coordinates are written as the shortest text that reads back to the same double, so
+    the file holds the mesh exactly.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        The mesh to write.
+    path : OutputPath
+        File path relative to the output directory.
+    normals : bool
+        Also write one normal per vertex (``vn``; the area-weighted average of the normals
+        of the faces around it) and reference them from the faces (``f 1//1 2//2 3//3``).
+    """
+    v, fi, fo = mesh.vertices, mesh.face_indices, mesh.face_offsets
+    vn = _vertex_normals(v, fi, fo) if normals else None
+    return str(ctx.write(path, obj_bytes(v, fi, fo, normals=vn)))
+
+
+@node("export.ply", version=1)
+def ply(mesh: Mesh, path: OutputPath, *, ctx: Context) -> str:
+    """Write a mesh as binary little-endian PLY: double coordinates, polygon faces kept.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        The mesh to write.
+    path : OutputPath
+        File path relative to the output directory.
+    """
+    data = ply_binary(mesh.vertices, mesh.face_indices, mesh.face_offsets)
+    return str(ctx.write(path, data))
+
+
+@node("export.svg", version=1)
+def svg(
+    curves: list[Curve],
+    path: OutputPath,
+    margin: Annotated[float, Range(min=0)] = 1.0,
+    stroke_width: Annotated[float, Range(min=1e-6)] = 0.1,
+    samples: Annotated[int, Range(min=2)] = 1024,
+    *,
+    ctx: Context,
+) -> str:
+    """Draw curves (seen from +z, the XY plane) as SVG in millimetres, for a laser cutter.
+
+    One drawing unit is one millimetre, the view box fits the drawing plus ``margin``, and
+    +y points up. Curves that are cubic or lower-degree Beziers/B-splines (Catmull-Rom,
+    Bezier chains) become exact ``C`` commands, circles and arcs exact ``A`` commands,
+    polylines ``L``; anything else a fine polyline.
+
+    Parameters
+    ----------
+    curves : list[Curve]
+        The curves to draw; z is dropped.
+    path : OutputPath
+        File path relative to the output directory.
+    margin : float
+        Space around the drawing, in mm.
+    stroke_width : float
+        Line width, in mm.
+    samples : int
+        Points per curve for curves that can only be drawn as polylines.
+    """
+    paths = [curve_path(c, samples) for c in curves]
+    return str(ctx.write(path, svg_bytes(paths, margin=margin, stroke_width=stroke_width)))
+
+
+@node("export.pdf", version=1)
+def pdf(
+    curves: list[Curve],
+    path: OutputPath,
+    margin: Annotated[float, Range(min=0)] = 1.0,
+    stroke_width: Annotated[float, Range(min=1e-6)] = 0.1,
+    samples: Annotated[int, Range(min=2)] = 1024,
+    *,
+    ctx: Context,
+) -> str:
+    """Draw curves (the XY plane) as a one-page PDF at true scale, in millimetres.
+
+    The page fits the drawing plus ``margin``. Beziers are exact; arcs become cubic Beziers
+    within 1e-7 of the radius (PDF has no arc operator); anything else a fine polyline.
+
+    Parameters
+    ----------
+    curves : list[Curve]
+        The curves to draw; z is dropped.
+    path : OutputPath
+        File path relative to the output directory.
+    margin : float
+        Space around the drawing, in mm.
+    stroke_width : float
+        Line width, in mm.
+    samples : int
+        Points per curve for curves that can only be drawn as polylines.
+    """
+    paths = [curve_path(c, samples) for c in curves]
+    return str(ctx.write(path, pdf_bytes(paths, margin=margin, stroke_width=stroke_width)))
+
+
+@node("export.dxf", version=1)
+def dxf(
+    path: OutputPath,
+    curves: list[Curve] | None = None,
+    mesh: Mesh | None = None,
+    samples: Annotated[int, Range(min=2)] = 1024,
+    *,
+    ctx: Context,
+) -> str:
+    """Write curves and a mesh as DXF for CAD: NURBS as exact SPLINEs, meshes as MESH.
+
+    A NURBS curve keeps its degree, knots, weights and control points (a circle stays a
+    circle); degree-1 curves become polylines (LWPOLYLINE when flat at z = 0, else a 3-D
+    POLYLINE); other curves a polyline of ``samples`` points. Units are millimetres.
+
+    Parameters
+    ----------
+    path : OutputPath
+        File path relative to the output directory.
+    curves : list[Curve] | None
+        Curves to write.
+    mesh : Mesh | None
+        A mesh to write.
+    samples : int
+        Points per curve for curves that are not NURBS.
+    """
+    splines, polylines = [], []
+    for c in curves or []:  # one iteration per curve
+        if isinstance(c, NurbsCurve) and c.degree == 1:
+            pts = np.asarray(c.control_points)
+            closed = len(pts) > 2 and np.array_equal(pts[0], pts[-1])
+            polylines.append((pts[:-1] if closed else pts, closed))
+        elif isinstance(c, NurbsCurve):
+            w = np.asarray(c.weights) if c.rational else None
+            splines.append((c.control_points, c.degree, c.knots, w))
+        else:
+            pts, closed = c.sample(samples), bool(c.closed)
+            polylines.append((pts[:-1] if closed else pts, closed))
+    meshes = [] if mesh is None else [(mesh.vertices, mesh.face_indices, mesh.face_offsets)]
+    if not splines and not polylines and not meshes:
+        raise ValueError("export.dxf needs curves or a mesh to write, got neither")
+    return str(ctx.write(path, dxf_bytes(splines, polylines, meshes)))
+
+
+# --------------------------------------------------------------------------------------------
+# adapters
+
+
+def curve_path(curve: Curve, samples: int = 1024) -> Path2D:
+    """The drawing path of a curve seen from +z (z dropped), exact where it can be.
+
+    - degree 1 NURBS: a polyline through its control points;
+    - non-rational NURBS of degree 2 or 3: its Bezier pieces (knot insertion, The NURBS
+      Book A5.6), quadratics raised to cubics exactly, as a cubic chain;
+    - rational quadratic NURBS whose every piece is a circular arc (equal tangent lengths
+      and middle weight cos(half angle) once the end weights are 1): an arc chain;
+    - anything else: a polyline of ``samples`` points evenly spaced in the parameter.
+    """
+    closed = bool(curve.closed)
+    if isinstance(curve, NurbsCurve):
+        cp = np.asarray(curve.control_points)
+        if curve.degree == 1:
+            pts = cp[:, :2]
+            if closed and len(pts) > 2 and np.array_equal(pts[0], pts[-1]):
+                pts = pts[:-1]
+            return Path2D("polyline", pts, closed=closed)
+        w = np.asarray(curve.weights) if curve.rational else None
+        if curve.degree <= 3 and w is None:
+            seg, _ = nurbs.decompose_bezier(cp, curve.degree, curve.knots, None)
+            seg = seg[:, :, :2]
+            if curve.degree == 2:  # degree elevation of a quadratic Bezier (exact)
+                seg = np.stack(
+                    [
+                        seg[:, 0],
+                        (seg[:, 0] + 2 * seg[:, 1]) / 3,
+                        (2 * seg[:, 1] + seg[:, 2]) / 3,
+                        seg[:, 2],
+                    ],
+                    axis=1,
+                )
+            chain = np.concatenate([seg[:1, 0], seg[:, 1:].reshape(-1, 2)])
+            return Path2D("cubic", chain, closed=closed)
+        if curve.degree == 2 and w is not None:
+            arcs = _circular_pieces(cp, curve.knots, w)
+            if arcs is not None:
+                return Path2D("arc", arcs, closed=closed)
+    pts = np.asarray(curve.sample(samples))[:, :2]
+    if closed:
+        pts = pts[:-1]
+    return Path2D("polyline", pts, closed=closed)
+
+
+def _circular_pieces(cp: np.ndarray, knots: np.ndarray, w: np.ndarray) -> np.ndarray | None:
+    """The arc chain (2k+1, 2) of a rational quadratic in XY, or None if a piece is no arc."""
+    seg, sw = nurbs.decompose_bezier(cp, 2, knots, w)
+    p = seg[:, :, :2]
+    # standard form: end weights 1, middle weight w1 / sqrt(w0 w2) (a reparametrization)
+    wm = sw[:, 1] / np.sqrt(sw[:, 0] * sw[:, 2])
+    t0 = np.linalg.norm(p[:, 1] - p[:, 0], axis=1)
+    t1 = np.linalg.norm(p[:, 2] - p[:, 1], axis=1)
+    half_chord = 0.5 * np.linalg.norm(p[:, 2] - p[:, 0], axis=1)
+    scale = np.maximum(np.maximum(t0, t1), 1e-300)
+    cos_half = half_chord / scale
+    circular = (
+        (np.abs(t0 - t1) <= _CIRCLE_TOL * scale)
+        & (np.abs(wm - cos_half) <= _CIRCLE_TOL)
+        & (wm > 0)
+        & (wm < 1)
+    )
+    if not np.all(circular):
+        return None
+    return np.concatenate([p[:1, 0], p[:, 1:].reshape(-1, 2)])
+
+
+def _vertex_normals(v: np.ndarray, fi: np.ndarray, fo: np.ndarray) -> np.ndarray:
+    """Area-weighted vertex normals: the sum of the area vectors of the faces around each.
+
+    A face's area vector is the sum of its fan triangles' cross products (Newell's normal,
+    twice the area, exact for planar polygons); it is added to each of the face's vertices.
+    """
+    tris = fan_triangles(fi, fo)
+    a = v[tris[:, 0]]
+    cross = np.cross(v[tris[:, 1]] - a, v[tris[:, 2]] - a)
+    face_of_tri = np.repeat(np.arange(fo.size - 1), np.diff(fo) - 2)
+    area = np.zeros((fo.size - 1, 3))
+    np.add.at(area, face_of_tri, cross)
+    acc = np.zeros_like(v)
+    np.add.at(acc, fi, area[np.repeat(np.arange(fo.size - 1), np.diff(fo))])
+    length = np.linalg.norm(acc, axis=1)
+    out = np.zeros_like(v)
+    np.divide(acc, length[:, None], out=out, where=length[:, None] > 0)
+    return out

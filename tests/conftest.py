@@ -1,0 +1,18 @@
+from __future__ import annotations
+
+import os
+
+import pytest
+
+os.environ.setdefault("PYVISTA_OFF_SCREEN", "true")
+# two test workers on two cores: BLAS threads would only fight each other
+for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
+
+import stubs  # noqa: E402,F401  (registers the stub.* node types for executor tests)
+
+
+@pytest.fixture(autouse=True)
+def _clear_run_record():
+    stubs.CALLS.clear()
+    yield

@@ -1,0 +1,165 @@
+"""The command line, through a real subprocess: exit codes, messages, no tracebacks."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+GRAPH = """
+formgraph: 1
+params:
+  n: {default: 8, min: 3, max: 64}
+  r: 2.0
+nodes:
+  pts:
+    type: points.circle
+    count: "=n"
+    radius: "=r"
+"""
+
+
+def cli(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-m", "formgraph.cli", *args],
+        capture_output=True,
+        text=True,
+        cwd=cwd,
+        timeout=120,
+    )
+
+
+@pytest.fixture
+def graph_file(tmp_path: Path) -> Path:
+    p = tmp_path / "g.yaml"
+    p.write_text(textwrap.dedent(GRAPH).lstrip())
+    return p
+
+
+def test_run_prints_outputs_and_profile(graph_file, tmp_path):
+    r = cli("run", str(graph_file), "--set", "n=5", "--no-cache", "--profile", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert "pts: Points(n=5)" in r.stdout
+    assert "computed" in r.stdout and "seconds" in r.stdout
+
+
+def test_run_with_disk_cache_reports_cached(graph_file, tmp_path):
+    args = ("run", str(graph_file), "--cache-dir", str(tmp_path / "c"), "--profile")
+    assert cli(*args, cwd=tmp_path).returncode == 0
+    r = cli(*args, cwd=tmp_path)
+    assert r.returncode == 0
+    assert "cached" in r.stdout
+
+
+def test_set_is_parsed_by_the_param_type(graph_file, tmp_path):
+    r = cli("run", str(graph_file), "--set", "n=2.5", "--no-cache", cwd=tmp_path)
+    assert r.returncode == 1
+    assert "param 'n': expected int, got float 2.5" in r.stderr
+    r = cli("run", str(graph_file), "--set", "n=100", "--no-cache", cwd=tmp_path)
+    assert r.returncode == 1 and "must be <= 64" in r.stderr
+    r = cli("run", str(graph_file), "--set", "r=3", "--no-cache", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    r = cli("run", str(graph_file), "--set", "radius=3", "--no-cache", cwd=tmp_path)
+    assert r.returncode == 1 and "unknown param" in r.stderr
+    r = cli("run", str(graph_file), "--set", "oops", "--no-cache", cwd=tmp_path)
+    assert r.returncode == 2 and "NAME=VALUE" in r.stderr
+
+
+def test_check_exit_codes(graph_file, tmp_path):
+    assert cli("check", str(graph_file)).returncode == 0
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("formgraph: 1\nnodes:\n  a:\n    type: points.circel\n    count: 3\n")
+    r = cli("check", str(bad))
+    assert r.returncode == 1
+    assert (
+        "bad.yaml:3: unknown node type 'points.circel' (did you mean 'points.circle'?)" in r.stderr
+    )
+    assert "Traceback" not in r.stderr
+
+
+def test_usage_error_is_exit_2():
+    assert cli("frobnicate").returncode == 2
+    assert cli("run").returncode == 2
+
+
+def test_node_failure_has_no_traceback_unless_debug(tmp_path):
+    g = tmp_path / "g.yaml"
+    g.write_text(
+        "formgraph: 1\nnodes:\n  c:\n    type: curves.polyline\n    points: [[0, 0], [0, 0]]\n"
+    )
+    r = cli("run", str(g), "--no-cache", cwd=tmp_path)
+    assert r.returncode == 1
+    assert "node 'c' (curves.polyline)" in r.stderr
+    assert "Traceback" not in r.stderr
+    r = cli("--debug", "run", str(g), "--no-cache", cwd=tmp_path)
+    assert r.returncode == 1
+    assert "Traceback" in r.stderr
+
+
+def test_nodes_catalogue_and_one_node():
+    r = cli("nodes")
+    assert r.returncode == 0 and "points.circle(count, [radius], [center]) -> Points" in r.stdout
+    r = cli("nodes", "points.grid")
+    assert r.returncode == 0 and "spacing" in r.stdout
+    r = cli("nodes", "points.gird")
+    assert r.returncode == 1 and "did you mean 'points.grid'" in r.stderr
+
+
+def test_schema_validates_the_example_graphs():
+    jsonschema = pytest.importorskip("jsonschema")
+    import yaml
+
+    r = cli("schema")
+    assert r.returncode == 0
+    schema = json.loads(r.stdout)
+    jsonschema.Draft202012Validator.check_schema(schema)
+    validator = jsonschema.Draft202012Validator(schema)
+    graphs = sorted((ROOT / "graphs").glob("*.yaml"))
+    for path in graphs:
+        errors = list(validator.iter_errors(yaml.safe_load(path.read_text())))
+        assert not errors, f"{path.name}: {errors[0].message}"
+    bad = {"formgraph": 1, "nodes": {"a": {"type": "points.circle", "count": "many"}}}
+    assert list(validator.iter_errors(bad))
+    typo = {"formgraph": 1, "nodes": {"a": {"type": "points.circel", "count": 3}}}
+    assert list(validator.iter_errors(typo))
+
+
+def test_docs_nodes_md_is_current():
+    r = cli("nodes", "--markdown")
+    assert r.returncode == 0
+    current = (ROOT / "docs" / "nodes.md").read_text()
+    assert r.stdout == current, "docs/nodes.md is stale: formgraph nodes --markdown > docs/nodes.md"
+
+
+def test_readme_catalogue_is_current():
+    r = subprocess.run(
+        [
+            sys.executable,
+            "-c",
+            "from formgraph.catalogue import readme_table; print(readme_table())",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    readme = (ROOT / "README.md").read_text()
+    assert r.stdout.strip() in readme, (
+        "README catalogue is stale: python -m formgraph.catalogue README.md"
+    )
+
+
+def test_schema_accepts_expressions_inside_coordinates():
+    jsonschema = pytest.importorskip("jsonschema")
+    schema = json.loads(cli("schema").stdout)
+    graph = {
+        "formgraph": 1,
+        "params": {"h": 2.0},
+        "nodes": {"p": {"type": "points.list", "points": [[0, 0, "=h"], [1, 2]]}},
+    }
+    assert not list(jsonschema.Draft202012Validator(schema).iter_errors(graph))

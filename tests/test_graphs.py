@@ -1,0 +1,30 @@
+"""Every example graph in graphs/ loads, checks and evaluates all its sinks."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+import formgraph as fg
+
+GRAPHS = sorted((Path(__file__).resolve().parents[1] / "graphs").glob("*.yaml"))
+
+
+def test_there_are_example_graphs():
+    assert len(GRAPHS) >= 2
+
+
+@pytest.mark.parametrize("path", GRAPHS, ids=[p.stem for p in GRAPHS])
+def test_example_graph_evaluates(path, tmp_path):
+    g = fg.load(path, out_dir=tmp_path)
+    outs = g.evaluate_all()
+    assert outs
+    for name, value in outs.items():
+        if fg.node_types()[g.nodes[name]].is_export:
+            out = Path(value)
+            assert out.is_file() and out.stat().st_size > 0, name
+            assert tmp_path in out.parents
+    # a second run is served from the cache and writes nothing new
+    g.evaluate_all()
+    assert all(s.status == "cached" for s in g.stats.values())

@@ -1,0 +1,433 @@
+"""Interactive viewing, sliders and screenshots of graphs and geometry values.
+
+A :class:`Session` ties a graph (or a bare geometry value) to a plotter: it evaluates the
+shown nodes through the graph's cache, draws them with a :class:`~.scene.Scene`, and
+:meth:`Session.apply_params` is what every slider calls. It needs no window, so tests drive
+it off screen.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import time
+from collections.abc import Iterable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from formgraph.errors import FormgraphError, GraphError, Problem, Where
+from formgraph.graph import Graph, load
+from formgraph.model import Items, Wire, parse_input
+from formgraph.registry import node_types
+
+from .scene import PALETTE, TEXT_COLOR, Scene
+
+__all__ = ["Session", "Slider", "screenshot", "show", "shown_nodes"]
+
+HELP = "c control polygons   n control nets   g grid   f fit   v isometric   q quit"
+
+
+def shown_nodes(graph: Graph, node: str | Iterable[str] | None = None) -> list[str]:
+    """What to show: ``node`` (names, ``name.output`` allowed), else the graph's results.
+
+    The results are the nodes wired into its export nodes (``@mesh`` feeding
+    ``export.stl``), in author order; a graph without exports shows its sinks.
+    """
+    registry = node_types()
+    if node is not None:
+        names = [node] if isinstance(node, str) else list(node)
+        for n in names:
+            _check_target(graph, registry, n)
+        return names
+    shown: list[str] = []
+    for name, type_name in graph.nodes.items():
+        if not registry[type_name].is_export:
+            continue
+        for raw in graph.node_inputs(name).values():
+            for wire in _wires(raw):
+                if registry[graph.nodes[wire.node]].is_export:
+                    continue
+                target = str(wire)[1:]
+                if target not in shown:
+                    shown.append(target)
+    return shown or graph.sinks()
+
+
+def _check_target(graph: Graph, registry: dict[str, Any], target: str) -> None:
+    from formgraph.check import suggest
+
+    where = Where(graph.file)
+    if target in graph.nodes:
+        return
+    base, _, output = target.partition(".")
+    if base not in graph.nodes:
+        raise GraphError(Problem(where, f"no node '{target}'{suggest(target, graph.nodes)}"))
+    spec = registry[graph.nodes[base]]
+    if not spec.multi_output or output not in spec.outputs:
+        outputs = ", ".join(spec.outputs) if spec.multi_output else "only one, unnamed"
+        raise GraphError(
+            Problem(
+                where,
+                f"node '{base}' ({spec.name}) has no output '{output}'; its outputs: {outputs}",
+            )
+        )
+
+
+def _wires(raw: Any) -> list[Wire]:
+    try:
+        value = parse_input(raw)
+    except FormgraphError:
+        return []
+    if isinstance(value, Wire):
+        return [value]
+    if isinstance(value, Items):
+        return [i for i in value.items if isinstance(i, Wire)]
+    return []
+
+
+@dataclass(frozen=True)
+class Slider:
+    """A numeric graph param with a range: what a slider needs."""
+
+    name: str
+    min: float
+    max: float
+    value: float
+    integer: bool
+    doc: str = ""
+
+
+class Session:
+    """A graph (or a geometry value) drawn in a plotter, re-evaluated on demand.
+
+    Parameters
+    ----------
+    source : Graph, str, path, geometry or list of geometries
+        A graph, a graph file, or values to draw as they are.
+    node : str or list of str, optional
+        The nodes to show (``name`` or ``name.output``); default: the graph's results.
+    plotter : pyvista.Plotter
+        Where to draw.
+    params : dict
+        Param values for the evaluations (sliders change them).
+    timing : bool
+        Draw the last evaluation time at the top left.
+    """
+
+    def __init__(
+        self,
+        source: Any,
+        node: str | Iterable[str] | None = None,
+        *,
+        plotter: Any,
+        params: dict[str, Any] | None = None,
+        timing: bool = True,
+    ):
+        if isinstance(source, (str, os.PathLike)):
+            source = load(source)
+        self.graph: Graph | None = source if isinstance(source, Graph) else None
+        self.value = None if self.graph is not None else source
+        self.node = node
+        self.plotter = plotter
+        self.scene = Scene(plotter)
+        self.params: dict[str, Any] = dict(params or {})
+        self.timing = timing
+        self.seconds: float | None = None
+        self.targets = shown_nodes(self.graph, node) if self.graph is not None else []
+        self._slider_values: dict[str, float] = {}
+        self.widgets: dict[str, Any] = {}  # slider widgets by param name
+        self.scene.update(self.evaluate())
+        self.scene.fit_camera()
+        self._status()
+
+    # ---------------------------------------------------------------------- evaluation
+
+    def evaluate(self) -> list[tuple[str, Any]]:
+        """``(label, value)`` of every shown node, evaluated with the current params."""
+        if self.graph is None:
+            return [(_label_of(self.value), self.value)]
+        bases = list(dict.fromkeys(_base(self.graph, t) for t in self.targets))
+        t0 = time.perf_counter()
+        outs = self.graph.evaluate(bases, **self.params)
+        self.seconds = time.perf_counter() - t0
+        shown = []
+        for t in self.targets:
+            base = _base(self.graph, t)
+            value = outs[base]
+            if t != base:
+                output = t[len(base) + 1 :]
+                value = getattr(value, output)
+            shown.append((t, value))
+        return shown
+
+    def apply_params(self, **values: Any) -> bool:
+        """Re-evaluate with some params changed and redraw in place (the slider callback).
+
+        Only the nodes the changed params reach recompute (see ``graph.stats``). On an
+        error the message is shown in the window and on stderr, the last good geometry
+        stays, and the params are left as they were. Returns whether it succeeded.
+        """
+        if self.graph is None:
+            raise ValueError("a geometry value has no params; pass a graph to use params")
+        old = dict(self.params)
+        self.params.update(values)
+        try:
+            shown = self.evaluate()
+        except FormgraphError as exc:
+            self.params = old
+            self.report(str(exc))
+            return False
+        self.scene.update(shown)
+        self.scene.set_error(None)
+        self._status()
+        for name, value in values.items():
+            if name in self.widgets:
+                self._slider_values[name] = value
+                self.widgets[name].GetRepresentation().SetValue(float(value))
+        self.plotter.render()
+        return True
+
+    def replace_graph(self, graph: Graph, params: dict[str, Any] | None = None) -> None:
+        """Show a new version of the graph (watch mode), keeping the camera if it still fits.
+
+        Raises
+        ------
+        FormgraphError
+            When the new version fails; what is drawn, and the session, stay as they were.
+        """
+        old = (self.graph, self.targets, self.params, self.seconds)
+        old_bounds = self.scene.bounds()
+        try:
+            self.graph, self.params = graph, dict(params or {})
+            self.targets = shown_nodes(graph, self.node)
+            shown = self.evaluate()
+        except BaseException:
+            self.graph, self.targets, self.params, self.seconds = old
+            raise
+        self.scene.update(shown)
+        self.scene.set_error(None)
+        self._status()
+        if _camera_lost(old_bounds, self.scene.bounds()):
+            self.scene.fit_camera()
+        self.plotter.render()
+
+    def report(self, message: str) -> None:
+        """Show an error in the window and on stderr, keeping what is drawn."""
+        print(message, file=sys.stderr)
+        kept = "\n(the picture is the last version that worked)" if self.scene.layers else ""
+        self.scene.set_error(message + kept)
+        self.plotter.render()
+
+    def _status(self) -> None:
+        if not self.timing or self.graph is None or self.seconds is None:
+            return
+        stats = self.graph.stats
+        computed = sum(1 for s in stats.values() if s.status == "computed")
+        cached = len(stats) - computed
+        name = Path(self.graph.file).name if self.graph.file else "graph"
+        self.scene.set_status(
+            f"{name}: evaluated in {_ms(self.seconds)} ({computed} computed, {cached} cached)"
+        )
+
+    # ------------------------------------------------------------------ interaction
+
+    def sliders(self) -> list[Slider]:
+        """Every numeric graph param that has both a min and a max."""
+        if self.graph is None:
+            return []
+        out = []
+        values = {**self.graph.params, **self.params}
+        for name, p in self.graph.param_defs.items():
+            value = values.get(name)
+            if p.min is None or p.max is None or isinstance(value, bool):
+                continue
+            if not isinstance(value, (int, float)):
+                continue
+            integer = isinstance(p.default, int) and not isinstance(p.default, bool)
+            out.append(Slider(name, float(p.min), float(p.max), float(value), integer, p.doc))
+        return out
+
+    def on_slider(self, name: str, value: float) -> bool:
+        """A slider moved: round integer params, skip repeats, then :meth:`apply_params`."""
+        spec = next(s for s in self.sliders() if s.name == name)
+        v: float | int = int(round(value)) if spec.integer else float(value)
+        if self._slider_values.get(name) == v:
+            return True
+        self._slider_values[name] = v
+        return self.apply_params(**{name: v})
+
+    def add_sliders(self) -> None:
+        """One slider per ranged numeric param, in a column at the right.
+
+        The view is shifted left so that the sliders do not cover the geometry.
+        """
+        sliders = self.sliders()
+        if not sliders:
+            return
+        step = min(0.11, 0.72 / len(sliders))
+        for i, s in enumerate(sliders):
+            y = 0.74 - i * step
+            self._slider_values[s.name] = int(s.value) if s.integer else s.value
+            widget = self.plotter.add_slider_widget(
+                lambda v, name=s.name: self.on_slider(name, v),
+                rng=(s.min, s.max),
+                value=s.value,
+                title=f"{s.name}   ({s.min:g} to {s.max:g})",
+                pointa=(0.76, y),
+                pointb=(0.97, y),
+                color=TEXT_COLOR,
+                interaction_event="always",
+                fmt="%.0f" if s.integer else "%.3g",
+                title_height=0.018,
+            )
+            _style_slider(widget.GetRepresentation())
+            self.widgets[s.name] = widget
+        self.scene.view_shift = 0.24
+        self.scene.fit_camera()
+        self.plotter.render()
+
+    def add_keys(self) -> None:
+        """Key toggles: control polygons, control nets, grid, fit."""
+        p = self.plotter
+
+        def toggle(what: str) -> None:
+            if what == "grid":
+                self.scene.toggle_grid()
+            else:
+                self.scene.toggle(what)
+            p.render()
+
+        p.add_key_event("c", lambda: toggle("polygon"))
+        p.add_key_event("n", lambda: toggle("net"))
+        p.add_key_event("g", lambda: toggle("grid"))
+        p.add_key_event("f", lambda: (self.scene.fit_camera(), p.render()))
+        self.scene.set_help(HELP)
+
+
+def _style_slider(rep: Any) -> None:
+    """A slim slider: thin grey track, small accent knob, value above, name below."""
+    import pyvista as pv
+
+    rep.SetSliderLength(0.018)
+    rep.SetSliderWidth(0.022)
+    rep.SetTubeWidth(0.006)
+    rep.SetEndCapLength(0.004)
+    rep.SetEndCapWidth(0.022)
+    rep.SetLabelHeight(0.018)
+    rep.GetTubeProperty().SetColor(pv.Color("#c8c8c8").float_rgb)
+    rep.GetCapProperty().SetColor(pv.Color("#c8c8c8").float_rgb)
+    rep.GetSliderProperty().SetColor(pv.Color(PALETTE[0]).float_rgb)
+    rep.GetSelectedProperty().SetColor(pv.Color(PALETTE[3]).float_rgb)
+    for prop in (rep.GetTitleProperty(), rep.GetLabelProperty()):
+        prop.SetBold(False)
+        prop.SetShadow(False)
+
+
+def _camera_lost(old: Any, new: Any) -> bool:
+    """Whether new bounds no longer suit a camera framed for the old ones."""
+    import numpy as np
+
+    from .scene import view_axis
+
+    if old is None or new is None:
+        return new is not None
+    a, b = np.asarray(old).reshape(3, 2), np.asarray(new).reshape(3, 2)
+    size_a = float(np.linalg.norm(a[:, 1] - a[:, 0]))
+    size_b = float(np.linalg.norm(b[:, 1] - b[:, 0]))
+    slack = 0.25 * max(size_a, 1e-12)
+    outside = bool(np.any(b[:, 0] < a[:, 0] - slack) or np.any(b[:, 1] > a[:, 1] + slack))
+    return outside or size_b < 0.3 * size_a or view_axis(old) != view_axis(new)
+
+
+def _base(graph: Graph, target: str) -> str:
+    return target if target in graph.nodes else target.split(".", 1)[0]
+
+
+def _label_of(value: Any) -> str:
+    return ""  # a value shown as it is: the legend says what it is
+
+
+def _ms(seconds: float) -> str:
+    return f"{seconds * 1000:.1f} ms" if seconds < 10 else f"{seconds:.1f} s"
+
+
+def _window_title(source: Any) -> str:
+    if isinstance(source, Graph) and source.file:
+        return f"formgraph - {Path(source.file).name}"
+    if isinstance(source, (str, os.PathLike)):
+        return f"formgraph - {Path(source).name}"
+    return "formgraph"
+
+
+# ---------------------------------------------------------------------- entry points
+
+
+def show(
+    source: Any,
+    node: str | Iterable[str] | None = None,
+    size: tuple[int, int] = (1024, 768),
+    *,
+    jupyter_backend: str | None = None,
+    **params: Any,
+) -> Session:
+    """Open an interactive window on a graph's results (or ``node``) or on geometry values.
+
+    Every numeric graph param with a min and a max gets a slider; moving it re-evaluates
+    through the cache and redraws in place. Keys: ``c`` control polygons, ``n`` control
+    nets, ``g`` grid, ``f`` fit, ``v`` isometric, ``q`` quit. In Jupyter, pass
+    ``jupyter_backend`` (``"static"``, or ``"trame"`` where trame is installed).
+
+    Parameters
+    ----------
+    source : Graph, str, path, geometry or list of geometries
+    node : str or list of str, optional
+        Nodes to show (``name`` or ``name.output``); default: the graph's results.
+    size : (int, int)
+        Window size in pixels.
+    **params
+        Graph param values.
+
+    Example
+    -------
+    >>> import formgraph as fg
+    >>> from formgraph import viewer
+    >>> viewer.show(fg.load("graphs/spiral_tube.yaml"), turns=5)  # doctest: +SKIP
+    """
+    import pyvista as pv
+
+    plotter = pv.Plotter(window_size=list(size), title=_window_title(source))
+    session = Session(source, node, plotter=plotter, params=params)
+    session.add_sliders()
+    session.add_keys()
+    plotter.show(jupyter_backend=jupyter_backend)
+    return session
+
+
+def screenshot(
+    source: Any,
+    path: str | os.PathLike[str],
+    node: str | Iterable[str] | None = None,
+    size: tuple[int, int] = (1024, 768),
+    **params: Any,
+) -> Path:
+    """Render a graph's results (or ``node``, or geometry values) off screen to a PNG.
+
+    The parent folder of ``path`` is created. Returns the path written.
+
+    Example
+    -------
+    >>> viewer.screenshot("graphs/spiral_tube.yaml", "out/tube.png", turns=5)  # doctest: +SKIP
+    PosixPath('out/tube.png')
+    """
+    import pyvista as pv
+
+    path = Path(path)
+    plotter = pv.Plotter(off_screen=True, window_size=list(size))
+    try:
+        Session(source, node, plotter=plotter, params=params, timing=False)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        plotter.screenshot(str(path))
+    finally:
+        plotter.close()
+    return path
