@@ -5,10 +5,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import shapely
-from formgraph.kernels.distance import RowParity, SegmentTree, point_segment
-from formgraph.kernels.offset import default_cell, offset_polylines
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+
+from formgraph.kernels.distance import RowParity, SegmentTree, point_segment
+from formgraph.kernels.offset import default_cell, offset_polylines
 
 
 def circle(r: float, n: int = 2000, c=(0.0, 0.0)) -> np.ndarray:
