@@ -79,7 +79,7 @@ def run(table) -> None:  # noqa: ANN001 - the harness's Table
     y, x = np.mgrid[-1 : 1 : GRID * 1j, -1 : 1 : GRID * 1j]
     cone = np.hypot(x, y)
     busy = busy_field()
-    for name, field, level in (("one contour", cone, 0.5), ("busy", busy, 0.5)):
+    for name, field, level in (("one contour", 1 - cone, 0.5), ("busy", busy, 0.5)):
         count = len(marching_squares(field, level))
         case = f"contour {GRID}x{GRID} {name}"
         table.time(

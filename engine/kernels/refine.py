@@ -422,11 +422,12 @@ def refine_chords(
         rows = np.flatnonzero(reach_k)
         su, sw = loops.seg[todo[rows]], loops.seg_in[nxt[rows]]
         kr = k[rows]
-        near = tree.query(kr, radius - eps, radius + eps)
-        ok = near.exact & (np.abs(near.dist - radius) <= eps)
         du, tu = point_segment(kr, tree.a[su], tree.b[su])
         dw, tw = point_segment(kr, tree.a[sw], tree.b[sw])
-        ok &= (np.abs(du - radius) <= eps) & (np.abs(dw - radius) <= eps)
+        ok = (np.abs(du - radius) <= eps) & (np.abs(dw - radius) <= eps)
+        # (Only those need a query: that no other segment comes closer.)
+        near = tree.query(kr[ok], radius - eps, radius + eps)
+        ok[ok] = near.exact & (np.abs(near.dist - radius) <= eps)
         ok &= _fits(loops, todo[rows], nxt[rows], kr, gap[rows])
         n_in = _unit(kr - (tree.a[su] + tu[:, None] * (tree.b[su] - tree.a[su])))
         n_out = _unit(kr - (tree.a[sw] + tw[:, None] * (tree.b[sw] - tree.a[sw])))
@@ -601,6 +602,8 @@ def tidy(loops: Loops, gap: float) -> Loops:
         if not cut.any():
             break
         loops = loops.select(~cut)
+    if loops.loop.size == 0:
+        return loops
     nxt = loops.next
     x, y = loops.xy[:, 0], loops.xy[:, 1]
     area = np.bincount(loops.loop, x * y[nxt] - x[nxt] * y, minlength=loops.loop.max() + 1)
