@@ -38,7 +38,7 @@ from .refine import exact_loops
 from .refine import simplify as simplify_loops
 from .refine import smooth as smooth_loops
 
-__all__ = ["default_cell", "offset_polylines"]
+__all__ = ["default_cell", "grid_cells", "offset_polylines"]
 
 DEFAULT_MAX_CELLS = 2**27
 _COARSE_CELLS = 32  # cells per side of the first, full level of the quadtree
@@ -210,6 +210,21 @@ def _band_cells(field: _Field, ncx: int, ncy: int, levels: int):
         keep = gap <= step * field.cell * (np.sqrt(0.5) * (1 + 1e-9))
         ci, cj = ci[keep], cj[keep]
     return pid, values, feet, ci * (ncx + 1) + cj
+
+
+def grid_cells(lo: np.ndarray, hi: np.ndarray, distance: float, cell: float) -> int:
+    """How many cells the offset grid has, for input bounds ``lo, hi`` (each (2,)).
+
+    The grid covers the input grown by ``|distance|`` plus two cells, rounded up to whole
+    coarse cells. (Only a band of it is ever sampled; this is the size checked against
+    ``max_cells``.)
+    """
+    margin = abs(distance) + 2 * cell
+    size = (np.asarray(hi, float) - np.asarray(lo, float) + 2 * margin) / cell
+    levels = max(0, int(np.ceil(np.log2(max(size.max() / _COARSE_CELLS, 1.0)))))
+    step = 2**levels
+    ncx, ncy = (np.ceil(size / step) * step).tolist()
+    return int(ncx * ncy)
 
 
 def _trace(field: _Field, ids, values, cells, ncx: int):
