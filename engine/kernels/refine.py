@@ -398,13 +398,24 @@ def refine_chords(
         reach_k &= np.hypot(*(k - u - c).T) < 0.9 * radius
         inside = reach_k & (along > 0) & (along < 1)
         # The chord point below k (kept off the chord's ends), moved onto the level along
-        # the gradient: the check of a suspect chord, and step 3 below.
+        # the gradient: step 3 below. A suspect chord is asked at a quarter, half and three
+        # quarters of its length (a notch may sit near an end), and its worst point serves.
         ask = np.flatnonzero(bad | suspect)
-        m = u + np.where(inside, np.clip(along, 0.2, 0.8), 0.5)[:, None] * c
-        m = m[ask]
+        at = np.where(inside, np.clip(along, 0.2, 0.8), 0.5)[ask]
+        sus = np.flatnonzero(suspect[ask])
+        m_at = np.concatenate([at, np.full(sus.size, 0.25), np.full(sus.size, 0.75)])
+        rows = np.concatenate([ask, ask[sus], ask[sus]])
+        m = u[rows] + m_at[:, None] * c[rows]
         p3, n3, s3, dist_m, ok3 = project(tree, m, radius, 0.9 * radius)
-        strays = ~ok3 | (np.hypot(*(p3 - m).T) > tol)
-        bad[ask] |= suspect[ask] & strays
+        stray = np.where(ok3, np.hypot(*(p3 - m).T), np.inf)
+        # Per chord, the sample that strays most.
+        worst = np.arange(ask.size)
+        for extra in (1, 2):
+            alt = ask.size + (extra - 1) * sus.size + np.arange(sus.size)
+            better = stray[alt] > stray[worst[sus]]
+            worst[sus[better]] = alt[better]
+        m, p3, n3, s3, dist_m, ok3 = (x[worst] for x in (m, p3, n3, s3, dist_m, ok3))
+        bad[ask] |= suspect[ask] & (stray[worst] > tol)
         loops.todo[todo] = False
         if not bad.any():
             break
