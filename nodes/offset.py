@@ -1,0 +1,149 @@
+"""Robust offsets: outlines at a distance from any curves, from a signed distance field."""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+import numpy as np
+
+from formgraph.errors import InputError
+from formgraph.geometry import Curve, NurbsCurve
+from formgraph.kernels.offset import default_cell, grid_cells, offset_polylines
+from formgraph.registry import Context, Range, node
+
+_TOLERANCE = 1e-3  # the kernel's accuracy, as a fraction of the input's extent
+_SAMPLE_SHARE = 0.1  # sampling error allowed, as a share of that (and of the cell)
+
+
+@node("offset.marching_squares", version=1)
+def marching_squares(
+    curves: list[Curve],
+    distance: float,
+    cell: Annotated[float | None, Range(min=0)] = None,
+    smooth: Annotated[int, Range(min=0)] = 0,
+    simplify: Annotated[float, Range(min=0)] = 0.0,
+    *,
+    ctx: Context,
+) -> list[Curve]:
+    """Closed outlines at a distance from curves: islands, holes and all, however messy.
+
+    The offset of a set of curves in the XY plane (other coordinates are projected: z is
+    dropped, and the results lie at z = 0). Closed curves bound a region by the even-odd
+    rule (nested curves make holes, self-intersections are fine); open curves bound
+    nothing, so they get a band on both sides. A positive distance grows the region, a
+    negative one shrinks it: the CNC tool path of a pocket, a wall thickness, a kerf.
+
+    Each curve is sampled adaptively (a polyline exactly at its vertices) so the sampling
+    error stays a tenth of the result's; the exact signed distance to the samples is
+    evaluated only near the offset, on a quadtree of a grid, contoured by marching
+    squares, and every vertex is then moved exactly onto the offset, corners recovered
+    where two features' offsets meet. The error is below 0.1 % of the input's extent.
+    Parts of the result thinner than the grid's cell can be missed; pass a smaller cell.
+
+    Outlines come back as closed degree-1 NurbsCurves: islands counter-clockwise, holes
+    clockwise.
+
+    Parameters
+    ----------
+    curves : list[Curve]
+        The curves to offset (any kind), in the XY plane.
+    distance : float
+        Offset distance, nonzero: positive outward, negative inward.
+    cell : float
+        Grid cell size. Default: chosen from the distance and the input's size (about
+        2 sqrt(|distance| * 0.001 * extent), at most |distance| / 2).
+    smooth : int
+        Smoothing passes that even out the vertices along the offset (each vertex stays
+        exactly on it; corners stay sharp).
+    simplify : float
+        Douglas-Peucker tolerance for the result (0: keep every vertex).
+
+    Example
+    -------
+    ``pocket: {type: offset.marching_squares, curves: ["@letter"], distance: -0.5}``
+    """
+    if isinstance(curves, Curve):
+        curves = [curves]
+    if len(curves) == 0:
+        raise InputError("curves", "the offset needs at least one curve, got none")
+    if not np.isfinite(distance) or distance == 0:
+        raise InputError("distance", f"the offset distance must be nonzero, got {distance}")
+
+    # A first, coarse sampling sizes the input; then each curve is sampled to a tolerance.
+    rough = [_initial_samples(c) for c in curves]
+    pts = np.concatenate([r[1][:, :2] for r in rough])
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    extent = float((hi - lo).max())
+    if cell is None:
+        cell = default_cell(extent, distance)
+    elif not cell > 0:
+        raise InputError("cell", f"cell must be positive, got {cell}")
+    scale = extent if extent > 0 else 2 * abs(distance)
+    tol = _SAMPLE_SHARE * min(cell, _TOLERANCE * scale)
+    ctx.guard(grid_cells(lo, hi, distance, cell), "offset grid cells")
+
+    polylines, closed = [], []
+    for curve, (t, xyz) in zip(curves, rough, strict=True):
+        p, is_closed = _adaptive(curve, t, xyz, tol, ctx)
+        polylines.append(p)
+        closed.append(is_closed)
+    try:
+        loops = offset_polylines(
+            polylines, closed, distance, cell, smooth, simplify, max_cells=ctx.budget
+        )
+    except ValueError as exc:
+        raise InputError("cell", str(exc)) from None
+    if not loops:
+        ctx.warn(f"the offset at {distance} is empty (the inward offset removes everything)")
+    return [NurbsCurve.polyline(np.c_[lp, np.zeros(len(lp))], closed=True) for lp in loops]
+
+
+def _initial_samples(curve: Curve) -> tuple[np.ndarray | None, np.ndarray]:
+    """Parameters and points of a first sampling (a polyline: its vertices, no parameters)."""
+    if isinstance(curve, NurbsCurve) and curve.degree == 1:
+        return None, np.asarray(curve.control_points)
+    t0, t1 = curve.domain
+    if isinstance(curve, NurbsCurve):
+        breaks = np.unique(curve.knots[curve.degree : len(curve.control_points) + 1])
+        t = (breaks[:-1, None] + np.diff(breaks)[:, None] * np.linspace(0, 1, 9)[:-1]).ravel()
+        t = np.append(t, breaks[-1])
+    else:
+        t = np.linspace(t0, t1, max(65, getattr(curve, "samples", 256)))
+    return t, np.asarray(curve.evaluate(t))
+
+
+def _adaptive(
+    curve: Curve, t: np.ndarray | None, xyz: np.ndarray, tol: float, ctx: Context
+) -> tuple[np.ndarray, bool]:
+    """XY samples of a curve with every chord within ``tol`` of it, and whether it closes.
+
+    Chords are split at their parameter midpoint while the curve's point there is farther
+    than ``tol`` from the chord (a polyline is taken exactly, at its vertices).
+    """
+    closed = curve.closed
+    if t is None:
+        p = xyz[:, :2]
+    else:
+        for _ in range(40):
+            mid = (t[:-1] + t[1:]) / 2
+            at = np.asarray(curve.evaluate(mid))
+            far = _chord_gap(xyz[:-1, :2], xyz[1:, :2], at[:, :2]) > tol
+            if not far.any():
+                break
+            ctx.guard(t.size + int(far.sum()), "curve samples")
+            order = np.argsort(np.concatenate([t, mid[far]]), kind="stable")
+            t = np.concatenate([t, mid[far]])[order]
+            xyz = np.concatenate([xyz, at[far]])[order]
+        p = xyz[:, :2]
+    if closed and len(p) > 1 and np.abs(p[0] - p[-1]).max() <= 1e-12 * max(1.0, np.abs(p).max()):
+        p = p[:-1]
+    return np.ascontiguousarray(p, dtype=float), closed
+
+
+def _chord_gap(a: np.ndarray, b: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """Distance from each point ``p`` to the chord ``a -> b``."""
+    ab = b - a
+    den = np.einsum("ij,ij->i", ab, ab)
+    num = np.einsum("ij,ij->i", p - a, ab)
+    s = np.clip(np.divide(num, den, out=np.zeros_like(den), where=den > 0), 0.0, 1.0)
+    return np.hypot(*(p - a - s[:, None] * ab).T)

@@ -1,0 +1,322 @@
+"""Offset kernel against shapely's exact buffers (shapely is a test-only dependency)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import shapely
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from formgraph.kernels.distance import RowParity, SegmentTree, point_segment
+from formgraph.kernels.offset import default_cell, offset_polylines
+
+
+def circle(r: float, n: int = 2000, c=(0.0, 0.0)) -> np.ndarray:
+    a = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    return np.c_[c[0] + r * np.cos(a), c[1] + r * np.sin(a)]
+
+
+def area(loop: np.ndarray) -> float:
+    x, y = loop[:, 0], loop[:, 1]
+    return 0.5 * float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
+
+
+def as_shape(loops: list[np.ndarray]):
+    """Our loops as a shapely region: even-odd union of the rings (they never cross)."""
+    region = shapely.Polygon()
+    for loop in loops:
+        region = region.symmetric_difference(shapely.Polygon(loop))
+    return region
+
+
+def hausdorff(loops: list[np.ndarray], reference, step: float = 0.01) -> float:
+    """Hausdorff distance between our loops and a shapely region's boundary, sampled."""
+    ours = shapely.segmentize(
+        shapely.MultiLineString([np.r_[loop, loop[:1]] for loop in loops]), step
+    )
+    theirs = shapely.segmentize(reference.boundary, step)
+    a = shapely.distance(shapely.points(shapely.get_coordinates(ours)), reference.boundary)
+    b = shapely.distance(shapely.points(shapely.get_coordinates(theirs)), ours)
+    return float(max(a.max(), b.max()))
+
+
+def extent(*polylines: np.ndarray) -> float:
+    pts = np.concatenate(polylines)
+    return float(np.ptp(pts, axis=0).max())
+
+
+# --- closed forms and shapely references ---------------------------------------------------
+
+
+@pytest.mark.parametrize("d", [0.3, 0.05, -0.4, -0.05])
+def test_circle_offsets_to_a_circle(d):
+    (loop,) = offset_polylines([circle(1.0)], [True], d)
+    radius = np.hypot(loop[:, 0], loop[:, 1])
+    assert np.abs(radius - (1 + d)).max() < 1e-3 * 2.0
+    # Between vertices too: the chords' midpoints.
+    mid = (loop + np.roll(loop, -1, axis=0)) / 2
+    assert np.abs(np.hypot(mid[:, 0], mid[:, 1]) - (1 + d)).max() < 1e-3 * 2.0
+    assert area(loop) > 0  # an island runs counter-clockwise
+
+
+def test_square_outward_matches_round_buffer_area():
+    square = np.array([[0, 0], [2, 0], [2, 2], [0, 2]], dtype=float)
+    d = 0.3
+    (loop,) = offset_polylines([square], [True], d)
+    exact = 4 + 4 * 2 * d + np.pi * d**2
+    assert abs(area(loop) - exact) < 0.005 * exact
+    reference = shapely.Polygon(square).buffer(d, quad_segs=64)
+    assert abs(area(loop) - reference.area) < 0.005 * reference.area
+    assert hausdorff([loop], reference) < 1e-3 * 2
+
+
+def test_square_inward_keeps_sharp_corners():
+    square = np.array([[0, 0], [2, 0], [2, 2], [0, 2]], dtype=float)
+    (loop,) = offset_polylines([square], [True], -0.3)
+    # The inward offset of a square is a square with sharp corners at (0.3, 0.3) etc.
+    corners = np.array([[0.3, 0.3], [1.7, 0.3], [1.7, 1.7], [0.3, 1.7]])
+    gap = np.hypot(*(loop[:, None] - corners[None]).transpose(2, 0, 1)).min(axis=0)
+    assert gap.max() < 1e-3 * 2
+    assert abs(area(loop) - 1.4**2) < 1e-3
+
+
+def test_clockwise_input_gives_the_same_result():
+    square = np.array([[0, 0], [2, 0], [2, 2], [0, 2]], dtype=float)
+    (ccw,) = offset_polylines([square], [True], 0.25)
+    (cw,) = offset_polylines([square[::-1]], [True], 0.25)
+    assert area(ccw) > 0 and area(cw) > 0
+    assert abs(area(ccw) - area(cw)) < 1e-9
+
+
+def test_inward_offset_splits_a_dumbbell_into_two_islands():
+    # Two 1 x 1 squares joined by a bar 0.2 wide.
+    shape = np.array(
+        [[0, 0], [1, 0], [1, 0.4], [2, 0.4], [2, 0], [3, 0], [3, 1], [2, 1], [2, 0.6],
+         [1, 0.6], [1, 1], [0, 1]],
+        dtype=float,
+    )
+    joined = offset_polylines([shape], [True], -0.05)
+    assert len(joined) == 1
+    loops = offset_polylines([shape], [True], -0.15)
+    assert len(loops) == 2
+    assert all(area(loop) > 0 for loop in loops)
+    reference = shapely.Polygon(shape).buffer(-0.15, quad_segs=64)
+    assert len(reference.geoms) == 2
+    assert hausdorff(loops, reference) < 1e-3 * 3
+
+
+def test_overlapping_circles_follow_the_even_odd_rule():
+    a, b = circle(1.0), circle(1.0, c=(1.0, 0.0))
+    region = shapely.Polygon(a).symmetric_difference(shapely.Polygon(b))
+    # The lens is outside; a small offset leaves it as a hole (clockwise).
+    loops = offset_polylines([a, b], [True, True], 0.2)
+    assert len(loops) == 2
+    assert sorted(np.sign([area(loop) for loop in loops])) == [-1, 1]
+    reference = region.buffer(0.2, quad_segs=64)
+    assert abs(as_shape(loops).area - reference.area) < 0.005 * reference.area
+    assert hausdorff(loops, reference) < 1e-3 * 2
+    # The lens is 1 wide: an offset past 0.5 covers it.
+    (loop,) = offset_polylines([a, b], [True, True], 0.6)
+    assert area(loop) > 0
+    assert abs(area(loop) - region.buffer(0.6, quad_segs=64).area) < 0.005 * area(loop)
+
+
+def test_distant_circles_stay_apart():
+    loops = offset_polylines([circle(1.0), circle(1.0, c=(3.0, 0.0))], [True, True], 0.3)
+    assert len(loops) == 2
+    assert all(area(loop) > 0 for loop in loops)
+    assert sorted(round(float(loop[:, 0].mean())) for loop in loops) == [0, 3]
+
+
+@pytest.mark.parametrize("d", [0.1, -0.1])
+def test_concentric_circles_give_a_ring(d):
+    loops = offset_polylines([circle(1.0), circle(0.5)], [True, True], d)
+    assert len(loops) == 2
+    outer, inner = sorted(loops, key=lambda loop: -abs(area(loop)))
+    assert area(outer) > 0 > area(inner)
+    assert np.allclose(np.hypot(*outer.T), 1 + d, atol=2e-3)
+    assert np.allclose(np.hypot(*inner.T), 0.5 - d, atol=2e-3)
+
+
+def test_open_segment_gives_a_stadium():
+    segment = np.array([[0.0, 0.0], [1.0, 0.0]])
+    (loop,) = offset_polylines([segment], [False], 0.2)
+    assert area(loop) > 0
+    assert abs(area(loop) - (2 * 0.2 * 1 + np.pi * 0.2**2)) < 1e-3
+    reference = shapely.LineString(segment).buffer(0.2, quad_segs=64)
+    assert hausdorff([loop], reference) < 1e-3 * 1.4
+    # Every vertex is exactly at the distance.
+    d, _ = point_segment(loop, np.zeros_like(loop), np.tile([1.0, 0.0], (len(loop), 1)))
+    assert np.abs(d - 0.2).max() < 1e-9
+
+
+def test_open_input_with_negative_distance_is_empty():
+    assert offset_polylines([np.array([[0.0, 0.0], [1.0, 0.0]])], [False], -0.2) == []
+
+
+def test_single_point_gives_a_circle():
+    (loop,) = offset_polylines([np.array([[2.0, 3.0]])], [False], 0.5)
+    assert np.abs(np.hypot(loop[:, 0] - 2, loop[:, 1] - 3) - 0.5).max() < 1e-9
+
+
+def test_self_intersecting_figure_eight():
+    bowtie = np.array([[0, 0], [2, 2], [2, 0], [0, 2]], dtype=float)
+    lobes = shapely.make_valid(shapely.Polygon(bowtie))
+    assert abs(lobes.area - 2.0) < 1e-12  # two triangles of area 1
+    for d in (0.1, -0.05):
+        loops = offset_polylines([bowtie], [True], d)
+        reference = lobes.buffer(d, quad_segs=64)
+        assert abs(as_shape(loops).area - reference.area) < 0.005 * reference.area
+        assert hausdorff(loops, reference) < 1e-3 * 2
+    # Outward the lobes join at the crossing; inward they part.
+    assert len(offset_polylines([bowtie], [True], 0.1)) == 1
+    assert len(offset_polylines([bowtie], [True], -0.05)) == 2
+
+
+def test_inward_past_the_middle_is_empty():
+    assert offset_polylines([circle(1.0)], [True], -1.2) == []
+
+
+def test_every_vertex_is_on_the_offset():
+    pts = circle(1.0, 300) * (1 + 0.2 * np.sin(5 * np.linspace(0, 2 * np.pi, 300)))[:, None]
+    tree = SegmentTree(pts, np.roll(pts, -1, axis=0))
+    for d in (0.15, -0.1):
+        for loop in offset_polylines([pts], [True], d):
+            assert np.abs(tree.query(loop).dist - abs(d)).max() < 1e-6
+
+
+def test_error_is_within_the_tolerance_for_a_user_cell():
+    # A coarse cell does not cost accuracy: vertices are projected and chords refined.
+    pts = circle(1.0, 500) * (1 + 0.1 * np.sin(9 * np.linspace(0, 2 * np.pi, 500)))[:, None]
+    reference = shapely.Polygon(pts).buffer(0.1, quad_segs=64)
+    for cell in (0.01, 0.04):
+        loops = offset_polylines([pts], [True], 0.1, cell=cell)
+        assert hausdorff(loops, reference) < 1e-3 * extent(pts)
+
+
+# --- smoothing and simplification ----------------------------------------------------------
+
+
+def test_smoothing_keeps_the_distance():
+    pts = circle(1.0, 300) * (1 + 0.2 * np.sin(5 * np.linspace(0, 2 * np.pi, 300)))[:, None]
+    tree = SegmentTree(pts, np.roll(pts, -1, axis=0))
+    (loop,) = offset_polylines([pts], [True], 0.15, smooth=4)
+    assert np.abs(tree.query(loop).dist - 0.15).max() < 1e-6
+    (plain,) = offset_polylines([pts], [True], 0.15)
+    # Smoothing evens out the spacing of the vertices.
+    def spread(p):
+        step = np.hypot(*(np.roll(p, -1, axis=0) - p).T)
+        return step.std() / step.mean()
+
+    assert spread(loop) < spread(plain)
+
+
+def test_simplify_stays_within_its_tolerance():
+    pts = circle(1.0)
+    (full,) = offset_polylines([pts], [True], 0.2)
+    (simple,) = offset_polylines([pts], [True], 0.2, simplify=0.01)
+    assert len(simple) < len(full) / 3
+    # Every dropped vertex is within the tolerance of the simplified loop.
+    ring = shapely.LinearRing(simple)
+    assert max(ring.distance(shapely.Point(p)) for p in full) <= 0.01 + 1e-9
+    assert area(simple) > 0
+
+
+# --- hypothesis: random polygons against shapely -------------------------------------------
+
+
+@st.composite
+def star_polygons(draw):
+    n = draw(st.integers(min_value=3, max_value=24))
+    radii = draw(st.lists(st.floats(0.3, 1.0), min_size=n, max_size=n))
+    gaps = draw(st.lists(st.floats(0.2, 1.0), min_size=n, max_size=n))
+    angles = 2 * np.pi * np.cumsum(gaps) / np.sum(gaps)
+    return np.c_[np.array(radii) * np.cos(angles), np.array(radii) * np.sin(angles)]
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(star_polygons(), st.floats(-0.25, 0.3).filter(lambda d: abs(d) > 0.02))
+def test_random_polygons_match_shapely(polygon, d):
+    loops = offset_polylines([polygon], [True], d)
+    # Every loop is a simple ring, islands counter-clockwise and holes clockwise.
+    assert all(shapely.Polygon(loop).is_valid for loop in loops)
+    reference = shapely.Polygon(polygon).buffer(d, quad_segs=64)
+    ours = as_shape(loops)
+    assert ours.is_valid
+    assert np.isclose(sum(area(loop) for loop in loops), ours.area, rtol=1e-9, atol=1e-12)
+    # The symmetric difference is no more than the boundary length times the 0.1 %
+    # tolerance (so a sliver at most that thin along the whole boundary).
+    size = extent(polygon)
+    assert ours.symmetric_difference(reference).area <= 1e-3 * size * reference.length + 1e-9
+
+
+# --- errors ---------------------------------------------------------------------------------
+
+
+def test_errors():
+    square = np.array([[0, 0], [1, 0], [1, 1]], dtype=float)
+    with pytest.raises(ValueError, match="at least one polyline, got none"):
+        offset_polylines([], [], 0.1)
+    with pytest.raises(ValueError, match="distance must be a nonzero finite number, got 0"):
+        offset_polylines([square], [True], 0.0)
+    with pytest.raises(ValueError, match="distance must be a nonzero finite number, got nan"):
+        offset_polylines([square], [True], float("nan"))
+    with pytest.raises(ValueError, match="one flag per polyline: 1 polylines, 2 flags"):
+        offset_polylines([square], [True, False], 0.1)
+    with pytest.raises(ValueError, match=r"polyline 0 must be an \(n, 2\) array"):
+        offset_polylines([np.zeros((3, 3))], [True], 0.1)
+    with pytest.raises(ValueError, match="polyline 0 has NaN or infinite coordinates"):
+        offset_polylines([np.array([[0, 0], [np.nan, 1.0]])], [False], 0.1)
+    with pytest.raises(ValueError, match="cell must be a positive finite number, got -1"):
+        offset_polylines([square], [True], 0.1, cell=-1)
+    with pytest.raises(ValueError, match="smooth must be a whole number of passes"):
+        offset_polylines([square], [True], 0.1, smooth=1.5)
+    with pytest.raises(ValueError, match="simplify must be a tolerance >= 0"):
+        offset_polylines([square], [True], 0.1, simplify=-1)
+    with pytest.raises(ValueError, match=r"cells, more than the limit of 1000; use a larger cell"):
+        offset_polylines([square], [True], 0.1, cell=0.001, max_cells=1000)
+
+
+def test_default_cell():
+    # Second order: the chord sag h^2 / (4 R) with R >= |d| stays well below the tolerance.
+    h = default_cell(2.0, 0.05)
+    assert h == pytest.approx(min(0.025, 2 * np.sqrt(0.05 * 2e-3)))
+    assert default_cell(0.0, 0.5) == pytest.approx(min(0.25, 2 * np.sqrt(0.5 * 1e-3)))
+
+
+# --- the distance kernel --------------------------------------------------------------------
+
+
+def test_segment_tree_matches_brute_force():
+    rng = np.random.default_rng(3)
+    a = rng.uniform(-1, 1, (300, 2))
+    b = a + rng.normal(0, 0.1, (300, 2))
+    b[7] = a[7]  # a zero-length segment
+    p = rng.uniform(-1.5, 1.5, (500, 2))
+    brute = point_segment(p[:, None], a[None], b[None])[0]
+    tree = SegmentTree(a, b)
+    near = tree.query(p)
+    assert np.allclose(near.dist, brute.min(axis=1), rtol=0, atol=1e-12)
+    assert np.allclose(brute[np.arange(500), near.segment], near.dist, atol=1e-12)
+    # A band: exact inside it, certified outside.
+    lo, hi = 0.1, 0.2
+    band = tree.query(p, lo, hi)
+    true = brute.min(axis=1)
+    inside = (true >= lo) & (true <= hi)
+    assert np.allclose(band.dist[inside], true[inside], atol=1e-12)
+    assert band.exact[inside].all()
+    assert ((band.dist < lo) == (true < lo)).all()
+    assert ((band.dist > hi) == (true > hi)).all()
+
+
+def test_row_parity_matches_shapely():
+    rng = np.random.default_rng(5)
+    star = circle(1.0, 9) * rng.uniform(0.4, 1.0, (9, 1))
+    a, b = star, np.roll(star, -1, axis=0)
+    origin, cell, ny, nx = np.array([-1.2, -1.2]), 0.05, 49, 49
+    parity = RowParity(a, b, origin, cell, ny, nx)
+    i, j = np.divmod(np.arange(ny * nx), nx)
+    inside = parity.inside(i, j)
+    pts = shapely.points(origin[0] + j * cell, origin[1] + i * cell)
+    assert (inside == shapely.contains(shapely.Polygon(star), pts)).all()
