@@ -358,14 +358,16 @@ class Scene:
         bounds = grid[0] if self.show_grid else self.bounds()
         axis = view_axis(bounds)
         p = self.plotter
-        # sliders take the right of the window: centre the picture in what is left
-        p.camera.SetWindowCenter(self.view_shift, 0.0)
+        # sliders take the right of the window: centre the picture in what is left; the
+        # legend takes the top right: on a drawing, move the picture down below it
+        legend = self._legend_height() if axis is not None else 0.0
+        p.camera.SetWindowCenter(self.view_shift, legend)
         # flat geometry is a drawing: look straight at it, without perspective
         p.camera.parallel_projection = axis is not None
         {None: p.view_isometric, 2: p.view_xy, 1: p.view_xz, 0: p.view_yz}[axis](render=False)
         p.reset_camera(render=False, bounds=bounds)
         # leave room for the axis labels (and, on a drawing, the legend above it)
-        self._zoom_to_fit(bounds, fill=0.8 if axis is None else 0.7)
+        self._zoom_to_fit(bounds, fill=0.8 if axis is None else 0.8 - legend)
 
     def _zoom_to_fit(self, bounds: Sequence[float], fill: float) -> None:
         """Zoom until the box's projection fills ``fill`` of the free part of the window.
@@ -440,6 +442,11 @@ class Scene:
 
     # -------------------------------------------------------------------- legend, text
 
+    def _legend_height(self) -> float:
+        """The fraction of the window's height the legend takes (0 with no legend)."""
+        n = len(self.layers)
+        return 0.0 if n == 0 else min((20 * n + 8) / self.plotter.window_size[1], 0.5)
+
     def _legend(self) -> None:
         p = self.plotter
         entries = []
@@ -458,7 +465,7 @@ class Scene:
         # placed by hand: pyvista's loc="upper right" offsets x by the height, not the width
         # about 13-pixel text, whatever the window size
         win_w, win_h = p.window_size
-        height = min((20 * len(entries) + 8) / win_h, 0.5)
+        height = self._legend_height()
         width = min((7.5 * max(len(e[0]) for e in entries) + 34) / win_w, 0.45)
         legend = p.add_legend(
             entries,
