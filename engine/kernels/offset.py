@@ -34,8 +34,8 @@ import numpy as np
 
 from .contour import split_loops, trace_crossings
 from .distance import RowParity, SegmentTree
+from .loops import simplify as simplify_loops
 from .refine import exact_loops
-from .refine import simplify as simplify_loops
 from .refine import smooth as smooth_loops
 
 __all__ = ["default_cell", "grid_cells", "offset_polylines"]

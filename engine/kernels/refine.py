@@ -13,9 +13,8 @@ at any point is the unit vector from its nearest point on the segments:
   two end features' offsets meet (the sharp-feature recovery of Kobbelt, Botsch,
   Schwanecke & Seidel, "Feature sensitive surface extraction from volume data",
   SIGGRAPH 2001);
-* `smooth` relaxes vertices along the level set and `simplify` applies Douglas-Peucker
-  (Douglas & Peucker, "Algorithms for the reduction of the number of points required to
-  represent a digitized line", Cartographica 1973) to every loop at once.
+* `smooth` relaxes vertices along the level set (the clean-up and Douglas-Peucker are in
+  `loops`).
 
 Every step is vectorized over all vertices of all loops. Distances are unsigned: callers
 keep every point they pass within ``0.9 radius`` of the level, which (the signed distance
@@ -24,105 +23,19 @@ being 1-Lipschitz) puts it on the level's side of the input.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from .distance import Nearest, SegmentTree, point_segment
+from .loops import COS30, Loops, drop_folds, segments_cross, tidy, unit
 
-__all__ = ["Loops", "exact_loops", "project", "refine_chords", "simplify", "smooth", "tidy"]
-
-_COS30 = float(np.cos(np.radians(30)))
-_UNTANGLE = 8  # chords ahead checked for a crossing by the final clean-up
-
-
-@dataclass
-class Loops:
-    """Closed loops stored flat, loop after loop, with what refinement needs per vertex.
-
-    Attributes
-    ----------
-    xy : (n, 2) float
-    normal, normal_in : (n, 2) float
-        Unit gradient of the distance at the vertex, as seen from the chord leaving it and
-        from the chord arriving at it (they differ at a corner, where two features meet).
-    seg, seg_in : (n,) int64
-        The nearest input segment on either side, likewise.
-    loop : (n,) int64
-        Loop id of each vertex, nondecreasing.
-    todo : (n,) bool
-        The chord from this vertex to the next still needs a check.
-    """
-
-    xy: np.ndarray
-    normal: np.ndarray
-    seg: np.ndarray
-    loop: np.ndarray
-    todo: np.ndarray
-    normal_in: np.ndarray | None = None
-    seg_in: np.ndarray | None = None
-
-    def __post_init__(self) -> None:
-        if self.normal_in is None:
-            self.normal_in = self.normal.copy()
-        if self.seg_in is None:
-            self.seg_in = self.seg.copy()
-
-    @property
-    def next(self) -> np.ndarray:
-        n = self.loop.size
-        nxt = np.arange(1, n + 1)
-        last = np.flatnonzero(np.diff(self.loop, append=-1) != 0)
-        nxt[last] = np.concatenate([[0], last[:-1] + 1])
-        return nxt
-
-    def offsets(self) -> np.ndarray:
-        counts = np.bincount(self.loop)
-        return np.concatenate([[0], np.cumsum(counts[counts > 0])])
-
-    def insert(self, after: np.ndarray, new: _Picks, rows: np.ndarray) -> Loops:
-        """New vertices ``new[rows]`` after the given ones; the chords on both sides of each
-        are to do."""
-        n = self.loop.size
-        order = np.argsort(np.concatenate([np.arange(n), after + 0.5]), kind="stable")
-        todo = self.todo.copy()
-        todo[after] = True
-
-        def cat(old, extra):
-            return np.concatenate([old, extra[rows]])[order]
-
-        return Loops(
-            cat(self.xy, new.point),
-            cat(self.normal, new.normal),
-            cat(self.seg, new.seg),
-            np.concatenate([self.loop, self.loop[after]])[order],
-            np.concatenate([todo, np.ones(after.size, dtype=bool)])[order],
-            cat(self.normal_in, new.normal_in),
-            cat(self.seg_in, new.seg_in),
-        )
-
-    def select(self, keep: np.ndarray) -> Loops:
-        return Loops(
-            self.xy[keep],
-            self.normal[keep],
-            self.seg[keep],
-            self.loop[keep],
-            self.todo[keep],
-            self.normal_in[keep],
-            self.seg_in[keep],
-        )
-
-
-def _unit(v: np.ndarray) -> np.ndarray:
-    length = np.hypot(v[:, 0], v[:, 1])
-    return v / np.where(length > 0, length, 1.0)[:, None]
+__all__ = ["exact_loops", "project", "refine_chords", "smooth"]
 
 
 def _feet(tree: SegmentTree, near: Nearest, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Nearest points on the input and the unit gradient of the distance at ``p``."""
     seg = np.maximum(near.segment, 0)
     foot = tree.a[seg] + near.t[:, None] * (tree.b[seg] - tree.a[seg])
-    return foot, _unit(p - foot)
+    return foot, unit(p - foot)
 
 
 def project(tree: SegmentTree, p: np.ndarray, radius: float, band: float):
@@ -262,8 +175,8 @@ def _corner(tree, s1, s2, start, radius, tol, chases=2, iterations=4):
         for _ in range(iterations):
             d1, t1 = point_segment(x, a1, b1)
             d2, t2 = point_segment(x, a2, b2)
-            n1 = _unit(x - (a1 + t1[:, None] * (b1 - a1)))
-            n2 = _unit(x - (a2 + t2[:, None] * (b2 - a2)))
+            n1 = unit(x - (a1 + t1[:, None] * (b1 - a1)))
+            n2 = unit(x - (a2 + t2[:, None] * (b2 - a2)))
             det = n1[:, 0] * n2[:, 1] - n1[:, 1] * n2[:, 0]
             safe = np.abs(det) > 1e-6
             det = np.where(safe, det, 1.0)
@@ -273,8 +186,8 @@ def _corner(tree, s1, s2, start, radius, tol, chases=2, iterations=4):
             x = np.where(safe[:, None], x + step / det[:, None], x)
         d1, t1 = point_segment(x, a1, b1)
         d2, t2 = point_segment(x, a2, b2)
-        n1 = _unit(x - (a1 + t1[:, None] * (b1 - a1)))
-        n2 = _unit(x - (a2 + t2[:, None] * (b2 - a2)))
+        n1 = unit(x - (a1 + t1[:, None] * (b1 - a1)))
+        n2 = unit(x - (a2 + t2[:, None] * (b2 - a2)))
         near = tree.query(x, radius - 0.5 * radius, radius + 0.5 * radius)
         nx = _feet(tree, near, x)[1]
         ok = near.exact & (np.abs(near.dist - radius) <= eps) & safe
@@ -296,15 +209,6 @@ def _between(u: np.ndarray, c: np.ndarray, p: np.ndarray) -> np.ndarray:
     return (along > 0) & (along < np.einsum("ij,ij->i", c, c))
 
 
-def _segments_cross(a, b, c, d) -> np.ndarray:
-    """Whether segments ``a -> b`` and ``c -> d`` properly cross, pairwise."""
-
-    def orient(p, q, r):
-        return (q[:, 0] - p[:, 0]) * (r[:, 1] - p[:, 1]) - (q[:, 1] - p[:, 1]) * (r[:, 0] - p[:, 0])
-
-    return (orient(a, b, c) * orient(a, b, d) < 0) & (orient(c, d, a) * orient(c, d, b) < 0)
-
-
 def _fits(loops: Loops, i: np.ndarray, j: np.ndarray, p: np.ndarray, gap) -> np.ndarray:
     """Whether ``p`` can go between vertices ``i`` and ``j = next(i)`` without a local fold.
 
@@ -319,7 +223,7 @@ def _fits(loops: Loops, i: np.ndarray, j: np.ndarray, p: np.ndarray, gap) -> np.
     apart = (np.hypot(*(p - u).T) > gap) & (np.hypot(*(p - w).T) > gap)
     # Not back on the chords next to this one (a vertex found again from the other side).
     apart &= (point_segment(p, before, u)[0] > gap) & (point_segment(p, w, after)[0] > gap)
-    return apart & ~_segments_cross(before, u, p, w) & ~_segments_cross(w, after, u, p)
+    return apart & ~segments_cross(before, u, p, w) & ~segments_cross(w, after, u, p)
 
 
 class _Picks:
@@ -393,7 +297,7 @@ def refine_chords(
         bad = np.where(meet, height > tol, skew > tol)
         # The bound needs one sign of curvature; a chord whose normals turn a lot may hide
         # a line, an arc and a notch (as at the mouth of a V): ask at a chord point.
-        suspect = ~bad & (np.einsum("ij,ij->i", nu, nw) < _COS30) & (clen > tol)
+        suspect = ~bad & (np.einsum("ij,ij->i", nu, nw) < COS30) & (clen > tol)
         reach_k = (sin != 0) & (np.hypot(*ku.T) < 0.9 * radius)
         reach_k &= np.hypot(*(k - u - c).T) < 0.9 * radius
         inside = reach_k & (along > 0) & (along < 1)
@@ -440,14 +344,14 @@ def refine_chords(
         near = tree.query(kr[ok], radius - eps, radius + eps)
         ok[ok] = near.exact & (np.abs(near.dist - radius) <= eps)
         ok &= _fits(loops, todo[rows], nxt[rows], kr, gap[rows])
-        n_in = _unit(kr - (tree.a[su] + tu[:, None] * (tree.b[su] - tree.a[su])))
-        n_out = _unit(kr - (tree.a[sw] + tw[:, None] * (tree.b[sw] - tree.a[sw])))
+        n_in = unit(kr - (tree.a[su] + tu[:, None] * (tree.b[su] - tree.a[su])))
+        n_out = unit(kr - (tree.a[sw] + tw[:, None] * (tree.b[sw] - tree.a[sw])))
         take(rows, ok, kr, n_out, sw, n_in, su)
         # 2. Where the normals turn sharply, the corner where the end segments' offsets
         # meet (chasing a third segment that comes closer).
         rows = np.flatnonzero(
             ~found
-            & (np.einsum("ij,ij->i", nu, nw) < _COS30)
+            & (np.einsum("ij,ij->i", nu, nw) < COS30)
             & (loops.seg[todo] != loops.seg_in[nxt])
         )
         if rows.size:
@@ -488,47 +392,6 @@ def refine_chords(
         take(slid_rows, last, slid_p, slid_n, slid_s)
         loops = loops.insert(todo[found], pick, np.flatnonzero(found))
     return loops
-
-
-def _crosses(xy: np.ndarray, i1: np.ndarray, j0: np.ndarray, j1: np.ndarray) -> np.ndarray:
-    """Whether chord ``k -> i1[k]`` properly crosses chord ``j0[k] -> j1[k]``, for every k."""
-    return _segments_cross(xy, xy[i1], xy[j0], xy[j1])
-
-
-def _drop_folds(loops: Loops, before: np.ndarray, ok: np.ndarray) -> Loops:
-    """Drop the vertices that failed to project, and pairs that projection put in reverse.
-
-    Near a corner of the offset two neighbours can be moved past each other; both go, and
-    the chord refinement recovers the corner from their neighbours. A loop that would keep
-    fewer than three vertices is kept as it was.
-    """
-    keep = ok.copy()
-    for _ in range(4):
-        idx = np.flatnonzero(keep)
-        sub = loops.select(keep)
-        nxt = sub.next
-        n2 = nxt[nxt]
-        flip = np.einsum("ij,ij->i", sub.xy[nxt] - sub.xy, before[idx[nxt]] - before[idx]) <= 0
-        # A chord crossing the chord two or three ahead: the vertices between are reversed.
-        cross2 = _crosses(sub.xy, nxt, n2, nxt[n2])
-        cross3 = _crosses(sub.xy, nxt, nxt[n2], nxt[nxt[n2]])
-        # Going back along one smooth stretch (normals alike): a spike the projection
-        # folded flat onto one side of a notch narrower than a cell.
-        back = (
-            (np.einsum("ij,ij->i", sub.xy[nxt] - sub.xy, sub.xy[n2] - sub.xy[nxt]) < 0)
-            & (np.einsum("ij,ij->i", sub.normal, sub.normal[nxt]) > _COS30)
-            & (np.einsum("ij,ij->i", sub.normal[nxt], sub.normal[n2]) > _COS30)
-        )
-        if not (flip.any() or cross2.any() or cross3.any() or back.any()):
-            break
-        keep[idx[flip]] = False
-        keep[idx[nxt[back]]] = False
-        keep[idx[nxt[flip | cross2 | cross3]]] = False
-        keep[idx[n2[cross2 | cross3]]] = False
-        keep[idx[nxt[n2[cross3]]]] = False
-    count = np.bincount(loops.loop[keep], minlength=loops.loop.max() + 1)
-    keep |= count[loops.loop] < 3
-    return loops.select(keep)
 
 
 def exact_loops(
@@ -576,79 +439,9 @@ def exact_loops(
     loops = Loops(moved, normal, seg, loop, np.ones(n, dtype=bool))
     # A vertex whose projection another feature swallows sits next to a corner of the
     # offset: it goes, and the chord across the corner recovers the corner.
-    loops = _drop_folds(loops, xy, ok)
+    loops = drop_folds(loops, xy, ok)
     loops = refine_chords(tree, loops, radius, tol, far_inside)
     return tidy(loops, 1e-3 * tol)
-
-
-def tidy(loops: Loops, gap: float) -> Loops:
-    """Remove degenerate bits: repeated vertices, folds, detours, flat loops.
-
-    A vertex within ``gap`` of the previous one goes; so does a vertex where the loop turns
-    straight back along one smooth stretch (normals alike). A loop that passes the same
-    point twice (a corner found from two chords) loses the shorter way between the two
-    visits. Loops left with fewer than three vertices or no area go too.
-    """
-    for _ in range(6):
-        nxt = loops.next
-        n2 = nxt[nxt]
-        xy, normal = loops.xy, loops.normal
-        cut = np.zeros(xy.shape[0], dtype=bool)
-        cut[nxt[np.hypot(*(xy[nxt] - xy).T) < gap]] = True
-        back = (
-            (np.einsum("ij,ij->i", xy[nxt] - xy, xy[n2] - xy[nxt]) < 0)
-            & (np.einsum("ij,ij->i", normal, normal[nxt]) > _COS30)
-            & (np.einsum("ij,ij->i", normal[nxt], normal[n2]) > _COS30)
-        )
-        cut[nxt[back]] = True
-        cut |= _detours(loops, gap)
-        # A chord crossing one a few chords ahead: the vertices between are twisted.
-        steps = [nxt]  # steps[o - 1] = the vertex o ahead
-        for _ in range(_UNTANGLE):
-            steps.append(nxt[steps[-1]])
-        for o in range(2, _UNTANGLE + 1):
-            crossing = _crosses(xy, nxt, steps[o - 1], steps[o])
-            for between in steps[:o]:
-                cut[between[crossing]] = True
-        if not cut.any():
-            break
-        loops = loops.select(~cut)
-    if loops.loop.size == 0:
-        return loops
-    nxt = loops.next
-    x, y = loops.xy[:, 0], loops.xy[:, 1]
-    area = np.bincount(loops.loop, x * y[nxt] - x[nxt] * y, minlength=loops.loop.max() + 1)
-    count = np.bincount(loops.loop, minlength=area.size)
-    keep = (count >= 3) & (np.abs(area) > gap * gap)
-    return loops.select(keep[loops.loop])
-
-
-def _detours(loops: Loops, gap: float) -> np.ndarray:
-    """Vertices on the shorter way between two visits of a loop to the same point."""
-    n = loops.loop.size
-    cut = np.zeros(n, dtype=bool)
-    if n == 0:
-        return cut
-    first = np.flatnonzero(np.diff(loops.loop, prepend=-1) != 0)
-    runs = np.diff(np.append(first, n))
-    start, size = np.repeat(first, runs), np.repeat(runs, runs)
-    for shift in (0.0, 0.5):  # two staggered bucketings catch pairs across bucket borders
-        key = np.floor(loops.xy / (4 * gap) + shift).astype(np.int64)
-        order = np.lexsort((key[:, 1], key[:, 0], loops.loop))
-        a, b = order[:-1], order[1:]
-        same = (
-            (loops.loop[a] == loops.loop[b])
-            & (key[a] == key[b]).all(axis=1)
-            & (np.hypot(*(loops.xy[a] - loops.xy[b]).T) < gap)
-        )
-        i, j = np.minimum(a[same], b[same]), np.maximum(a[same], b[same])
-        for p, q in zip(i.tolist(), j.tolist(), strict=True):  # a handful at most
-            if q - p <= size[p] - (q - p):
-                cut[p + 1 : q + 1] = True
-            else:
-                cut[q + 1 : start[p] + size[p]] = True
-                cut[start[p] : p + 1] = True
-    return cut
 
 
 def smooth(tree: SegmentTree, loops: Loops, radius: float, passes: int) -> Loops:
@@ -663,8 +456,8 @@ def smooth(tree: SegmentTree, loops: Loops, radius: float, passes: int) -> Loops
         prev = np.empty_like(nxt)
         prev[nxt] = np.arange(nxt.size)
         xy = loops.xy
-        turn = np.einsum("ij,ij->i", _unit(xy - xy[prev]), _unit(xy[nxt] - xy))
-        move = np.flatnonzero(turn > _COS30)
+        turn = np.einsum("ij,ij->i", unit(xy - xy[prev]), unit(xy[nxt] - xy))
+        move = np.flatnonzero(turn > COS30)
         target = (xy[move] + (xy[prev[move]] + xy[nxt[move]]) / 2) / 2
         moved, normal, seg, _, ok = project(tree, target, radius, 0.9 * radius)
         # Keep the order: the vertex must stay between its neighbours.
@@ -676,66 +469,3 @@ def smooth(tree: SegmentTree, loops: Loops, radius: float, passes: int) -> Loops
     return loops
 
 
-def simplify(xy: np.ndarray, offsets: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
-    """Douglas-Peucker on closed loops, all loops at once.
-
-    Each loop is split at its first vertex and the vertex farthest from it; every span
-    whose farthest interior vertex (from the span's chord) is beyond ``tol`` is split there,
-    round after round, and the other interior vertices are dropped. Loops left with fewer
-    than three vertices (slivers thinner than ``2 tol``) are dropped.
-
-    Parameters
-    ----------
-    xy : (n, 2) float
-        Vertices, loop after loop (first vertex not repeated).
-    offsets : (n_loops + 1,) int
-    tol : float
-        Largest distance from a dropped vertex to the simplified loop.
-
-    Returns
-    -------
-    xy : (m, 2) float
-    offsets : (k + 1,) int
-    """
-    n = xy.shape[0]
-    sizes = np.diff(offsets)
-    real = np.flatnonzero(sizes > 0)
-    first, end = offsets[:-1][real], offsets[1:][real]
-    loop = np.repeat(np.arange(real.size), sizes[real])
-    d0 = np.hypot(*(xy - xy[first[loop]]).T)
-    best = np.full(real.size, -1.0)
-    np.maximum.at(best, loop, d0)
-    far = np.full(real.size, n)
-    np.minimum.at(far, loop, np.where(d0 == best[loop], np.arange(n), n))
-    keep = np.zeros(n, dtype=bool)
-    keep[first] = keep[far] = True
-    # Spans (s, e) of loop lp in global indices; e == end[lp] stands for the loop's first
-    # vertex again.
-    s = np.concatenate([first, far])
-    e = np.concatenate([far, end])
-    lp = np.concatenate([np.arange(real.size), np.arange(real.size)])
-    while True:
-        inner = e - s - 1
-        live = inner > 0
-        s, e, lp, inner = s[live], e[live], lp[live], inner[live]
-        if s.size == 0:
-            break
-        span = np.repeat(np.arange(s.size), inner)
-        idx = np.arange(span.size) - np.repeat(np.cumsum(inner) - inner, inner) + s[span] + 1
-        stop = np.where(e == end[lp], first[lp], e)
-        dist, _ = point_segment(xy[idx], xy[s][span], xy[stop][span])
-        top = np.full(s.size, -1.0)
-        np.maximum.at(top, span, dist)
-        pick = np.full(s.size, n)
-        np.minimum.at(pick, span, np.where(dist == top[span], idx, n))
-        split = top > tol
-        keep[pick[split]] = True
-        s, e, lp = (
-            np.concatenate([s[split], pick[split]]),
-            np.concatenate([pick[split], e[split]]),
-            np.concatenate([lp[split], lp[split]]),
-        )
-    counts = np.bincount(loop[keep], minlength=real.size)
-    ok = counts >= 3
-    keep &= ok[loop]
-    return xy[keep], np.concatenate([[0], np.cumsum(counts[ok])])
