@@ -107,8 +107,8 @@ class MemoryCache:
         self._items.move_to_end(key)
         return True, item[0]
 
-    def put(self, key: str, value: Any) -> None:
-        size = sizeof(value)
+    def put(self, key: str, value: Any, size: int | None = None) -> None:
+        size = sizeof(value) if size is None else size
         if key in self._items:
             self.bytes -= self._items.pop(key)[1]
         if size > self.max_bytes:

@@ -542,9 +542,9 @@ class _Run:
                 kwargs[port] = p.type.coerce(raw)
             except (TypeMismatch, ValueError) as exc:
                 raise GraphError([Problem(self.where(name, port), str(exc))]) from None
-        ctx = Context(name, self.out_path, self.g.budget)
+        warnings: list[str] = []
         if spec.wants_context:
-            kwargs["ctx"] = ctx
+            kwargs["ctx"] = Context(name, self.out_path, self.g.budget, warnings)
         if self.g.progress is not None:
             computed = sum(1 for s in self.stats.values() if s.status == "computed")
             self.g.progress(name, computed, self.total)
@@ -572,7 +572,8 @@ class _Run:
         value = self.check_output(name, nd, spec, value)
         key = self.key(name)
         identity = self.cutoff_identity(name, key, value)
-        self.g.memory.put(key, value)
+        size = _cache.sizeof(value)
+        self.g.memory.put(key, value, size)
         if self.g.disk is not None:
             self.g.disk.put(key, value, identity)
         if len(self.g._identity) > 1_000_000:  # bounded: forgetting only costs cache hits
@@ -582,7 +583,7 @@ class _Run:
         self.g._last[name] = (key, identity)
         if spec.is_export:
             self.g._written[key] = _file_stamp(value)
-        self.stats[name] = NodeStat("computed", seconds, _cache.sizeof(value), ctx.warnings)
+        self.stats[name] = NodeStat("computed", seconds, size, warnings)
         return value
 
     def cutoff_identity(self, name: str, key: str, value: Any) -> str:

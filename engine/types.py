@@ -115,6 +115,13 @@ class PortType:
         return " | ".join(k.name for k in self.kinds)
 
     @functools.cached_property
+    def _geometry_item(self) -> type | None:
+        """The geometry class of a single-kind, non-list port (None otherwise)."""
+        if len(self.kinds) == 1 and not self.kinds[0].is_list and _is_geometry(self.kinds[0].base):
+            return self.kinds[0].base
+        return None
+
+    @functools.cached_property
     def is_expression(self) -> bool:
         return any(k.base is Expression for k in self.kinds)
 
@@ -147,6 +154,8 @@ class PortType:
         TypeMismatch
             With a sentence saying what was expected and what came.
         """
+        if self._geometry_item is not None and isinstance(value, self._geometry_item):
+            return value  # the common case of a wire: already the right geometry
         if value is None:
             if self.optional:
                 return None

@@ -230,9 +230,7 @@ def _cycles(succ: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return order, offsets
 
 
-def split_loops(
-    points: np.ndarray, offsets: np.ndarray, min_vertices: int = 3
-) -> list[np.ndarray]:
+def split_loops(points: np.ndarray, offsets: np.ndarray, min_vertices: int = 3) -> list[np.ndarray]:
     """Split concatenated loops, dropping repeated consecutive vertices and tiny loops.
 
     Parameters

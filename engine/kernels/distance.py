@@ -26,9 +26,7 @@ import numpy as np
 __all__ = ["Nearest", "RowParity", "SegmentTree", "point_segment"]
 
 
-def point_segment(
-    p: np.ndarray, a: np.ndarray, b: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
+def point_segment(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Distance from points to segments, pairwise (broadcasting over leading axes).
 
     Parameters

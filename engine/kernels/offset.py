@@ -182,9 +182,7 @@ def _band_cells(field: _Field, ncx: int, ncy: int, levels: int):
             ci = (2 * ci[:, None] + np.array([0, 0, 1, 1])).ravel()
             cj = (2 * cj[:, None] + np.array([0, 1, 0, 1])).ravel()
             pid = np.unique(
-                (ci[:, None] + np.array([0, 0, 1, 1])) * w
-                + cj[:, None]
-                + np.array([0, 1, 0, 1])
+                (ci[:, None] + np.array([0, 0, 1, 1])) * w + cj[:, None] + np.array([0, 1, 0, 1])
             )
         pi, pj = np.divmod(pid, w)
         band = 1.5 * step * field.cell

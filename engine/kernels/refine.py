@@ -467,5 +467,3 @@ def smooth(tree: SegmentTree, loops: Loops, radius: float, passes: int) -> Loops
         loops.xy[move], loops.normal[move], loops.seg[move] = moved[ok], normal[ok], seg[ok]
         loops.normal_in[move], loops.seg_in[move] = normal[ok], seg[ok]
     return loops
-
-
