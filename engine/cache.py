@@ -30,6 +30,15 @@ FORMAT = 1
 
 def canonical(value: Any) -> Any:
     """A JSON-able, order-stable form of a literal input (for cache keys)."""
+    t = type(value)  # exact types first: the common case, and no str-Enum mistaken for str
+    if t is str or t is int or t is bool or value is None:
+        return value
+    if t is float:
+        return {"f": value.hex()}
+    if t is dict:
+        return {str(k): canonical(v) for k, v in sorted(value.items())}
+    if t is list:
+        return [canonical(v) for v in value]
     if isinstance(value, enum.Enum):
         return {"enum": str(value.value)}
     if isinstance(value, (bool, int, str)) or value is None:
