@@ -92,8 +92,20 @@ def test_clockwise_input_gives_the_same_result():
 def test_inward_offset_splits_a_dumbbell_into_two_islands():
     # Two 1 x 1 squares joined by a bar 0.2 wide.
     shape = np.array(
-        [[0, 0], [1, 0], [1, 0.4], [2, 0.4], [2, 0], [3, 0], [3, 1], [2, 1], [2, 0.6],
-         [1, 0.6], [1, 1], [0, 1]],
+        [
+            [0, 0],
+            [1, 0],
+            [1, 0.4],
+            [2, 0.4],
+            [2, 0],
+            [3, 0],
+            [3, 1],
+            [2, 1],
+            [2, 0.6],
+            [1, 0.6],
+            [1, 1],
+            [0, 1],
+        ],
         dtype=float,
     )
     joined = offset_polylines([shape], [True], -0.05)
@@ -204,6 +216,7 @@ def test_smoothing_keeps_the_distance():
     (loop,) = offset_polylines([pts], [True], 0.15, smooth=4)
     assert np.abs(tree.query(loop).dist - 0.15).max() < 1e-6
     (plain,) = offset_polylines([pts], [True], 0.15)
+
     # Smoothing evens out the spacing of the vertices.
     def spread(p):
         step = np.hypot(*(np.roll(p, -1, axis=0) - p).T)

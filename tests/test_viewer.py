@@ -489,3 +489,21 @@ def test_gallery_renders_every_graph_and_prints_a_table(tmp_path, capsys):
     assert_not_blank(out / "ring.png")
     assert picture(out / "ring.png").shape[:2] == (480, 640)
     assert not (out / "broken.png").exists()
+
+
+def test_bool_params_get_check_boxes(plotter):
+    g = fg.Graph()
+    g.add_param("closed", False)
+    g.add_param("n", 5, min=3, max=12)
+    g.add("pts", "points.circle", count="=n", radius=2)
+    g.add("outline", "curves.polyline", points="@pts", closed="=closed")
+    session = viewer.Session(g, ["outline"], plotter=plotter)
+    assert session.toggles() == ["closed"]
+    session.add_sliders()
+    assert set(session.widgets) == {"n", "closed"}
+    data = session.scene.layers["outline"].parts["curves"].data
+    assert data.n_points == 5  # open: five corners
+    assert session.on_toggle("closed", True)
+    assert session.params["closed"] is True
+    assert session.scene.layers["outline"].parts["curves"].data.n_points == 6
+    assert g.stats["pts"].status == "cached" and g.stats["outline"].status == "computed"

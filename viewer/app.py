@@ -183,8 +183,12 @@ class Session:
         self._status()
         for name, value in values.items():
             if name in self.widgets:
+                rep = self.widgets[name].GetRepresentation()
+                if isinstance(value, bool):  # a check box: state 1 is on
+                    rep.SetState(int(value))
+                    continue
                 self._slider_values[name] = value
-                self.widgets[name].GetRepresentation().SetValue(float(value))
+                rep.SetValue(float(value))
         self.plotter.render()
         return True
 
@@ -257,13 +261,54 @@ class Session:
         self._slider_values[name] = v
         return self.apply_params(**{name: v})
 
-    def add_sliders(self) -> None:
-        """One slider per ranged numeric param, in a column at the right.
+    def toggles(self) -> list[str]:
+        """Every bool graph param (each gets a check box)."""
+        if self.graph is None:
+            return []
+        values = {**self.graph.params, **self.params}
+        return [n for n in self.graph.param_defs if isinstance(values.get(n), bool)]
 
-        The view is shifted left so that the sliders do not cover the geometry.
+    def on_toggle(self, name: str, state: bool) -> bool:
+        """A check box was clicked: :meth:`apply_params` with the bool param set."""
+        return self.apply_params(**{name: bool(state)})
+
+    def add_toggles(self, top: float) -> None:
+        """One check box per bool param, below the sliders (``top`` is where they start)."""
+        values = {**self.graph.params, **self.params} if self.graph is not None else {}
+        width, height = self.plotter.window_size
+        box = max(14, int(0.03 * height))
+        for i, name in enumerate(self.toggles()):
+            y = top - i * 0.06
+            widget = self.plotter.add_checkbox_button_widget(
+                lambda state, name=name: self.on_toggle(name, state),
+                value=bool(values[name]),
+                position=(int(0.76 * width), int(y * height)),
+                size=box,
+                color_on="steelblue",
+                color_off="white",
+                background_color=TEXT_COLOR,
+            )
+            self.plotter.add_text(
+                name,
+                position=(int(0.76 * width) + box + 8, int(y * height)),
+                font_size=7,
+                color=TEXT_COLOR,
+            )
+            self.widgets[name] = widget
+
+    def add_sliders(self) -> None:
+        """One slider per ranged numeric param, in a column at the right, then a check box
+        per bool param. The view is shifted left so that they do not cover the geometry.
         """
         sliders = self.sliders()
+        toggles = self.toggles()
+        if not sliders and not toggles:
+            return
         if not sliders:
+            self.add_toggles(0.74)
+            self.scene.view_shift = 0.24
+            self.scene.fit_camera()
+            self.plotter.render()
             return
         step = min(0.11, 0.72 / len(sliders))
         for i, s in enumerate(sliders):
@@ -283,6 +328,8 @@ class Session:
             )
             _style_slider(widget.GetRepresentation())
             self.widgets[s.name] = widget
+        if toggles:
+            self.add_toggles(0.74 - len(sliders) * step - 0.02)
         self.scene.view_shift = 0.24
         self.scene.fit_camera()
         self.plotter.render()
