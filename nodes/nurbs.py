@@ -250,6 +250,8 @@ def interpolate(
     count = len(pts) - (1 if closed and len(pts) > 1 and np.array_equal(pts[0], pts[-1]) else 0)
     if degree > count - 1 >= 1:
         ctx.warn(f"degree {degree} needs {degree + 1} points, got {count}: using {count - 1}")
+    # the interpolation system is solved dense: its size, not the output's, is what to guard
+    ctx.guard(count * count, "entries of the dense interpolation system (points squared)")
     return _curve(_call("points", K.interpolate, pts, degree, closed, parametrization.value))
 
 

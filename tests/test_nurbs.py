@@ -370,3 +370,11 @@ def test_tessellation_budget_is_checked_before_allocating():
     g.add("m", "nurbs.tessellate", surface="@s", u=100_000, v=100_000)
     with pytest.raises(fg.GraphError, match="over the budget"):
         g.evaluate("m")
+
+
+def test_interpolation_of_too_many_points_is_refused_before_solving():
+    g = fg.Graph(budget=1_000_000)
+    g.add("pts", "points.random", count=1001, seed=1)
+    g.add("c", "nurbs.interpolate", points="@pts")
+    with pytest.raises(fg.BudgetError, match=r"1,002,001 entries of the dense interpolation"):
+        g.evaluate("c")
