@@ -499,6 +499,7 @@ def sweep(
     m = stations or _auto_stations(path)
     prof = _as_nurbs(profile, "profile")
     ctx.guard(m * len(prof[0]), "control points")
+    ctx.guard(m * m, "entries of the dense skinning system (stations squared)")
     t0, t1 = path.domain
     t = np.linspace(t0, t1, m)
     pts = np.asarray(path.evaluate(t))
