@@ -163,3 +163,28 @@ def test_schema_accepts_expressions_inside_coordinates():
         "nodes": {"p": {"type": "points.list", "points": [[0, 0, "=h"], [1, 2]]}},
     }
     assert not list(jsonschema.Draft202012Validator(schema).iter_errors(graph))
+
+
+def test_progress_line_on_a_terminal_only():
+    import io
+
+    from formgraph.cli import _ProgressLine
+
+    class Terminal(io.StringIO):
+        def isatty(self):
+            return True
+
+    term = Terminal()
+    line = _ProgressLine(term)
+    line("quick", 0, 3)  # the first half second stays quiet
+    assert term.getvalue() == ""
+    line.start -= 1.0
+    line("mesh", 1, 3)
+    assert "cooking 'mesh' (2/3 nodes)" in term.getvalue()
+    line.clear()
+    assert term.getvalue().endswith("\r\x1b[K")
+    pipe = io.StringIO()  # not a terminal: never a progress line
+    quiet = _ProgressLine(pipe)
+    quiet.start -= 1.0
+    quiet("mesh", 1, 3)
+    assert pipe.getvalue() == ""
