@@ -11,8 +11,6 @@ from __future__ import annotations
 import difflib
 from typing import TYPE_CHECKING, Any
 
-import networkx as nx
-
 from . import safety
 from .errors import ExpressionError, Problem, Where
 from .expr import compile_expression
@@ -278,7 +276,32 @@ def _check_expr(g: Graph, pt: PortType, e: Expr) -> list[str]:
     return [f"{m} (from '={e.text}')" for m in _coerce_problems(pt, value)]
 
 
+def _acyclic(g: Graph) -> bool:
+    """Kahn's algorithm: True when every node can be ordered after its inputs."""
+    indegree = {n: 0 for n in g._nodes}
+    users: dict[str, list[str]] = {n: [] for n in g._nodes}
+    for nd in g._nodes.values():
+        for up in nd.upstream():
+            if up in indegree:
+                indegree[nd.name] += 1
+                users[up].append(nd.name)
+    ready = [n for n, d in indegree.items() if d == 0]
+    ordered = 0
+    while ready:
+        n = ready.pop()
+        ordered += 1
+        for user in users[n]:
+            indegree[user] -= 1
+            if indegree[user] == 0:
+                ready.append(user)
+    return ordered == len(indegree)
+
+
 def _check_cycles(g: Graph) -> list[Problem]:
+    if _acyclic(g):
+        return []
+    import networkx as nx  # only to name the cycles' paths; keeps `import formgraph` quick
+
     dag = nx.DiGraph()
     for nd in g._nodes.values():
         dag.add_node(nd.name)
