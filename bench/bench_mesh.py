@@ -7,22 +7,16 @@ and pymeshlab when it imports (it is optional and usually not installed).
 
 from __future__ import annotations
 
+import sys
+from pathlib import Path
+
 import numpy as np
 
-from formgraph.kernels.grid import grid_faces
 from formgraph.kernels.subdivision import catmull_clark, doo_sabin
 
-
-def torus(nu: int = 100, nv: int = 100, r_major: float = 3.0, r_minor: float = 1.0):
-    """An (nu x nv)-quad torus: vertices (nu*nv, 3), flat faces, offsets."""
-    u = np.linspace(0, 2 * np.pi, nu, endpoint=False)[:, None]
-    v = np.linspace(0, 2 * np.pi, nv, endpoint=False)[None, :]
-    ring = r_major + r_minor * np.cos(v)
-    xyz = np.stack(
-        np.broadcast_arrays(ring * np.cos(u), ring * np.sin(u), r_minor * np.sin(v)), axis=-1
-    ).reshape(-1, 3)
-    fi, fo = grid_faces(nu, nv, closed_u=True, closed_v=True)
-    return xyz, fi, fo
+# the benchmarks measure the tests' canonical shapes
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+from mesh_shapes import torus  # noqa: E402
 
 
 def _opensubdiv(levels: int, verts: list, faces: list, flat: list, sizes: list):
@@ -42,7 +36,7 @@ def _pymeshlab(v: np.ndarray, fi: np.ndarray, filter_name: str, levels: int):
 
 
 def run(table) -> None:
-    v, fi, fo = torus()
+    v, fi, fo = torus(100, 100)  # 10,000 quads
     verts = v.tolist()
     faces = fi.reshape(-1, 4).tolist()
     flat = fi.tolist()
