@@ -1,6 +1,6 @@
 """Mesh export: a 1,000,000-triangle mesh to binary STL, ASCII STL and OBJ.
 
-Ours (``formgraph.kernels.exporters``) against numpy-stl, trimesh, meshio and pyvista (VTK's
+Ours (``formgraph.kernels.io``) against numpy-stl, trimesh, meshio and pyvista (VTK's
 compiled writers), all writing a real file into a temporary directory; our times include
 triangulation, normals, formatting and the file write. Each reference gets its own mesh
 object built before the clock starts.
@@ -13,8 +13,8 @@ import tempfile
 
 import numpy as np
 
-from formgraph.kernels.exporters import obj_bytes, stl_ascii, stl_binary
-from formgraph.kernels.grid import grid_faces
+from formgraph.kernels.io import obj_bytes, stl_ascii, stl_binary
+from formgraph.kernels.mesh import grid_faces
 
 N_U, N_V = 1000, 500  # torus grid: 2 * N_U * N_V = 1,000,000 triangles
 

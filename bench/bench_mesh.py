@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from formgraph.kernels.subdivision import catmull_clark, doo_sabin
+from formgraph.kernels.mesh.subdivision import catmull_clark, doo_sabin
 
 # the benchmarks measure the tests' canonical shapes
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))

@@ -18,8 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from formgraph.kernels.contour import marching_squares
-from formgraph.kernels.offset import offset_polylines
+from formgraph.kernels.offset import marching_squares, offset_polylines
 
 N_VERTICES = 10_000
 GRID = 2000
@@ -42,9 +41,7 @@ def busy_field(n: int = GRID) -> np.ndarray:
 def _hausdorff(loops: list[np.ndarray], shape) -> float:
     import shapely
 
-    ours = shapely.segmentize(
-        shapely.MultiLineString([np.r_[lp, lp[:1]] for lp in loops]), 0.005
-    )
+    ours = shapely.segmentize(shapely.MultiLineString([np.r_[lp, lp[:1]] for lp in loops]), 0.005)
     theirs = shapely.segmentize(shape.boundary, 0.005)
     a = shapely.distance(shapely.points(shapely.get_coordinates(ours)), shape.boundary)
     b = shapely.distance(shapely.points(shapely.get_coordinates(theirs)), ours)

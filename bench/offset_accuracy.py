@@ -18,8 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from formgraph.kernels.contour import marching_squares
-from formgraph.kernels.offset import offset_polylines
+from formgraph.kernels.offset import marching_squares, offset_polylines
 
 
 def circle_error(loops: list[np.ndarray], radius: float) -> float:

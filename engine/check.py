@@ -9,7 +9,9 @@ fixes a graph in one pass.
 from __future__ import annotations
 
 import difflib
-from typing import TYPE_CHECKING, Any
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
 
 from . import safety
 from .errors import ExpressionError, Problem, Where
@@ -17,9 +19,6 @@ from .expr import compile_expression
 from .model import Expr, Input, Items, Literal, NodeDef, ParamDef, Wire
 from .registry import NodeSpec, node_types
 from .types import Kind, PortType, TypeMismatch, describe
-
-if TYPE_CHECKING:
-    from .graph import Graph
 
 
 def suggest(name: str, options: Any) -> str:
@@ -51,7 +50,20 @@ def check_param_value(p: ParamDef, value: Any) -> Any:
     return out
 
 
-def check_graph(g: Graph, extra: list[Problem] | None = None) -> list[Problem]:
+@dataclass(frozen=True)
+class Outline:
+    """What the checker reads of a graph: where it came from, its params and its nodes.
+
+    The checker needs nothing else (no caches, no evaluation), so it depends on this
+    narrow view instead of on :class:`formgraph.Graph`.
+    """
+
+    file_label: str
+    params: Mapping[str, ParamDef]
+    nodes: Mapping[str, NodeDef]
+
+
+def check_graph(g: Outline, extra: list[Problem] | None = None) -> list[Problem]:
     """Every problem of graph ``g`` (an empty list when it can run)."""
     problems = list(extra or [])
     file = g.file_label
@@ -59,7 +71,7 @@ def check_graph(g: Graph, extra: list[Problem] | None = None) -> list[Problem]:
 
     from .expr import CONSTANTS, FUNCTIONS
 
-    for p in g._params.values():
+    for p in g.params.values():
         if not p.name.isidentifier() or p.name.startswith("_"):
             problems.append(
                 Problem(
@@ -82,7 +94,7 @@ def check_graph(g: Graph, extra: list[Problem] | None = None) -> list[Problem]:
         except TypeMismatch as exc:
             problems.append(Problem(Where(file, p.line), f"param '{p.name}': default {exc}"))
 
-    for nd in g._nodes.values():
+    for nd in g.nodes.values():
         spec = registry.get(nd.type)
         if spec is None:
             if nd.type:
@@ -102,7 +114,7 @@ def check_graph(g: Graph, extra: list[Problem] | None = None) -> list[Problem]:
 
 
 def _check_node(
-    g: Graph, nd: NodeDef, spec: NodeSpec, registry: dict[str, NodeSpec]
+    g: Outline, nd: NodeDef, spec: NodeSpec, registry: dict[str, NodeSpec]
 ) -> list[Problem]:
     out: list[Problem] = []
     file = g.file_label
@@ -133,7 +145,7 @@ def _check_node(
 
 
 def _check_input(
-    g: Graph, nd: NodeDef, pt: PortType, value: Input, registry: dict[str, NodeSpec]
+    g: Outline, nd: NodeDef, pt: PortType, value: Input, registry: dict[str, NodeSpec]
 ) -> list[str]:
     if isinstance(value, Wire):
         return _check_wire(g, pt, value, registry)
@@ -164,15 +176,15 @@ def _check_input(
     return problems
 
 
-def _check_wire(g: Graph, pt: PortType, wire: Wire, registry: dict[str, NodeSpec]) -> list[str]:
-    target = g._nodes.get(wire.node)
+def _check_wire(g: Outline, pt: PortType, wire: Wire, registry: dict[str, NodeSpec]) -> list[str]:
+    target = g.nodes.get(wire.node)
     if target is None:
-        if wire.node in g._params:
+        if wire.node in g.params:
             return [
                 f"'@{wire.node}' wires to a node, but '{wire.node}' is a param: write "
                 f"'={wire.node}'"
             ]
-        return [f"wire to missing node '@{wire.node}'{suggest(wire.node, g._nodes)}"]
+        return [f"wire to missing node '@{wire.node}'{suggest(wire.node, g.nodes)}"]
     spec = registry.get(target.type)
     if spec is None:
         return []  # reported on the target itself
@@ -194,11 +206,11 @@ def _check_wire(g: Graph, pt: PortType, wire: Wire, registry: dict[str, NodeSpec
     return []
 
 
-def _check_literal(g: Graph, pt: PortType, value: Any) -> list[str]:
+def _check_literal(g: Outline, pt: PortType, value: Any) -> list[str]:
     if pt.is_expression:
         if not isinstance(value, str):
             return [f"expected an expression (text), got {describe(value)}"]
-        allowed = set(g._params) | set(pt.variables)
+        allowed = set(g.params) | set(pt.variables)
         try:
             compile_expression(value, allowed)
         except ExpressionError as exc:
@@ -226,7 +238,7 @@ class _Unknown(Exception):
     """A value that cannot be known before running (a geometry param with no default)."""
 
 
-def _static_value(g: Graph, item: Input) -> Any:
+def _static_value(g: Outline, item: Input) -> Any:
     if isinstance(item, Literal):
         return item.value
     if isinstance(item, Items):
@@ -235,28 +247,28 @@ def _static_value(g: Graph, item: Input) -> Any:
         msg = _expr_names_problem(g, item)
         if msg:
             raise _Unknown(msg)
-        if any(g._params[n].default is None for n in item.compiled.names):
+        if any(g.params[n].default is None for n in item.compiled.names):
             raise _Unknown("")
-        return g._expr_value(item, {n: p.default for n, p in g._params.items()})
+        return item.value({n: p.default for n, p in g.params.items()})
     raise _Unknown("")
 
 
-def _expr_names_problem(g: Graph, e: Expr) -> str | None:
-    unknown = sorted(e.compiled.names - set(g._params))
+def _expr_names_problem(g: Outline, e: Expr) -> str | None:
+    unknown = sorted(e.compiled.names - set(g.params))
     if unknown:
         return (
             f"expression '={e.text}' names unknown param '{unknown[0]}'"
-            f"{suggest(unknown[0], g._params)}; params are {', '.join(g._params) or 'none'}"
+            f"{suggest(unknown[0], g.params)}; params are {', '.join(g.params) or 'none'}"
         )
     return None
 
 
-def _check_expr(g: Graph, pt: PortType, e: Expr) -> list[str]:
+def _check_expr(g: Outline, pt: PortType, e: Expr) -> list[str]:
     msg = _expr_names_problem(g, e)
     if msg:
         return [msg]
     if e.compiled.is_bare_name:
-        p = g._params[e.text.strip()]
+        p = g.params[e.text.strip()]
         if p.type is not None:
             if not pt.accepts(p.type):
                 return [f"expected {pt.name}, got {p.type.name} from param '{p.name}'"]
@@ -276,11 +288,11 @@ def _check_expr(g: Graph, pt: PortType, e: Expr) -> list[str]:
     return [f"{m} (from '={e.text}')" for m in _coerce_problems(pt, value)]
 
 
-def _acyclic(g: Graph) -> bool:
+def _acyclic(g: Outline) -> bool:
     """Kahn's algorithm: True when every node can be ordered after its inputs."""
-    indegree = {n: 0 for n in g._nodes}
-    users: dict[str, list[str]] = {n: [] for n in g._nodes}
-    for nd in g._nodes.values():
+    indegree = {n: 0 for n in g.nodes}
+    users: dict[str, list[str]] = {n: [] for n in g.nodes}
+    for nd in g.nodes.values():
         for up in nd.upstream():
             if up in indegree:
                 indegree[nd.name] += 1
@@ -297,16 +309,16 @@ def _acyclic(g: Graph) -> bool:
     return ordered == len(indegree)
 
 
-def _check_cycles(g: Graph) -> list[Problem]:
+def _check_cycles(g: Outline) -> list[Problem]:
     if _acyclic(g):
         return []
     import networkx as nx  # only to name the cycles' paths; keeps `import formgraph` quick
 
     dag = nx.DiGraph()
-    for nd in g._nodes.values():
+    for nd in g.nodes.values():
         dag.add_node(nd.name)
         for up in nd.upstream():
-            if up in g._nodes:
+            if up in g.nodes:
                 dag.add_edge(up, nd.name)
     problems = []
     seen: set[frozenset[str]] = set()
@@ -316,7 +328,7 @@ def _check_cycles(g: Graph) -> list[Problem]:
             continue
         seen.add(key)
         # start the path at the node written first in the file
-        order = list(g._nodes)
+        order = list(g.nodes)
         start = min(range(len(cycle)), key=lambda i: order.index(cycle[i]))
         path = cycle[start:] + cycle[:start]
         problems.append(Problem(Where(g.file_label), "cycle: " + " -> ".join(path + [path[0]])))

@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from .kernels import grid as _grid
+from .kernels.mesh import grid as _grid
 
 
 def frozen_array(values: Any, dtype: Any = np.float64) -> np.ndarray:
@@ -579,8 +579,8 @@ class Mesh(Geometry):
 
     @functools.cached_property
     def halfedges(self) -> Any:
-        """Half-edge connectivity (:class:`formgraph.kernels.halfedge.HalfEdges`)."""
-        from .kernels.halfedge import build_halfedges
+        """Half-edge connectivity (:class:`formgraph.kernels.mesh.halfedge.HalfEdges`)."""
+        from .kernels.mesh import build_halfedges
 
         return build_halfedges(self.face_indices, self.face_offsets, self.n_vertices)
 

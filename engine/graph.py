@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from . import cache as _cache
-from .check import check_graph, check_param_value
+from .check import Outline, check_graph, check_param_value
 from .errors import (
     BudgetError,
     CycleError,
@@ -150,6 +150,9 @@ class Graph:
     def file_label(self) -> str:
         return self.file if self.file else "<graph>"
 
+    def _outline(self) -> Outline:
+        return Outline(self.file_label, self._params, self._nodes)
+
     def add_param(
         self,
         name: str,
@@ -244,14 +247,14 @@ class Graph:
 
     def check(self) -> None:
         """Check the whole graph; raise one GraphError listing every problem."""
-        problems = check_graph(self, self._parse_problems)
+        problems = check_graph(self._outline(), self._parse_problems)
         if problems:
             cycles = all(p.message.startswith("cycle: ") for p in problems)
             raise (CycleError if cycles else GraphError)(problems)
         self._checked = True
 
     def problems(self) -> list[Problem]:
-        return check_graph(self, self._parse_problems)
+        return check_graph(self._outline(), self._parse_problems)
 
     # ----------------------------------------------------------------------- evaluate
 
@@ -309,22 +312,6 @@ class Graph:
                     (u, False) for u in reversed(self._nodes[n].upstream()) if u not in seen
                 )
         return order
-
-    def _expr_value(self, e: Expr, values: dict[str, Any]) -> Any:
-        if e.compiled.is_bare_name:
-            return values[e.text.strip()]
-        env = {
-            n: np.asarray(values[n], dtype=np.float64) if isinstance(values[n], list) else values[n]
-            for n in e.compiled.names
-        }  # list params act as vectors
-        value = e.compiled(env)
-        if hasattr(value, "ndim"):
-            value = value.item() if value.ndim == 0 else value.tolist()
-        if isinstance(value, float) and value != value:
-            raise ValueError(f"'={e.text}' is not a number (NaN)")
-        if isinstance(value, float) and value in (float("inf"), float("-inf")):
-            raise ValueError(f"'={e.text}' overflows to infinity")
-        return value
 
     # ------------------------------------------------------------------------ saving
 
@@ -466,7 +453,7 @@ class _Run:
                     ]
                 )
             try:
-                return self.g._expr_value(value, self.values)
+                return value.value(self.values)
             except (ValueError, TypeError, ZeroDivisionError, ExpressionError) as exc:
                 raise GraphError([Problem(self.where(name, port), str(exc))]) from None
         out: list[Any] = []

@@ -7,8 +7,11 @@ is kept so that ``save()`` writes back exactly what the author wrote.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any, Union
+
+import numpy as np
 
 from .errors import ExpressionError
 from .expr import Compiled, compile_expression
@@ -36,6 +39,32 @@ class Expr:
     @property
     def text(self) -> str:
         return self.compiled.text
+
+    def value(self, values: Mapping[str, Any]) -> Any:
+        """The expression's value over ``values`` (param name -> value).
+
+        A bare name passes its value through, whatever its type; list params act as
+        vectors; an array result comes back as a Python number or list.
+
+        Raises
+        ------
+        ValueError
+            The result is NaN or infinite.
+        """
+        if self.compiled.is_bare_name:
+            return values[self.text.strip()]
+        env = {
+            n: np.asarray(values[n], dtype=np.float64) if isinstance(values[n], list) else values[n]
+            for n in self.compiled.names
+        }
+        value = self.compiled(env)
+        if hasattr(value, "ndim"):
+            value = value.item() if value.ndim == 0 else value.tolist()
+        if isinstance(value, float) and value != value:
+            raise ValueError(f"'={self.text}' is not a number (NaN)")
+        if isinstance(value, float) and value in (float("inf"), float("-inf")):
+            raise ValueError(f"'={self.text}' overflows to infinity")
+        return value
 
 
 @dataclass(frozen=True)

@@ -1,7 +1,7 @@
 """Export: STL, OBJ and PLY meshes; SVG, PDF and DXF drawings.
 
-Each node builds the file's bytes with a kernel (:mod:`formgraph.kernels.exporters`,
-:mod:`~formgraph.kernels.drawing`, :mod:`~formgraph.kernels.dxf`) and hands them to
+Each node builds the file's bytes with a kernel (:mod:`formgraph.kernels.io.exporters`,
+:mod:`~formgraph.kernels.io.drawing`, :mod:`~formgraph.kernels.io.dxf`) and hands them to
 ``ctx.write``, which writes atomically inside the output directory, creates sub-folders,
 refuses paths that leave it, and leaves a file alone when it already holds these bytes. Each
 returns the written file's path.
@@ -15,15 +15,17 @@ import numpy as np
 
 from formgraph.geometry import Curve, Mesh, NurbsCurve
 from formgraph.kernels import nurbs
-from formgraph.kernels.drawing import Path2D, pdf_bytes, svg_bytes
-from formgraph.kernels.dxf import dxf_bytes
-from formgraph.kernels.exporters import (
+from formgraph.kernels.io import (
+    Path2D,
+    dxf_bytes,
     fan_triangles,
     mesh_report,
     obj_bytes,
+    pdf_bytes,
     ply_binary,
     stl_ascii,
     stl_binary,
+    svg_bytes,
 )
 from formgraph.registry import Context, Range, node
 from formgraph.types import OutputPath

@@ -1,8 +1,8 @@
 """Polygon meshes: boxes and explicit faces, Catmull-Clark and Doo-Sabin subdivision,
 triangulation, merging and transforms.
 
-Each node is a thin adapter over :mod:`formgraph.kernels.meshops` and
-:mod:`formgraph.kernels.subdivision`; subdivision refuses, before allocating, a level
+Each node is a thin adapter over :mod:`formgraph.kernels.mesh.meshops` and
+:mod:`formgraph.kernels.mesh.subdivision`; subdivision refuses, before allocating, a level
 whose face count (known in closed form) would pass the element budget.
 """
 
@@ -14,8 +14,7 @@ import numpy as np
 
 from formgraph.errors import InputError
 from formgraph.geometry import Mesh, Points
-from formgraph.kernels import meshops, subdivision
-from formgraph.kernels.halfedge import HalfEdges, MeshTopologyError
+from formgraph.kernels.mesh import HalfEdges, MeshTopologyError, meshops, subdivision
 from formgraph.registry import Context, Range, node
 from formgraph.types import Faces, Vec3
 

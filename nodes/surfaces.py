@@ -9,7 +9,7 @@ import numpy as np
 from formgraph.errors import InputError
 from formgraph.geometry import Mesh, NurbsSurface, ParametricSurface, Points
 from formgraph.kernels import curves as kc
-from formgraph.kernels.grid import grid_faces
+from formgraph.kernels.mesh import grid_faces
 from formgraph.registry import Context, node
 from formgraph.types import Expression, Variables
 

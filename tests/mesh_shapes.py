@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from formgraph.kernels.grid import grid_faces
+from formgraph.kernels.mesh import grid_faces
 
 
 def flat(faces: list[list[int]]) -> tuple[np.ndarray, np.ndarray]:

@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from skimage import measure
 
-from formgraph.kernels.contour import _cycles, marching_squares
+from formgraph.kernels.offset.contour import _cycles, marching_squares
 
 
 def area(loop: np.ndarray) -> float:

@@ -14,17 +14,20 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from formgraph.kernels.drawing import Path2D, drawing_bounds, pdf_bytes, svg_bytes
-from formgraph.kernels.dxf import dxf_bytes
-from formgraph.kernels.exporters import (
+from formgraph.kernels.io import (
+    Path2D,
+    drawing_bounds,
+    dxf_bytes,
     fan_triangles,
     mesh_report,
     obj_bytes,
+    pdf_bytes,
     ply_binary,
     stl_ascii,
     stl_binary,
+    svg_bytes,
 )
-from formgraph.kernels.numfmt import (
+from formgraph.kernels.io.numfmt import (
     float_words,
     format_e9,
     format_fixed,

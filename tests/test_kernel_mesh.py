@@ -21,13 +21,13 @@ from mesh_shapes import (
 from scipy.interpolate import BSpline
 from scipy.spatial import cKDTree
 
-from formgraph.kernels.halfedge import MeshTopologyError, build_halfedges
-from formgraph.kernels.meshops import (
+from formgraph.kernels.mesh import MeshTopologyError, build_halfedges
+from formgraph.kernels.mesh.meshops import (
     reverse_faces,
     triangulate,
     validate_faces,
 )
-from formgraph.kernels.subdivision import (
+from formgraph.kernels.mesh.subdivision import (
     catmull_clark,
     catmull_clark_counts,
     doo_sabin,
@@ -106,7 +106,7 @@ def test_boundary_loops_of_an_annulus():
     v = np.stack(
         np.broadcast_arrays(np.cos(a)[:, None] * r, np.sin(a)[:, None] * r, 0 * r), -1
     ).reshape(-1, 3)
-    from formgraph.kernels.grid import grid_faces
+    from formgraph.kernels.mesh import grid_faces
 
     fi, fo = grid_faces(8, 3, closed_u=True)
     if signed_area_z(v, fi, fo) < 0:
@@ -463,7 +463,7 @@ def random_meshes(draw):
     nu = draw(st.integers(3, 6))
     nv = draw(st.integers(3, 6))
     closed_u, closed_v = draw(st.booleans()), draw(st.booleans())
-    from formgraph.kernels.grid import grid_faces
+    from formgraph.kernels.mesh import grid_faces
 
     fi, fo = grid_faces(nu, nv, closed_u, closed_v)
     n_faces = fo.size - 1

@@ -8,8 +8,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from mesh_shapes import cube, flat, prism, tetrahedron
 
-from formgraph.kernels.halfedge import build_halfedges
-from formgraph.kernels.meshops import (
+from formgraph.kernels.mesh import build_halfedges
+from formgraph.kernels.mesh.meshops import (
     box,
     dihedral_angles,
     face_normals,
@@ -20,7 +20,7 @@ from formgraph.kernels.meshops import (
     triangulate,
     validate_faces,
 )
-from formgraph.kernels.subdivision import catmull_clark, doo_sabin
+from formgraph.kernels.mesh.subdivision import catmull_clark, doo_sabin
 
 
 def signed_volume(v, fi, fo):

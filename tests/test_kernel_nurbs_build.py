@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 from nurbs_shapes import T, random_curve
 
 from formgraph.kernels import nurbs as K
-from formgraph.kernels.nurbs_construct import _reflection_steps
+from formgraph.kernels.nurbs.construct import _reflection_steps
 
 # ------------------------------------------------------------------ circles and arcs
 

@@ -8,8 +8,8 @@ import shapely
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from formgraph.kernels.distance import RowParity, SegmentTree, point_segment
 from formgraph.kernels.offset import default_cell, offset_polylines
+from formgraph.kernels.offset.distance import RowParity, SegmentTree, point_segment
 
 
 def circle(r: float, n: int = 2000, c=(0.0, 0.0)) -> np.ndarray:

@@ -9,7 +9,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 import formgraph as fg
-from formgraph.kernels.meshops import triangulate
+from formgraph.kernels.mesh.meshops import triangulate
 
 GRAPHS = Path(__file__).resolve().parents[1] / "graphs"
 

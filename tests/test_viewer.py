@@ -19,7 +19,8 @@ from formgraph.geometry import (
     ParametricSurface,
     Points,
 )
-from formgraph.kernels import meshops, nurbs
+from formgraph.kernels import nurbs
+from formgraph.kernels.mesh import meshops
 from formgraph.registry import node
 from formgraph.types import OutputPath
 

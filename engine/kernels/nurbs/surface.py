@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .nurbs_basis import (
+from .basis import (
     CHUNK,
     _basis_from_table,
     _basis_rows,
@@ -19,7 +19,7 @@ from .nurbs_basis import (
     domain_spans,
     find_spans,
 )
-from .nurbs_curve import homogeneous
+from .curve import homogeneous
 
 __all__ = [
     "basis_matrix",

@@ -2,7 +2,7 @@
 
 Formatting millions of floats one ``repr`` at a time costs about half a microsecond each;
 here every number is turned into digits with integer array arithmetic
-(:mod:`formgraph.kernels.shortest` finds the shortest round-trip digits) and its characters
+(:mod:`formgraph.kernels.io.shortest` finds the shortest round-trip digits) and its characters
 are packed eight to a 64-bit word and moved with shifts and masks, so a mesh of a million
 triangles formats in a fraction of a second.
 
@@ -18,7 +18,7 @@ from functools import cache
 
 import numpy as np
 
-from formgraph.kernels.shortest import POW10_INT, check_finite, shortest_decimal
+from .shortest import POW10_INT, check_finite, shortest_decimal
 
 PAD = 0  # filler byte in canvases, removed when the text is assembled
 

@@ -13,7 +13,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from formgraph.kernels.exporters import check_mesh
+from .exporters import check_mesh
 
 __all__ = ["dxf_bytes"]
 

@@ -4,13 +4,13 @@ Pure numpy array functions, vectorized over parameters, following L. Piegl and W
 *The NURBS Book* (2nd ed., 1997); algorithm numbers are cited in each docstring. This
 module gathers the family's public names; the code lives in
 
-- ``nurbs_basis``: knot spans, basis functions and their derivatives, blossoms, validation;
-- ``nurbs_curve``: curve points and derivatives, knot vectors, periodic curves, circles, arcs;
-- ``nurbs_surface``: surface points, grids, partial derivatives and normals;
-- ``nurbs_knots``: knot insertion and refinement, degree elevation, Bezier decomposition,
+- ``basis``: knot spans, basis functions and their derivatives, blossoms, validation;
+- ``curve``: curve points and derivatives, knot vectors, periodic curves, circles, arcs;
+- ``surface``: surface points, grids, partial derivatives and normals;
+- ``knots``: knot insertion and refinement, degree elevation, Bezier decomposition,
   reparametrization, compatibility;
-- ``nurbs_fit``: global interpolation, open and closed;
-- ``nurbs_construct``: loft, extrusion, revolution, rotation-minimizing frames, sweep.
+- ``fit``: global interpolation, open and closed;
+- ``construct``: loft, extrusion, revolution, rotation-minimizing frames, sweep.
 
 Curves are ``(control_points (n, 3), degree, knots (n + degree + 1,), weights (n,) | None)``;
 surfaces ``(control_points (nu, nv, 3), degree_u, degree_v, knots_u, knots_v,
@@ -19,7 +19,7 @@ weights (nu, nv) | None)`` with u along the first axis. ``weights=None`` is non-
 
 from __future__ import annotations
 
-from .nurbs_basis import (
+from .basis import (
     basis_function_derivatives,
     basis_functions,
     blossom_basis,
@@ -28,7 +28,7 @@ from .nurbs_basis import (
     validate_curve,
     validate_surface,
 )
-from .nurbs_construct import (
+from .construct import (
     extrude,
     loft,
     revolve,
@@ -36,7 +36,7 @@ from .nurbs_construct import (
     skin,
     sweep,
 )
-from .nurbs_curve import (
+from .curve import (
     arc,
     circle,
     clamped_uniform_knots,
@@ -48,8 +48,8 @@ from .nurbs_curve import (
     plane_frame,
     project,
 )
-from .nurbs_fit import fit_columns, interpolate, interpolation_parameters
-from .nurbs_knots import (
+from .fit import fit_columns, interpolate, interpolation_parameters
+from .knots import (
     clamp,
     decompose_bezier,
     elevate_degree,
@@ -60,7 +60,7 @@ from .nurbs_knots import (
     reparametrize,
     respace,
 )
-from .nurbs_surface import (
+from .surface import (
     basis_matrix,
     surface_derivatives,
     surface_evaluate,

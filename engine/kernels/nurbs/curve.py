@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from .nurbs_basis import (
+from .basis import (
     CHUNK,
     _basis_from_table,
     _span_table,

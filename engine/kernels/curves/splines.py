@@ -8,9 +8,7 @@ whose first and last control points coincide (and, for the splines here, whose d
 matches across that seam). Surfaces come back as ``(control_points (mu, mv, 3), degree_u,
 degree_v, knots_u, knots_v, weights)``.
 
-Point arrays may be (n, 3) or (n, 2); (n, 2) gets z = 0. The polyline kernels
-(subdivision, resampling, offset; :mod:`formgraph.kernels.polylines`) are re-exported here,
-so the whole curve family is one import.
+Point arrays may be (n, 3) or (n, 2); (n, 2) gets z = 0.
 """
 
 from __future__ import annotations
@@ -19,21 +17,12 @@ import math
 
 import numpy as np
 
-from .nurbs_construct import CurveTuple, SurfaceTuple
+from ..nurbs.construct import CurveTuple, SurfaceTuple
 from .polylines import (
-    arc_length_table,
     as_points,
-    bisector_offset,
-    drop_repeats,
     norms,
-    parameters_at_lengths,
-    polyline_length,
-    resample_count,
-    resample_polyline,
     span_vectors,
     spans,
-    subdivide_polygon,
-    subdivided_count,
 )
 
 __all__ = [
@@ -44,15 +33,6 @@ __all__ = [
     "bezier_chain",
     "catmull_rom",
     "catmull_rom_surface",
-    "subdivide_polygon",
-    "subdivided_count",
-    "polyline_length",
-    "resample_count",
-    "resample_polyline",
-    "arc_length_table",
-    "parameters_at_lengths",
-    "bisector_offset",
-    "drop_repeats",
 ]
 
 

@@ -2,7 +2,7 @@
 
 The text exporters write coordinates as the shortest decimal that reads back to the same
 double; :func:`shortest_decimal` finds those digits for a whole array at once, with no
-Python loop per value (:mod:`formgraph.kernels.numfmt` lays them out as text).
+Python loop per value (:mod:`formgraph.kernels.io.numfmt` lays them out as text).
 """
 
 from __future__ import annotations

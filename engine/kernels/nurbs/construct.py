@@ -16,10 +16,10 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from .nurbs_basis import validate_curve
-from .nurbs_curve import _arc_local, homogeneous, plane_frame, project
-from .nurbs_fit import fit_columns, interpolation_parameters
-from .nurbs_knots import make_compatible
+from .basis import validate_curve
+from .curve import _arc_local, homogeneous, plane_frame, project
+from .fit import fit_columns, interpolation_parameters
+from .knots import make_compatible
 
 __all__ = [
     "extrude",

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from formgraph.kernels.halfedge import HalfEdges, build_halfedges
+from .halfedge import HalfEdges, build_halfedges
 
 __all__ = [
     "catmull_clark",

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from formgraph.kernels.numfmt import float_words, squeeze
+from .numfmt import float_words, squeeze
 
 __all__ = ["Path2D", "drawing_bounds", "pdf_bytes", "svg_bytes"]
 

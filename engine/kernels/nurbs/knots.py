@@ -21,8 +21,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from .nurbs_basis import blossom_basis, domain_spans, find_spans, validate_curve
-from .nurbs_curve import homogeneous, project
+from .basis import blossom_basis, domain_spans, find_spans, validate_curve
+from .curve import homogeneous, project
 
 __all__ = [
     "clamp",

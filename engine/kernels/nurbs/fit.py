@@ -15,8 +15,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .nurbs_knots import respace
-from .nurbs_surface import basis_matrix
+from .knots import respace
+from .surface import basis_matrix
 
 __all__ = ["fit_columns", "interpolate", "interpolation_parameters"]
 

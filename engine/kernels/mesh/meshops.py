@@ -10,7 +10,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from formgraph.kernels.halfedge import HalfEdges, build_halfedges
+from .halfedge import HalfEdges, build_halfedges
 
 __all__ = [
     "box",

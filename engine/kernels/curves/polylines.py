@@ -1,7 +1,7 @@
 """Polyline kernels: B-spline subdivision, arc length and resampling, bisector offset.
 
 Pure array functions (numpy in, numpy out, inputs never modified), also the point-array
-helpers the spline kernels in :mod:`formgraph.kernels.curves` share. Point arrays may be
+helpers the spline kernels in :mod:`formgraph.kernels.curves.splines` share. Point arrays may be
 (n, 3) or (n, 2); (n, 2) gets z = 0. A closed polyline is given without repeating its
 first point (a repeat is dropped).
 """

@@ -2,7 +2,7 @@
 
 STL (binary and ASCII), OBJ and PLY. Every writer builds its output with whole-array numpy
 operations — binary records through structured dtypes, text through the bulk number
-formatting of :mod:`formgraph.kernels.numfmt` — and never loops over faces or vertices in
+formatting of :mod:`formgraph.kernels.io.numfmt` — and never loops over faces or vertices in
 Python. Writing the bytes to disk (atomically, inside the output directory) is the engine's
 job, not these functions'.
 
@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from formgraph.kernels.numfmt import E9_WIDTH, float_words, format_e9, int_words, squeeze
+from .numfmt import E9_WIDTH, float_words, format_e9, int_words, squeeze
 
 __all__ = [
     "MeshReport",

@@ -1,0 +1,28 @@
+"""Mesh kernels: half-edge connectivity, subdivision, and the polygon-mesh operations.
+
+- ``halfedge``: vectorized half-edge build (twin, next, face, vertex fans), boundaries and
+  non-manifold edges reported as :class:`MeshTopologyError`;
+- ``subdivision``: Catmull-Clark and Doo-Sabin with open boundaries;
+- ``meshops``: box, merge, transform, face normals, dihedral angles, triangulation;
+- ``grid``: the quads of a structured grid (tessellation and ``surfaces.grid``).
+
+Meshes are plain arrays ``(vertices (n, 3), face_indices (flat), face_offsets (faces + 1,))``.
+"""
+
+from __future__ import annotations
+
+from . import halfedge, meshops, subdivision
+from .grid import grid_faces
+from .halfedge import Fans, HalfEdges, MeshTopologyError, build_halfedges, check_faces
+
+__all__ = [
+    "Fans",
+    "HalfEdges",
+    "MeshTopologyError",
+    "build_halfedges",
+    "check_faces",
+    "grid_faces",
+    "halfedge",
+    "meshops",
+    "subdivision",
+]
