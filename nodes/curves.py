@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 from enum import Enum
-from typing import Annotated, Any
+from typing import Annotated, Any, NamedTuple
 
 import numpy as np
 
 from formgraph.errors import InputError
 from formgraph.geometry import Curve, NurbsCurve, ParametricCurve, Points
 from formgraph.kernels import curves as kc
+from formgraph.kernels.curves import measure as kmeasure
 from formgraph.registry import Context, Range, node
 from formgraph.types import Expression, Variables
 
@@ -315,3 +316,36 @@ def offset(
         "curve", kc.bisector_offset, p, closed=closed, distance=distance, miter_limit=miter_limit
     )
     return _polyline(out, closed=closed)
+
+
+class CurveMeasures(NamedTuple):
+    length: float
+    area: float
+    closed: bool
+
+
+@node("curves.measure", version=1)
+def measure(curve: Curve) -> CurveMeasures:
+    """Length of a curve, the area it encloses if closed and planar, and whether it is closed.
+
+    Gauss-Legendre quadrature (8 points) of the speed ``|C'(t)|`` and of the vector area
+    ``1/2 C x C'`` on every knot span of a NURBS curve, each split in 8 (a parametric curve:
+    its ``samples`` intervals); the area is 0 for an open or non-planar curve.
+
+    Parameters
+    ----------
+    curve : Curve
+        Any curve.
+    """
+    t0, t1 = curve.domain
+    if isinstance(curve, NurbsCurve):
+        knots = np.unique(curve.knots[(curve.knots >= t0) & (curve.knots <= t1)])
+        split = 1 if curve.degree == 1 else 8
+        steps = np.arange(split) / split
+        inner = knots[:-1, None] + np.diff(knots)[:, None] * steps
+        breaks = np.append(inner.reshape(-1), knots[-1])
+    else:
+        breaks = np.linspace(t0, t1, max(2, getattr(curve, "samples", 256)) + 1)
+    closed = curve.closed
+    length, area = kmeasure.length_and_area(curve.evaluate, curve.derivative, breaks, closed)
+    return CurveMeasures(length=length, area=area, closed=closed)

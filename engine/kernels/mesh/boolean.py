@@ -18,7 +18,15 @@ import numpy as np
 from .measure import signed_volume, solid_report
 from .meshops import triangulate
 
-__all__ = ["NotSolidError", "Operation", "boolean", "union", "to_manifold"]
+__all__ = [
+    "NotSolidError",
+    "Operation",
+    "boolean",
+    "combine",
+    "from_manifold",
+    "to_manifold",
+    "union",
+]
 
 MeshArrays = tuple[np.ndarray, np.ndarray, np.ndarray]
 
@@ -52,7 +60,30 @@ def _why_not_solid(v: np.ndarray, fi: np.ndarray, fo: np.ndarray, what: str) -> 
     return f"{what} is not a valid solid for the boolean (it may intersect itself)"
 
 
-def to_manifold(vertices: np.ndarray, face_indices: np.ndarray, face_offsets: np.ndarray, what: str = "the mesh") -> object:
+class _Interface:
+    """Exposes an array's memory through the array interface with the read-only flag off."""
+
+    def __init__(self, a: np.ndarray):
+        self.base = a
+        self.__array_interface__ = {**a.__array_interface__, "data": (a.ctypes.data, False)}
+
+
+def _alias(a: np.ndarray) -> np.ndarray:
+    """A writable-flagged alias of a C-contiguous array, for bindings that only read it.
+
+    manifold3d's nanobind signature asks for writable arrays although ``Mesh64`` only
+    copies them into its own buffers; our meshes are read-only, and copying 100k-triangle
+    inputs just to flip a flag would be the one needless copy of the conversion. Nothing
+    writes through the alias (the tests check the input is unchanged).
+    """
+    if a.flags.writeable:
+        return a
+    return np.asarray(_Interface(a))
+
+
+def to_manifold(
+    vertices: np.ndarray, face_indices: np.ndarray, face_offsets: np.ndarray, what: str = "the mesh"
+) -> object:
     """A ``manifold3d.Manifold`` of a closed outward mesh (float64, no copy of triangles).
 
     Raises
@@ -70,7 +101,7 @@ def to_manifold(vertices: np.ndarray, face_indices: np.ndarray, face_offsets: np
     if not (fo[-1] == 3 * (fo.size - 1) and np.all(np.diff(fo) == 3)):
         _, fi, fo = triangulate(v, fi, fo)
     tris = np.ascontiguousarray(fi).view(np.uint64).reshape(-1, 3)
-    m = manifold3d.Manifold(manifold3d.Mesh64(vert_properties=v, tri_verts=tris))
+    m = manifold3d.Manifold(manifold3d.Mesh64(vert_properties=_alias(v), tri_verts=_alias(tris)))
     if m.status() != manifold3d.Error.NoError:
         raise NotSolidError(_why_not_solid(v, fi, fo, what))
     if m.volume() < 0 or (m.is_empty() and fo.size > 1):
@@ -107,16 +138,17 @@ def boolean(a: MeshArrays, b: MeshArrays, operation: Operation | str = "union") 
     NotSolidError
         Either input is not a closed outward solid.
     """
+    return from_manifold(combine(to_manifold(*a, "input a"), to_manifold(*b, "input b"), operation))
+
+
+def combine(a: object, b: object, operation: Operation | str = "union") -> object:
+    """The boolean of two ``manifold3d.Manifold`` values."""
     op = Operation(operation)
-    ma = to_manifold(*a, what="input a")
-    mb = to_manifold(*b, what="input b")
     if op is Operation.union:
-        out = ma + mb
-    elif op is Operation.difference:
-        out = ma - mb
-    else:
-        out = ma ^ mb
-    return from_manifold(out)
+        return a + b  # type: ignore[operator]
+    if op is Operation.difference:
+        return a - b  # type: ignore[operator]
+    return a ^ b  # type: ignore[operator]
 
 
 def union(meshes: Sequence[MeshArrays]) -> MeshArrays:

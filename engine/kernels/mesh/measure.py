@@ -251,7 +251,9 @@ class SolidReport:
         return ", ".join(parts)
 
 
-def solid_report(face_indices: np.ndarray, face_offsets: np.ndarray, n_vertices: int) -> SolidReport:
+def solid_report(
+    face_indices: np.ndarray, face_offsets: np.ndarray, n_vertices: int
+) -> SolidReport:
     """Count open, non-manifold and misoriented edges (see :func:`edge_table`)."""
     t = edge_table(face_indices, face_offsets, n_vertices)
     bad = (t.counts != 2) | t.same_way

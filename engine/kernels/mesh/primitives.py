@@ -75,7 +75,9 @@ def cylinder(
     return vertices, np.concatenate(parts).astype(np.int64), _offsets(np.concatenate(sizes))
 
 
-def sphere(radius: float, segments: int = 32, center: Sequence[float] = (0.0, 0.0, 0.0)) -> MeshArrays:
+def sphere(
+    radius: float, segments: int = 32, center: Sequence[float] = (0.0, 0.0, 0.0)
+) -> MeshArrays:
     """A UV sphere: ``segments`` around, ``max(2, segments // 2)`` bands pole to pole.
 
     Quads between the rings, triangle fans at the poles (one vertex each). Between rings of
@@ -105,9 +107,7 @@ def sphere(radius: float, segments: int = 32, center: Sequence[float] = (0.0, 0.
     k = (j + 1) % n
     north_fan = np.stack([np.zeros(n, np.int64), 1 + j, 1 + k], axis=1)
     upper = 1 + n * np.arange(m - 2)[:, None]  # first vertex of each ring but the last
-    bands = np.stack(
-        [upper + j, upper + n + j, upper + n + k, upper + k], axis=-1
-    ).reshape(-1)
+    bands = np.stack([upper + j, upper + n + j, upper + n + k, upper + k], axis=-1).reshape(-1)
     last = 1 + n * (m - 2)
     south_fan = np.stack([np.full(n, south), last + k, last + j], axis=1)
     fi = np.concatenate([north_fan.reshape(-1), bands, south_fan.reshape(-1)])

@@ -222,9 +222,12 @@ def orient(
         [np.bincount(face, weights=v[fi, k], minlength=n_faces) for k in range(3)], 1
     )
     corners = np.bincount(root, weights=sizes, minlength=n_faces)
-    part_centroid = np.stack(
-        [np.bincount(root, weights=centroid[:, k], minlength=n_faces) for k in range(3)], 1
-    ) / np.maximum(corners, 1)[:, None]
+    part_centroid = (
+        np.stack(
+            [np.bincount(root, weights=centroid[:, k], minlength=n_faces) for k in range(3)], 1
+        )
+        / np.maximum(corners, 1)[:, None]
+    )
     vol = np.bincount(
         root, weights=sign * signed_volume(v, fi, fo, part_centroid[root]), minlength=n_faces
     )

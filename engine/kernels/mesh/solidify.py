@@ -30,9 +30,7 @@ def vertex_normals(
     prv[nxt] = np.arange(nxt.size)
     e1 = v[fi[nxt]] - v[fi]
     e0 = v[fi[prv]] - v[fi]
-    angle = np.arctan2(
-        np.linalg.norm(np.cross(e0, e1), axis=1), np.einsum("ij,ij->i", e0, e1)
-    )
+    angle = np.arctan2(np.linalg.norm(np.cross(e0, e1), axis=1), np.einsum("ij,ij->i", e0, e1))
     fn = face_normals(v, fi, fo)
     corner_n = fn[np.repeat(np.arange(fo.size - 1), np.diff(fo))] * angle[:, None]
     out = np.stack([np.bincount(fi, weights=corner_n[:, k], minlength=len(v)) for k in range(3)], 1)
