@@ -152,10 +152,15 @@ def combine(a: object, b: object, operation: Operation | str = "union") -> objec
 
 
 def union(meshes: Sequence[MeshArrays]) -> MeshArrays:
-    """Union of several closed outward meshes at once (manifold3d's batch boolean)."""
+    """Union of several closed outward meshes, and of the separate parts within each.
+
+    Each mesh is split into its connected parts first, so parts of one mesh that overlap
+    (e.g. boxes merged by ``mesh.merge``) are fused too; then manifold3d's batch boolean
+    adds them all at once.
+    """
     import manifold3d
 
-    parts = [to_manifold(*m, what=f"mesh {i}") for i, m in enumerate(meshes)]
+    parts = [p for i, m in enumerate(meshes) for p in to_manifold(*m, what=f"mesh {i}").decompose()]
     if not parts:
         return np.zeros((0, 3)), np.zeros(0, np.int64), np.zeros(1, np.int64)
     return from_manifold(manifold3d.Manifold.batch_boolean(parts, manifold3d.OpType.Add))
