@@ -48,11 +48,12 @@ def _why_not_solid(v: np.ndarray, fi: np.ndarray, fo: np.ndarray, what: str) -> 
     if not report.is_solid and report.example is not None:
         a, b = report.example
         at = ", ".join(f"{x:.6g}" for x in 0.5 * (v[a] + v[b]))
-        hint = (
-            "mesh.weld joins duplicate vertices, mesh.cap closes open loops"
-            if report.open_edges
-            else "mesh.orient makes the faces agree"
-        )
+        if report.open_edges:
+            hint = "mesh.weld joins duplicate vertices, mesh.cap closes open loops"
+        elif report.nonmanifold_edges:
+            hint = "an edge on more than two faces comes from duplicated or touching parts"
+        else:
+            hint = "mesh.orient makes the faces agree"
         return (
             f"{what} is not a closed solid: it has {report.problems()} (e.g. edge {a}-{b} "
             f"at ({at})); {hint}"
@@ -98,13 +99,14 @@ def to_manifold(
     fo = np.asarray(face_offsets, dtype=np.int64)
     if fo.size < 2:
         raise NotSolidError(f"{what} has no faces")
+    tris = fi
     if not (fo[-1] == 3 * (fo.size - 1) and np.all(np.diff(fo) == 3)):
-        _, fi, fo = triangulate(v, fi, fo)
-    tris = np.ascontiguousarray(fi).view(np.uint64).reshape(-1, 3)
+        _, tris, _ = triangulate(v, fi, fo)
+    tris = np.ascontiguousarray(tris).view(np.uint64).reshape(-1, 3)
     m = manifold3d.Manifold(manifold3d.Mesh64(vert_properties=_alias(v), tri_verts=_alias(tris)))
     if m.status() != manifold3d.Error.NoError:
         raise NotSolidError(_why_not_solid(v, fi, fo, what))
-    if m.volume() < 0 or (m.is_empty() and fo.size > 1):
+    if m.volume() < 0:
         vol = float(signed_volume(v, fi, fo).sum())
         raise NotSolidError(
             f"{what} is inside out (its volume is {vol:.6g}); mesh.orient turns it outward"
