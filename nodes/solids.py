@@ -300,11 +300,11 @@ def boolean(
         union, difference or intersection.
     """
     try:
-        ma = kb.to_manifold(*_arrays(a), "input a")
+        ma = kb.to_manifold(*_arrays(a), "the mesh")
     except kb.NotSolidError as exc:
         raise InputError("a", str(exc)) from None
     try:
-        mb = kb.to_manifold(*_arrays(b), "input b")
+        mb = kb.to_manifold(*_arrays(b), "the mesh")
     except kb.NotSolidError as exc:
         raise InputError("b", str(exc)) from None
     out = Mesh(*kb.from_manifold(kb.combine(ma, mb, operation)))

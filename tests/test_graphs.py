@@ -28,3 +28,21 @@ def test_example_graph_evaluates(path, tmp_path):
     # a second run is served from the cache and writes nothing new
     g.evaluate_all()
     assert all(s.status == "cached" for s in g.stats.values())
+
+
+STL_GRAPHS = [p for p in GRAPHS if "export.stl" in p.read_text()]
+
+
+@pytest.mark.parametrize("path", STL_GRAPHS, ids=[p.stem for p in STL_GRAPHS])
+def test_example_stl_exports_are_watertight_and_outward(path, tmp_path):
+    import trimesh
+
+    g = fg.load(path, out_dir=tmp_path)
+    g.evaluate_all()
+    stls = [n for n, t in g.nodes.items() if t == "export.stl"]
+    assert stls
+    for name in stls:
+        assert g.stats[name].warnings == [], name  # the exporter's own mesh report is clean
+        mesh = trimesh.load(tmp_path / g.node_inputs(name)["path"], file_type="stl")
+        assert mesh.is_watertight and mesh.is_winding_consistent, name
+        assert mesh.volume > 0, name
