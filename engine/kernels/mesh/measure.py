@@ -69,7 +69,7 @@ class EdgeTable:
 
 
 def edge_table(face_indices: np.ndarray, face_offsets: np.ndarray, n_vertices: int) -> EdgeTable:
-    """Group the half-edges of all faces by undirected edge (one stable sort, O(m log m)).
+    """Group the half-edges of all faces by undirected edge (one sort, O(m log m)).
 
     Parameters
     ----------
@@ -87,7 +87,7 @@ def edge_table(face_indices: np.ndarray, face_offsets: np.ndarray, n_vertices: i
     lo, hi = np.minimum(a, b), np.maximum(a, b)
     # the direction is the last bit, so equal neighbours in the sort run an edge the same way
     key = (lo * nv + hi) * 2 + (a > b)
-    order = np.argsort(key, kind="stable")
+    order = np.argsort(key)
     skey = key[order]
     edge = skey >> 1
     first = np.r_[edge.size > 0, edge[1:] != edge[:-1]] if edge.size else np.zeros(0, bool)

@@ -46,7 +46,7 @@ def _close_pairs(v: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
     q += 1
     key = (q[:, 0] * dims[1] + q[:, 1]) * dims[2] + q[:, 2]
     cells, cell_of, counts = np.unique(key, return_inverse=True, return_counts=True)
-    order = np.argsort(cell_of, kind="stable")
+    order = np.argsort(cell_of)
     start = np.zeros(cells.size + 1, dtype=np.int64)
     np.cumsum(counts, out=start[1:])
     ii, jj = [], []
@@ -113,14 +113,8 @@ def weld(
         raise ValueError(f"tolerance must be a finite number >= 0, got {tolerance!r}")
     if len(v) == 0:
         return v.copy(), fi.copy(), fo.copy()
-    uniq, first, inverse = np.unique(v, axis=0, return_index=True, return_inverse=True)
-    inverse = inverse.reshape(-1)
-    # unique sorts the rows; keep the vertices in their first-seen order instead
-    rank = np.argsort(first, kind="stable")
-    uniq, first = uniq[rank], first[rank]
-    where = np.empty(rank.size, dtype=np.int64)
-    where[rank] = np.arange(rank.size)
-    inverse = where[inverse]
+    first, inverse = exact_duplicates(v)
+    uniq = v[first]
     if tol > 0 and len(uniq) > 1:
         i, j = _close_pairs(uniq, tol)
         root, _ = union_find(len(uniq), i, j)
@@ -130,6 +124,48 @@ def weld(
     vmap = root[inverse]
     out_fi, out_fo = drop_collapsed(vmap[fi], fo, len(uniq))
     return compact(uniq, out_fi, out_fo)
+
+
+def _mix(x: np.ndarray) -> np.ndarray:
+    """The splitmix64 finalizer (Steele et al. 2014): a bijection of 64-bit words."""
+    with np.errstate(over="ignore"):
+        x = (x ^ (x >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
+        x = (x ^ (x >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
+        return x ^ (x >> np.uint64(31))
+
+
+def exact_duplicates(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Group identical rows: one sort of a 64-bit hash of the coordinates' bits.
+
+    The hash groups are checked against the coordinates themselves; in the (astronomically
+    unlikely) case of a collision the rows are grouped by a sort of the rows instead.
+
+    Returns
+    -------
+    first : (k,) int64
+        The first row of each group, in the order the groups first appear.
+    inverse : (n,) int64
+        The group of each row.
+    """
+    p = np.ascontiguousarray(np.asarray(points, dtype=np.float64) + 0.0)  # -0.0 -> 0.0
+    if len(p) == 0:
+        return np.zeros(0, np.int64), np.zeros(0, np.int64)
+    bits = p.view(np.uint64).reshape(-1, 3)
+    h = _mix(_mix(_mix(bits[:, 0]) ^ bits[:, 1]) ^ bits[:, 2])
+    order = np.argsort(h)
+    hs = h[order]
+    starts = np.flatnonzero(np.r_[True, hs[1:] != hs[:-1]])
+    group_sorted = np.cumsum(np.r_[True, hs[1:] != hs[:-1]]) - 1
+    first = np.minimum.reduceat(order, starts)
+    inverse = np.empty(len(p), dtype=np.int64)
+    inverse[order] = group_sorted
+    if not np.array_equal(p[first[inverse]], p):  # a hash collision: do it the slow way
+        _, first, inverse = np.unique(p, axis=0, return_index=True, return_inverse=True)
+        inverse = inverse.reshape(-1)
+    rank = np.argsort(first)
+    where = np.empty(rank.size, dtype=np.int64)
+    where[rank] = np.arange(rank.size)
+    return first[rank], where[inverse]
 
 
 def drop_collapsed(
