@@ -50,6 +50,8 @@ def cylinder(
     segments: Annotated[int, Range(min=3)] = 64,
     caps: bool = True,
     center: Vec3 = (0.0, 0.0, 0.0),
+    *,
+    ctx: Context,
 ) -> Mesh:
     """A cylinder along z: quads around, an n-gon at each end; watertight and outward.
 
@@ -69,6 +71,7 @@ def cylinder(
     center : Vec3
         Centre of the cylinder.
     """
+    ctx.guard(6 * segments, "face corners")
     try:
         return Mesh(*kp.cylinder(radius, height, segments, caps, center))
     except ValueError as exc:
@@ -80,6 +83,8 @@ def sphere(
     radius: Annotated[float, Range(min=0)],
     segments: Annotated[int, Range(min=3)] = 32,
     center: Vec3 = (0.0, 0.0, 0.0),
+    *,
+    ctx: Context,
 ) -> Mesh:
     """A UV sphere: segments around, segments / 2 bands, triangle fans at the poles.
 
@@ -95,6 +100,7 @@ def sphere(
     center : Vec3
         Centre of the sphere.
     """
+    ctx.guard(segments * max(2, segments // 2), "faces")
     try:
         return Mesh(*kp.sphere(radius, segments, center))
     except ValueError as exc:
@@ -108,6 +114,8 @@ def torus(
     segments_u: Annotated[int, Range(min=3)] = 64,
     segments_v: Annotated[int, Range(min=3)] = 32,
     center: Vec3 = (0.0, 0.0, 0.0),
+    *,
+    ctx: Context,
 ) -> Mesh:
     """A ring torus about the z axis, all quads, watertight and outward.
 
@@ -124,6 +132,7 @@ def torus(
     center : Vec3
         Centre of the torus.
     """
+    ctx.guard(segments_u * segments_v, "faces")
     try:
         return Mesh(*kp.torus(major, minor, segments_u, segments_v, center))
     except ValueError as exc:
@@ -135,6 +144,8 @@ def plane(
     size: list[float] = (1.0, 1.0),  # type: ignore[assignment]
     divisions: list[int] = (1, 1),  # type: ignore[assignment]
     center: Vec3 = (0.0, 0.0, 0.0),
+    *,
+    ctx: Context,
 ) -> Mesh:
     """A flat grid of quads in the xy plane, facing +z (an open sheet).
 
@@ -151,6 +162,7 @@ def plane(
         raise InputError("size", f"size takes [width, depth], got {list(size)}")
     if len(divisions) != 2:
         raise InputError("divisions", f"divisions takes [nx, ny], got {list(divisions)}")
+    ctx.guard(float(divisions[0] + 1) * float(divisions[1] + 1), "vertices")
     try:
         return Mesh(*kp.plane(size, divisions, center))
     except ValueError as exc:
@@ -248,6 +260,8 @@ def solidify(
     mesh: Mesh,
     thickness: Annotated[float, Range(min=0)],
     offset: Annotated[float, Range(min=-1, max=1)] = 0.0,
+    *,
+    ctx: Context,
 ) -> Mesh:
     """Thicken a surface into a closed shell: two offset copies joined along the rims.
 
@@ -267,6 +281,7 @@ def solidify(
     """
     if thickness <= 0:
         raise InputError("thickness", f"thickness must be > 0, got {thickness:g}")
+    ctx.guard(3 * mesh.face_indices.size, "face corners")
     return Mesh(*_topology("mesh", ks.solidify, *_arrays(mesh), thickness, offset))
 
 

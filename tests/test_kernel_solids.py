@@ -474,3 +474,12 @@ def test_measures_match_trimesh():
     opened = kp.cylinder(0.7, 3, 11, caps=False)
     report = km.solid_report(opened[1], opened[2], len(opened[0]))
     assert report.problems() == "22 open edges" and report.example is not None
+
+
+def test_exact_duplicates_survive_a_hash_collision(monkeypatch):
+    pts = np.array([[0, 0, 0], [1, 2, 3], [0, 0, 0], [-0.0, 5, 1], [0, 5, 1.0]])
+    first, inverse = kr.exact_duplicates(pts)
+    assert first.tolist() == [0, 1, 3] and inverse.tolist() == [0, 1, 0, 2, 2]
+    monkeypatch.setattr(kr, "_mix", lambda x: np.zeros_like(x))  # every row collides
+    first2, inverse2 = kr.exact_duplicates(pts)
+    assert first2.tolist() == [0, 1, 3] and inverse2.tolist() == [0, 1, 0, 2, 2]

@@ -13,6 +13,7 @@ import pytest
 import trimesh
 
 import formgraph as fg
+from formgraph.errors import BudgetError
 from formgraph.kernels.io import mesh_report
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -297,3 +298,23 @@ def test_quick_start_prints_no_warning(tmp_path):
     r = cli("run", str(ROOT / "graphs" / "spiral_tube.yaml"), "--out", str(tmp_path), "--strict")
     assert r.returncode == 0, r.stderr
     assert r.stderr == ""
+
+
+def test_primitives_refuse_a_size_over_the_budget_before_allocating():
+    with pytest.raises(BudgetError, match=r"would make 500,000,000,000 faces, over the budget"):
+        run("mesh.sphere", radius=1, segments=1_000_000)
+    with pytest.raises(BudgetError, match=r"over the budget"):
+        run("mesh.plane", divisions=[100_000, 100_000])
+
+
+def test_boolean_refuses_an_inside_out_mesh():
+    g = fg.Graph()
+    g.add("box", "mesh.box", size=2)
+    g.add("inside_out", "mesh.flip", mesh="@box")
+    g.add("d", "mesh.boolean", a="@inside_out", b="@box")
+    with pytest.raises(
+        fg.NodeError,
+        match=r"input 'a' \(mesh.boolean\): the mesh is inside out \(its volume is -8\); "
+        r"mesh.orient turns it outward",
+    ):
+        g.evaluate("d")
