@@ -20,7 +20,7 @@ from formgraph.kernels.mesh import primitives as kp
 from formgraph.kernels.mesh import repair as kr
 from formgraph.kernels.mesh import solidify as ks
 from formgraph.registry import Context, Range, node
-from formgraph.types import Vec3
+from formgraph.types import Expression, Variables, Vec3
 
 
 def _arrays(mesh: Mesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -260,6 +260,7 @@ def solidify(
     mesh: Mesh,
     thickness: Annotated[float, Range(min=0)],
     offset: Annotated[float, Range(min=-1, max=1)] = 0.0,
+    thickness_map: Annotated[Expression | None, Variables("x", "y", "z", "thickness")] = None,
     *,
     ctx: Context,
 ) -> Mesh:
@@ -278,11 +279,29 @@ def solidify(
         Wall thickness, > 0 (an expression like "=wall" reads the graph's params).
     offset : float
         Where the wall sits: -1 behind the surface (inside), 0 centred, 1 in front.
+    thickness_map : Expression | None
+        A wall that varies: the thickness at each vertex as an expression in its position
+        x, y, z and ``thickness``, e.g. "thickness * (1 + z / 5)". Each value must be > 0.
     """
     if thickness <= 0:
         raise InputError("thickness", f"thickness must be > 0, got {thickness:g}")
     ctx.guard(3 * mesh.face_indices.size, "face corners")
-    return Mesh(*_topology("mesh", ks.solidify, *_arrays(mesh), thickness, offset))
+    t: float | np.ndarray = thickness
+    if thickness_map is not None:
+        v = mesh.vertices
+        t = np.broadcast_to(
+            np.asarray(thickness_map(x=v[:, 0], y=v[:, 1], z=v[:, 2], thickness=thickness), float),
+            (mesh.n_vertices,),
+        )
+        bad = np.flatnonzero(~(np.isfinite(t) & (t > 0)))
+        if bad.size:
+            i = int(bad[0])
+            raise InputError(
+                "thickness_map",
+                f"{getattr(thickness_map, 'text', 'the expression')!r} gives {t[i]:g} at vertex "
+                f"{i} ({', '.join(f'{c:.6g}' for c in v[i])}); a thickness must be > 0",
+            )
+    return Mesh(*_topology("mesh", ks.solidify, *_arrays(mesh), t, offset))
 
 
 # -------------------------------------------------------------------------------- booleans

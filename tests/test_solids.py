@@ -318,3 +318,17 @@ def test_boolean_refuses_an_inside_out_mesh():
         r"mesh.orient turns it outward",
     ):
         g.evaluate("d")
+
+
+def test_solidify_with_a_thickness_map():
+    g = fg.Graph()
+    g.add("p", "mesh.plane", size=[2, 2], divisions=[4, 4])
+    g.add("s", "mesh.solidify", mesh="@p", thickness=0.1, thickness_map="thickness * (2 + x)")
+    s = g.evaluate("s")
+    # linear in x over each quad: the volume is the integral of 0.1 (2 + x) over the sheet
+    assert is_solid(s) and s.volume == pytest.approx(0.8, rel=1e-12)
+    g.set_input("s", "thickness_map", "thickness * x")
+    with pytest.raises(
+        fg.NodeError, match=r"input 'thickness_map'.*'thickness \* x' gives -0.1 at vertex 0"
+    ):
+        g.evaluate("s")
