@@ -483,3 +483,11 @@ def test_exact_duplicates_survive_a_hash_collision(monkeypatch):
     monkeypatch.setattr(kr, "_mix", lambda x: np.zeros_like(x))  # every row collides
     first2, inverse2 = kr.exact_duplicates(pts)
     assert first2.tolist() == [0, 1, 3] and inverse2.tolist() == [0, 1, 0, 2, 2]
+
+
+def test_weld_refuses_a_tolerance_that_would_compare_everything(monkeypatch):
+    monkeypatch.setattr(kr, "MAX_PAIRS", 1000)
+    v, fi, fo = kp.sphere(1, 64)
+    with pytest.raises(ValueError, match=r"weld tolerance 3 is too coarse for this mesh: [\d,]+ "):
+        kr.weld(v, fi, fo, 3.0)
+    assert len(kr.weld(v, fi, fo)[0]) == len(v)  # the default tolerance compares few pairs

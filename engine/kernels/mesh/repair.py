@@ -24,6 +24,9 @@ MeshArrays = tuple[np.ndarray, np.ndarray, np.ndarray]
 
 #: default weld tolerance, relative to the bounding-box diagonal
 RELATIVE_TOLERANCE = 1e-6
+#: most candidate vertex pairs a weld compares (a tolerance near the mesh's size would
+#: compare every vertex with every other)
+MAX_PAIRS = 20_000_000
 
 
 def weld_tolerance(vertices: np.ndarray) -> float:
@@ -49,20 +52,32 @@ def _close_pairs(v: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
     order = np.argsort(cell_of)
     start = np.zeros(cells.size + 1, dtype=np.int64)
     np.cumsum(counts, out=start[1:])
-    ii, jj = [], []
     # the cell itself and the 13 neighbours "after" it: each unordered cell pair once
     offsets = [(dx, dy, dz) for dx in (-1, 0, 1) for dy in (-1, 0, 1) for dz in (-1, 0, 1)]
-    offsets = offsets[13:]
-    for dx, dy, dz in offsets:
+    found = []
+    for dx, dy, dz in offsets[13:]:
         target = cells + (dx * dims[1] + dy) * dims[2] + dz
         pos = np.minimum(np.searchsorted(cells, target), cells.size - 1)
         hit = np.flatnonzero(cells[pos] == target)
-        if hit.size == 0:
+        found.append((dx, dy, dz, hit, pos[hit]))
+    # pairs to compare: na * nb between two cells, na (na - 1) / 2 within one
+    total = 0
+    for dx, dy, dz, ca, cb in found:
+        na, nb = counts[ca], counts[cb]
+        same = (dx, dy, dz) == (0, 0, 0)
+        total += int(np.sum(na * (nb - 1) // 2 if same else na * nb))
+    if total > MAX_PAIRS:
+        raise ValueError(
+            f"weld tolerance {tol:g} is too coarse for this mesh: {total:,} vertex pairs fall "
+            f"within a cell of each other (limit {MAX_PAIRS:,}); use a smaller tolerance"
+        )
+    ii, jj = [], []
+    for dx, dy, dz, ca, cb in found:
+        if ca.size == 0:
             continue
-        ca, cb = hit, pos[hit]
         na, nb = counts[ca], counts[cb]
         pairs = na * nb
-        owner = np.repeat(np.arange(hit.size), pairs)
+        owner = np.repeat(np.arange(ca.size), pairs)
         k = np.arange(owner.size) - np.repeat(np.cumsum(pairs) - pairs, pairs)
         i = order[start[ca][owner] + k // nb[owner]]
         j = order[start[cb][owner] + k % nb[owner]]
