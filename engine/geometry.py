@@ -587,7 +587,7 @@ class Mesh(Geometry):
     # measures (kernels in :mod:`formgraph.kernels.mesh.measure`), computed once per mesh
 
     @functools.cached_property
-    def edges(self) -> Any:
+    def edge_table(self) -> Any:
         """Undirected edges with their face counts (:class:`~.kernels.mesh.measure.EdgeTable`)."""
         from .kernels.mesh import measure
 
@@ -617,12 +617,12 @@ class Mesh(Geometry):
     @property
     def is_watertight(self) -> bool:
         """Every edge lies on exactly two faces (no open or non-manifold edge)."""
-        return self.n_faces > 0 and bool(np.all(self.edges.counts == 2))
+        return self.n_faces > 0 and bool(np.all(self.edge_table.counts == 2))
 
     @property
     def euler_characteristic(self) -> int:
         """V - E + F, counting every vertex: 2 for a closed sphere-like mesh."""
-        return self.n_vertices - self.edges.n_edges + self.n_faces
+        return self.n_vertices - self.edge_table.n_edges + self.n_faces
 
     @property
     def nbytes(self) -> int:

@@ -388,7 +388,7 @@ def measure(mesh: Mesh, *, ctx: Context) -> MeshMeasures:
     watertight = mesh.is_watertight
     volume = mesh.volume if watertight else 0.0
     if not watertight:
-        open_edges = int(np.count_nonzero(mesh.edges.counts != 2))
+        open_edges = int(np.count_nonzero(mesh.edge_table.counts != 2))
         ctx.warn(f"mesh is not watertight ({open_edges} open or non-manifold edges): volume 0")
     lo, hi = mesh.bounds
     return MeshMeasures(
