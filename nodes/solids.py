@@ -206,8 +206,10 @@ def orient(mesh: Mesh, *, ctx: Context) -> Mesh:
 
     Faces that share an edge are made to run it in opposite directions (a parity
     union-find over the edges, all at once); then each closed part is turned so its signed
-    volume is positive. An open part is turned so its faces look away from its centroid,
-    or, if it is flat, so most of its area keeps the side it had.
+    volume is positive, except a cavity (a part inside an odd number of the others, by the
+    generalized winding number), which faces inward so a hollow stays hollow. An open part
+    is turned so its faces look away from its centroid, or, if it is flat, so most of its
+    area keeps the side it had.
 
     Parameters
     ----------

@@ -491,3 +491,19 @@ def test_weld_refuses_a_tolerance_that_would_compare_everything(monkeypatch):
     with pytest.raises(ValueError, match=r"weld tolerance 3 is too coarse for this mesh: [\d,]+ "):
         kr.weld(v, fi, fo, 3.0)
     assert len(kr.weld(v, fi, fo)[0]) == len(v)  # the default tolerance compares few pairs
+
+
+def test_orient_keeps_a_cavity_facing_inward():
+    hollow = ks.solidify(*kp.sphere(1, 32), 0.1, -1)  # outer wall and an inward inner wall
+    out, _ = kr.orient(*hollow)
+    np.testing.assert_array_equal(out, hollow[1])
+    v, fi, fo = hollow
+    scrambled = mix(hollow, 7)
+    out, _ = kr.orient(*scrambled)
+    assert volume((v, out, fo)) == pytest.approx(volume(hollow), rel=1e-12)
+    # a ball inside the cavity is a separate solid again: outward
+    nested = _merge(hollow, kp.sphere(0.5, 16))
+    nv, nfi, nfo = nested
+    inward_ball = np.concatenate([nfi[: fi.size], reverse_faces(nfi, nfo)[fi.size :]])
+    out, _ = kr.orient(nv, inward_ball, nfo)
+    np.testing.assert_array_equal(out, nfi)

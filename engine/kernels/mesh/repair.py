@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..io.exporters import fan_triangles
 from .halfedge import build_halfedges
 from .measure import edge_table, face_areas, next_corner, signed_volume, union_find
 from .meshops import reverse_faces, triangulate
@@ -232,9 +233,11 @@ def orient(
     faces run the edge the same way says "orientations differ". A parity union-find over
     these links (:func:`~formgraph.kernels.mesh.measure.union_find`) gives every face its
     orientation relative to its part's root face. A closed part is then turned so its signed
-    volume is positive; an open part so its signed volume about its own centroid is (its
-    faces look away from its middle, like a cup's outside), or, when that volume is about 0
-    (a flat sheet), so that most of its area keeps the orientation it came with.
+    volume is positive, unless it lies inside an odd number of the other closed parts (a
+    cavity, such as the inner wall of a hollow shell): that one faces inward. An open part
+    is turned so its signed volume about its own centroid is positive (its faces look away
+    from its middle, like a cup's outside), or, when that volume is about 0 (a flat sheet),
+    so that most of its area keeps the orientation it came with.
 
     Parameters
     ----------
@@ -290,7 +293,52 @@ def orient(
     turn = np.where(part_open & flat, kept < 0, vol < 0)
     flip = flip ^ turn[root]
     reversed_ = reverse_faces(fi, fo)
-    return np.where(np.repeat(flip, sizes), reversed_, fi), conflicts
+    out = np.where(np.repeat(flip, sizes), reversed_, fi)
+    closed_parts = np.flatnonzero((np.bincount(root, minlength=n_faces) > 0) & ~part_open)
+    if 1 < closed_parts.size <= MAX_NESTED_PARTS:
+        inner = _nested_inside(v, out, fo, root, closed_parts)
+        if inner.any():
+            flip_part = np.zeros(n_faces, dtype=bool)
+            flip_part[closed_parts[inner]] = True
+            out = np.where(np.repeat(flip_part[root], sizes), reverse_faces(out, fo), out)
+    return out, conflicts
+
+
+#: parts of one mesh above which orient skips the nesting test (each part is tested
+#: against the triangles of all the others)
+MAX_NESTED_PARTS = 64
+
+
+def _nested_inside(
+    v: np.ndarray, fi: np.ndarray, fo: np.ndarray, root: np.ndarray, parts: np.ndarray
+) -> np.ndarray:
+    """(len(parts),) bool: the part lies inside an odd number of the other closed parts.
+
+    With every closed part outward, the winding number of the others at a vertex of a part
+    counts the parts around it (the generalized winding number: the solid angle of each
+    triangle, Van Oosterom & Strackee 1983, summed over 4 pi). A cavity (inside one other
+    part, like the inner wall of a hollow shell) must face inward, so it is turned back.
+    """
+    tris = fan_triangles(fi, fo)
+    face_of_tri = np.repeat(np.arange(fo.size - 1), np.diff(fo) - 2)
+    part_of_tri = root[face_of_tri]
+    closed = np.isin(part_of_tri, parts)
+    out = np.zeros(parts.size, dtype=bool)
+    for k, part in enumerate(parts):  # one vectorized pass over the triangles per part
+        p = v[fi[fo[np.flatnonzero(root == part)[0]]]]
+        others = tris[closed & (part_of_tri != part)]
+        a, b, c = v[others[:, 0]] - p, v[others[:, 1]] - p, v[others[:, 2]] - p
+        la, lb, lc = (np.linalg.norm(x, axis=1) for x in (a, b, c))
+        num = np.einsum("ij,ij->i", a, np.cross(b, c))
+        den = (
+            la * lb * lc
+            + np.einsum("ij,ij->i", a, b) * lc
+            + np.einsum("ij,ij->i", a, c) * lb
+            + np.einsum("ij,ij->i", b, c) * la
+        )
+        winding = np.sum(2.0 * np.arctan2(num, den)) / (4.0 * np.pi)
+        out[k] = int(round(winding)) % 2 == 1
+    return out
 
 
 def cap(
