@@ -522,7 +522,7 @@ def _auto_stations(path: Curve) -> int:
     return 256
 
 
-@node("nurbs.tessellate", version=1)
+@node("nurbs.tessellate", version=2)
 def tessellate(
     surface: Surface,
     u: Annotated[int, Range(min=1)] = 32,
@@ -532,6 +532,10 @@ def tessellate(
 ) -> Mesh:
     """A quad mesh of the surface: u x v faces over its whole domain, evenly spaced in the
     parameters; seams of closed surfaces are joined (no duplicate vertices there).
+
+    A row of the grid that sits at one point (a pole: a revolve whose profile ends on the
+    axis, a sphere's tip) becomes one vertex, its quads triangles: no zero-area faces, and
+    a revolve to the axis comes out closed there.
 
     Parameters
     ----------
