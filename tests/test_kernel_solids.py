@@ -295,28 +295,47 @@ def test_cap_closes_an_open_tube():
     assert len(capped[0]) == len(tube[0])  # planar loops: no new vertex
 
 
-def test_cap_triangulates_a_concave_outline_inside_it():
-    shapely = pytest.importorskip("shapely")
-    from shapely.geometry import Polygon
-    from shapely.ops import unary_union
-
-    outline = np.array([[0, 0], [4, 0], [4, 1], [1, 1], [1, 3], [3, 3], [3, 4], [0, 4.0]])
+def _open_prism(outline: np.ndarray):
+    """Walls and a bottom over a planar outline (counter-clockwise), open at the top."""
     k = len(outline)
     ring = np.column_stack([outline, np.zeros(k)])
     v = np.concatenate([ring, ring + [0, 0, 1]])
     walls = [[i, (i + 1) % k, k + (i + 1) % k, k + i] for i in range(k)]
-    bottom = [list(range(k - 1, -1, -1))]  # open at the top
-    fi, fo = flat(walls + bottom)
+    fi, fo = flat(walls + [list(range(k - 1, -1, -1))])
+    return v, fi, fo
+
+
+def _check_cap_inside(outline: np.ndarray):
+    from shapely.geometry import Polygon
+    from shapely.ops import unary_union
+
+    v, fi, fo = _open_prism(outline)
     out_v, out_fi, out_fo = kr.cap(v, fi, fo)
     assert solid((out_v, out_fi, out_fo))
-    n_new = out_fo.size - fo.size
-    new = out_fi[fo[-1] :].reshape(n_new, 3)
+    new = out_fi[fo[-1] :].reshape(-1, 3)
+    assert len(new) == len(outline) - 2
     tris = [Polygon(out_v[t, :2]) for t in new]
     poly = Polygon(outline)
-    assert all(t.area > 0 and poly.buffer(1e-9).contains(t) for t in tris)
-    assert unary_union(tris).symmetric_difference(poly).area < 1e-9
-    assert sum(t.area for t in tris) == pytest.approx(poly.area)
-    assert shapely is not None
+    scale = poly.length
+    assert all(poly.buffer(1e-9 * scale).contains(t) for t in tris)
+    assert sum(t.area for t in tris) == pytest.approx(poly.area, rel=1e-9)
+    assert unary_union(tris).symmetric_difference(poly).area < 1e-9 * poly.area
+
+
+def test_cap_triangulates_a_concave_outline_inside_it():
+    pytest.importorskip("shapely")
+    _check_cap_inside(np.array([[0, 0], [4, 0], [4, 1], [1, 1], [1, 3], [3, 3], [3, 4], [0, 4.0]]))
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.lists(st.floats(0.2, 1.0), min_size=3, max_size=24), st.integers(0, 2**31))
+def test_cap_of_random_star_outlines_stays_inside(radii, seed):
+    pytest.importorskip("shapely")
+    k = len(radii)
+    gaps = np.random.default_rng(seed).uniform(0.5, 1.5, k)
+    angle = 2 * np.pi * np.cumsum(gaps) / gaps.sum()
+    r = np.asarray(radii)
+    _check_cap_inside(np.column_stack([r * np.cos(angle), r * np.sin(angle)]))
 
 
 def test_cap_fans_a_non_planar_loop_to_its_centroid():
