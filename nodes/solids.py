@@ -8,7 +8,8 @@ tube into a printable solid.
 
 from __future__ import annotations
 
-from typing import Annotated, NamedTuple
+from collections.abc import Callable
+from typing import Annotated, Any, NamedTuple
 
 import numpy as np
 
@@ -27,7 +28,7 @@ def _arrays(mesh: Mesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return mesh.vertices, mesh.face_indices, mesh.face_offsets
 
 
-def _topology(port: str, fn, *args):  # type: ignore[no-untyped-def]
+def _topology(port: str, fn: Callable[..., Any], *args: Any) -> Any:
     """Call a kernel that needs an oriented manifold; say which node fixes what it lacks."""
     try:
         return fn(*args)
@@ -309,7 +310,7 @@ def solidify(
 # -------------------------------------------------------------------------------- booleans
 
 
-def _solid(port: str, fn, *args):  # type: ignore[no-untyped-def]
+def _solid(port: str, fn: Callable[..., Any], *args: Any) -> Any:
     try:
         return fn(*args)
     except kb.NotSolidError as exc:

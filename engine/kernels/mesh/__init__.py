@@ -4,7 +4,15 @@
   non-manifold edges reported as :class:`MeshTopologyError`;
 - ``subdivision``: Catmull-Clark and Doo-Sabin with open boundaries;
 - ``meshops``: box, merge, transform, face normals, dihedral angles, triangulation;
-- ``grid``: the quads of a structured grid (tessellation and ``surfaces.grid``).
+- ``grid``: the quads of a structured grid (tessellation and ``surfaces.grid``), poles
+  collapsed;
+- ``primitives``: cylinder, UV sphere, torus, plane;
+- ``repair``: weld, orient, cap; ``solidify``: thickened shells;
+- ``boolean``: union, difference, intersection through manifold3d;
+- ``measure``: the edge table, union-find, areas, volumes, the solid report.
+
+The solid modules are imported on use (``from formgraph.kernels.mesh import repair``), so
+``import formgraph`` does not pay for them.
 
 Meshes are plain arrays ``(vertices (n, 3), face_indices (flat), face_offsets (faces + 1,))``.
 """
