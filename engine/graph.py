@@ -31,8 +31,10 @@ from .errors import (
     Problem,
     Where,
 )
-from .model import Expr, Input, Items, Literal, NodeDef, ParamDef, Wire, parse_input
+from .geometry import Points
+from .model import Expr, Input, Items, Literal, NodeDef, ParamDef, Wire, parse_input, wires_of
 from .registry import DEFAULT_BUDGET, Context, NodeSpec, node_types
+from .subgraph import Includes, SubgraphSpec, is_graph_type
 from .types import TypeMismatch, type_by_name
 from .yamlio import MAX_BYTES, dump, parse
 
@@ -48,6 +50,9 @@ class NodeStat:
     nbytes: int = 0
     warnings: list[str] = field(default_factory=list)
     source: str = ""  # where a cached value came from: 'memory' or 'disk'
+    items: int | None = None  # a repeated node: how many items it has
+    computed_items: int = 0  # ... and how many of them were computed (not cached)
+    inner: dict[str, NodeStat] | None = None  # a subgraph node: its own nodes' stats
 
 
 Progress = Callable[[str, int, int], None]
@@ -126,6 +131,11 @@ class Graph:
         self._digests: dict[str, str | None] = {}  # cache key -> content digest, when computed
         self._written: dict[str, tuple[int, int] | None] = {}  # export key -> file stamp
         self._parse_problems: list[Problem] = []
+        self.outputs: dict[str, Any] = {}  # the `outputs:` mapping, for use as a subgraph
+        self._output_lines: dict[str, int] = {}
+        self._subgraphs: dict[str, SubgraphSpec] = {}  # graph-file node types -> specs
+        self._includes: Includes | None = None
+        self._children: dict[Any, Graph] = {}  # subgraph path -> its graph, caches shared
         self._checked = False
         self.stats: dict[str, NodeStat] = {}
         self.progress: Progress | None = None
@@ -142,6 +152,8 @@ class Graph:
         g._values = {n: p.default for n, p in doc.params.items()}
         g._nodes = doc.nodes
         g._parse_problems = doc.problems
+        g.outputs = doc.outputs
+        g._output_lines = doc.output_lines
         if check:
             g.check()
         return g
@@ -151,7 +163,53 @@ class Graph:
         return self.file if self.file else "<graph>"
 
     def _outline(self) -> Outline:
-        return Outline(self.file_label, self._params, self._nodes)
+        self._subgraphs, problems = self._resolve_includes()
+        self._include_problems = problems
+        return Outline(
+            self.file_label,
+            self._params,
+            self._nodes,
+            self._subgraphs,
+            self.outputs,
+            self._output_lines,
+        )
+
+    def _resolve_includes(self) -> tuple[dict[str, SubgraphSpec], list[Problem]]:
+        if not any(is_graph_type(nd.type) for nd in self._nodes.values()):
+            return {}, []
+        if self._includes is None:
+            top = Path(self.file) if self.file else None
+            root = top.resolve().parent if top is not None else Path.cwd()
+            self._includes = Includes(root, top)
+        base = Path(self.file).resolve().parent if self.file else Path.cwd()
+        return self._includes.resolve_all(self._nodes, self.file_label, base)
+
+    @property
+    def files(self) -> list[Path]:
+        """The graph's file and every subgraph file it reads (what ``watch`` watches)."""
+        own = [Path(self.file)] if self.file else []
+        return own + (list(self._includes.files) if self._includes is not None else [])
+
+    def _child(self, spec: SubgraphSpec) -> Graph:
+        """The graph of a subgraph file, sharing this graph's caches and settings."""
+        child = self._children.get(spec.path)
+        if child is None:
+            doc = spec.document
+            assert doc is not None
+            child = Graph(file=spec.label, description=doc.description, out_dir=self.out_dir)
+            child.budget = self.budget
+            child.memory, child.disk = self.memory, self.disk
+            child._identity, child._digests, child._written = (
+                self._identity,
+                self._digests,
+                self._written,
+            )
+            child._params, child._nodes, child.outputs = doc.params, doc.nodes, doc.outputs
+            child._values = {n: p.default for n, p in doc.params.items()}
+            child._subgraphs = dict(spec.subgraphs)
+            child._checked = True  # checked with this graph
+            self._children[spec.path] = child
+        return child
 
     def add_param(
         self,
@@ -247,14 +305,16 @@ class Graph:
 
     def check(self) -> None:
         """Check the whole graph; raise one GraphError listing every problem."""
-        problems = check_graph(self._outline(), self._parse_problems)
+        outline = self._outline()
+        problems = check_graph(outline, self._parse_problems + self._include_problems)
         if problems:
             cycles = all(p.message.startswith("cycle: ") for p in problems)
             raise (CycleError if cycles else GraphError)(problems)
         self._checked = True
 
     def problems(self) -> list[Problem]:
-        return check_graph(self._outline(), self._parse_problems)
+        outline = self._outline()
+        return check_graph(outline, self._parse_problems + self._include_problems)
 
     # ----------------------------------------------------------------------- evaluate
 
@@ -316,7 +376,7 @@ class Graph:
     # ------------------------------------------------------------------------ saving
 
     def to_yaml(self) -> str:
-        return dump(self.description, self._params, self._nodes)
+        return dump(self.description, self._params, self._nodes, self.outputs)
 
     def save(self, path: str | os.PathLike[str]) -> None:
         """Write the graph as YAML (author order kept); ``load`` reads back an equal graph."""
@@ -328,6 +388,7 @@ class Graph:
             self.description,
             {n: p.to_yaml() for n, p in self._params.items()},
             [(n, nd.to_yaml()) for n, nd in self._nodes.items()],
+            dict(self.outputs),
         )
 
     def __eq__(self, other: object) -> bool:
@@ -351,6 +412,27 @@ def _plain(value: Any) -> Any:
     return value
 
 
+def _names(value: Input, pt: Any) -> set[str]:
+    """The names an input's expressions read (an expression port's text too)."""
+    if isinstance(value, Expr):
+        return set(value.compiled.names)
+    if isinstance(value, Items):
+        return {n for i in value.items for n in _names(i, pt)}
+    if isinstance(value, Literal) and pt.is_expression and isinstance(value.value, str):
+        from .expr import compile_expression
+
+        try:
+            return set(compile_expression(value.value).names)
+        except ExpressionError:
+            return set()
+    return set()
+
+
+def _reads(value: Input, loop: str, pt: Any) -> bool:
+    """Whether an input reads the loop name (and so differs item by item)."""
+    return loop in _names(value, pt)
+
+
 def _file_stamp(path: Any) -> tuple[int, int] | None:
     """(size, mtime in ns) of a written file, or None when it is gone."""
     try:
@@ -363,11 +445,16 @@ def _file_stamp(path: Any) -> tuple[int, int] | None:
 class _Run:
     """One evaluation call: memoized keys, identities and values, and the run record."""
 
-    def __init__(self, g: Graph, values: dict[str, Any]):
+    def __init__(self, g: Graph, values: dict[str, Any], tokens: dict[str, Any] | None = None):
         self.g = g
         self.values = values
-        self.registry = node_types()
+        self.tokens = tokens or {}  # key stand-ins of params that hold wired values
+        self.registry = {**node_types(), **g._subgraphs}
         self.keys: dict[str, str] = {}
+        self.item_keys: dict[str, list[str]] = {}  # repeated node -> its items' keys
+        self.items: dict[str, tuple[list[Any], list[Any]]] = {}  # -> (items, key tokens)
+        self.item_values: dict[str, dict[int, Any]] = {}  # -> items found or computed
+        self.inner: dict[str, dict[str, NodeStat]] = {}  # subgraph node -> its run's stats
         self.results: dict[str, Any] = {}
         self.stats: dict[str, NodeStat] = {}
         self.out_path = g.out_dir.resolve()
@@ -388,6 +475,10 @@ class _Run:
         """
         order = self.g._order(targets)
         self.total = len(order)
+        for n in order:  # the budget applies to every count known before anything runs
+            r = self.g._nodes[n].repeat
+            if r is not None and not wires_of(r.source):
+                self.repeat_items(n)
         for n in order:
             key = self.key(n)
             if key in self.g._identity and not self.registry[self.g._nodes[n].type].is_export:
@@ -408,12 +499,92 @@ class _Run:
         nd = self.g._nodes[name]
         spec = self.registry[nd.type]
         parts: dict[str, Any] = {"type": nd.type, "version": spec.version, "inputs": {}}
+        digest = getattr(spec, "digest", None)
+        if digest is not None:  # a subgraph: its file tree's content
+            parts["file"] = digest
+        loop = nd.repeat.name if nd.repeat is not None else None
         for port, value in nd.inputs.items():
+            if loop is not None and _reads(value, loop, spec.inputs[port].type):
+                # known item by item: the authored text and the params it reads here, the
+                # item's own token in the item's key
+                names = sorted(_names(value, spec.inputs[port].type) & set(self.values))
+                parts["inputs"][port] = {
+                    "loop": nd.raw[port],
+                    "params": {n: self.tokens.get(n, self.values[n]) for n in names},
+                }
+                continue
             parts["inputs"][port] = self.key_part(name, port, spec, value)
         if spec.is_export:
             parts["out_dir"] = self.out_dir
-        self.keys[name] = _cache.key_of(parts)
+        if nd.repeat is None:
+            self.keys[name] = _cache.key_of(parts)
+            return self.keys[name]
+        base = _cache.key_of(parts)
+        _, tokens = self.repeat_items(name)
+        items = [_cache.key_of({"node": base, "item": t}) for t in tokens]
+        self.item_keys[name] = items
+        self.keys[name] = _cache.key_of({"repeat": items})
         return self.keys[name]
+
+    def repeat_items(self, name: str) -> tuple[list[Any], list[Any]]:
+        """The items of a repeated node and their key tokens (memoized; budget checked)."""
+        if name in self.items:
+            return self.items[name]
+        r = self.g._nodes[name].repeat
+        assert r is not None
+        src = r.source
+        where = self.where(name, "repeat")
+        if isinstance(src, Wire):
+            self.fetch(src.node)
+            value = self.resolve(name, "repeat", src)
+            token: Any = {"wire": self.identity(src.node), "output": src.output}
+        else:
+            value = self.resolve(name, "repeat", src)
+            token = None if isinstance(src, (Literal, Expr)) else self.key_part_items(name, src)
+        if isinstance(value, Points):
+            value = value.xyz.tolist()
+        elif isinstance(value, float) and value.is_integer():
+            value = int(value)
+        if isinstance(value, int) and not isinstance(value, bool):
+            if value < 0:
+                raise GraphError([Problem(where, f"a repeat count must be >= 0, got {value}")])
+            count = value
+        elif isinstance(value, (list, tuple)):
+            count = len(value)
+        else:
+            raise GraphError(
+                [
+                    Problem(
+                        where,
+                        f"repeat '{r.name}' runs over a count, a list or Points, got "
+                        f"{type(value).__name__}",
+                    )
+                ]
+            )
+        if count > self.g.budget:
+            raise BudgetError(
+                [
+                    Problem(
+                        where,
+                        f"repeat '{r.name}' would run {count:,} items, over the budget of "
+                        f"{self.g.budget:,} (raise it with budget= or --budget if you mean it)",
+                    )
+                ]
+            )
+        values = list(range(count)) if isinstance(value, int) else list(value)
+        if token is None:
+            tokens = values
+        else:
+            tokens = [{"source": token, "index": k} for k in range(count)]
+        self.items[name] = (values, tokens)
+        return self.items[name]
+
+    def key_part_items(self, name: str, src: Input) -> Any:
+        if isinstance(src, Wire):
+            return {"wire": self.identity(src.node), "output": src.output}
+        if isinstance(src, Items):
+            return [self.key_part_items(name, i) for i in src.items]
+        return _cache.canonical(self.resolve(name, "repeat", src))
 
     def key_part(self, name: str, port: str, spec: NodeSpec, value: Input) -> Any:
         if isinstance(value, Wire):
@@ -431,17 +602,29 @@ class _Run:
                 raise GraphError(
                     [Problem(self.where(name, port), exc.problems[0].message)]
                 ) from None
-            return {"expr": text, "params": {n: self.values[n] for n in sorted(names)}}
+            return {
+                "expr": text,
+                "params": {n: self.tokens.get(n, self.values[n]) for n in sorted(names)},
+            }
+        if isinstance(value, Expr) and value.compiled.names & self.tokens.keys():
+            names = sorted(value.compiled.names)  # reads a wired subgraph param: its identity
+            return {
+                "expr": value.text,
+                "params": {n: self.tokens.get(n, self.values[n]) for n in names},
+            }
         return self.resolve(name, port, value)
 
-    def resolve(self, name: str, port: str, value: Input) -> Any:
+    def resolve(self, name: str, port: str, value: Input, env: dict[str, Any] | None = None) -> Any:
         if isinstance(value, Literal):
             return value.value
         if isinstance(value, Wire):
             out = self.results[value.node]
-            return getattr(out, value.output) if value.output else out
+            if value.output and self.registry[self.g._nodes[value.node].type].multi_output:
+                return getattr(out, value.output)
+            return out
+        values = self.values if env is None else env
         if isinstance(value, Expr):
-            missing = [n for n in value.compiled.names if self.values.get(n) is None]
+            missing = [n for n in value.compiled.names if values.get(n) is None]
             if missing:
                 raise GraphError(
                     [
@@ -453,12 +636,12 @@ class _Run:
                     ]
                 )
             try:
-                return value.value(self.values)
+                return value.value(values)
             except (ValueError, TypeError, ZeroDivisionError, ExpressionError) as exc:
                 raise GraphError([Problem(self.where(name, port), str(exc))]) from None
         out: list[Any] = []
         for item in value.items:
-            v = self.resolve(name, port, item)
+            v = self.resolve(name, port, item, env)
             if isinstance(item, Wire) and isinstance(v, list):
                 out.extend(v)  # a list from a wire joins the list (checked at load)
             else:
@@ -478,12 +661,17 @@ class _Run:
             spec = self.registry[nd.type]
             if n not in missed:
                 t0 = time.perf_counter()
-                hit, value, source = self.lookup(self.keys[n], spec)
+                if nd.repeat is not None:
+                    hit, value, source = self.lookup_items(n, spec)
+                else:
+                    hit, value, source = self.lookup(self.keys[n], spec)
                 if hit:
                     self.results[n] = value
                     self.stats[n] = NodeStat(
                         "cached", time.perf_counter() - t0, _cache.sizeof(value), source=source
                     )
+                    if nd.repeat is not None:
+                        self.stats[n].items = len(self.item_keys[n])
                     stack.pop()
                     continue
                 missed.add(n)
@@ -491,9 +679,91 @@ class _Run:
             if pending:
                 stack.extend(pending)
                 continue
-            self.results[n] = self.compute(n, nd, spec)
+            if nd.repeat is not None:
+                self.results[n] = self.compute_items(n, nd, spec)
+            else:
+                self.results[n] = self.compute(n, nd, spec)
             stack.pop()
         return self.results[target]
+
+    def lookup_items(self, name: str, spec: NodeSpec) -> tuple[bool, Any, str]:
+        """A repeated node's value when every item is cached (the hits are remembered)."""
+        found = self.item_values.setdefault(name, {})
+        source = "memory"
+        for k, key in enumerate(self.item_keys[name]):
+            if k in found:
+                continue
+            hit, value, src = self.lookup(key, spec)
+            if hit:
+                found[k] = value
+                source = src if src == "disk" else source
+        if len(found) < len(self.item_keys[name]):
+            return False, None, ""
+        value = self.assemble(spec, [found[k] for k in range(len(found))])
+        self.g._identity.setdefault(self.keys[name], self.keys[name])
+        return True, value, source
+
+    def assemble(self, spec: NodeSpec, values: list[Any]) -> Any:
+        """The items' outputs as the node's list (items that are lists are joined)."""
+
+        def join(column: list[Any]) -> list[Any]:
+            out: list[Any] = []
+            for v in column:
+                if isinstance(v, list):
+                    out.extend(v)
+                else:
+                    out.append(v)
+            return out
+
+        if spec.multi_output:
+            return spec.output_class(
+                *(join([v[i] for v in values]) for i in range(len(spec.outputs)))
+            )
+        return join(values)
+
+    def compute_items(self, name: str, nd: NodeDef, spec: NodeSpec) -> Any:
+        """Compute the items of a repeated node that no cache holds, each under its own key."""
+        assert nd.repeat is not None
+        loop = nd.repeat.name
+        items, _ = self.repeat_items(name)
+        found = self.item_values.setdefault(name, {})
+        keys = self.item_keys[name]
+        static = {
+            port: v for port, v in nd.inputs.items() if not _reads(v, loop, spec.inputs[port].type)
+        }
+        base = self.inputs(name, nd, spec, None, skip=set(nd.inputs) - set(static))
+        seconds = 0.0
+        size = 0
+        warnings: list[str] = []
+        computed = 0
+        for k, item in enumerate(items):
+            if k in found:
+                continue
+            env = dict(self.values)
+            env[loop] = item
+            kwargs = dict(base)
+            kwargs.update(self.inputs(name, nd, spec, env, only=set(nd.inputs) - set(static)))
+            value, dt, w = self.call(name, nd, spec, kwargs, env)
+            value = self.check_output(name, nd, spec, value)
+            seconds += dt
+            warnings.extend(f"item {k}: {m}" for m in w)
+            n = _cache.sizeof(value)
+            size += n
+            self.g.memory.put(keys[k], value, n)
+            if self.g.disk is not None:
+                self.g.disk.put(keys[k], value, keys[k])
+            self.g._identity[keys[k]] = keys[k]
+            if spec.is_export:
+                self.g._written[keys[k]] = _file_stamp(value)
+            found[k] = value
+            computed += 1
+        key = self.keys[name]
+        self.g._identity[key] = key
+        self.g._last[name] = (key, key)
+        self.stats[name] = NodeStat(
+            "computed", seconds, size, warnings, items=len(items), computed_items=computed
+        )
+        return self.assemble(spec, [found[k] for k in range(len(items))])
 
     def lookup(self, key: str, spec: NodeSpec) -> tuple[bool, Any, str]:
         hit, value = self.g.memory.get(key)
@@ -512,23 +782,46 @@ class _Run:
             self.g._identity[key] = identity or key
         return hit, value, source
 
-    def compute(self, name: str, nd: NodeDef, spec: NodeSpec) -> Any:
+    def inputs(
+        self,
+        name: str,
+        nd: NodeDef,
+        spec: NodeSpec,
+        env: dict[str, Any] | None,
+        *,
+        only: set[str] | None = None,
+        skip: set[str] = frozenset(),  # type: ignore[assignment]
+    ) -> dict[str, Any]:
+        """The node function's keyword arguments (``env``: the values expressions see)."""
         kwargs: dict[str, Any] = {}
         for port, p in spec.inputs.items():
+            if (only is not None and port not in only) or port in skip:
+                continue
             if port not in nd.inputs:  # defaults reach the node typed like any input
                 if p.type.is_expression and p.default is not None:
-                    kwargs[port] = self.bind_expression(name, port, p.type, p.default)
+                    kwargs[port] = self.bind_expression(name, port, p.type, p.default, env)
                 else:
                     kwargs[port] = p.type.coerce(p.default)
                 continue
-            raw = self.resolve(name, port, nd.inputs[port])
+            raw = self.resolve(name, port, nd.inputs[port], env)
             if p.type.is_expression:
-                kwargs[port] = self.bind_expression(name, port, p.type, raw)
+                kwargs[port] = self.bind_expression(name, port, p.type, raw, env)
                 continue
             try:
                 kwargs[port] = p.type.coerce(raw)
             except (TypeMismatch, ValueError) as exc:
                 raise GraphError([Problem(self.where(name, port), str(exc))]) from None
+        return kwargs
+
+    def call(
+        self,
+        name: str,
+        nd: NodeDef,
+        spec: NodeSpec,
+        kwargs: dict[str, Any],
+        env: dict[str, Any] | None = None,
+    ) -> tuple[Any, float, list[str]]:
+        """Run the node function (or the subgraph) on ``kwargs``: (value, seconds, warnings)."""
         warnings: list[str] = []
         if spec.wants_context:
             kwargs["ctx"] = Context(name, self.out_path, self.g.budget, warnings)
@@ -537,12 +830,19 @@ class _Run:
             self.g.progress(name, computed, self.total)
         t0 = time.perf_counter()
         try:
-            value = spec.func(**kwargs)
+            if isinstance(spec, SubgraphSpec):
+                value = self.run_subgraph(name, nd, spec, kwargs, env)
+            else:
+                value = spec.func(**kwargs)
         except BudgetError as exc:
             raise BudgetError(
                 [Problem(self.where(name), p.message) for p in exc.problems]
             ) from None
-        except GraphError as exc:
+        except (NodeError, GraphError) as exc:
+            if isinstance(spec, SubgraphSpec):
+                raise  # already names the subgraph's file, line and node
+            if isinstance(exc, NodeError):
+                raise
             raise type(exc)(
                 [
                     Problem(self.where(name, getattr(exc, "port", None)), p.message)
@@ -555,7 +855,49 @@ class _Run:
             raise NodeError(self.where(name), nd.type, str(exc)) from exc
         except Exception as exc:
             raise NodeError(self.where(name), nd.type, f"{type(exc).__name__}: {exc}") from exc
-        seconds = time.perf_counter() - t0
+        return value, time.perf_counter() - t0, warnings
+
+    def run_subgraph(
+        self,
+        name: str,
+        nd: NodeDef,
+        spec: SubgraphSpec,
+        kwargs: dict[str, Any],
+        env: dict[str, Any] | None,
+    ) -> Any:
+        """Evaluate a subgraph's outputs with the node's inputs as its params.
+
+        A wired input enters the subgraph's keys as the wire's identity, never hashed.
+        """
+        child = self.g._child(spec)
+        values = dict(child._values)
+        values.update(kwargs)
+        tokens = {
+            port: self.key_part(name, port, spec, v)
+            for port, v in nd.inputs.items()
+            if wires_of(v)
+            and not (nd.repeat is not None and _reads(v, nd.repeat.name, spec.inputs[port].type))
+        }
+        run = _Run(child, values, tokens)
+        targets = list(dict.fromkeys(w.node for w in spec.output_wires.values()))
+        chain = f" (in the subgraph '{name}' of {self.g.file_label})"
+        try:
+            run.run(targets)
+        except NodeError as exc:
+            raise NodeError(
+                exc.where, exc.node_type, str(exc).split(": ", 1)[-1] + chain
+            ) from exc.__cause__
+        except GraphError as exc:
+            raise type(exc)([Problem(p.where, p.message + chain) for p in exc.problems]) from None
+        self.inner[name] = run.stats
+        outs = []
+        for wire in spec.output_wires.values():
+            outs.append(run.resolve(targets[0], "outputs", wire))
+        return spec.output_class(*outs) if spec.multi_output else outs[0]
+
+    def compute(self, name: str, nd: NodeDef, spec: NodeSpec) -> Any:
+        kwargs = self.inputs(name, nd, spec, None)
+        value, seconds, warnings = self.call(name, nd, spec, kwargs)
         value = self.check_output(name, nd, spec, value)
         key = self.key(name)
         identity = self.cutoff_identity(name, key, value)
@@ -571,6 +913,7 @@ class _Run:
         if spec.is_export:
             self.g._written[key] = _file_stamp(value)
         self.stats[name] = NodeStat("computed", seconds, size, warnings)
+        self.stats[name].inner = self.inner.pop(name, None)
         return value
 
     def cutoff_identity(self, name: str, key: str, value: Any) -> str:
@@ -589,21 +932,24 @@ class _Run:
             self.g._digests[key] = _cache.digest(value)
         return self.g._digests[key]
 
-    def bind_expression(self, name: str, port: str, pt: Any, text: Any) -> Any:
+    def bind_expression(
+        self, name: str, port: str, pt: Any, text: Any, env: dict[str, Any] | None = None
+    ) -> Any:
         from .expr import Bound, compile_expression
 
-        allowed = set(self.values) | set(pt.variables)
+        values = self.values if env is None else env
+        allowed = set(values) | set(pt.variables)
         try:
             compiled = compile_expression(text, allowed)
         except ExpressionError as exc:
             raise GraphError([Problem(self.where(name, port), exc.problems[0].message)]) from None
-        params = {n: self.values[n] for n in compiled.names if n in self.values}
+        params = {n: values[n] for n in compiled.names if n in values}
         return Bound(compiled, params)
 
     def check_output(self, name: str, nd: NodeDef, spec: NodeSpec, value: Any) -> Any:
         if spec.multi_output:
             return value
-        out_type = spec.outputs["out"]
+        out_type = spec.output_type(None)
         try:
             return out_type.coerce(value)
         except (TypeMismatch, ValueError) as exc:

@@ -42,8 +42,10 @@ class _Shared:
     def __call__(self, **variables: Any) -> np.ndarray:
         args = tuple(variables.values())
         last = self._last
-        if last is not None and len(last[0]) == len(args) and all(
-            a is b for a, b in zip(last[0], args, strict=True)
+        if (
+            last is not None
+            and len(last[0]) == len(args)
+            and all(a is b for a, b in zip(last[0], args, strict=True))
         ):
             return last[1]
         shape = np.broadcast_shapes(*(np.shape(a) for a in args))
