@@ -706,10 +706,11 @@ class _Run:
     def assemble(self, spec: NodeSpec, values: list[Any]) -> Any:
         """The items' outputs as the node's list (items that are lists are joined)."""
 
-        def join(column: list[Any]) -> list[Any]:
+        def join(column: list[Any], t: Any) -> list[Any]:
+            listed = all(k.is_list for k in t.kinds)
             out: list[Any] = []
             for v in column:
-                if isinstance(v, list):
+                if isinstance(v, list) or (listed and isinstance(v, np.ndarray)):
                     out.extend(v)
                 else:
                     out.append(v)
@@ -717,9 +718,9 @@ class _Run:
 
         if spec.multi_output:
             return spec.output_class(
-                *(join([v[i] for v in values]) for i in range(len(spec.outputs)))
+                *(join([v[i] for v in values], t) for i, t in enumerate(spec.outputs.values()))
             )
-        return join(values)
+        return join(values, spec.output_type(None))
 
     def compute_items(self, name: str, nd: NodeDef, spec: NodeSpec) -> Any:
         """Compute the items of a repeated node that no cache holds, each under its own key."""
