@@ -161,8 +161,8 @@ nodes:
     msg = str(err.value)
     assert "r.yaml:7: node 'a', input 'repeat': loop name 'n' would hide a param" in msg
     assert (
-        "r.yaml:10: node 'b', input 'repeat': repeat 'i' runs over a count (int), a list, or a wire to a list or to Points; '@c' gives NurbsCurve"
-        in msg
+        "r.yaml:10: node 'b', input 'repeat': repeat 'i' runs over a count (int), a list, "
+        "or a wire to a list or to Points; '@c' gives NurbsCurve" in msg
     )
     assert "r.yaml:14: node 'd', input 'radius': expression '=j + 1' names unknown param 'j'" in msg
     assert "r.yaml:17: node 'e', input 'repeat': repeat 'i': a count must be >= 0, got -2" in msg
