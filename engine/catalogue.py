@@ -19,6 +19,20 @@ WIRE = {
     "description": "a wire: '@node' or '@node.output'",
 }
 EXPR = {"type": "string", "pattern": "^=", "description": "an expression over the graph params"}
+REPEAT = {
+    "type": "object",
+    "minProperties": 1,
+    "maxProperties": 1,
+    "additionalProperties": {
+        "anyOf": [{"type": "integer", "minimum": 0}, EXPR, WIRE, {"type": "array"}]
+    },
+    "description": "run the node once per item: {name: count | list | '@list' | '@points'}",
+}
+GRAPH_FILE = {
+    "type": "string",
+    "pattern": r"\.ya?ml$",
+    "description": "a subgraph: a graph file, relative to this one",
+}
 ESCAPED = {
     "type": "object",
     "properties": {"value": {}},
@@ -100,6 +114,7 @@ def json_schema() -> dict[str, Any]:
                     "description": spec.summary,
                     "properties": {
                         "type": {"const": name},
+                        "repeat": REPEAT,
                         **{p.name: port_schema(p) for p in spec.inputs.values()},
                     },
                     "required": ["type", *[p.name for p in spec.inputs.values() if p.required]],
@@ -134,12 +149,20 @@ def json_schema() -> dict[str, Any]:
                     "anyOf": [param_long, {"type": ["number", "string", "boolean", "array"]}]
                 },
             },
+            "outputs": {
+                "type": "object",
+                "additionalProperties": WIRE,
+                "description": "the outputs of this graph when another uses it as a node",
+            },
             "nodes": {
                 "type": "object",
                 "additionalProperties": {
                     "type": "object",
                     "required": ["type"],
-                    "properties": {"type": {"enum": list(registry)}},
+                    "properties": {
+                        "type": {"anyOf": [{"enum": list(registry)}, GRAPH_FILE]},
+                        "repeat": REPEAT,
+                    },
                     "allOf": branches,
                 },
             },

@@ -275,6 +275,12 @@ def cmd_nodes(args: argparse.Namespace) -> int:
     if args.markdown:
         sys.stdout.write(markdown())
         return 0
+    if args.type and args.type.endswith((".yaml", ".yml")):  # a graph file's interface
+        from .graph import load
+
+        g = load(args.type)
+        print(node_text(g.as_node_spec()))
+        return 0
     if args.type:
         registry = node_types()
         if args.type not in registry:

@@ -190,6 +190,20 @@ class Graph:
         own = [Path(self.file)] if self.file else []
         return own + (list(self._includes.files) if self._includes is not None else [])
 
+    def as_node_spec(self) -> SubgraphSpec:
+        """This graph as a node type, as another graph using its file sees it (its params
+        as inputs, its ``outputs:`` as outputs): what ``formgraph nodes part.yaml`` prints."""
+        if not self.file:
+            raise GraphError("only a graph read from a file can be used as a node")
+        path = Path(self.file)
+        nd = NodeDef.make(path.name, path.name, {})
+        spec, problems = Includes(path.resolve().parent).load(
+            nd, str(path), path.resolve().parent, [], ()
+        )
+        if spec is None:
+            raise GraphError(problems)
+        return spec
+
     def _child(self, spec: SubgraphSpec) -> Graph:
         """The graph of a subgraph file, sharing this graph's caches and settings."""
         child = self._children.get(spec.path)
