@@ -155,7 +155,11 @@ class Graph:
         g.outputs = doc.outputs
         g._output_lines = doc.output_lines
         if check:
-            g.check()
+            try:
+                g.check()
+            except GraphError as exc:
+                exc.files = g.files  # type: ignore[attr-defined]  (what watch must watch)
+                raise
         return g
 
     @property

@@ -290,3 +290,31 @@ def test_the_schema_accepts_graph_file_types_repeat_and_outputs():
     assert not list(validator.iter_errors(doc))
     doc["nodes"]["r"]["repeat"] = {"i": 3, "j": 2}
     assert list(validator.iter_errors(doc))
+
+
+def test_watch_reloads_when_a_subgraph_file_changes(tree):
+    import os
+
+    pv = pytest.importorskip("pyvista")
+    from formgraph import viewer
+
+    def touch(path, text):
+        path.write_text(text)
+        st = path.stat()  # a new stamp even when the clock has not moved
+        os.utime(path, ns=(st.st_atime_ns, st.st_mtime_ns + 1_000_000_000))
+
+    plotter = pv.Plotter(off_screen=True, window_size=[320, 240])
+    try:
+        w = viewer.Watcher(tree / "top.yaml", "both", plotter=plotter, out_dir=tree / "out")
+        assert w.reload() is True
+        assert w.poll() is None
+        part = tree / "parts" / "ring.yaml"
+        touch(part, RING.replace("u: 8, v: 16", "u: 4, v: 16"))
+        assert w.poll() is True
+        assert w.session.graph.evaluate("both").n_faces == 2 * 4 * 16
+        touch(part, RING.replace('radius: "=radius"', 'radius: "=radiu"'))
+        assert w.poll() is False and "radiu" in w.error_text()
+        touch(part, RING)  # the broken part is still watched: fixing it redraws
+        assert w.poll() is True and w.error_text() is None
+    finally:
+        plotter.close()
