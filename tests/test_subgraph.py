@@ -77,7 +77,8 @@ def test_a_single_output_is_the_node_itself(tree):
             "parts/circle.yaml": "formgraph: 1\nparams: {r: 1.0}\noutputs: {curve: '@c'}\n"
             "nodes:\n  c: {type: nurbs.circle, radius: '=r'}\n",
             "one.yaml": "formgraph: 1\nnodes:\n  a: {type: parts/circle.yaml, r: 2}\n"
-            "  b: {type: nurbs.extrude, curve: '@a'}\n  c: {type: nurbs.extrude, curve: '@a.curve'}\n",
+            "  b: {type: nurbs.extrude, curve: '@a'}\n"
+            "  c: {type: nurbs.extrude, curve: '@a.curve'}\n",
         },
     )
     g = fg.load(tree / "one.yaml")
@@ -119,7 +120,8 @@ def test_a_broken_subgraph_is_reported_with_its_own_file_and_line(tree):
         {
             "parts/broken.yaml": "formgraph: 1\noutputs: {m: '@t'}\nnodes:\n"
             "  c: {type: nurbs.circle}\n  t: {type: nurbs.tessellate, surface: '@c'}\n",
-            "mid.yaml": "formgraph: 1\noutputs: {m: '@x.m'}\nnodes:\n  x: {type: parts/broken.yaml}\n",
+            "mid.yaml": "formgraph: 1\noutputs: {m: '@x.m'}\nnodes:\n"
+            "  x: {type: parts/broken.yaml}\n",
             "top2.yaml": "formgraph: 1\nnodes:\n  user: {type: mid.yaml}\n",
         },
     )
@@ -158,8 +160,10 @@ def test_paths_that_leave_the_top_folder_are_refused(tmp_path):
             "outside.yaml": "formgraph: 1\noutputs: {o: '@c'}\nnodes:\n  c: {type: nurbs.circle}\n",
             "g/top.yaml": "formgraph: 1\nnodes:\n  a: {type: ../outside.yaml}\n"
             f"  b: {{type: {tmp_path / 'outside.yaml'}}}\n",
-            "g/parts/p.yaml": "formgraph: 1\noutputs: {o: '@c'}\nnodes:\n  c: {type: ../../outside.yaml}\n",
-            "g/top2.yaml": "formgraph: 1\nnodes:\n  a: {type: parts/p.yaml}\n  b: {type: missing.yaml}\n",
+            "g/parts/p.yaml": "formgraph: 1\noutputs: {o: '@c'}\nnodes:\n"
+            "  c: {type: ../../outside.yaml}\n",
+            "g/top2.yaml": "formgraph: 1\nnodes:\n  a: {type: parts/p.yaml}\n"
+            "  b: {type: missing.yaml}\n",
         },
     )
     with pytest.raises(fg.GraphError) as err:
