@@ -258,6 +258,12 @@ class Graph:
         del self._nodes[name]
         self._checked = False
 
+    def node_types(self) -> dict[str, NodeSpec]:
+        """The node types this graph can use: the registry, and the graph files it names."""
+        if not self._checked:
+            self._outline()  # reads the subgraph files
+        return {**node_types(), **self._subgraphs}
+
     @property
     def nodes(self) -> dict[str, str]:
         """Node name -> node type, in author order."""
