@@ -228,7 +228,25 @@ def mesh_copy_to_points(
     v, fi, fo = instancing.copy_mesh(
         mesh.vertices, mesh.face_indices, mesh.face_offsets, linear, points.xyz, rev
     )
-    return Mesh(v, fi, fo)
+    if not np.isfinite(v).all():
+        raise InputError("points", "the copies' coordinates overflow (not finite)")
+    return _valid_mesh(v, fi, fo)
+
+
+def _valid_mesh(v: np.ndarray, fi: np.ndarray, fo: np.ndarray) -> Mesh:
+    """A Mesh of fresh arrays that are valid by construction (copies of a valid mesh's
+    faces, shifted): frozen in place instead of copied and validated again, which for
+    10,000 copies would cost more than building them."""
+    out = Mesh.__new__(Mesh)
+    for name, a, dtype in (
+        ("vertices", v, np.float64),
+        ("face_indices", fi, np.int64),
+        ("face_offsets", fo, np.int64),
+    ):
+        a = np.ascontiguousarray(a, dtype=dtype)
+        a.flags.writeable = False
+        object.__setattr__(out, name, a)
+    return out
 
 
 @node("curves.copy_to_points", version=1)

@@ -221,6 +221,10 @@ def test_align_handles_straight_down_and_refuses_zero():
     r = affine.align_z(np.array([[0, 0, -2.0], [0, 0, 1.0]]))
     np.testing.assert_allclose(r[0] @ [0, 0, 1], [0, 0, -1])
     np.testing.assert_allclose(r[1], np.eye(3))
+    d = np.array([0.0, 3.5e-7, -1.0])  # almost straight down: still exact
+    r = affine.align_z(d[None])[0]
+    np.testing.assert_allclose(r @ [0, 0, 1], d / np.linalg.norm(d), atol=1e-15)
+    np.testing.assert_allclose(r.T @ r, np.eye(3), atol=1e-12)
     with pytest.raises(ValueError, match="align direction 0 is zero"):
         affine.align_z(np.zeros((1, 3)))
 

@@ -74,8 +74,9 @@ def align_z(directions: np.ndarray) -> np.ndarray:
     """The minimal rotations taking +z onto each direction (Rodrigues' formula).
 
     For a unit direction d with ``c = z . d`` and ``v = z x d``, ``R = I + [v]x +
-    [v]x^2 / (1 + c)``; for d = -z (c = -1, the formula's singular case) the half turn
-    about x is used.
+    [v]x^2 / (1 + c)``. Near d = -z the factor ``1 / (1 + c)`` is computed as
+    ``(1 - c) / (x^2 + y^2)``, which keeps full precision; for d = -z exactly (the
+    formula's singular case) the half turn about x is used.
 
     Parameters
     ----------
@@ -99,8 +100,10 @@ def align_z(directions: np.ndarray) -> np.ndarray:
     d = d / length[:, None]
     x, y, z = d.T
     c = z
-    flip = c < -1.0 + 1e-12
-    k = 1.0 / np.where(flip, 1.0, 1.0 + c)
+    r2 = x * x + y * y
+    flip = (c < 0) & (r2 == 0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        k = np.where(c >= 0, 1.0 / (1.0 + c), (1.0 - c) / np.where(r2 > 0, r2, 1.0))
     # v = (-y, x, 0); [v]x^2 / (1 + c) written out
     m = np.empty((len(d), 3, 3))
     m[:, 0, 0] = 1.0 - x * x * k

@@ -1,7 +1,8 @@
 """Copies of a point set or a mesh under many affine maps, as one array operation.
 
-``n`` copies of ``m`` vertices are one ``einsum`` of ``(n, 3, 3)`` maps with the ``(m, 3)``
-vertices; the faces of every copy are the original index array shifted by ``k * m``, built
+``n`` copies of ``m`` vertices are one batched ``matmul`` of the ``(m, 3)`` vertices with the
+``(n, 3, 3)`` maps (faster than ``einsum`` here: it runs the 3 x 3 products as BLAS-free
+inner loops without temporaries); the faces of every copy are the original index array shifted by ``k * m``, built
 by broadcasting. Copies whose map mirrors (negative determinant) get their faces reversed,
 so every copy keeps facing outward.
 """
@@ -26,7 +27,9 @@ def copy_points(points: np.ndarray, linear: np.ndarray, offsets: np.ndarray) -> 
     (n, m, 3) float64
     """
     p = np.asarray(points, dtype=np.float64)
-    return np.einsum("nij,mj->nmi", linear, p, optimize=True) + offsets[:, None, :]
+    out = np.matmul(p[None], np.asarray(linear, dtype=np.float64).transpose(0, 2, 1))
+    out += np.asarray(offsets, dtype=np.float64)[:, None, :]
+    return out
 
 
 def copy_mesh(
