@@ -277,6 +277,10 @@ class Graph:
         """Change one input of a node as authored (a literal, wire or expression)."""
         nd = self._nodes[node]
         value = _plain(value)
+        if port == "repeat":  # not an input: the node's loop
+            nd.set_repeat(value)
+            self._checked = False
+            return
         nd.raw[port] = value
         nd.parse_errors.pop(port, None)
         try:

@@ -204,3 +204,37 @@ def test_profile_shows_a_repeated_node_once_with_its_items(tmp_path, capsys):
     out = capsys.readouterr().out
     rows = [r for r in out.splitlines() if r.startswith("rings")]
     assert len(rows) == 1 and "5 items" in rows[0] and "5/5" in rows[0]
+
+
+def test_items_come_back_from_the_disk_cache(tmp_path):
+    def make():
+        g = fg.Graph(cache_dir=tmp_path / "cache")
+        g.add(
+            "wall",
+            "nurbs.surface",
+            points=[[[0, 0], [0, 1]], [[1, 0], [1, 1]]],
+            degree_u=1,
+            degree_v=1,
+        )
+        g.add("s", "geometry.sample_surface", repeat={"k": [1, 2]}, surface="@wall", u="=k")
+        g.add("rings", "nurbs.circle", repeat={"r": [1, 2]}, radius="=r")
+        return g
+
+    first = make().evaluate(["s", "rings"])
+    g = make()
+    again = g.evaluate(["s", "rings"])
+    assert g.stats["s"].status == "cached" and g.stats["s"].source == "disk"
+    assert [len(p) for p in again["s"].points] == [8, 16]
+    for a, b in zip(first["rings"], again["rings"], strict=True):
+        np.testing.assert_array_equal(a.control_points, b.control_points)
+
+
+def test_set_input_changes_the_loop():
+    g = fg.Graph()
+    g.add("c", "nurbs.circle", repeat={"i": 2}, radius="=i + 1")
+    assert len(g.evaluate("c")) == 2
+    g.set_input("c", "repeat", {"i": 4})
+    assert len(g.evaluate("c")) == 4
+    g.set_input("c", "repeat", None)
+    with pytest.raises(fg.GraphError, match="names unknown param 'i'"):
+        g.evaluate("c")

@@ -2,8 +2,8 @@
 
 ``n`` copies of ``m`` vertices are one batched ``matmul`` of the ``(m, 3)`` vertices with the
 ``(n, 3, 3)`` maps (several times faster than ``einsum`` here); the faces of every copy are
-the original index array shifted by ``k * m``, built by broadcasting. Copies whose map mirrors (negative determinant) get their faces reversed,
-so every copy keeps facing outward.
+the original index array shifted by ``k * m``, built by broadcasting. Copies whose map
+mirrors (negative determinant) get their faces reversed, so every copy keeps facing outward.
 """
 
 from __future__ import annotations
