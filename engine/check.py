@@ -177,7 +177,12 @@ def output_type(
         return None
     t = spec.output_type(wire.output)
     if t.same_as is not None:
-        follows = _input_type(g, nd.inputs.get(t.same_as), registry, seen | {wire.node})
+        value = nd.inputs.get(t.same_as)
+        follows = _input_type(g, value, registry, seen | {wire.node})
+        r = nd.repeat
+        if r is not None and isinstance(value, Expr) and value.text.strip() == r.name:
+            loop = _check_repeat(g, nd, registry, seen | {wire.node})[1]  # the loop's item
+            follows = loop.item if loop is not None else None
         t = follows if follows is not None else PortType(t.kinds, t.optional)
     return as_list(t) if nd.repeat is not None else t
 
@@ -218,7 +223,10 @@ def _item_type(value: Any) -> PortType | None:
 
 
 def _check_repeat(
-    g: Outline, nd: NodeDef, registry: dict[str, NodeSpec]
+    g: Outline,
+    nd: NodeDef,
+    registry: Mapping[str, NodeSpec],
+    seen: frozenset[str] = frozenset(),
 ) -> tuple[list[str], _Loop | None]:
     """Problems of a node's ``repeat:``, and its loop."""
     from .expr import CONSTANTS, FUNCTIONS
@@ -240,7 +248,7 @@ def _check_repeat(
         msgs = _check_wire(g, PortType((Kind(Any),)), src, registry)
         if msgs:
             return msgs, _Loop(name)
-        t = output_type(g, src, registry)
+        t = output_type(g, src, registry, seen)
         if t is None:
             return [], _Loop(name)
         if all(k.is_list for k in t.kinds):
@@ -372,7 +380,8 @@ def _check_wire(g: Outline, pt: PortType, wire: Wire, registry: dict[str, NodeSp
     produced = output_type(g, wire, registry) or spec.output_type(wire.output)
     if not pt.accepts(produced):
         why = ""
-        if target.repeat is not None and pt.accepts(spec.output_type(wire.output)):
+        item = PortType(tuple(Kind(k.base) for k in produced.kinds))
+        if target.repeat is not None and pt.accepts(item):
             why = (
                 f" ('{wire.node}' is repeated over '{target.repeat.name}': it gives a list, "
                 f"one item per {target.repeat.name})"

@@ -238,3 +238,18 @@ def test_set_input_changes_the_loop():
     g.set_input("c", "repeat", None)
     with pytest.raises(fg.GraphError, match="names unknown param 'i'"):
         g.evaluate("c")
+
+
+def test_a_repeated_transform_of_the_loop_item_keeps_its_type():
+    g = fg.Graph()
+    g.add("pts", "points.circle", count=3)
+    g.add("c", "nurbs.circle", radius=0.3)
+    g.add("cs", "curves.copy_to_points", curve="@c", points="@pts")
+    g.add("t", "geometry.transform", repeat={"k": "@cs"}, geometry="=k", translate=[0, 0, 1])
+    g.add("loft", "nurbs.loft", curves="@t", degree_v=2)
+    assert g.evaluate("loft").evaluate(0.0, 0.0)[2] == pytest.approx(1.0)
+    g.add("bad", "nurbs.extrude", curve="@t")
+    with pytest.raises(
+        fg.GraphError, match=r"expected Curve, got list\[Curve\] from '@t' \('t' is"
+    ):
+        g.check()
