@@ -282,3 +282,33 @@ def test_curves_copy_to_points_are_exact_copies():
         np.testing.assert_allclose(np.linalg.norm(s - p, axis=1), 0.5, atol=1e-12)
         np.testing.assert_allclose(s[:, 0], p[0], atol=1e-12)  # the circle now faces +x
     g.evaluate("loft")
+
+
+@given(
+    n=st.integers(0, 10),
+    seed=st.integers(0, 2**31 - 1),
+    mirror=st.booleans(),
+)
+@settings(max_examples=40, deadline=None)
+def test_copy_to_points_against_mesh_transform_per_point(n, seed, mirror):
+    from pathlib import Path
+
+    from formgraph.kernels.mesh import meshops
+    from formgraph.nodes.geometry import mesh_copy_to_points
+    from formgraph.nodes.mesh import transform as mesh_transform
+    from formgraph.registry import Context
+
+    rng = np.random.default_rng(seed)
+    part = _part()
+    pts = rng.normal(size=(n, 3)) * 5
+    scale = rng.uniform(0.3, 3, size=(n, 3)) * np.where(rng.random((n, 3)) < 0.3 * mirror, -1, 1)
+    rot = rng.uniform(-180, 180, size=(n, 3))
+    out = mesh_copy_to_points(
+        part, Points(pts), scale=scale, rotate=rot, ctx=Context("c", Path("."))
+    )
+    copies = [mesh_transform(part, pts[k], rot[k], scale[k]) for k in range(n)]
+    v, fi, fo = meshops.merge([(c.vertices, c.face_indices, c.face_offsets) for c in copies])
+    assert out.n_faces == n * part.n_faces
+    np.testing.assert_allclose(out.vertices, v.reshape(-1, 3), atol=1e-9)
+    np.testing.assert_array_equal(out.face_indices, fi)
+    np.testing.assert_array_equal(out.face_offsets, fo)

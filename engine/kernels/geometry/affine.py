@@ -140,6 +140,8 @@ def frames(
     -------
     (n, 3, 3) float64
     """
+    if n == 0:
+        return np.zeros((0, 3, 3))
     s = per_copy(scale, n, "scale")
     if (s == 0).any():
         raise ValueError("scale factors must be non-zero")
