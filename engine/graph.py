@@ -1,4 +1,5 @@
-"""The graph: params and nodes, checked whole, evaluated on demand through the caches.
+"""The graph: params and nodes, checked whole, evaluated on demand through the caches
+(one evaluation call is a run of :mod:`formgraph.run`).
 
 Evaluation is pull-based: asking for a node evaluates only its ancestors. Each node's cache
 key hashes its type, implementation version, resolved literal inputs and the identities of

@@ -157,7 +157,7 @@ class Includes:
             return None, [Problem(where, f"cannot read the subgraph file '{text}': {exc}{suffix}")]
         self.files.append(path)
         doc = parse(source, label)
-        inner_chain = [*chain, (nd.name, file_label)]
+        inner_chain = [*chain, (nd.name, file_label)] if file_label != label else list(chain)
         subs, problems = self.resolve_all(
             doc.nodes, label, path.parent, inner_chain, (*stack, path)
         )
