@@ -119,8 +119,9 @@ class LanguageRun:
         assert r is not None
         src = r.source
         where = self.where(name, "repeat")
+        for w in wires_of(src):  # the count is known only from the value
+            self.fetch(w.node)
         if isinstance(src, Wire):
-            self.fetch(src.node)
             value = self.resolve(name, "repeat", src)
             token: Any = {"wire": self.identity(src.node), "output": src.output}
         else:

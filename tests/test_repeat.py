@@ -253,3 +253,14 @@ def test_a_repeated_transform_of_the_loop_item_keeps_its_type():
         fg.GraphError, match=r"expected Curve, got list\[Curve\] from '@t' \('t' is"
     ):
         g.check()
+
+
+def test_repeat_over_a_list_of_wires_twice():
+    g = fg.Graph()
+    g.add("a", "nurbs.circle", radius=1)
+    g.add("b", "nurbs.circle", radius=2)
+    g.add("e", "nurbs.extrude", repeat={"c": ["@a", "@b"]}, curve="=c")
+    assert len(g.evaluate("e")) == 2
+    g.add("f", "mesh.box")  # a change elsewhere; a, b and e come from the cache
+    assert len(g.evaluate("e")) == 2
+    assert g.stats["e"].status == "cached"
