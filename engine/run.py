@@ -90,7 +90,9 @@ class _Run(LanguageRun):
         for n in order:
             key = self.key(n)
             if key in self.g._identity and not self.registry[self.g._nodes[n].type].is_export:
-                self.stats.setdefault(n, NodeStat("cached", 0.0, source="identity"))
+                st = self.stats.setdefault(n, NodeStat("cached", 0.0, source="identity"))
+                if n in self.item_keys:
+                    st.items = len(self.item_keys[n])
             else:
                 self.fetch(n)
         for t in targets:

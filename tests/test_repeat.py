@@ -263,4 +263,4 @@ def test_repeat_over_a_list_of_wires_twice():
     assert len(g.evaluate("e")) == 2
     g.add("f", "mesh.box")  # a change elsewhere; a, b and e come from the cache
     assert len(g.evaluate("e")) == 2
-    assert g.stats["e"].status == "cached"
+    assert g.stats["e"].status == "cached" and g.stats["e"].items == 2
