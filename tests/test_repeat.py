@@ -264,3 +264,16 @@ def test_repeat_over_a_list_of_wires_twice():
     g.add("f", "mesh.box")  # a change elsewhere; a, b and e come from the cache
     assert len(g.evaluate("e")) == 2
     assert g.stats["e"].status == "cached" and g.stats["e"].items == 2
+
+
+def test_the_readme_repeat_example_runs():
+    import re
+    from pathlib import Path
+
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    (block,) = [
+        b for b in re.findall(r"```yaml\n(.*?)```", readme, flags=re.S) if "repeat: {i:" in b
+    ]
+    g = fg.Graph.from_text("formgraph: 1\n" + block)
+    assert len(g.evaluate("rings")) == 7
+    assert g.evaluate("body").evaluate(0.0, 1.0)[2] == pytest.approx(6.0)
