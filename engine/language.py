@@ -285,9 +285,8 @@ class LanguageRun:
         try:
             run.run(targets)
         except NodeError as exc:
-            raise NodeError(
-                exc.where, exc.node_type, str(exc).split(": ", 1)[-1] + chain
-            ) from exc.__cause__
+            message = str(exc)[len(f"{exc.where.prefix()} ({exc.node_type}): ") :]
+            raise NodeError(exc.where, exc.node_type, message + chain) from exc.__cause__
         except GraphError as exc:
             raise type(exc)([Problem(p.where, p.message + chain) for p in exc.problems]) from None
         self.inner[name] = run.stats

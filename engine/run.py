@@ -121,6 +121,7 @@ class _Run(LanguageRun):
                 parts["inputs"][port] = {
                     "loop": nd.raw[port],
                     "params": {n: self.tokens.get(n, self.values[n]) for n in names},
+                    "wires": [self.key_part(name, port, spec, w) for w in wires_of(value)],
                 }
                 continue
             parts["inputs"][port] = self.key_part(name, port, spec, value)

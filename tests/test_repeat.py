@@ -277,3 +277,18 @@ def test_the_readme_repeat_example_runs():
     g = fg.Graph.from_text("formgraph: 1\n" + block)
     assert len(g.evaluate("rings")) == 7
     assert g.evaluate("body").evaluate(0.0, 1.0)[2] == pytest.approx(6.0)
+
+
+def test_a_wire_beside_the_loop_name_in_one_input_still_invalidates():
+    g = fg.Graph()
+    g.add_param("t", 0.5)
+    g.add("a", "nurbs.circle")
+    g.add("pts", "points.circle", count=2, radius=5)
+    g.add("rings", "curves.copy_to_points", curve="@a", points="@pts")
+    g.add("top", "nurbs.circle", radius="=t", center=[0, 0, 3])
+    # each item lofts one ring to the top circle: the input reads the loop name and a wire
+    g.add("lofts", "nurbs.loft", repeat={"c": "@rings"}, curves=["=c", "@top"], degree_v=1)
+    first = g.evaluate("lofts")
+    again = g.evaluate("lofts", t=1.5)  # only the wired circle changes
+    assert g.stats["lofts"].computed_items == 2
+    assert not np.allclose(first[0].control_points, again[0].control_points)

@@ -259,6 +259,7 @@ def test_a_failure_inside_names_the_subgraph_and_the_chain(tree):
         g.evaluate("user")
     msg = str(err.value)
     assert msg.startswith(f"{tree / 'parts' / 'fail.yaml'}:5: node 'f' (stub.fail):")
+    assert msg.count("(stub.fail)") == 1
     assert msg.endswith(f"(in the subgraph 'user' of {tree / 'f.yaml'})")
 
 
