@@ -185,11 +185,15 @@ class Includes:
         subs: dict[str, SubgraphSpec],
         data: bytes,
     ) -> SubgraphSpec:
+        registry = {**node_types(), **subs}
+        # the file, the files it uses, and the versions of the node types it runs: a new
+        # implementation of a node inside invalidates the subgraph's cached outputs too
         h = hashlib.blake2b(data, digest_size=20)
         for t in sorted(subs):
             h.update(f"\0{t}\0{subs[t].digest}".encode())
+        for t in sorted({nd.type for nd in doc.nodes.values()} - set(subs)):
+            h.update(f"\0{t}\0{registry[t].version}".encode())
         outline = Outline(label, doc.params, doc.nodes, subs, doc.outputs, doc.output_lines)
-        registry = {**node_types(), **subs}
         wires: dict[str, Wire] = {}
         outputs: dict[str, PortType] = {}
         for out, text in doc.outputs.items():
