@@ -323,3 +323,15 @@ def test_watch_reloads_when_a_subgraph_file_changes(tree):
         assert w.poll() is True and w.error_text() is None
     finally:
         plotter.close()
+
+
+def test_a_new_version_of_a_node_inside_changes_the_subgraphs_key(tree, monkeypatch):
+    import dataclasses
+
+    from formgraph import registry
+
+    before = fg.load(tree / "top.yaml").node_types()["parts/ring.yaml"].digest
+    spec = registry._REGISTRY["nurbs.sweep"]
+    monkeypatch.setitem(registry._REGISTRY, "nurbs.sweep", dataclasses.replace(spec, version=99))
+    after = fg.load(tree / "top.yaml").node_types()["parts/ring.yaml"].digest
+    assert before != after
