@@ -190,6 +190,11 @@ def _type_text(t: PortType) -> str:
     return t.name + (" | None" if t.optional else "")
 
 
+def _out_text(t: PortType) -> str:
+    """An output type; one that follows an input says so."""
+    return f"same type as {t.same_as}" if t.same_as else t.name
+
+
 def node_text(spec: NodeSpec) -> str:
     """One node type's ports and outputs, for ``formgraph nodes TYPE``."""
     lines = [f"{spec.name}  (version {spec.version})", "", spec.summary, "", "inputs:"]
@@ -198,7 +203,7 @@ def node_text(spec: NodeSpec) -> str:
     lines.append("outputs:")
     for name, t in spec.outputs.items():
         label = "(single)" if not spec.multi_output else name
-        lines.append(f"  {label:<12} {t.name}")
+        lines.append(f"  {label:<12} {_out_text(t)}")
     return "\n".join(lines)
 
 
@@ -211,7 +216,7 @@ def catalogue_text() -> str:
             family = spec.family
             out.append(f"\n{family}" if out else family)
         ports = ", ".join(p.name if p.required else f"[{p.name}]" for p in spec.inputs.values())
-        ret = " | ".join(t.name for t in spec.outputs.values())
+        ret = " | ".join(_out_text(t) for t in spec.outputs.values())
         out.append(f"  {name}({ports}) -> {ret}\n      {spec.summary}")
     return "\n".join(out)
 
@@ -234,7 +239,8 @@ def markdown() -> str:
             family = spec.family
             lines += ["", f"## {family}", ""]
         ret = ", ".join(
-            f"{k}: {t.name}" if spec.multi_output else t.name for k, t in spec.outputs.items()
+            f"{k}: {_out_text(t)}" if spec.multi_output else _out_text(t)
+            for k, t in spec.outputs.items()
         )
         lines += [f"### `{name}` -> {ret}", "", spec.summary, ""]
         if spec.inputs:
@@ -256,7 +262,7 @@ def readme_table() -> str:
     rows = ["| node | inputs ([optional]) | output | what it does |", "|---|---|---|---|"]
     for name, spec in node_types().items():
         ports = ", ".join(p.name if p.required else f"[{p.name}]" for p in spec.inputs.values())
-        ret = ", ".join(t.name for t in spec.outputs.values())
+        ret = ", ".join(_out_text(t) for t in spec.outputs.values())
         summary = spec.summary.replace("|", "\\|")
         rows.append(f"| `{name}` | {ports} | {ret} | {summary} |")
     return "\n".join(rows)
