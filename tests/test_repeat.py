@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from stubs import CALLS
 
 import formgraph as fg
@@ -292,3 +294,16 @@ def test_a_wire_beside_the_loop_name_in_one_input_still_invalidates():
     again = g.evaluate("lofts", t=1.5)  # only the wired circle changes
     assert g.stats["lofts"].computed_items == 2
     assert not np.allclose(first[0].control_points, again[0].control_points)
+
+
+@given(first=st.integers(0, 30), second=st.integers(0, 30))
+@settings(max_examples=30, deadline=None)
+def test_changing_the_count_computes_only_new_items(first, second):
+    g = fg.Graph()
+    g.add_param("n", first)
+    g.add("v", "stub.value", repeat={"i": "=n"}, x="=i * i", label="v")
+    assert g.evaluate("v") == [float(i * i) for i in range(first)]
+    CALLS.clear()
+    assert g.evaluate("v", n=second) == [float(i * i) for i in range(second)]
+    assert CALLS.count("value:v") == max(0, second - first)
+    assert g.stats["v"].items == second
