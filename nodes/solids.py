@@ -304,7 +304,10 @@ def solidify(
                 f"{getattr(thickness_map, 'text', 'the expression')!r} gives {t[i]:g} at vertex "
                 f"{i} ({', '.join(f'{c:.6g}' for c in v[i])}); a thickness must be > 0",
             )
-    return Mesh(*_topology("mesh", ks.solidify, *_arrays(mesh), t, offset))
+    try:
+        return Mesh(*_topology("mesh", ks.solidify, *_arrays(mesh), t, offset))
+    except ValueError as exc:
+        raise InputError("mesh", str(exc)) from None
 
 
 # -------------------------------------------------------------------------------- booleans
@@ -390,7 +393,9 @@ def measure(mesh: Mesh, *, ctx: Context) -> MeshMeasures:
     """
     watertight = mesh.is_watertight
     volume = mesh.volume if watertight else 0.0
-    if not watertight:
+    if mesh.n_faces == 0:
+        ctx.warn("mesh has no faces: area and volume 0")
+    elif not watertight:
         open_edges = int(np.count_nonzero(mesh.edge_table.counts != 2))
         ctx.warn(f"mesh is not watertight ({open_edges} open or non-manifold edges): volume 0")
     lo, hi = mesh.bounds

@@ -11,6 +11,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 import trimesh
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import formgraph as fg
 from formgraph.errors import BudgetError
@@ -332,3 +334,36 @@ def test_solidify_with_a_thickness_map():
         fg.NodeError, match=r"input 'thickness_map'.*'thickness \* x' gives -0.1 at vertex 0"
     ):
         g.evaluate("s")
+
+
+def test_empty_meshes_get_sentences_not_tracebacks():
+    empty = fg.Mesh(np.zeros((0, 3)), np.zeros(0, np.int64), np.zeros(1, np.int64))
+    with pytest.raises(fg.NodeError, match="input 'mesh'.*the surface has no faces to thicken"):
+        run("mesh.solidify", mesh=empty, thickness=0.1)
+    with pytest.raises(fg.NodeError, match="input 'a'.*the mesh has no faces"):
+        run("mesh.boolean", a=empty, b=empty)
+    m, warnings = run("mesh.measure", mesh=empty)
+    assert (m.faces, m.area, m.watertight) == (0, 0.0, False)
+    assert warnings == ["mesh has no faces: area and volume 0"]
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(4, 12), st.lists(st.tuples(*[st.integers(0, 11)] * 3), min_size=1, max_size=30))
+def test_random_triangle_soups_never_crash_the_solid_nodes(n, tris):
+    rng = np.random.default_rng(n)
+    v = rng.random((n, 3))
+    faces = [list(t) for t in tris if len({x % n for x in t}) == 3]
+    if not faces:
+        return
+    mesh = fg.Mesh(v, [[x % n for x in f] for f in faces])
+    for node_type in ("mesh.weld", "mesh.orient", "mesh.cap", "mesh.solidify", "mesh.measure"):
+        extra = {"thickness": 0.05} if node_type == "mesh.solidify" else {}
+        try:
+            run(node_type, mesh=mesh, **extra)
+        except fg.NodeError as exc:  # a sentence naming the input, never a numpy traceback
+            assert "input 'mesh'" in str(exc), str(exc)
+    try:
+        out, _ = run("mesh.boolean", a=mesh, b=run("mesh.box")[0])
+        assert out.n_faces == 0 or out.is_watertight
+    except fg.NodeError as exc:
+        assert "input 'a'" in str(exc) and "not" in str(exc), str(exc)

@@ -5,7 +5,9 @@ manifold input, in float64 through ``Mesh64``. This adapter hands it our arrays 
 are: float64 vertices and int64 triangle indices viewed as uint64, without a copy, for a
 mesh of triangles (other polygons are triangulated first). Anything that is not a closed,
 consistently oriented, outward solid is refused with a sentence that counts the defects
-and names one of them, never with the library's own exception text.
+and names one of them, never with the library's own exception text; the check comes from
+our edge table, before manifold3d sees the mesh, because manifold3d 3.5 can crash the
+process (not only refuse) on open, messy input.
 """
 
 from __future__ import annotations
@@ -45,7 +47,7 @@ class Operation(str, Enum):
 
 def _why_not_solid(v: np.ndarray, fi: np.ndarray, fo: np.ndarray, what: str) -> str:
     report = solid_report(fi, fo, len(v))
-    if not report.is_solid and report.example is not None:
+    if report.example is not None:
         a, b = report.example
         at = ", ".join(f"{x:.6g}" for x in 0.5 * (v[a] + v[b]))
         if report.open_edges:
@@ -99,13 +101,19 @@ def to_manifold(
     fo = np.asarray(face_offsets, dtype=np.int64)
     if fo.size < 2:
         raise NotSolidError(f"{what} has no faces")
+    # our own check first: manifold3d can crash (not only refuse) on open, messy input
+    if not solid_report(fi, fo, len(v)).is_solid:
+        raise NotSolidError(_why_not_solid(v, fi, fo, what))
     tris = fi
     if not (fo[-1] == 3 * (fo.size - 1) and np.all(np.diff(fo) == 3)):
         _, tris, _ = triangulate(v, fi, fo)
     tris = np.ascontiguousarray(tris).view(np.uint64).reshape(-1, 3)
     m = manifold3d.Manifold(manifold3d.Mesh64(vert_properties=_alias(v), tri_verts=_alias(tris)))
     if m.status() != manifold3d.Error.NoError:
-        raise NotSolidError(_why_not_solid(v, fi, fo, what))
+        raise NotSolidError(
+            f"{what} is not a valid solid for the boolean (manifold3d: {m.status().name}); it "
+            "may be degenerate or intersect itself"
+        )
     if m.volume() < 0:
         vol = float(signed_volume(v, fi, fo).sum())
         raise NotSolidError(

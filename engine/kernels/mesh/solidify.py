@@ -77,7 +77,7 @@ def solidify(
     Raises
     ------
     ValueError
-        A thickness that is not > 0, an offset outside -1 .. 1.
+        A thickness that is not > 0, an offset outside -1 .. 1, a mesh without faces.
     MeshTopologyError
         A non-manifold or inconsistently oriented surface.
     """
@@ -90,6 +90,8 @@ def solidify(
         raise ValueError(f"thickness must be > 0, got {t[bad]:g} at vertex {bad}")
     if not -1.0 <= offset <= 1.0:
         raise ValueError(f"offset must be between -1 and 1, got {offset:g}")
+    if fo.size < 2:
+        raise ValueError("the surface has no faces to thicken")
     he = build_halfedges(fi, fo, len(v))
     n = vertex_normals(v, fi, fo)
     front = v + n * (t * (1.0 + offset) / 2.0)[:, None]
