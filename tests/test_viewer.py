@@ -273,7 +273,9 @@ def test_keys_toggle_overlays_and_grid(plotter):
     assert part.actor.GetVisibility() and session.scene.show_polygons
     press("n")
     assert session.scene.layers[""].parts["net"].actor.GetVisibility()
-    assert plotter.renderer.cube_axes_actor is not None
+    assert plotter.renderer.cube_axes_actor is None  # no grid until asked for
+    press("g")
+    assert plotter.renderer.cube_axes_actor is not None and session.scene.show_grid
     press("g")
     assert plotter.renderer.cube_axes_actor is None and not session.scene.show_grid
 

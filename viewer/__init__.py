@@ -24,8 +24,19 @@ if (
 ):
     os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
 
-from .app import Session, screenshot, show, shown_nodes
+from .app import LAYOUTS, Session, shown_nodes
+from .entry import make_plotter, screenshot, show
 from .scene import Scene
 from .watch import Watcher, watch
 
-__all__ = ["Scene", "Session", "Watcher", "screenshot", "show", "shown_nodes", "watch"]
+__all__ = [
+    "LAYOUTS",
+    "Scene",
+    "Session",
+    "Watcher",
+    "make_plotter",
+    "screenshot",
+    "show",
+    "shown_nodes",
+    "watch",
+]

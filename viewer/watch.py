@@ -18,7 +18,8 @@ from formgraph.errors import FormgraphError
 from formgraph.graph import load
 from formgraph.registry import DEFAULT_BUDGET
 
-from .app import Session, _window_title
+from .app import Session
+from .entry import _window_title
 from .scene import Scene
 
 __all__ = ["Watcher", "watch"]
