@@ -27,13 +27,15 @@ if (
 from .app import LAYOUTS, Session, shown_nodes
 from .entry import make_plotter, screenshot, show
 from .scene import Scene
-from .watch import Watcher, watch
+from .watch import ScreenshotWatcher, Watcher, display_problem, watch
 
 __all__ = [
     "LAYOUTS",
     "Scene",
+    "ScreenshotWatcher",
     "Session",
     "Watcher",
+    "display_problem",
     "make_plotter",
     "screenshot",
     "show",
