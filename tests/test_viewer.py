@@ -4,6 +4,7 @@ re-evaluating through the cache, watch mode surviving broken edits, the gallery.
 from __future__ import annotations
 
 import os
+import re
 from collections import namedtuple
 from pathlib import Path
 
@@ -510,3 +511,268 @@ def test_bool_params_get_check_boxes(plotter):
     assert session.params["closed"] is True
     assert session.scene.layers["outline"].parts["curves"].data.n_points == 6
     assert g.stats["pts"].status == "cached" and g.stats["outline"].status == "computed"
+
+
+# ----------------------------------------------------------------- shading, layouts
+
+from formgraph.viewer.style import BACK_FACE, PALETTE  # noqa: E402
+
+
+def hue_share(path: Path, colors: list[str], rows: slice = slice(None)) -> np.ndarray:
+    """The share of the picture's saturated pixels nearest in hue to each of ``colors``
+    (shading changes a colour's brightness, not its hue)."""
+    import colorsys
+
+    img = picture(path)[rows]
+    rgb = img.reshape(-1, 3)
+    sat = rgb.max(axis=1) - rgb.min(axis=1)
+    rgb = rgb[sat > 0.25]
+    if not len(rgb):
+        return np.zeros(len(colors))
+    hsv = np.array([colorsys.rgb_to_hsv(*p) for p in rgb[:: max(1, len(rgb) // 4000)]])
+    refs = np.array([colorsys.rgb_to_hsv(*pv.Color(c).float_rgb)[0] for c in colors])
+    d = np.abs(hsv[:, :1] - refs[None, :])
+    nearest = np.minimum(d, 1 - d).argmin(axis=1)
+    return np.bincount(nearest, minlength=len(colors)) / len(nearest)
+
+
+def flipped(mesh: Mesh) -> Mesh:
+    return Mesh(mesh.vertices, [f[::-1] for f in mesh.faces])
+
+
+def two_boxes_graph() -> fg.Graph:
+    g = fg.Graph()
+    g.add("a", "mesh.box", size=[1, 1, 1])
+    g.add("b", "mesh.box", size=[1, 1, 1], center=[3, 0, 0])
+    g.add("c", "mesh.box", size=[0.5, 2, 1], center=[0, 3, 0])
+    return g
+
+
+def test_a_flipped_mesh_shows_the_back_face_colour(tmp_path):
+    good = viewer.screenshot(box_mesh(), tmp_path / "good.png", size=SIZE)
+    bad = viewer.screenshot(flipped(box_mesh()), tmp_path / "bad.png", size=SIZE)
+    colours = [PALETTE[0], BACK_FACE]
+    rows = slice(int(0.15 * SIZE[1]), None)  # below the legend
+    front, back = hue_share(good, colours, rows)
+    assert front > 0.95 and back < 0.05
+    front, back = hue_share(bad, colours, rows)
+    assert back > 0.95 and front < 0.05, "an inward-facing box must not look like a good one"
+
+
+def test_meshes_are_smooth_shaded_with_feature_edges_kept(plotter):
+    from formgraph.kernels.mesh import subdivision
+
+    scene = viewer.Scene(plotter)
+    smooth = Mesh(*subdivision.catmull_clark(*meshops.box([1.0, 1.0, 1.0]), levels=3))
+    scene.update([("box", box_mesh()), ("smooth", smooth)])
+    box, blob = scene.layers["box"].parts["meshes"], scene.layers["smooth"].parts["meshes"]
+    assert box.actor.GetProperty().GetInterpolationAsString() == "Phong"
+    assert box.data.point_data.active_normals is not None
+    assert box.data.n_points == 24  # each corner split three ways: the box stays a box
+    assert blob.data.n_points == smooth.n_vertices  # nothing sharp: nothing split
+    assert scene.layers["box"].parts["features"].data.n_lines == 12  # the box's edges
+    assert "features" not in scene.layers["smooth"].parts
+    # the faces are never reordered (that would hide a wrong orientation)
+    assert box.actor.GetBackfaceProperty() is not None
+
+
+def test_face_edges_on_coarse_meshes_only_or_when_asked(plotter):
+    from formgraph.kernels.mesh import subdivision
+
+    fine = Mesh(*subdivision.catmull_clark(*meshops.box([1.0, 1.0, 1.0]), levels=4))
+    assert fine.n_faces > 1000
+    scene = viewer.Scene(plotter)
+    scene.update([("coarse", box_mesh()), ("fine", fine)])
+
+    def edges(label):
+        return bool(scene.layers[label].parts["meshes"].actor.GetProperty().GetEdgeVisibility())
+
+    assert edges("coarse") and not edges("fine")
+    assert scene.toggle_edges() is True and edges("fine") and edges("coarse")
+    assert scene.toggle_edges() is False and not edges("coarse")
+    forced = viewer.Scene(pv.Plotter(off_screen=True, window_size=list(SIZE)), edges=True)
+    forced.update([("fine", fine)])
+    assert forced.layers["fine"].parts["meshes"].actor.GetProperty().GetEdgeVisibility()
+    forced.plotter.close()
+
+
+def test_framing_fills_the_free_part_of_the_view(plotter):
+    from formgraph.viewer.frame import project
+
+    scene = viewer.Scene(plotter)
+    w, h = SIZE
+    for value in (box_mesh(), circle_curve(), Points([[0, 0, 0], [10, 0.5, 0.2]])):
+        scene.update([("v", value)])
+        scene.fit_camera()
+        left, bottom, right, top = scene.margins(view_axis(scene.bounds()))
+        free_lo = np.array([2 * left / w - 1, 2 * bottom / h - 1])
+        free_hi = np.array([1 - 2 * right / w, 1 - 2 * top / h])
+        xy = project(scene.renderer, scene.points())
+        lo, hi = xy.min(axis=0), xy.max(axis=0)
+        # clear of the legend above and of the texts and scale bar below ...
+        assert (lo >= free_lo - 1e-6).all() and (hi <= free_hi + 1e-6).all()
+        # ... centred there, and filling it in one direction
+        assert np.allclose((lo + hi) / 2, (free_lo + free_hi) / 2, atol=0.02)
+        fill = ((hi - lo) / (free_hi - free_lo)).max()
+        assert fill == pytest.approx(0.92, abs=0.02), type(value).__name__
+
+
+def test_scale_bar_on_drawings_and_size_line_in_model_units(plotter):
+    scene = viewer.Scene(plotter)
+    scene.update([("c", circle_curve(2.0))])
+    scene.fit_camera()
+    length = scene.scale_bar.length
+    assert length is not None and length in (0.5, 1.0, 2.0)
+    assert scene.texts()["size"] == "size  x 4  y 4"
+    scene.update([("m", box_mesh())])
+    scene.fit_camera()
+    plotter.screenshot()  # and the bar follows the camera at each render
+    assert scene.scale_bar.length is None  # perspective: no single scale
+    assert scene.texts()["size"] == "size  x 2  y 1  z 0.5"
+
+
+def test_overlay_screenshot_has_one_region_per_node(tmp_path):
+    g = two_boxes_graph()
+    out = viewer.screenshot(g, tmp_path / "overlay.png", ["a", "b", "c"], size=SIZE)
+    assert_not_blank(out)
+    shares = hue_share(out, list(PALETTE[:3]), slice(int(0.25 * SIZE[1]), None))
+    assert (shares > 0.1).all(), f"every node in its own colour, got {shares}"
+
+
+def test_side_layout_one_titled_view_per_node_with_linked_cameras(tmp_path):
+    g = fg.Graph()  # the issue's case: a box and two subdivisions of it, compared
+    g.add("a", "mesh.box", size=[1, 1, 1])
+    g.add("b", "mesh.catmull_clark", mesh="@a", levels=2)
+    g.add("c", "mesh.doo_sabin", mesh="@a", levels=2)
+    out = viewer.screenshot(
+        g, tmp_path / "side.png", ["a", "b", "c"], size=(3 * SIZE[0], SIZE[1]), layout="side"
+    )
+    img = picture(out)
+    assert img.shape[:2] == (SIZE[1], 3 * SIZE[0])
+    for i in range(3):  # each third holds its node, drawn large, in its colour
+        panel = tmp_path / f"panel{i}.png"
+        from matplotlib.image import imsave
+
+        imsave(panel, img[:, i * SIZE[0] : (i + 1) * SIZE[0]])
+        assert_not_blank(panel)
+        shares = hue_share(panel, list(PALETTE[:3]), slice(int(0.2 * SIZE[1]), None))
+        assert shares.argmax() == i and shares[i] > 0.9
+    p = viewer.make_plotter(3, "side", (3 * SIZE[0], SIZE[1]), off_screen=True)
+    session = viewer.Session(g, ["a", "b", "c"], plotter=p, layout="side")
+    assert len(session.scenes) == 3
+    assert len({id(s.renderer.GetActiveCamera()) for s in session.scenes}) == 1
+    assert session.scenes[1].texts()["title"] == "b"
+    assert session.scenes[1].texts()["caption"] == "mesh.catmull_clark, Mesh, 96 faces"
+    assert "evaluated in" in session.scenes[2].texts()["status"]
+    assert session.apply_params() and session.scenes[0].layers["a"].kinds == ["meshes"]
+    p.close()
+    with pytest.raises(ValueError, match="shape"):
+        viewer.Session(g, ["a", "b"], plotter=pv.Plotter(off_screen=True), layout="side")
+    with pytest.raises(ValueError, match="layout must be one of overlay, side"):
+        viewer.Session(g, plotter=pv.Plotter(off_screen=True), layout="grid")
+
+
+def test_fg_show_takes_several_nodes_and_a_layout():
+    session = fg.show(two_boxes_graph(), ["a", "c"], layout="side", size=SIZE)
+    assert [list(s.layers) for s in session.scenes] == [["a"], ["c"]]
+    session = fg.show(two_boxes_graph(), ["a", "b"], size=SIZE)
+    assert list(session.scene.layers) == ["a", "b"]
+
+
+def test_cli_view_several_nodes_side_by_side(tmp_path):
+    from formgraph.cli import main
+
+    f = tmp_path / "boxes.yaml"
+    two_boxes_graph().save(f)
+    png = tmp_path / "side.png"
+    args = ["view", str(f), "a", "b", "--layout", "side", "--screenshot", str(png)]
+    assert main([*args, "--size", "600x300", "--edges"]) == 0
+    assert picture(png).shape[:2] == (300, 600)
+
+
+# --------------------------------------------------------------------- headless watch
+
+STATUS = re.compile(r"^ring\.yaml: evaluated in [\d.]+ ms \((\d+) computed, (\d+) cached\), wrote ")
+
+
+def test_headless_watch_writes_a_png_per_change_and_keeps_the_last_good_one(tmp_path):
+    import io
+
+    f, png = tmp_path / "ring.yaml", tmp_path / "shots" / "ring.png"
+    write(f, RING.format(count=5))
+    out, err = io.StringIO(), io.StringIO()
+    w = viewer.ScreenshotWatcher(f, png, "outline", size=SIZE, out=out, err=err)
+    assert w.reload() is True and png.is_file()
+    assert_not_blank(png)
+    first = png.read_bytes()
+    assert w.poll() is None  # nothing changed: nothing written
+    write(f, RING.format(count=12))
+    assert w.poll() is True
+    second = png.read_bytes()
+    assert second != first
+    lines = out.getvalue().splitlines()
+    assert len(lines) == 2 and all(STATUS.match(line) for line in lines)
+    assert STATUS.match(lines[1]).groups() == ("2", "0")  # ring and outline recomputed
+
+    write(f, RING.format(count=12).replace("points.circle", "points.circel"))
+    assert w.poll() is False
+    assert png.read_bytes() == second, "a broken edit must keep the last good picture"
+    assert "unknown node type 'points.circel'" in err.getvalue()
+    assert f"(kept {png}, the last version that worked)" in err.getvalue()
+    assert len(out.getvalue().splitlines()) == 2
+    assert not list(png.parent.glob(".*tmp*")), "no temporary file left behind"
+
+    write(f, RING.format(count=12).replace("radius: 2", "radius: 3"))
+    assert w.poll() is True and png.read_bytes() != second
+    # the new version shares the cache: only what the edit reaches recomputes
+    assert STATUS.match(out.getvalue().splitlines()[-1]).groups() == ("2", "0")
+
+
+def test_headless_watch_starting_on_a_broken_file_writes_nothing(tmp_path):
+    import io
+
+    f, png = tmp_path / "ring.yaml", tmp_path / "ring.png"
+    write(f, "formgraph: 1\nnodes: [unclosed\n")
+    err = io.StringIO()
+    w = viewer.ScreenshotWatcher(f, png, out=io.StringIO(), err=err)
+    assert w.reload() is False and not png.exists()
+    assert f"({png} not written)" in err.getvalue()
+
+
+def test_watch_without_a_display_or_screenshot_says_what_to_do(tmp_path, capsys, monkeypatch):
+    from formgraph.cli import main
+
+    f = tmp_path / "ring.yaml"
+    write(f, RING.format(count=5))
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    assert main(["watch", str(f)]) == 2
+    err = capsys.readouterr().err
+    assert "there is no display" in err and "--screenshot FILE.png" in err
+    assert main(["view", str(f)]) == 2
+    assert "xvfb-run formgraph view" in capsys.readouterr().err
+    monkeypatch.setenv("DISPLAY", ":4711")  # no X server there
+    assert "no X server listens" in viewer.display_problem()
+
+
+def test_cli_watch_screenshot_runs_until_stopped(tmp_path):
+    import subprocess
+    import sys
+    import time
+
+    f, png = tmp_path / "ring.yaml", tmp_path / "ring.png"
+    write(f, RING.format(count=5))
+    cmd = [sys.executable, "-m", "formgraph.cli", "watch", str(f), "outline"]
+    cmd += ["--screenshot", str(png), "--size", "320x240", "--interval", "0.05"]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        assert STATUS.match(proc.stdout.readline()), proc.stderr.read() if proc.poll() else ""
+        stamp = png.stat().st_mtime_ns
+        time.sleep(0.05)
+        write(f, RING.format(count=9))
+        assert STATUS.match(proc.stdout.readline())
+        assert png.stat().st_mtime_ns != stamp
+        assert proc.poll() is None  # still watching
+    finally:
+        proc.terminate()
+        proc.wait(timeout=30)

@@ -246,6 +246,22 @@ class Scene:
         plotter.enable_anti_aliasing("ssaa")
         self.scale_bar = ScaleBar(self.renderer)
 
+    def set_frame(self, bounds: Sequence[float] | None) -> None:
+        """An invisible box (8 points, opacity 0) that this view's clipping planes must
+        keep: views sharing a camera then never clip what another view draws."""
+        import pyvista as pv
+
+        self.activate()
+        if bounds is None:
+            self.plotter.remove_actor("frame", render=False)
+            return
+        b = np.asarray(bounds, dtype=np.float64).reshape(3, 2)
+        corners = np.array(np.meshgrid(*b, indexing="ij")).reshape(3, -1).T
+        actor = self.plotter.add_mesh(
+            pv.PolyData(corners), opacity=0.0, name="frame", reset_camera=False, pickable=False
+        )
+        actor.SetPickable(False)
+
     def activate(self) -> None:
         """Make this scene's subplot the one the plotter draws in."""
         if self.subplot is not None:
@@ -611,7 +627,12 @@ def fit_scenes(scenes: Sequence[Scene]) -> None:
     margins = np.max([s.margins(axis) for s in scenes], axis=0)
     left, bottom, right, top = margins
     free = (left / w, bottom / h, 1.0 - scene.view_shift - right / w, 1.0 - top / h)
+    if len(scenes) > 1:
+        for s in scenes:
+            s.set_frame(bounds)
     fit(scene.renderer, points, free)
+    for s in scenes:
+        s.scale_bar.update()
 
 
 def _vertices(data: Any) -> Any:
