@@ -24,7 +24,7 @@ import numpy as np
 
 from formgraph.geometry import Curve, Geometry, Mesh, NurbsCurve, NurbsSurface, Points, Surface
 
-from .frame import ScaleBar, fit, nice_range, sample, size_text, view_axis
+from .frame import ScaleBar, fit_scenes, nice_range, sample, size_text, view_axis
 from .style import (
     BACKGROUND,
     COARSE_FACES,
@@ -591,48 +591,6 @@ class Scene:
             if actor is not None:
                 out[name] = _text_of(actor)
         return out
-
-
-def fit_scenes(scenes: Sequence[Scene]) -> None:
-    """Frame what ``scenes`` draw with the camera they share (one scene, or linked views).
-
-    Flat geometry (a drawing) is seen straight on without perspective, a top view when it
-    lies in XY; anything else isometric. Everything drawn fills the views less their
-    margins (legend, title, texts, scale bar, the sliders' column).
-    """
-    scene = scenes[0]
-    boxes = [
-        b
-        for b in (
-            s.grid_bounds()[0] if s.show_grid and s.grid_bounds() else s.bounds() for s in scenes
-        )
-        if b is not None
-    ]
-    if not boxes:
-        return
-    b = np.asarray(boxes).reshape(-1, 3, 2)
-    bounds = np.column_stack([b[:, :, 0].min(axis=0), b[:, :, 1].max(axis=0)]).ravel()
-    axis = view_axis(bounds)
-    points = np.concatenate([s.points() for s in scenes])
-    if scene.show_grid:  # the grid box's corners, so that its labels fit too
-        corners = np.array(np.meshgrid(*bounds.reshape(3, 2), indexing="ij")).reshape(3, -1).T
-        points = np.concatenate([points, corners])
-    scene.activate()
-    p = scene.plotter
-    views = {None: p.view_isometric, 2: p.view_xy, 1: p.view_xz, 0: p.view_yz}
-    views[axis](render=False)
-    p.camera.parallel_projection = axis is not None  # a drawing: no perspective
-    p.reset_camera(render=False, bounds=tuple(bounds))
-    w, h = scene.size()
-    margins = np.max([s.margins(axis) for s in scenes], axis=0)
-    left, bottom, right, top = margins
-    free = (left / w, bottom / h, 1.0 - scene.view_shift - right / w, 1.0 - top / h)
-    if len(scenes) > 1:
-        for s in scenes:
-            s.set_frame(bounds)
-    fit(scene.renderer, points, free)
-    for s in scenes:
-        s.scale_bar.update()
 
 
 def _vertices(data: Any) -> Any:
