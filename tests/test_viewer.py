@@ -537,9 +537,12 @@ def test_framing_fills_the_free_part_of_the_view(plotter):
     for value in (box_mesh(), circle_curve(), Points([[0, 0, 0], [10, 0.5, 0.2]])):
         scene.update([("v", value)])
         scene.fit_camera()
-        left, bottom, right, top = scene.margins(view_axis(scene.bounds()))
-        free_lo = np.array([2 * left / w - 1, 2 * bottom / h - 1])
-        free_hi = np.array([1 - 2 * right / w, 1 - 2 * top / h])
+        x0, y0, x1, y1 = scene.free
+        assert scene.free in [
+            (left / w, bottom / h, 1 - right / w, 1 - top / h)
+            for left, bottom, right, top in scene.margin_options(view_axis(scene.bounds()))
+        ]
+        free_lo, free_hi = np.array([2 * x0 - 1, 2 * y0 - 1]), np.array([2 * x1 - 1, 2 * y1 - 1])
         xy = project(scene.renderer, scene.points())
         lo, hi = xy.min(axis=0), xy.max(axis=0)
         # clear of the legend above and of the texts and scale bar below ...

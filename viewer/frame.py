@@ -195,12 +195,25 @@ def fit_scenes(scenes: Sequence[Any]) -> None:
     p.camera.parallel_projection = axis is not None  # a drawing: no perspective
     p.reset_camera(render=False, bounds=tuple(bounds))
     w, h = scene.size()
-    margins = np.max([s.margins(axis) for s in scenes], axis=0)
-    left, bottom, right, top = margins
-    free = (left / w, bottom / h, 1.0 - scene.view_shift - right / w, 1.0 - top / h)
+    if len(scenes) == 1:
+        options = scene.margin_options(axis)
+    else:
+        options = [tuple(np.max([s.margins(axis) for s in scenes], axis=0))]
+    frees = [
+        (left / w, bottom / h, 1.0 - scene.view_shift - right / w, 1.0 - top / h)
+        for left, bottom, right, top in options
+    ]
+    free = frees[0]
+    if len(frees) > 1:  # the one that lets the picture be largest
+        fit(scene.renderer, points, (0.0, 0.0, 1.0, 1.0), fill=1.0)
+        xy = project(scene.renderer, points)
+        ex, ey = np.maximum(np.ptp(xy, axis=0), 1e-12)
+        free = max(frees, key=lambda f: min((f[2] - f[0]) / ex, (f[3] - f[1]) / ey))
     if len(scenes) > 1:
         for s in scenes:
             s.set_frame(bounds)
+    for s in scenes:
+        s.free = free
     fit(scene.renderer, points, free)
     for s in scenes:
         s.scale_bar.update()

@@ -240,6 +240,8 @@ class Scene:
         self.view_shift = 0.0  # move the picture left, to leave room for the sliders
         self._drawn_grid: Any = None  # what the bounds grid and legend show now
         self._drawn_legend: list[Any] = []
+        self._legend_width = 0.0  # fraction of the view's width the legend takes
+        self.free = (0.0, 0.0, 1.0, 1.0)  # where the last fit put the picture (fractions)
         self.activate()
         self.renderer = plotter.renderer
         plotter.set_background(BACKGROUND)
@@ -423,6 +425,16 @@ class Scene:
             side, bottom, top = side + 0.08 * w, bottom + 0.06 * h, top + 0.04 * h
         return side, bottom, side, top
 
+    def margin_options(self, axis: int | None) -> list[tuple[float, float, float, float]]:
+        """:meth:`margins`, and with a legend the other way to keep clear of it: the
+        picture beside the legend rather than below it (a tall drawing fits better so)."""
+        options = [self.margins(axis)]
+        if not self.titled and self.layers and not self.show_grid:
+            left, bottom, right, _ = options[0]
+            right += self._legend_width * self.size()[0] + 8
+            options.append((left, bottom, right, float(STATUS_HEIGHT)))
+        return options
+
     def fit_camera(self, others: Sequence[Scene] = ()) -> None:
         """Frame everything (and what ``others``, sharing this camera, draw): a straight
         view without perspective of flat geometry (a drawing), else an isometric one."""
@@ -501,6 +513,7 @@ class Scene:
         self._drawn_legend = entries
         if p.legend is not None:
             p.remove_legend(render=False)
+        self._legend_width = 0.0
         if not entries:
             return
         # placed by hand: pyvista's loc="upper right" offsets x by the height, not the width
@@ -516,6 +529,7 @@ class Scene:
             loc=None,
             background_opacity=0.85,
         )
+        self._legend_width = width
         legend.SetPosition(0.985 - width, 0.985 - height)
         legend.SetPosition2(width, height)
 
