@@ -268,15 +268,19 @@ def _layers(boxes: dict[str, Box], edges: list[Edge]) -> dict[str, int]:
 
 
 def _order(
-    keys_by_layer: list[list[str]], links: list[tuple[str, str]], sweeps: int = 4
+    keys_by_layer: list[list[str]],
+    links: list[tuple[str, str, float, float]],
+    sweeps: int = 4,
 ) -> list[list[str]]:
     """Reorder each layer by the barycenter of its neighbours in the layer before (down
-    sweeps) or after (up sweeps)."""
-    preds: dict[str, list[str]] = {}
-    succs: dict[str, list[str]] = {}
-    for a, b in links:
-        succs.setdefault(a, []).append(b)
-        preds.setdefault(b, []).append(a)
+    sweeps) or after (up sweeps). A link ``(a, b, at_a, at_b)`` meets its ends at
+    ``at_a`` / ``at_b`` (0 to 1) down a box: the row of a port, so that two wires into one
+    node arrive in the order of its ports instead of crossing."""
+    preds: dict[str, list[tuple[str, float]]] = {}
+    succs: dict[str, list[tuple[str, float]]] = {}
+    for a, b, at_a, at_b in links:
+        succs.setdefault(a, []).append((b, at_b))
+        preds.setdefault(b, []).append((a, at_a))
     order = [list(layer) for layer in keys_by_layer]
     for sweep in range(sweeps):
         down = sweep % 2 == 0
@@ -288,8 +292,8 @@ def _order(
 
             def bary(item: tuple[int, str], pos: dict[str, int] = pos, near: Any = near) -> float:
                 j, key = item
-                ns = [pos[n] for n in near.get(key, []) if n in pos]
-                return sum(ns) / len(ns) if ns else float(j)
+                ns = [pos[n] + at for n, at in near.get(key, []) if n in pos]
+                return sum(ns) / len(ns) if ns else float(j) + 0.5
 
             order[i] = [k for _, k in sorted(enumerate(order[i]), key=bary)]
     return order
@@ -350,7 +354,7 @@ def draw_graph(
     members: list[list[str]] = [[] for _ in range(n_layers)]
     for key in boxes:  # author order: params, then nodes
         members[layer[key]].append(key)
-    links: list[tuple[str, str]] = []
+    links: list[tuple[str, str, float, float]] = []
     chains: list[list[str]] = []
     for i, e in enumerate(edges):
         chain = [e.src]
@@ -359,7 +363,12 @@ def draw_graph(
             members[lay].append(dummy)
             chain.append(dummy)
         chain.append(e.dst)
-        links.extend(zip(chain[:-1], chain[1:], strict=True))
+        src, dst = boxes[e.src], boxes[e.dst]
+        at_src = (src.output_y(e.output) - src.y) / src.height
+        at_dst = (dst.port_y(e.port) - dst.y) / dst.height
+        ats = [at_src] + [0.5] * (len(chain) - 2) + [at_dst]
+        for a, b, at_a, at_b in zip(chain[:-1], chain[1:], ats[:-1], ats[1:], strict=True):
+            links.append((a, b, at_a, at_b))
         chains.append(chain)
     order = _order(members, links)
     return _place_and_draw(graph, boxes, edges, chains, order, ran, path)
@@ -411,9 +420,9 @@ def _place_and_draw(
     for e, chain in zip(edges, chains, strict=True):
         src, dst = boxes[e.src], boxes[e.dst]
         pts = [(src.x + src.width, src.output_y(e.output))]
-        for k in chain[1:-1]:
+        for k in chain[1:-1]:  # straight across each crossed layer, in its own slot
             i = layer_of[k]
-            pts.append((xs[i] + widths[i] / 2, point[k]))
+            pts += [(xs[i], point[k]), (xs[i] + widths[i], point[k])]
         pts.append((dst.x, dst.port_y(e.port)))
         data = (("from", e.src[2:]), ("to", f"{e.dst[2:]}.{e.port}"))
         if e.param:
