@@ -599,13 +599,30 @@ def test_side_layout_one_titled_view_per_node_with_linked_cameras(tmp_path):
     assert len({id(s.renderer.GetActiveCamera()) for s in session.scenes}) == 1
     assert session.scenes[1].texts()["title"] == "b"
     assert session.scenes[1].texts()["caption"] == "mesh.catmull_clark, Mesh, 96 faces"
-    assert "evaluated in" in session.scenes[2].texts()["status"]
+    assert "evaluated in" in session.scenes[0].texts()["status"]  # under the first title
     assert session.apply_params() and session.scenes[0].layers["a"].kinds == ["meshes"]
     p.close()
     with pytest.raises(ValueError, match="shape"):
         viewer.Session(g, ["a", "b"], plotter=pv.Plotter(off_screen=True), layout="side")
     with pytest.raises(ValueError, match="layout must be one of overlay, side"):
         viewer.Session(g, plotter=pv.Plotter(off_screen=True), layout="grid")
+
+
+def test_side_layout_puts_the_sliders_in_a_column_of_their_own(tmp_path):
+    g = ring_graph(tmp_path)
+    p = viewer.make_plotter(2, "side", (900, 300), off_screen=True, controls=True)
+    assert p.shape == (1, 3)
+    session = viewer.Session(g, ["outline", "grid"], plotter=p, layout="side")
+    session.add_sliders()
+    session.add_keys()
+    assert set(session.widgets) == {"count", "radius", "height"}
+    column = p.renderers[2]
+    assert column.GetViewport()[0] > 0.7  # the narrow last column
+    assert "status" in column.actors and "help" in column.actors
+    assert all(s.view_shift == 0 for s in session.scenes)  # the views keep their width
+    assert session.on_slider("count", 9)
+    assert session.scenes[0].layers["outline"].parts["curves"].data.n_points == 10
+    p.close()
 
 
 def test_fg_show_takes_several_nodes_and_a_layout():

@@ -26,6 +26,7 @@ from .scene import PALETTE, TEXT_COLOR, Scene, fit_scenes
 __all__ = ["LAYOUTS", "Session", "Slider", "shown_nodes"]
 
 HELP = "c control polygons   n control nets   e edges   g grid   f fit   v isometric   q quit"
+HELP_LINES = "c control polygons   n control nets\ne edges   g grid   f fit   v iso   q quit"
 LAYOUTS = ("overlay", "side")
 
 
@@ -288,10 +289,36 @@ class Session:
             return
         name = Path(self.graph.file).name if self.graph.file else "graph"
         text = f"{name}: {self.status_line()}"
-        if self.layout == "side":
-            self.scenes[-1].set_status(text, "upper_right")
-        else:
+        if self.layout == "overlay":
             self.scene.set_status(text)
+        elif self._has_controls_column():  # at the top of the sliders' column
+            self._controls_frame()
+            self.plotter.add_text(
+                text, position="upper_left", font_size=12, color=TEXT_COLOR, name="status"
+            )
+        else:  # under the first view's title
+            scene = self.scenes[0]
+            scene.activate()
+            self.plotter.add_text(
+                text,
+                position=(10, scene.size()[1] - 62),
+                font_size=8,
+                color=TEXT_COLOR,
+                name="status",
+            )
+
+    def _has_controls_column(self) -> bool:
+        return self.layout == "side" and self.plotter.shape[1] > len(self.scenes)
+
+    def _controls_frame(self) -> tuple[float, float, float, float]:
+        """Make the sliders' subplot active: (left, right) of the sliders as fractions of
+        it, and its left edge and width as fractions of the window."""
+        if self._has_controls_column():
+            self.plotter.subplot(0, len(self.scenes))
+            vx0, _, vx1, _ = self.plotter.renderer.GetViewport()
+            return 0.08, 0.92, vx0, vx1 - vx0
+        self.scene.activate()
+        return self.controls_x, 0.97, 0.0, 1.0
 
     def status_line(self) -> str:
         """``'evaluated in 8.7 ms (3 computed, 4 cached)'`` for the last evaluation."""
@@ -344,20 +371,21 @@ class Session:
         values = {**self.graph.params, **self.params} if self.graph is not None else {}
         width, height = self.plotter.window_size
         box = max(14, int(0.03 * height))
+        left, _, vx0, vw = self._controls_frame()
         for i, name in enumerate(self.toggles()):
             y = top - i * 0.06
             widget = self.plotter.add_checkbox_button_widget(
                 lambda state, name=name: self.on_toggle(name, state),
                 value=bool(values[name]),
-                position=(int(self.controls_x * width), int(y * height)),
+                position=(int((vx0 + left * vw) * width), int(y * height)),
                 size=box,
                 color_on="steelblue",
                 color_off="white",
                 background_color=TEXT_COLOR,
             )
-            self.plotter.add_text(
+            self.plotter.add_text(  # placed in the subplot's own pixels
                 name,
-                position=(int(self.controls_x * width) + box + 8, int(y * height)),
+                position=(int(left * vw * width) + box + 8, int(y * height)),
                 font_size=7,
                 color=TEXT_COLOR,
             )
@@ -377,6 +405,7 @@ class Session:
             self.plotter.render()
             return
         step = min(0.11, 0.72 / len(sliders))
+        left, right, _, _ = self._controls_frame()
         for i, s in enumerate(sliders):
             y = 0.74 - i * step
             self._slider_values[s.name] = int(s.value) if s.integer else s.value
@@ -385,8 +414,8 @@ class Session:
                 rng=(s.min, s.max),
                 value=s.value,
                 title=f"{s.name}   ({s.min:g} to {s.max:g})",
-                pointa=(self.controls_x, y),
-                pointb=(0.97, y),
+                pointa=(left, y),
+                pointb=(right, y),
                 color=TEXT_COLOR,
                 interaction_event="always",
                 fmt="%.0f" if s.integer else "%.3g",
@@ -424,7 +453,15 @@ class Session:
         p.add_key_event("g", lambda: toggle("grid"))
         p.add_key_event("e", lambda: toggle("edges"))
         p.add_key_event("f", lambda: (self.fit_camera(), p.render()))
-        self.scene.set_help(HELP)
+        if self.layout == "overlay":
+            self.scene.set_help(HELP)
+            return
+        short = HELP_LINES
+        if self._has_controls_column():
+            self._controls_frame()
+            p.add_text(short, position="lower_left", font_size=8, color="#777777", name="help")
+        else:
+            self.scenes[-1].set_help(short)
 
 
 def _style_slider(rep: Any) -> None:
