@@ -628,6 +628,10 @@ def test_side_layout_puts_the_sliders_in_a_column_of_their_own(tmp_path):
 def test_fg_show_takes_several_nodes_and_a_layout():
     session = fg.show(two_boxes_graph(), ["a", "c"], layout="side", size=SIZE)
     assert [list(s.layers) for s in session.scenes] == [["a"], ["c"]]
+    p = viewer.make_plotter(2, "side", SIZE, off_screen=True)
+    session = viewer.Session([box_mesh(), circle_curve()], plotter=p, layout="side")
+    assert [s.texts()["caption"] for s in session.scenes] == ["Mesh, 6 faces", "NurbsCurve"]
+    p.close()
     session = fg.show(two_boxes_graph(), ["a", "b"], size=SIZE)
     assert list(session.scene.layers) == ["a", "b"]
 

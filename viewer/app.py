@@ -206,7 +206,7 @@ class Session:
         """``(label, value)`` of every shown node, evaluated with the current params."""
         if self.graph is None:
             if self.layout == "side" and isinstance(self.value, (list, tuple)):
-                return [(_label_of(v), v) for v in self.value]
+                return [(f"{i + 1}", v) for i, v in enumerate(self.value)]
             return [(_label_of(self.value), self.value)]
         bases = list(dict.fromkeys(_base(self.graph, t) for t in self.targets))
         t0 = time.perf_counter()
