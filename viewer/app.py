@@ -446,6 +446,8 @@ class Session:
                     scene.toggle_edges()
                 else:
                     scene.toggle(what)
+            if what == "grid":  # the grid's labels need room around the geometry
+                self.fit_camera()
             p.render()
 
         p.add_key_event("c", lambda: toggle("polygon"))
