@@ -351,7 +351,7 @@ def cmd_graph(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from .cache import default_cache_dir
-    from .drawgraph import draw_graph
+    from .drawgraph import draw_graph, failed_nodes
     from .graph import load
 
     output = args.output or f"{Path(args.graph).stem}.svg"
@@ -360,22 +360,29 @@ def cmd_graph(args: argparse.Namespace) -> int:
     cache_dir = None if args.no_cache else (args.cache_dir or default_cache_dir())
     g = load(args.graph, out_dir=args.out, cache_dir=cache_dir, budget=args.budget)
     params = parse_sets(g, args.set)
+    failure: FormgraphError | None = None
     if args.run:
         progress = _ProgressLine(sys.stderr)
         g.progress = progress
         try:
             g.evaluate(args.nodes, **params) if args.nodes else g.evaluate_all(**params)
+        except FormgraphError as exc:  # still draw: how far the run got, the failure red
+            failure = exc
         finally:
             progress.clear()
     elif args.nodes:
         raise UsageError("NODE names are what --run evaluates; add --run")
-    drawing = draw_graph(g)
+    failed = failed_nodes(failure) if failure is not None else []
+    drawing = draw_graph(g, failed=failed)
     if output == "-":
         sys.stdout.write(drawing.svg)
-        return 0
-    path = drawing.save(output)
-    run = f", after a run of {len(g.stats)} nodes" if args.run else ""
-    print(f"wrote {path} ({len(g.nodes)} nodes, {len(g.params)} params{run})")
+    else:
+        path = drawing.save(output)
+        run = f", after a run of {len(g.stats)} nodes" if args.run else ""
+        run += f", {', '.join(failed)} failed" if failed else ""
+        print(f"wrote {path} ({len(g.nodes)} nodes, {len(g.params)} params{run})")
+    if failure is not None:
+        raise failure
     return 0
 
 

@@ -29,7 +29,7 @@ from .errors import FormgraphError
 from .model import Expr, Items, Literal, exprs_of, parse_input, wires_of
 from .registry import node_types
 
-__all__ = ["MARKS", "draw_graph", "node_marks"]
+__all__ = ["MARKS", "draw_graph", "failed_nodes", "node_marks"]
 
 Mark = Callable[[Any, str], list[str]]
 
@@ -43,7 +43,13 @@ FAMILY_COLORS = {
     "offset": "#bcbd22",
     "export": "#7f7f7f",
 }
-STATUS_FILL = {"computed": "#fde2c4", "cached": "#d9e9f7", None: "white", "not run": "#f1f1f1"}
+STATUS_FILL = {
+    "computed": "#fde2c4",
+    "cached": "#d9e9f7",
+    "failed": "#f4b6b6",
+    "not run": "#f1f1f1",
+    None: "white",
+}
 PARAM_FILL, PARAM_STROKE = "#fff6d5", "#b39a3e"
 INK, GREY, WIRE = "#222222", "#666666", "#7a7a7a"
 
@@ -305,6 +311,7 @@ def draw_graph(
     *,
     stats: Mapping[str, Any] | None = None,
     marks: Iterable[Mark] | None = None,
+    failed: Iterable[str] = (),
 ) -> Drawing:
     """Draw ``graph``'s nodes, params and wires as a layered diagram.
 
@@ -319,6 +326,8 @@ def draw_graph(
         record of its last evaluation (empty before one: no colours).
     marks : iterable of callables, optional
         Mark functions ``(graph, node) -> list[str]``; default :data:`MARKS`.
+    failed : iterable of str
+        Nodes whose run failed (drawn red): see :func:`failed_nodes`.
 
     Returns
     -------
@@ -336,13 +345,16 @@ def draw_graph(
     True
     """
     stats = graph.stats if stats is None else stats
+    failed = set(failed)
     boxes, edges = _model(graph, marks)
-    ran = bool(stats)
+    ran = bool(stats) or bool(failed)
     for key, box in boxes.items():
         if box.is_param:
             continue
         st = stats.get(key[2:]) if ran else None
-        if st is not None:
+        if key[2:] in failed:
+            box.status, box.status_text = "failed", "failed"
+        elif st is not None:
             box.status = st.status
             where = f" ({st.source})" if getattr(st, "source", "") in ("disk",) else ""
             box.status_text = f"{st.status}{where} {_seconds(st.seconds)}"
@@ -374,6 +386,15 @@ def draw_graph(
     return _place_and_draw(graph, boxes, edges, chains, order, ran, path)
 
 
+def failed_nodes(error: BaseException) -> list[str]:
+    """The nodes an evaluation error names (a NodeError's node, a GraphError's problems)."""
+    where = getattr(error, "where", None)
+    if where is not None and getattr(where, "node", None):
+        return [where.node]
+    problems = getattr(error, "problems", [])
+    return list(dict.fromkeys(p.where.node for p in problems if p.where.node))
+
+
 def _seconds(s: float) -> str:
     return f"{s * 1000:.3g} ms" if s < 1 else f"{s:.3g} s"
 
@@ -401,7 +422,8 @@ def _place_and_draw(
         x += 0.0 if i == 0 else max(MIN_H_GAP, arriving[i])
         xs.append(x)
         x += w
-    page_w = x + MARGIN
+    header = text_width(_title(graph), 15, True) + (text_width(_summary(graph), 11) + 40) * ran
+    page_w = max(x + MARGIN, header + 2 * MARGIN, 300.0)
     column_h = [sum(height(k) for k in lay) + V_GAP * (len(lay) - 1) for lay in order]
     tallest = max(column_h, default=0.0)
     point: dict[str, float] = {}  # the y of each bend point
@@ -414,7 +436,7 @@ def _place_and_draw(
                 point[k] = y + 5.0
             y += height(k) + V_GAP
     d = Drawing(page_w, TOP + tallest + MARGIN + 4, title=_title(graph))
-    _header(d, graph, ran)
+    _header(d, graph, ran, list(boxes.values()))
     layer_of = {k: i for i, lay in enumerate(order) for k in lay}
     labels: dict[tuple[str, str], set[str]] = {}
     for e, chain in zip(edges, chains, strict=True):
@@ -452,24 +474,29 @@ def _place_and_draw(
     return d
 
 
+def _summary(graph: Any) -> str:
+    stats = graph.stats
+    total = sum(s.seconds for s in stats.values())
+    computed = sum(1 for s in stats.values() if s.status == "computed")
+    return f"last run: {computed} computed, {len(stats) - computed} cached, {_seconds(total)}"
+
+
 def _title(graph: Any) -> str:
     name = os.path.basename(graph.file) if getattr(graph, "file", None) else "graph"
     return f"{name}: {len(graph.nodes)} nodes, {len(graph.params)} params"
 
 
-def _header(d: Drawing, graph: Any, ran: bool) -> None:
+def _header(d: Drawing, graph: Any, ran: bool, d_boxes: Iterable[Box] = ()) -> None:
     d.add(Text(MARGIN, 24, _title(graph), 15, INK, bold=True, cls="title"))
     legend_left = d.width - MARGIN
     if ran:
-        stats = graph.stats
-        total = sum(s.seconds for s in stats.values())
-        computed = sum(1 for s in stats.values() if s.status == "computed")
-        summary = (
-            f"last run: {computed} computed, {len(stats) - computed} cached, {_seconds(total)}"
-        )
+        summary = _summary(graph)
         x = d.width - MARGIN
         d.add(Text(x, 24, summary, 11, INK, anchor="end", cls="run"))
-        for label in ("not run", "cached", "computed"):
+        labels = ["not run", "cached", "computed"]
+        if any(b.status == "failed" for b in d_boxes):
+            labels.insert(0, "failed")
+        for label in labels:
             x -= text_width(label, 10) + 4
             d.add(Text(x, 42, label, 10, GREY, cls="legend"))
             x -= 16

@@ -286,3 +286,20 @@ def test_a_node_with_several_outputs_gets_a_row_and_an_anchor_per_output():
     assert y0 == pytest.approx(anchors[1], abs=0.1)  # leaves from the 'hi' row
     assert {t.text for t in by_class(root, "text", "wire-label")} == {"float"}
     assert g.evaluate("c") is not None
+
+
+def test_cli_graph_run_that_fails_draws_how_far_it_got(tmp_path, capsys):
+    f = tmp_path / "big.yaml"
+    f.write_text(
+        "formgraph: 1\nnodes:\n  box: {type: mesh.box}\n"
+        "  smooth: {type: mesh.catmull_clark, mesh: '@box', levels: 6}\n"
+    )
+    svg = tmp_path / "big.svg"
+    args = ["graph", str(f), "--run", "--no-cache", "--budget", "1000", "-o", str(svg)]
+    assert main(args) == 1
+    captured = capsys.readouterr()
+    assert "smooth failed" in captured.out and "node 'smooth'" in captured.err
+    fills = fills_of(parse(svg.read_text()))
+    assert fills == {"box": "#fde2c4", "smooth": "#f4b6b6"}  # computed, failed
+    legend = {t.text for t in by_class(parse(svg.read_text()), "text", "legend")}
+    assert "failed" in legend
