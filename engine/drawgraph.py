@@ -60,8 +60,19 @@ V_GAP, MIN_H_GAP, MARGIN, TOP = 16.0, 56.0, 16.0, 58.0
 # ------------------------------------------------------------------------------- marks
 
 
+def _registry(graph: Any) -> dict[str, Any]:
+    """The node types ``graph`` can use (subgraph files too, where the graph knows them)."""
+    types = getattr(graph, "node_types", None)
+    if callable(types):
+        try:
+            return types()
+        except FormgraphError:  # a subgraph file that does not load: draw without it
+            pass
+    return node_types()
+
+
 def _export_mark(graph: Any, name: str) -> list[str]:
-    spec = node_types().get(graph.nodes[name])
+    spec = _registry(graph).get(graph.nodes[name])
     return ["export"] if spec is not None and spec.is_export else []
 
 
@@ -70,11 +81,8 @@ def _subgraph_mark(graph: Any, name: str) -> list[str]:
 
 
 def _repeat_mark(graph: Any, name: str) -> list[str]:
-    repeat = _repeat_of(graph, name)
-    if not repeat:
-        return []
-    loops = ", ".join(repeat) if isinstance(repeat, Mapping) else ""
-    return [f"repeat {loops}".strip()]
+    loops = _repeat_of(graph, name)
+    return [f"repeat {', '.join(loops)}".strip()] if loops is not None else []
 
 
 MARKS: list[Mark] = [_export_mark, _subgraph_mark, _repeat_mark]
@@ -88,13 +96,22 @@ def node_marks(graph: Any, name: str, marks: Iterable[Mark] | None = None) -> li
     return out
 
 
-def _repeat_of(graph: Any, name: str) -> Any:
-    """A node's ``repeat:`` mapping, wherever the graph model keeps it (None without)."""
-    nd = graph._nodes[name]
-    repeat = getattr(nd, "repeat", None)
-    if repeat is None and isinstance(getattr(nd, "raw", None), dict):
-        repeat = nd.raw.get("repeat")
-    return repeat if repeat else None
+def _repeat_of(graph: Any, name: str) -> dict[str, Any] | None:
+    """A node's ``repeat:`` as {loop name: its source (an input)}, or None without one."""
+    repeat = getattr(graph._nodes[name], "repeat", None)
+    if not repeat:
+        return None
+    if hasattr(repeat, "name") and hasattr(repeat, "source"):  # model.Repeat
+        return {repeat.name: repeat.source}
+    if isinstance(repeat, Mapping):
+        out = {}
+        for loop, raw in repeat.items():
+            try:
+                out[str(loop)] = parse_input(raw)
+            except FormgraphError:
+                continue
+        return out
+    return {}
 
 
 # ------------------------------------------------------------------------------ model
@@ -182,7 +199,7 @@ def _param_names(value: Any, port_type: Any, params: set[str]) -> list[str]:
 
 
 def _model(graph: Any, marks: Iterable[Mark] | None) -> tuple[dict[str, Box], list[Edge]]:
-    registry = node_types()
+    registry = _registry(graph)
     params = graph.param_defs
     values = graph.params
     boxes: dict[str, Box] = {}
@@ -211,11 +228,8 @@ def _model(graph: Any, marks: Iterable[Mark] | None) -> tuple[dict[str, Box], li
         else:
             box.outputs.append(("", "outputs"))
         inputs = dict(nd.inputs)
-        for loop, raw in (_repeat_of(graph, name) or {}).items():
-            try:
-                inputs[f"repeat {loop}"] = parse_input(raw)
-            except FormgraphError:
-                continue
+        for loop, source in (_repeat_of(graph, name) or {}).items():
+            inputs[f"repeat {loop}"] = source
         for port, value in inputs.items():
             port_type = spec.inputs[port].type if spec is not None and port in spec.inputs else None
             used = False

@@ -34,8 +34,14 @@ def by_class(root: ET.Element, tag: str, cls: str) -> list[ET.Element]:
 
 
 def wire_count(g: fg.Graph) -> int:
-    """Wires as authored: every @node reference in every input."""
-    return sum(len(wires_of(v)) for n in g.nodes for v in g._nodes[n].inputs.values())  # noqa: SLF001
+    """Wires as authored: every @node reference in every input and repeat: source."""
+    count = 0
+    for n in g.nodes:
+        nd = g._nodes[n]  # noqa: SLF001
+        count += sum(len(wires_of(v)) for v in nd.inputs.values())
+        if nd.repeat is not None:
+            count += len(wires_of(nd.repeat.source))
+    return count
 
 
 def path_ends(d: str) -> tuple[tuple[float, float], tuple[float, float]]:
@@ -188,7 +194,7 @@ def test_marks_come_from_a_hook_exports_subgraphs_and_repeats(tmp_path):
     g = ring_graph()
     g.add("save", "export.svg", curves="@both", path="x.svg")
     g.add("sub", "parts/ring.yaml", radius="=r")  # a subgraph node (not checked here)
-    g._nodes["wave"].repeat = {"i": "=n"}  # as a repeat: node will carry it  # noqa: SLF001
+    g.add("wave", "curves.parametric", repeat={"i": "=n"}, x="r * cos(t) + i", y="sin(t)")
     assert node_marks(g, "save") == ["export"]
     assert node_marks(g, "sub") == ["subgraph"]
     assert node_marks(g, "wave") == ["repeat i"]

@@ -174,3 +174,30 @@ def test_cli_watch_screenshot_runs_until_stopped(tmp_path):
     finally:
         proc.terminate()
         proc.wait(timeout=30)
+
+
+def test_headless_watch_follows_the_subgraph_files_too(tmp_path):
+    import io
+    import shutil
+    from pathlib import Path
+
+    graphs = Path(__file__).resolve().parents[1] / "graphs"
+    shutil.copy(graphs / "lamp.yaml", tmp_path / "lamp.yaml")
+    (tmp_path / "parts").mkdir()
+    part = tmp_path / "parts" / "ring.yaml"
+    shutil.copy(graphs / "parts" / "ring.yaml", part)
+    png, out, err = tmp_path / "lamp.png", io.StringIO(), io.StringIO()
+    w = viewer.ScreenshotWatcher(
+        tmp_path / "lamp.yaml", png, "upper", size=SIZE, out=out, err=err, out_dir=tmp_path / "o"
+    )
+    assert w.reload() is True and part in w.files
+    first = png.read_bytes()
+    assert w.poll() is None
+    text = part.read_text()
+    write(part, text.replace("u: 12", "u: 4"))  # a coarser tube in the part file
+    assert w.poll() is True and png.read_bytes() != first
+    write(part, text.replace('radius: "=radius"', 'radius: "=radiu"'))
+    assert w.poll() is False and "radiu" in err.getvalue()
+    write(part, text)  # the broken part is still watched: fixing it writes again
+    assert w.poll() is True
+    assert len(out.getvalue().splitlines()) == 3

@@ -208,7 +208,10 @@ def fit_scenes(scenes: Sequence[Any]) -> None:
         fit(scene.renderer, points, (0.0, 0.0, 1.0, 1.0), fill=1.0)
         xy = project(scene.renderer, points)
         ex, ey = np.maximum(np.ptp(xy, axis=0), 1e-12)
-        free = max(frees, key=lambda f: min((f[2] - f[0]) / ex, (f[3] - f[1]) / ey))
+        sizes = [min((f[2] - f[0]) / ex, (f[3] - f[1]) / ey) for f in frees]
+        # off centre only for a clear gain (a long legend over a tall drawing)
+        if max(sizes[1:]) > 1.1 * sizes[0]:
+            free = frees[1 + int(np.argmax(sizes[1:]))]
     if len(scenes) > 1:
         for s in scenes:
             s.set_frame(bounds)

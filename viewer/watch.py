@@ -1,6 +1,6 @@
-"""Watch mode: redraw a graph whenever its YAML file is saved.
+"""Watch mode: redraw a graph whenever its YAML file (or a subgraph file it uses) is saved.
 
-A :class:`Watcher` polls the file's modification stamp from the plotter's timer. Each
+A :class:`Watcher` polls the files' modification stamps from the plotter's timer. Each
 :meth:`Watcher.reload` reads, checks and evaluates the file again; a broken edit puts the
 error in the window (and on stderr) and leaves the last good geometry on screen. Successive
 versions share one memory cache, so an edit recomputes only the nodes it reaches.
@@ -70,7 +70,8 @@ class Watcher:
         self.out_dir = out_dir
         self.budget = budget
         self.session: Session | None = None
-        self.stamp: tuple[int, int] | None = None
+        self.stamp: tuple[Any, ...] | None = None
+        self.files: list[Path] = [self.path]  # the graph's file and its subgraph files
         self.reloads = 0
         self._blank: Scene | None = None  # shows the error of a broken first version
 
@@ -78,12 +79,8 @@ class Watcher:
     def scene(self) -> Any:
         return self.session.scene if self.session is not None else None
 
-    def _stamp(self) -> tuple[int, int] | None:
-        try:
-            st = self.path.stat()
-        except OSError:
-            return None  # mid-save (an editor's rename): look again on the next tick
-        return st.st_mtime_ns, st.st_size
+    def _stamp(self) -> tuple[Any, ...] | None:
+        return _stamps(self.path, self.files)
 
     def poll(self) -> bool | None:
         """Reload if the file changed since the last look; None when it did not."""
@@ -104,6 +101,8 @@ class Watcher:
         self.reloads += 1
         try:
             graph = load(self.path, out_dir=self.out_dir, budget=self.budget)
+            self.files = [self.path, *graph.files[1:]]
+            self.stamp = self._stamp()
             if self.session is not None and self.session.graph is not None:
                 graph.memory = self.session.graph.memory  # an edit recomputes what it reaches
             params = parse_sets(graph, self.sets)
@@ -121,6 +120,9 @@ class Watcher:
             else:
                 self.session.replace_graph(graph, params)
         except (FormgraphError, UsageError) as exc:
+            if getattr(exc, "files", None):  # a broken subgraph file is watched too
+                self.files = [self.path, *exc.files[1:]]
+                self.stamp = self._stamp()
             self._report(str(exc))
             return False
         except Exception as exc:  # a bug of ours must not close the designer's window
@@ -271,17 +273,14 @@ class ScreenshotWatcher:
         self.edges = edges
         self.out = out if out is not None else sys.stdout
         self.err = err if err is not None else sys.stderr
-        self.stamp: tuple[int, int] | None = None
+        self.stamp: tuple[Any, ...] | None = None
+        self.files: list[Path] = [self.path]  # the graph's file and its subgraph files
         self.memory: Any = None  # the cache shared by successive versions
         self.written = 0  # PNGs written
         self.last_error: str | None = None
 
-    def _stamp(self) -> tuple[int, int] | None:
-        try:
-            st = self.path.stat()
-        except OSError:
-            return None
-        return st.st_mtime_ns, st.st_size
+    def _stamp(self) -> tuple[Any, ...] | None:
+        return _stamps(self.path, self.files)
 
     def poll(self) -> bool | None:
         """Render if the file changed since the last look; None when it did not."""
@@ -299,6 +298,8 @@ class ScreenshotWatcher:
         self.stamp = self._stamp()
         try:
             graph = load(self.path, out_dir=self.out_dir, budget=self.budget)
+            self.files = [self.path, *graph.files[1:]]
+            self.stamp = self._stamp()
             if self.memory is not None:
                 graph.memory = self.memory
             params = parse_sets(graph, self.sets)
@@ -325,6 +326,9 @@ class ScreenshotWatcher:
             finally:
                 plotter.close()
         except (FormgraphError, UsageError) as exc:
+            if getattr(exc, "files", None):  # a broken subgraph file is watched too
+                self.files = [self.path, *exc.files[1:]]
+                self.stamp = self._stamp()
             return self._failed(str(exc))
         except Exception as exc:  # a bug of ours must not end the watch
             return self._failed(f"internal error: {type(exc).__name__}: {exc}")
@@ -356,3 +360,18 @@ class ScreenshotWatcher:
         while stop is None or not stop():
             time.sleep(interval)
             self.poll()
+
+
+def _stamps(path: Path, files: Sequence[Path]) -> tuple[Any, ...] | None:
+    """(mtime, size) of each file; None while the graph's own file is missing (mid-save)."""
+    stamps: list[Any] = []
+    for f in files:
+        try:
+            st = f.stat()
+        except OSError:
+            if f == path:
+                return None
+            stamps.append(None)
+            continue
+        stamps.append((st.st_mtime_ns, st.st_size))
+    return tuple(stamps)
