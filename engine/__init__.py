@@ -9,6 +9,9 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterable
+from typing import Any
+
 from . import geometry
 from .drawgraph import draw_graph
 from .errors import (
@@ -36,7 +39,7 @@ from .graph import Graph, NodeStat, load
 from .registry import node_types
 
 
-def show(source, node=None, **kwargs):  # type: ignore[no-untyped-def]
+def show(source: Any, node: str | Iterable[str] | None = None, **kwargs: Any) -> Any:
     """Open the viewer on a graph (or file, or geometry): :func:`formgraph.viewer.show`.
 
     ``fg.show(g, ["ds", "cc"], layout="side")`` shows two nodes side by side; pyvista is
