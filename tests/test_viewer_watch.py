@@ -201,3 +201,13 @@ def test_headless_watch_follows_the_subgraph_files_too(tmp_path):
     write(part, text)  # the broken part is still watched: fixing it writes again
     assert w.poll() is True
     assert len(out.getvalue().splitlines()) == 3
+
+
+def test_display_problem_names_what_is_missing(monkeypatch):
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.setenv("WAYLAND_DISPLAY", "wayland-0")
+    assert "Wayland display but no X display" in viewer.display_problem()
+    monkeypatch.delenv("WAYLAND_DISPLAY")
+    assert viewer.display_problem() == "there is no display (DISPLAY is not set)"
+    monkeypatch.setenv("DISPLAY", "remote.example:0")  # a remote display: trusted
+    assert viewer.display_problem() is None

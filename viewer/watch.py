@@ -208,16 +208,17 @@ def watch(
 def display_problem() -> str | None:
     """Why a window cannot open here (no display), or None when one can.
 
-    Only Linux and the BSDs are checked (elsewhere a window system is always there): a
-    ``DISPLAY`` or ``WAYLAND_DISPLAY`` must be set, and a local X display's socket must
-    exist (VTK aborts the process on a display that does not answer).
+    Only Linux and the BSDs are checked (elsewhere a window system is always there). VTK
+    draws its windows through X, so ``DISPLAY`` must be set (a Wayland desktop sets it for
+    XWayland), and a local display's socket must exist: VTK aborts the whole process on a
+    display that does not answer.
     """
     if not sys.platform.startswith(("linux", "freebsd", "openbsd", "netbsd")):
         return None
-    if os.environ.get("WAYLAND_DISPLAY"):
-        return None
     display = os.environ.get("DISPLAY", "")
     if not display:
+        if os.environ.get("WAYLAND_DISPLAY"):
+            return "there is a Wayland display but no X display for VTK (DISPLAY is not set)"
         return "there is no display (DISPLAY is not set)"
     host, _, number = display.partition(":")
     number = number.split(".", 1)[0]
