@@ -309,3 +309,23 @@ def test_cli_graph_run_that_fails_draws_how_far_it_got(tmp_path, capsys):
     assert fills == {"box": "#fde2c4", "smooth": "#f4b6b6"}  # computed, failed
     legend = {t.text for t in by_class(parse(svg.read_text()), "text", "legend")}
     assert "failed" in legend
+
+
+def test_the_svg_needs_neither_pyvista_nor_pillow():
+    import subprocess
+    import sys
+
+    code = (
+        "import sys, formgraph as fg\n"
+        "g = fg.load(sys.argv[1])\n"
+        "assert '<svg' in fg.draw_graph(g).svg\n"
+        "print(sorted(m for m in ('pyvista', 'vtk', 'PIL') if m in sys.modules))\n"
+    )
+    r = subprocess.run(
+        [sys.executable, "-c", code, str(ROOT / "graphs" / "lamp.yaml")],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.strip() == "[]"
