@@ -363,13 +363,13 @@ def cmd_graph(args: argparse.Namespace) -> int:
         raise UsageError(f"-o {output}: the drawing is written as .svg or .png")
     cache_dir = None if args.no_cache else (args.cache_dir or default_cache_dir())
     g = load(args.graph, out_dir=args.out, cache_dir=cache_dir, budget=args.budget)
-    params = parse_sets(g, args.set)
+    g.set(**parse_sets(g, args.set))  # the param boxes show the values used
     failure: FormgraphError | None = None
     if args.run:
         progress = _ProgressLine(sys.stderr)
         g.progress = progress
         try:
-            g.evaluate(args.nodes, **params) if args.nodes else g.evaluate_all(**params)
+            g.evaluate(args.nodes) if args.nodes else g.evaluate_all()
         except FormgraphError as exc:  # still draw: how far the run got, the failure red
             failure = exc
         finally:

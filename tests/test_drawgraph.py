@@ -329,3 +329,11 @@ def test_the_svg_needs_neither_pyvista_nor_pillow():
     )
     assert r.returncode == 0, r.stderr
     assert r.stdout.strip() == "[]"
+
+
+def test_cli_graph_shows_the_param_values_of_set(tmp_path):
+    svg = tmp_path / "v.svg"
+    f = ROOT / "graphs" / "spiral_tube.yaml"
+    assert main(["graph", str(f), "--set", "turns=7", "-o", str(svg)]) == 0
+    types = {t.text for t in by_class(parse(svg.read_text()), "text", "type")}
+    assert "= 7 [1..12]" in types
