@@ -164,6 +164,18 @@ def test_overlay_screenshot_has_one_region_per_node(tmp_path):
     assert_not_blank(out)
     shares = hue_share(out, list(PALETTE[:3]), slice(int(0.25 * SIZE[1]), None))
     assert (shares > 0.1).all(), f"every node in its own colour, got {shares}"
+    # ... and each colour a region of its own: seen from (1, 1, 1) the x and y axes run to
+    # opposite sides, so the box at the origin lies between those at x = 3 and y = 3
+    img = picture(out)[int(0.25 * SIZE[1]) :]
+    centres = []
+    for color in PALETTE[:3]:
+        ref = np.array(pv.Color(color).float_rgb)
+        near = np.abs(img / np.maximum(img.max(axis=-1, keepdims=True), 1e-6) - ref / ref.max())
+        ys, xs = np.nonzero(near.max(axis=-1) < 0.12)
+        assert xs.size > 200
+        centres.append(xs.mean() / SIZE[0])
+    a, b, c = centres
+    assert min(b, c) < a < max(b, c) and abs(b - c) > 0.3
 
 
 def test_side_layout_one_titled_view_per_node_with_linked_cameras(tmp_path):
