@@ -526,3 +526,24 @@ def test_orient_keeps_a_cavity_facing_inward():
     inward_ball = np.concatenate([nfi[: fi.size], reverse_faces(nfi, nfo)[fi.size :]])
     out, _ = kr.orient(nv, inward_ball, nfo)
     np.testing.assert_array_equal(out, nfi)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**31), st.sampled_from(["sphere", "cube", "open", "soup", "nonmanifold"]))
+def test_fast_solid_check_agrees_with_the_report(seed, which):
+    rng = np.random.default_rng(seed)
+    v, fi, fo = {
+        "sphere": kp.sphere(1, 8),
+        "cube": cube(),
+        "open": kp.cylinder(1, 1, 6, caps=False),
+        "soup": (rng.random((6, 3)), rng.integers(0, 6, 30), np.arange(0, 31, 3)),
+        "nonmanifold": _merge(cube(), cube()),
+    }[which]
+    if which == "nonmanifold":
+        fi = np.concatenate([fi[:24], fi[:24]])
+    if rng.random() < 0.5:  # flip a few faces
+        flips = rng.random(fo.size - 1) < 0.2
+        fi = np.where(np.repeat(flips, np.diff(fo)), reverse_faces(fi, fo), fi)
+    if which == "soup":
+        fi, fo = kr.drop_collapsed(fi, fo, 6)
+    assert km.is_closed_oriented(fi, fo, len(v)) == km.solid_report(fi, fo, len(v)).is_solid

@@ -17,7 +17,7 @@ from enum import Enum
 
 import numpy as np
 
-from .measure import signed_volume, solid_report
+from .measure import is_closed_oriented, signed_volume, solid_report
 from .meshops import triangulate
 
 __all__ = [
@@ -102,7 +102,7 @@ def to_manifold(
     if fo.size < 2:
         raise NotSolidError(f"{what} has no faces")
     # our own check first: manifold3d can crash (not only refuse) on open, messy input
-    if not solid_report(fi, fo, len(v)).is_solid:
+    if not is_closed_oriented(fi, fo, len(v)):
         raise NotSolidError(_why_not_solid(v, fi, fo, what))
     tris = fi
     if not (fo[-1] == 3 * (fo.size - 1) and np.all(np.diff(fo) == 3)):

@@ -24,6 +24,7 @@ __all__ = [
     "edge_table",
     "face_areas",
     "face_vectors",
+    "is_closed_oriented",
     "next_corner",
     "signed_volume",
     "solid_report",
@@ -249,6 +250,28 @@ class SolidReport:
             if n
         ]
         return ", ".join(parts)
+
+
+def is_closed_oriented(face_indices: np.ndarray, face_offsets: np.ndarray, n_vertices: int) -> bool:
+    """Every edge on exactly two faces that run it in opposite directions.
+
+    The fast form of ``solid_report(...).is_solid``: one sort of the directed edge keys
+    (no indices), after which a closed, consistently oriented manifold reads as pairs
+    ``(edge, forward), (edge, backward)`` with every pair a different edge.
+    """
+    fi = np.asarray(face_indices, dtype=np.int64)
+    if fi.size == 0 or fi.size % 2:
+        return False
+    a, b = fi, fi[next_corner(face_offsets)]
+    nv = max(int(n_vertices), 1)
+    key = np.sort((np.minimum(a, b) * nv + np.maximum(a, b)) * 2 + (a > b)).reshape(-1, 2)
+    edge = key >> 1
+    return bool(
+        np.all(edge[:, 0] == edge[:, 1])
+        and np.all((key[:, 0] & 1) == 0)
+        and np.all((key[:, 1] & 1) == 1)
+        and np.all(edge[1:, 0] != edge[:-1, 0])
+    )
 
 
 def solid_report(
