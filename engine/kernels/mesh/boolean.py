@@ -126,7 +126,7 @@ def from_manifold(m: object) -> MeshArrays:
     """Flat arrays of a ``manifold3d.Manifold`` (triangles)."""
     mesh = m.to_mesh64()  # type: ignore[attr-defined]
     v = np.asarray(mesh.vert_properties, dtype=np.float64)[:, :3]
-    tri = np.asarray(mesh.tri_verts).astype(np.int64).reshape(-1)
+    tri = np.ascontiguousarray(mesh.tri_verts).view(np.int64).reshape(-1)  # indices < 2**63
     return v, tri, np.arange(0, tri.size + 1, 3, dtype=np.int64)
 
 
