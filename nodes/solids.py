@@ -221,7 +221,7 @@ def orient(mesh: Mesh, *, ctx: Context) -> Mesh:
     if conflicts:
         ctx.warn(
             f"part of the mesh cannot be oriented (it is one-sided, like a Moebius strip): "
-            f"{conflicts} edges still join faces that disagree"
+            f"faces still disagree across {conflicts} of its edges"
         )
     return Mesh(mesh.vertices, fi, mesh.face_offsets)
 

@@ -367,3 +367,18 @@ def test_random_triangle_soups_never_crash_the_solid_nodes(n, tris):
         assert out.n_faces == 0 or out.is_watertight
     except fg.NodeError as exc:
         assert "input 'a'" in str(exc) and "not" in str(exc), str(exc)
+
+
+def test_orient_warns_about_a_one_sided_mesh():
+    n = 16
+    t = 2 * np.pi * np.arange(n) / n
+    centre = np.stack([np.cos(t), np.sin(t), np.zeros(n)], 1)
+    width = np.stack([np.cos(t / 2) * np.cos(t), np.cos(t / 2) * np.sin(t), np.sin(t / 2)], 1)
+    v = np.concatenate([centre - 0.2 * width, centre + 0.2 * width])
+    faces = [[i, (i + 1) % n, n + (i + 1) % n, n + i] for i in range(n - 1)]
+    faces.append([n - 1, n, 0, 2 * n - 1])  # the half twist
+    _, warnings = run("mesh.orient", mesh=fg.Mesh(v, faces))
+    assert warnings == [
+        "part of the mesh cannot be oriented (it is one-sided, like a Moebius strip): "
+        "faces still disagree across 1 of its edges"
+    ]
