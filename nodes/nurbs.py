@@ -60,12 +60,14 @@ def _surface(s: tuple) -> NurbsSurface:
     return NurbsSurface(*s)
 
 
-def _as_nurbs(curve: Curve, port: str) -> CurveTuple:
+def _as_nurbs(curve: Curve, port: str, ctx: Context) -> CurveTuple:
     """A NURBS curve exactly; any other curve (e.g. a parametric one) as the cubic through
-    its sample points (as many as it is drawn with), closed if it closes."""
+    its sample points (as many as it is drawn with), closed if it closes. The banded
+    interpolation (:mod:`~formgraph.kernels.nurbs.banded`) costs O(samples)."""
     if isinstance(curve, NurbsCurve):
         return _tuple(curve)
     samples = curve.samples if isinstance(curve, ParametricCurve) else 256
+    ctx.guard(4 * max(samples, 4), f"entries of the interpolation system of input '{port}'")
     pts = np.asarray(curve.sample(max(samples, 4)))
     closed = bool(curve.closed)
     return _call(port, K.interpolate, pts[:-1] if closed else pts, 3, closed)
@@ -250,8 +252,8 @@ def interpolate(
     count = len(pts) - (1 if closed and len(pts) > 1 and np.array_equal(pts[0], pts[-1]) else 0)
     if degree > count - 1 >= 1:
         ctx.warn(f"degree {degree} needs {degree + 1} points, got {count}: using {count - 1}")
-    # the interpolation system is solved dense: its size, not the output's, is what to guard
-    ctx.guard(count * count, "entries of the dense interpolation system (points squared)")
+    # the banded system holds (degree + 1) entries per point, and as many blocks in its solve
+    ctx.guard(count * (min(degree, max(count - 1, 1)) + 1), "entries of the interpolation system")
     return _curve(_call("points", K.interpolate, pts, degree, closed, parametrization.value))
 
 
@@ -415,13 +417,15 @@ def loft(
     closed : bool
         Join the last curve smoothly back to the first.
     """
-    tuples = [_as_nurbs(c, "curves") for c in curves]
+    tuples = [_as_nurbs(c, "curves", ctx) for c in curves]
     ctx.guard(sum(len(t[0]) for t in tuples) * len(tuples), "control points")
     return _surface(_call("curves", K.loft, tuples, degree_v, closed))
 
 
 @node("nurbs.extrude", version=1)
-def extrude(curve: Curve, direction: Vec3 = (0.0, 0.0, 1.0)) -> NurbsSurface:
+def extrude(
+    curve: Curve, direction: Vec3 = (0.0, 0.0, 1.0), *, ctx: Context
+) -> NurbsSurface:
     """The curve moved along a straight direction, as a ruled surface (u along the curve,
     v from 0 at the curve to 1 at the moved copy).
 
@@ -432,7 +436,7 @@ def extrude(curve: Curve, direction: Vec3 = (0.0, 0.0, 1.0)) -> NurbsSurface:
     direction : Vec3
         Direction and length of the extrusion.
     """
-    return _surface(_call("direction", K.extrude, _as_nurbs(curve, "curve"), direction))
+    return _surface(_call("direction", K.extrude, _as_nurbs(curve, "curve", ctx), direction))
 
 
 @node("nurbs.revolve", version=1)
@@ -441,6 +445,8 @@ def revolve(
     axis_point: Vec3 = (0.0, 0.0, 0.0),
     axis: Vec3 = (0.0, 0.0, 1.0),
     angle: float = 360.0,
+    *,
+    ctx: Context,
 ) -> NurbsSurface:
     """The exact surface of revolution of a profile curve about an axis (A8.1).
 
@@ -464,7 +470,7 @@ def revolve(
         raise InputError(
             "angle", f"angle must be more than 0 and at most 360 degrees, got {angle:g}"
         )
-    prof = _as_nurbs(curve, "curve")
+    prof = _as_nurbs(curve, "curve", ctx)
     return _surface(_call("axis", K.revolve, prof, axis_point, axis, angle))
 
 
@@ -497,9 +503,8 @@ def sweep(
     if stations == 1:
         raise InputError("stations", "a sweep needs at least 2 stations (or 0 for automatic)")
     m = stations or _auto_stations(path)
-    prof = _as_nurbs(profile, "profile")
+    prof = _as_nurbs(profile, "profile", ctx)
     ctx.guard(m * len(prof[0]), "control points")
-    ctx.guard(m * m, "entries of the dense skinning system (stations squared)")
     t0, t1 = path.domain
     t = np.linspace(t0, t1, m)
     pts = np.asarray(path.evaluate(t))

@@ -17,6 +17,7 @@ CAGD 6 (1989).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 import numpy as np
@@ -272,14 +273,17 @@ def elevate_degree(
     weights: np.ndarray | None,
     times: int = 1,
 ) -> Curve:
-    """Raise the degree by ``times`` without changing the curve.
+    """Raise the degree by ``times`` in one step, without changing the curve.
 
-    Each step raises the degree by one and every distinct knot's multiplicity by one, so
-    the continuity is kept (the result of A5.9). The new control points are the
-    symmetric blossoms (Ramshaw): for degree q = p + 1, row i is the average over the
-    q arguments ``new_knots[i+1 .. i+q]`` left out one at a time of the degree-p
-    blossom, vectorized over all rows. An unclamped (periodic) curve is clamped first
-    (same shape and domain).
+    Every distinct knot's multiplicity grows by ``times``, so the continuity is kept (the
+    result of A5.9, generalized there to any ``t``). As in A5.9 the curve is split into its
+    Bezier pieces (:func:`decompose_bezier`), each piece is raised from degree p to
+    q = p + t at once with the coefficients ``C(p, j) C(t, i - j) / C(q, i)`` (Eq. 5.36),
+    and the surplus knots are then removed all together: the new control points are the
+    dual functionals (blossoms, :func:`respace`) of the degree-q piecewise Bezier curve on
+    the target knot vector, which holds the curve exactly. The cost is one pass over the
+    new control points (O(n q^2)), whatever ``t``. An unclamped (periodic) curve is
+    clamped first (same shape and domain).
 
     Returns
     -------
@@ -288,25 +292,55 @@ def elevate_degree(
     validate_curve(control_points, degree, knots, weights)
     if isinstance(times, bool) or int(times) != times or times < 0:
         raise ValueError(f"times must be a whole number >= 0, got {times!r}")
+    t = int(times)
     cp, p, U, w = clamp(control_points, degree, knots, weights)
-    pw = homogeneous(cp, w)
-    for _ in range(int(times)):
-        values, counts = np.unique(U, return_counts=True)
-        tau = np.repeat(values, counts + 1)
-        q = p + 1
-        n_new = len(tau) - q - 1
-        lo = tau[:n_new]
-        mu = find_spans(p, U, lo)
-        args = np.lib.stride_tricks.sliding_window_view(tau[1:], q)[:n_new]
-        alpha = np.zeros((n_new, p + 1))
-        for leave in range(q):
-            alpha += blossom_basis(p, U, mu, np.delete(args, leave, axis=1))
-        alpha /= q
-        idx = mu[:, None] - p + np.arange(p + 1)
-        pw = np.einsum("ir,ird->id", alpha, pw[idx])
-        p, U = q, tau
+    if t == 0:
+        return cp, p, U, w
+    q = p + t
+    seg, spans = _bezier_pieces(p, U, homogeneous(cp, w))  # (S, p + 1, d)
+    j = np.arange(p + 1)
+    i = np.arange(q + 1)[:, None]
+    coef = np.where(
+        (i - j >= 0) & (i - j <= t),
+        _binom(p, j) * _binom(t, np.clip(i - j, 0, t)) / _binom(q, i),
+        0.0,
+    )
+    raised = np.einsum("ij,sjd->sid", coef, seg)  # (S, q + 1, d)
+    chain = np.concatenate([raised[:1, 0], raised[:, 1:].reshape(-1, raised.shape[2])])
+    breaks = np.concatenate([U[spans], U[spans[-1] + 1 : spans[-1] + 2]])
+    reps = np.full(len(breaks), q)
+    reps[[0, -1]] = q + 1
+    bezier_knots = np.repeat(breaks, reps)
+    values, counts = np.unique(U, return_counts=True)
+    tau = np.repeat(values, counts + t)
+    pw = respace(q, bezier_knots, chain, tau)
     cp, w = project(pw, weights is not None)
-    return cp, p, U, w
+    return cp, q, tau, w
+
+
+def _binom(n: int, k: np.ndarray) -> np.ndarray:
+    """Binomial coefficients C(n, k) as floats (exact for the degrees used here)."""
+    k = np.asarray(k)
+    return np.array([math.comb(n, int(x)) for x in k.ravel()], dtype=np.float64).reshape(k.shape)
+
+
+def _bezier_pieces(p: int, U: np.ndarray, pw: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Bezier control points (S, p + 1, d) of every non-empty span of the domain, and the
+    spans; Bezier point k of the piece on [a, b] is its blossom at (a^(p-k), b^k)."""
+    first, last = domain_spans(p, U)
+    spans = np.arange(first, last + 1)
+    spans = spans[U[spans + 1] > U[spans]]
+    a, b = U[spans], U[spans + 1]
+    kk = np.arange(p + 1)
+    # argument j of Bezier point k is b when j < k, else a
+    args = np.where(
+        np.arange(p)[None, None, :] < kk[None, :, None], b[:, None, None], a[:, None, None]
+    )  # (segments, p+1, p)
+    mu = np.repeat(spans, p + 1)
+    alpha = blossom_basis(p, U, mu, args.reshape(-1, p))
+    idx = mu[:, None] - p + kk
+    seg = np.einsum("ir,ird->id", alpha, pw[idx]).reshape(len(spans), p + 1, -1)
+    return seg, spans
 
 
 def decompose_bezier(
@@ -325,22 +359,8 @@ def decompose_bezier(
     segment_weights : (k, p + 1) float, or None for a non-rational curve
     """
     validate_curve(control_points, degree, knots, weights)
-    p = degree
     U = np.asarray(knots, dtype=np.float64)
-    first, last = domain_spans(p, U)
-    spans = np.arange(first, last + 1)
-    spans = spans[U[spans + 1] > U[spans]]
-    a, b = U[spans], U[spans + 1]
-    kk = np.arange(p + 1)
-    # argument j of Bezier point k is b when j < k, else a
-    args = np.where(
-        np.arange(p)[None, None, :] < kk[None, :, None], b[:, None, None], a[:, None, None]
-    )  # (segments, p+1, p)
-    mu = np.repeat(spans, p + 1)
-    alpha = blossom_basis(p, U, mu, args.reshape(-1, p))
-    pw = homogeneous(control_points, weights)
-    idx = mu[:, None] - p + kk
-    seg = np.einsum("ir,ird->id", alpha, pw[idx]).reshape(len(spans), p + 1, -1)
+    seg, _ = _bezier_pieces(degree, U, homogeneous(control_points, weights))
     cp, w = project(seg, weights is not None)
     return cp, w
 
