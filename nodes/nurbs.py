@@ -423,9 +423,7 @@ def loft(
 
 
 @node("nurbs.extrude", version=1)
-def extrude(
-    curve: Curve, direction: Vec3 = (0.0, 0.0, 1.0), *, ctx: Context
-) -> NurbsSurface:
+def extrude(curve: Curve, direction: Vec3 = (0.0, 0.0, 1.0), *, ctx: Context) -> NurbsSurface:
     """The curve moved along a straight direction, as a ruled surface (u along the curve,
     v from 0 at the curve to 1 at the moved copy).
 

@@ -64,9 +64,7 @@ def solve_banded_rows(
     with np.errstate(all="ignore"):
         x = _solve(cols, vals, flat, cyclic)
         r = flat - _apply(cols, vals, x)
-        scale = np.abs(vals).sum(axis=1, keepdims=True) * np.abs(x)[cols].max(axis=1) + np.abs(
-            flat
-        )
+        scale = np.abs(vals).sum(axis=1, keepdims=True) * np.abs(x)[cols].max(axis=1) + np.abs(flat)
         if np.all(np.isfinite(r)) and np.any(np.abs(r) > 1e-13 * scale):
             x = x + _solve(cols, vals, r, cyclic)  # one step of iterative refinement
     if not np.all(np.isfinite(x)):
@@ -107,9 +105,7 @@ def _solve_open(cols: np.ndarray, vals: np.ndarray, f: np.ndarray) -> np.ndarray
         blocks[-1, 1, k, k] = 1.0
     F = np.zeros((m * bw, f.shape[1]))
     F[:n] = f
-    x = _block_cyclic_reduction(
-        blocks[:, 0], blocks[:, 1], blocks[:, 2], F.reshape(m, bw, -1)
-    )
+    x = _block_cyclic_reduction(blocks[:, 0], blocks[:, 1], blocks[:, 2], F.reshape(m, bw, -1))
     return x.reshape(m * bw, -1)[:n]
 
 

@@ -313,9 +313,36 @@ def elevate_degree(
     bezier_knots = np.repeat(breaks, reps)
     values, counts = np.unique(U, return_counts=True)
     tau = np.repeat(values, counts + t)
-    pw = respace(q, bezier_knots, chain, tau)
+    pw = _blossoms_on_widest_span(q, bezier_knots, breaks, chain, tau)
     cp, w = project(pw, weights is not None)
     return cp, q, tau, w
+
+
+def _blossoms_on_widest_span(
+    q: int, bezier_knots: np.ndarray, breaks: np.ndarray, chain: np.ndarray, tau: np.ndarray
+) -> np.ndarray:
+    """Control points on ``tau`` of a piecewise Bezier curve of degree q (knots at
+    ``breaks``, each interior one q times): row i is the blossom at ``tau[i+1 .. i+q]`` of
+    the piece on the widest span under new basis function i. Any span under it gives the
+    same value in exact arithmetic; the widest extrapolates least, so rounding grows least
+    (a knot removal, unlike an insertion, is not a convex combination)."""
+    n_new = len(tau) - q - 1
+    width = np.diff(breaks)
+    first = np.searchsorted(breaks, tau[:n_new], side="right") - 1
+    last = np.searchsorted(breaks, tau[q + 1 : q + 1 + n_new], side="left") - 1
+    first = np.clip(first, 0, len(width) - 1)
+    last = np.clip(np.maximum(last, first), 0, len(width) - 1)
+    best = first.copy()
+    for step in range(1, int((last - first).max(initial=0)) + 1):  # at most q + 1 spans
+        cand = np.minimum(first + step, last)
+        best = np.where(width[cand] > width[best], cand, best)
+    # span index of piece `best` in the Bezier knot vector: q + 1 + q * best - 1
+    mu = q * best + q
+    args = np.lib.stride_tricks.sliding_window_view(tau[1:], q)[:n_new]
+    alpha = blossom_basis(q, bezier_knots, mu, args)
+    idx = mu[:, None] - q + np.arange(q + 1)
+    flat = chain.reshape(len(chain), -1)
+    return np.einsum("ir,ird->id", alpha, flat[idx]).reshape((n_new,) + chain.shape[1:])
 
 
 def _binom(n: int, k: np.ndarray) -> np.ndarray:
