@@ -284,6 +284,52 @@ def insert_knot(
         raise InputError("times" if "multiplicity" in str(exc) else "t", str(exc)) from None
 
 
+class Direction(str, Enum):
+    """A parameter direction of a surface."""
+
+    u = "u"  # across the rows of control points
+    v = "v"  # along each row
+
+
+@node("nurbs.insert_knot_surface", version=1)
+def insert_knot_surface(
+    surface: NurbsSurface,
+    t: float,
+    direction: Direction = Direction.u,
+    times: Annotated[int, Range(min=0)] = 1,
+    *,
+    ctx: Context,
+) -> NurbsSurface:
+    """The same surface with the knot t inserted in u or in v (A5.3): one more row (u) or
+    column (v) of control points per insertion, shape unchanged.
+
+    The surface counterpart of nurbs.insert_knot (a separate node because a node's output
+    has one type). A knot's multiplicity may not exceed that direction's degree.
+
+    Parameters
+    ----------
+    surface : NurbsSurface
+        The surface.
+    t : float
+        Parameter of the new knot, inside the surface's domain in that direction.
+    direction : Direction
+        u (across the rows) or v (along the rows).
+    times : int
+        How many times to insert it.
+    """
+    cp = np.asarray(surface.control_points)
+    nu, nv = cp.shape[:2]
+    ctx.guard(
+        (nu + times) * nv if direction is Direction.u else nu * (nv + times), "control points"
+    )
+    w = np.asarray(surface.weights) if surface.rational else None
+    args = (cp, surface.degree_u, surface.degree_v, surface.knots_u, surface.knots_v, w)
+    try:
+        return _surface(K.insert_knot_surface(*args, t, times, direction.value))
+    except ValueError as exc:
+        raise InputError("times" if "multiplicity" in str(exc) else "t", str(exc)) from None
+
+
 @node("nurbs.elevate_degree", version=1)
 def elevate_degree(
     curve: NurbsCurve,
@@ -325,7 +371,7 @@ def surface(
     degree_v: Annotated[int, Range(min=1)] = 3,
     knots_u: list[float] | None = None,
     knots_v: list[float] | None = None,
-    weights: list[float] | None = None,
+    weights: list[float] | list[list[float]] | None = None,
     *,
     ctx: Context,
 ) -> NurbsSurface:
@@ -348,8 +394,9 @@ def surface(
         Knot vector across the rows (rows + degree_u + 1 values).
     knots_v : list[float] | None
         Knot vector along the rows (row length + degree_v + 1 values).
-    weights : list[float] | None
-        One positive weight per control point, row after row (rows x row length values).
+    weights : list[float] | list[list[float]] | None
+        One positive weight per control point: a grid shaped like ``points`` (a list of
+        rows), or flat, row after row (rows x row length values).
     """
     sizes = [len(r) for r in points]
     if len(sizes) < 2:
@@ -363,18 +410,33 @@ def surface(
     net = np.stack([r.xyz for r in points])
     nu, nv = net.shape[:2]
     ctx.guard(nu * nv, "control points")
-    w = None
-    if weights is not None:
-        if len(weights) != nu * nv:
-            raise InputError(
-                "weights",
-                f"one weight per control point is needed: {nu} x {nv} = {nu * nv}, "
-                f"got {len(weights)}",
-            )
-        w = np.asarray(weights, dtype=np.float64).reshape(nu, nv)
+    w = None if weights is None else _surface_weights(weights, nu, nv)
     ku = _surface_knots(knots_u, degree_u, nu, "u", ctx)
     kv = _surface_knots(knots_v, degree_v, nv, "v", ctx)
     return _call("weights", NurbsSurface, net, ku[1], kv[1], ku[0], kv[0], w)
+
+
+def _surface_weights(weights: list, nu: int, nv: int) -> np.ndarray:
+    """Weights given as rows (shaped like the points) or flat, as an (nu, nv) array."""
+    if weights and all(isinstance(r, list) for r in weights):
+        sizes = [len(r) for r in weights]
+        if len(sizes) != nu or any(n != nv for n in sizes):
+            got = f"{len(sizes)} rows of " + (
+                f"{sizes[0]}" if len(set(sizes)) == 1 else "/".join(map(str, sizes))
+            )
+            raise InputError(
+                "weights",
+                f"a grid of weights must be shaped like the points, {nu} rows of {nv}; got {got}",
+            )
+        return np.asarray(weights, dtype=np.float64)
+    if any(isinstance(r, list) for r in weights):
+        raise InputError("weights", "give the weights as rows like the points, or all flat")
+    if len(weights) != nu * nv:
+        raise InputError(
+            "weights",
+            f"one weight per control point is needed: {nu} x {nv} = {nu * nv}, got {len(weights)}",
+        )
+    return np.asarray(weights, dtype=np.float64).reshape(nu, nv)
 
 
 def _surface_knots(

@@ -22,7 +22,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from .basis import blossom_basis, domain_spans, find_spans, validate_curve
+from .basis import blossom_basis, domain_spans, find_spans, validate_curve, validate_surface
 from .curve import homogeneous, project
 
 __all__ = [
@@ -30,6 +30,7 @@ __all__ = [
     "decompose_bezier",
     "elevate_degree",
     "insert_knot",
+    "insert_knot_surface",
     "is_clamped",
     "make_compatible",
     "refine_knots",
@@ -176,8 +177,17 @@ def insert_knot(
         If t is outside the domain or the multiplicity would exceed the degree.
     """
     validate_curve(control_points, degree, knots, weights)
-    p = degree
     U = np.asarray(knots, dtype=np.float64)
+    Qw, UQ = _insert_rows(degree, U, homogeneous(control_points, weights), t, times)
+    cp, w = project(Qw, weights is not None)
+    return cp, degree, UQ, w
+
+
+def _insert_rows(
+    p: int, U: np.ndarray, Pw: np.ndarray, t: float, times: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """Boehm's insertion (A5.1) on rows of control points ``Pw`` (n, ...): each row a
+    control point, trailing axes carried along (A5.3 for a surface's net)."""
     n = len(U) - p - 1
     if isinstance(times, bool) or int(times) != times or times < 0:
         raise ValueError(f"times must be a whole number >= 0, got {times!r}")
@@ -192,27 +202,78 @@ def insert_knot(
             f"knot {t:g} has multiplicity {s}; inserting it {times} more time(s) would exceed "
             f"the degree {p}"
         )
-    Pw = homogeneous(control_points, weights)
+    Pw = np.asarray(Pw, dtype=np.float64)
     if times == 0:
-        return np.array(control_points, dtype=np.float64), p, U.copy(), _copy(weights)
+        return Pw.copy(), U.copy()
     r = times
     k = int(np.searchsorted(U, t, side="right")) - 1
-    Qw = np.empty((n + r, Pw.shape[1]))
+    Qw = np.empty((n + r,) + Pw.shape[1:])
     Qw[: k - p + 1] = Pw[: k - p + 1]
     Qw[k - s + r :] = Pw[k - s :]
     Rw = Pw[k - p : k - s + 1].copy()
+    tail = (1,) * (Pw.ndim - 1)
     L = k - p
     for j in range(1, r + 1):  # loops over the inserted copies and the degree only
         L = k - p + j
         i = np.arange(p - j - s + 1)
-        alpha = ((t - U[L + i]) / (U[i + k + 1] - U[L + i]))[:, None]
+        alpha = ((t - U[L + i]) / (U[i + k + 1] - U[L + i])).reshape((-1,) + tail)
         Rw[: len(i)] = alpha * Rw[1 : len(i) + 1] + (1.0 - alpha) * Rw[: len(i)]
         Qw[L] = Rw[0]
         Qw[k + r - j - s] = Rw[p - j - s]
     Qw[L + 1 : k - s] = Rw[1 : k - s - L]
     UQ = np.concatenate([U[: k + 1], np.full(r, t), U[k + 1 :]])
-    cp, w = project(Qw, weights is not None)
-    return cp, p, UQ, w
+    return Qw, UQ
+
+
+def insert_knot_surface(
+    control_points: np.ndarray,
+    degree_u: int,
+    degree_v: int,
+    knots_u: np.ndarray,
+    knots_v: np.ndarray,
+    weights: np.ndarray | None,
+    t: float,
+    times: int = 1,
+    direction: str = "u",
+) -> tuple[np.ndarray, int, int, np.ndarray, np.ndarray, np.ndarray | None]:
+    """Insert a knot in u or in v without changing the surface (A5.3).
+
+    Inserting ``t`` in u is Boehm's curve insertion applied to every column of the net
+    (the control points with the same v index) at once: the same coefficients for all,
+    one more row of control points per insertion. In v, to every row.
+
+    Parameters
+    ----------
+    control_points : (nu, nv, 3) float
+    degree_u, degree_v : int
+    knots_u : (nu + degree_u + 1,) float
+    knots_v : (nv + degree_v + 1,) float
+    weights : (nu, nv) float or None
+    t : float
+        In the domain of the chosen direction.
+    times : int
+        How many times (the multiplicity may not exceed that direction's degree).
+    direction : {"u", "v"}
+
+    Returns
+    -------
+    surface tuple with (nu + times, nv) or (nu, nv + times) control points; new arrays.
+    """
+    validate_surface(control_points, degree_u, degree_v, knots_u, knots_v, weights)
+    if direction not in ("u", "v"):
+        raise ValueError(f"direction must be 'u' or 'v', got {direction!r}")
+    pw = homogeneous(control_points, weights)
+    if direction == "u":
+        U = np.asarray(knots_u, dtype=np.float64)
+        qw, knots = _insert_rows(degree_u, U, pw, t, times)
+        ku, kv = knots, np.array(knots_v, dtype=np.float64)
+    else:
+        U = np.asarray(knots_v, dtype=np.float64)
+        qw, knots = _insert_rows(degree_v, U, np.swapaxes(pw, 0, 1), t, times)
+        qw = np.swapaxes(qw, 0, 1)
+        ku, kv = np.array(knots_u, dtype=np.float64), knots
+    cp, w = project(np.ascontiguousarray(qw), weights is not None)
+    return cp, degree_u, degree_v, ku, kv, w
 
 
 def refine_knots(
