@@ -19,7 +19,8 @@ n x band entries.
 Collocation matrices of B-splines are totally positive (de Boor, *A Practical Guide to
 Splines*, XIII), so elimination needs no pivoting across blocks; each answer is checked by
 its residual (computed from the rows, O(n)) and refined once when it is not at rounding
-level.
+level; a system the blocks cannot solve accurately (a tiny pivot) is solved dense when it
+is small, and refused otherwise.
 """
 
 from __future__ import annotations
@@ -29,6 +30,7 @@ import numpy as np
 __all__ = ["solve_banded_rows"]
 
 _DENSE_UP_TO = 48  # below this many unknowns a dense solve is as cheap and simplest
+_DENSE_FALLBACK_UP_TO = 3000  # a failed fast solve is redone dense up to this size
 
 
 def solve_banded_rows(
@@ -62,14 +64,40 @@ def solve_banded_rows(
     n = b.shape[0]
     flat = b.reshape(n, -1)
     with np.errstate(all="ignore"):
-        x = _solve(cols, vals, flat, cyclic)
-        r = flat - _apply(cols, vals, x)
-        scale = np.abs(vals).sum(axis=1, keepdims=True) * np.abs(x)[cols].max(axis=1) + np.abs(flat)
-        if np.all(np.isfinite(r)) and np.any(np.abs(r) > 1e-13 * scale):
-            x = x + _solve(cols, vals, r, cyclic)  # one step of iterative refinement
-    if not np.all(np.isfinite(x)):
+        try:
+            x = _solve(cols, vals, flat, cyclic)
+            r = flat - _apply(cols, vals, x)
+            if not _small(r, cols, vals, x, flat, 1e-13):
+                x = x + _solve(cols, vals, r, cyclic)  # one step of iterative refinement
+                r = flat - _apply(cols, vals, x)
+            ok = _small(r, cols, vals, x, flat, 1e-8)
+        except np.linalg.LinAlgError:
+            ok = False
+        if not ok and n <= _DENSE_FALLBACK_UP_TO:
+            # a pivot of the block elimination was too small (possible when the band's
+            # largest entries are off its middle): LAPACK's pivoting solves it
+            try:
+                x = np.linalg.solve(_dense(cols, vals, n), flat)
+                ok = True
+            except np.linalg.LinAlgError:
+                ok = False
+    if not ok or not np.all(np.isfinite(x)):
         raise ValueError("the interpolation system is singular (points too close together?)")
     return x.reshape(b.shape)
+
+
+def _small(r, cols, vals, x, f, tol: float) -> bool:
+    """Whether the residual r is within ``tol`` of the size of the terms it sums."""
+    if not np.all(np.isfinite(r)):
+        return False
+    scale = np.abs(vals).sum(axis=1, keepdims=True) * np.abs(x)[cols].max(axis=1) + np.abs(f)
+    return bool(np.all(np.abs(r) <= tol * scale))
+
+
+def _dense(cols: np.ndarray, vals: np.ndarray, n: int) -> np.ndarray:
+    A = np.zeros((n, n))
+    np.add.at(A, (np.repeat(np.arange(n), cols.shape[1]), cols.ravel()), vals.ravel())
+    return A
 
 
 def _apply(cols: np.ndarray, vals: np.ndarray, x: np.ndarray) -> np.ndarray:
@@ -80,9 +108,7 @@ def _apply(cols: np.ndarray, vals: np.ndarray, x: np.ndarray) -> np.ndarray:
 def _solve(cols: np.ndarray, vals: np.ndarray, f: np.ndarray, cyclic: bool) -> np.ndarray:
     n = f.shape[0]
     if n <= _DENSE_UP_TO:
-        A = np.zeros((n, n))
-        np.add.at(A, (np.repeat(np.arange(n), cols.shape[1]), cols.ravel()), vals.ravel())
-        return np.linalg.solve(A, f)
+        return np.linalg.solve(_dense(cols, vals, n), f)
     if not cyclic:
         return _solve_open(cols, vals, f)
     return _solve_cyclic(cols, vals, f)
@@ -147,7 +173,7 @@ def _solve_cyclic(cols: np.ndarray, vals: np.ndarray, f: np.ndarray) -> np.ndarr
     n = f.shape[0]
     rows = np.arange(n)[:, None]
     # shift: the median offset of each row's largest entry puts the band on the diagonal
-    main = cols[np.arange(n), np.argmax(vals, axis=1)]
+    main = cols[np.arange(n), np.argmax(np.abs(vals), axis=1)]
     s = int(np.median((main - rows[:, 0]) % n))
     c = (cols - s) % n  # unknown j of the renumbered system is unknown (j + s) % n
     off = (c - rows + n // 2) % n - n // 2  # cyclic offset in [-n/2, n/2)
