@@ -331,9 +331,10 @@ def offset(
     if inside_out:
         raise InputError(
             "distance",
-            f"an inward offset by {abs(distance):g} is past the curve's inradius: nothing is "
-            "left inside (the bisector offset would turn the curve inside out); "
-            "offset.marching_squares gives the true offset (no loops when nothing is left)",
+            f"an inward offset by {abs(distance):g} turns the curve inside out: the distance "
+            "is past the curve's inradius (nothing is left inside) or past half its width "
+            "somewhere, where the bisector offset cannot be right; offset.marching_squares "
+            "gives the true offset (no loops when nothing is left)",
         )
     if folded:
         ctx.warn(

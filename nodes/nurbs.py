@@ -429,8 +429,6 @@ def _surface_weights(weights: list, nu: int, nv: int) -> np.ndarray:
                 f"a grid of weights must be shaped like the points, {nu} rows of {nv}; got {got}",
             )
         return np.asarray(weights, dtype=np.float64)
-    if any(isinstance(r, list) for r in weights):
-        raise InputError("weights", "give the weights as rows like the points, or all flat")
     if len(weights) != nu * nv:
         raise InputError(
             "weights",
