@@ -87,11 +87,13 @@ def solve_banded_rows(
 
 
 def _small(r, cols, vals, x, f, tol: float) -> bool:
-    """Whether the residual r is within ``tol`` of the size of the terms it sums."""
+    """Whether the residual r is within ``tol`` of the size of the terms it sums (a
+    normwise backward error per right-hand side: ||r|| <= tol (||A|| ||x|| + ||f||))."""
     if not np.all(np.isfinite(r)):
         return False
-    scale = np.abs(vals).sum(axis=1, keepdims=True) * np.abs(x)[cols].max(axis=1) + np.abs(f)
-    return bool(np.all(np.abs(r) <= tol * scale))
+    norm_a = float(np.abs(vals).sum(axis=1).max(initial=0.0))
+    scale = norm_a * np.abs(x).max(axis=0, initial=0.0) + np.abs(f).max(axis=0, initial=0.0)
+    return bool(np.all(np.abs(r).max(axis=0, initial=0.0) <= tol * scale))
 
 
 def _dense(cols: np.ndarray, vals: np.ndarray, n: int) -> np.ndarray:
@@ -144,6 +146,8 @@ def _block_cyclic_reduction(
     eliminates the odd block rows using their diagonal blocks, halving the system.
     """
     m, b = D.shape[0], D.shape[1]
+    if b == 1:  # scalar blocks (a tridiagonal system): plain products and quotients
+        return _scalar_cyclic_reduction(L[:, 0, 0], D[:, 0, 0], U[:, 0, 0], F[:, 0])[:, None]
     if m == 1:
         return np.linalg.solve(D[0], F[0])[None]
     mo, me = m // 2, (m + 1) // 2
@@ -152,18 +156,49 @@ def _block_cyclic_reduction(
     Le, De, Ue, Fe = L[0::2], D[0::2].copy(), U[0::2], F[0::2].copy()
     newL, newU = np.zeros_like(De), np.zeros_like(De)
     j = np.arange(mo)  # even row 2j has the odd row 2j + 1 on its right
-    De[j] -= Ue[j] @ XL
-    Fe[j] -= Ue[j] @ XF
+    right = Ue[:mo] @ sol  # [U XL | U XU | U XF], one product for the three
+    De[j] -= right[..., :b]
+    Fe[j] -= right[..., 2 * b :]
     jr = j[j + 1 < me]  # ... which has an even row 2j + 2 on its right
-    newU[jr] = -Ue[jr] @ XU[jr]
+    newU[jr] = -right[jr, :, b : 2 * b]
     jl = np.arange(1, me)  # even row 2j has the odd row 2j - 1 on its left
-    De[jl] -= Le[jl] @ XU[jl - 1]
-    Fe[jl] -= Le[jl] @ XF[jl - 1]
-    newL[jl] = -Le[jl] @ XL[jl - 1]
+    left = Le[1:me] @ sol[: me - 1]
+    De[jl] -= left[..., b : 2 * b]
+    Fe[jl] -= left[..., 2 * b :]
+    newL[jl] = -left[..., :b]
     xe = _block_cyclic_reduction(newL, De, newU, Fe)
     xo = XF - XL @ xe[:mo]
     xo[jr] -= XU[jr] @ xe[jr + 1]
     x = np.empty((m, b, F.shape[2]))
+    x[0::2], x[1::2] = xe, xo
+    return x
+
+
+def _scalar_cyclic_reduction(
+    L: np.ndarray, D: np.ndarray, U: np.ndarray, F: np.ndarray
+) -> np.ndarray:
+    """:func:`_block_cyclic_reduction` for 1 x 1 blocks: L, D, U (m,), F (m, r)."""
+    m = D.shape[0]
+    if m == 1:
+        return F / D[0]
+    mo, me = m // 2, (m + 1) // 2
+    inv = 1.0 / D[1::2]
+    XL, XU, XF = L[1::2] * inv, U[1::2] * inv, F[1::2] * inv[:, None]
+    Le, De, Ue, Fe = L[0::2], D[0::2].copy(), U[0::2], F[0::2].copy()
+    newL, newU = np.zeros(me), np.zeros(me)
+    j = np.arange(mo)
+    De[j] -= Ue[j] * XL
+    Fe[j] -= Ue[j, None] * XF
+    jr = j[j + 1 < me]
+    newU[jr] = -Ue[jr] * XU[jr]
+    jl = np.arange(1, me)
+    De[jl] -= Le[jl] * XU[jl - 1]
+    Fe[jl] -= Le[jl, None] * XF[jl - 1]
+    newL[jl] = -Le[jl] * XL[jl - 1]
+    xe = _scalar_cyclic_reduction(newL, De, newU, Fe)
+    xo = XF - XL[:, None] * xe[:mo]
+    xo[jr] -= XU[jr, None] * xe[jr + 1]
+    x = np.empty((m, F.shape[1]))
     x[0::2], x[1::2] = xe, xo
     return x
 
