@@ -182,7 +182,7 @@ def triangulate(mesh: Mesh, *, ctx: Context) -> Mesh:
     try:
         return Mesh(*meshops.triangulate(*_arrays(mesh), max_tests=ctx.budget))
     except WorkLimitError as exc:
-        ctx.guard(exc.work, "triangle-corner tests of ear clipping (one face)")
+        ctx.guard(exc.work, "triangle-corner tests of ear clipping")
         raise
 
 

@@ -72,3 +72,27 @@ def test_marching_squares_smoothing_passes_are_budgeted():
     g.add("o", "offset.marching_squares", curves=["@c"], distance=0.5, smooth=100)
     with pytest.raises(fg.FormgraphError, match="input 'smooth'.*vertex moves"):
         g.evaluate("o")
+
+
+def test_elevation_work_is_budgeted():
+    g = fg.Graph(budget=100_000)
+    g.add("pts", "points.random", count=1000, seed=2)
+    g.add("c", "nurbs.curve", points="@pts")
+    g.add("e", "nurbs.elevate_degree", curve="@c", times=29)
+    with pytest.raises(fg.BudgetError, match="blossom steps"):
+        g.evaluate("e")
+
+
+def test_many_small_concave_faces_are_budgeted_too():
+    star = np.array(_star(20))
+    verts = np.concatenate([star + [30.0 * i, 0, 0] for i in range(200)])
+    faces = [list(range(20 * i, 20 * i + 20)) for i in range(200)]
+    g = fg.Graph(budget=1_000_000)  # 200 faces x 20^3 = 1.6M corner tests at worst
+    g.add("m", "mesh.from_faces", vertices=verts.tolist(), faces=faces)
+    g.add("t", "mesh.triangulate", mesh="@m")
+    with pytest.raises(fg.BudgetError, match="triangle-corner tests"):
+        g.evaluate("t")
+    g2 = fg.Graph()
+    g2.add("m", "mesh.from_faces", vertices=verts.tolist(), faces=faces)
+    g2.add("t", "mesh.triangulate", mesh="@m")
+    assert g2.evaluate("t").n_faces == 200 * 18

@@ -346,7 +346,8 @@ def triangulate(
     Raises
     ------
     WorkLimitError
-        When a large concave face needs more than ``max_tests`` triangle-corner tests.
+        When a large concave face needs more than ``max_tests`` triangle-corner tests, or
+        the small concave faces of one size together (k^3 each) would.
     """
     v = np.asarray(vertices, dtype=np.float64)
     fi = np.asarray(face_indices, dtype=np.int64)
@@ -378,6 +379,9 @@ def triangulate(
             for f in concave:  # one large polygon at a time, each vectorized inside
                 local[f] = triangulate_polygon(p[f], max_tests)
         elif concave.size:
+            work = concave.size * k**3  # the batched clipper tests every corner, every round
+            if max_tests is not None and work > max_tests:
+                raise WorkLimitError(work, max_tests)
             nrm = normal[concave] / np.linalg.norm(normal[concave], axis=1, keepdims=True)
             helper = np.where(np.abs(nrm[:, :1]) < 0.9, [[1.0, 0, 0]], [[0, 1.0, 0]])
             u = np.cross(nrm, helper)
