@@ -127,3 +127,21 @@ def test_surface_knot_insertion_errors_name_the_input():
     g.add("k", "nurbs.insert_knot_surface", surface="@s", t=0.5, direction="v", times=2)
     with pytest.raises(fg.NodeError, match=r"input 'times'.*exceed the degree 1"):
         g.evaluate("k")
+
+
+def test_grid_weights_validate_against_the_json_schema():
+    jsonschema = pytest.importorskip("jsonschema")
+    from formgraph.catalogue import json_schema
+
+    doc = {
+        "formgraph": 1,
+        "nodes": {
+            "a": {
+                "type": "nurbs.surface",
+                "points": _NET,
+                "weights": [[1, 1, 1], [1, 3, 1], [1, 1, 1]],
+            },
+            "b": {"type": "nurbs.surface", "points": _NET, "weights": [1] * 9},
+        },
+    }
+    jsonschema.validate(doc, json_schema())
