@@ -24,7 +24,7 @@ from formgraph.geometry import (
 )
 from formgraph.kernels import nurbs as K
 from formgraph.registry import Context, Range, node
-from formgraph.types import Vec3
+from formgraph.types import SameAs, Vec3
 
 CurveTuple = tuple[np.ndarray, int, np.ndarray, "np.ndarray | None"]
 
@@ -257,33 +257,6 @@ def interpolate(
     return _curve(_call("points", K.interpolate, pts, degree, closed, parametrization.value))
 
 
-@node("nurbs.insert_knot", version=1)
-def insert_knot(
-    curve: NurbsCurve,
-    t: float,
-    times: Annotated[int, Range(min=0)] = 1,
-) -> NurbsCurve:
-    """The same curve with the knot t inserted (Boehm's algorithm, A5.1): one more control
-    point per insertion, shape unchanged.
-
-    A knot's multiplicity may not exceed the degree. Useful before editing control points
-    locally, or to split a curve.
-
-    Parameters
-    ----------
-    curve : NurbsCurve
-        The curve.
-    t : float
-        Parameter of the new knot, inside the curve's domain.
-    times : int
-        How many times to insert it.
-    """
-    try:
-        return _curve(K.insert_knot(*_tuple(curve), t, times))
-    except ValueError as exc:
-        raise InputError("times" if "multiplicity" in str(exc) else "t", str(exc)) from None
-
-
 class Direction(str, Enum):
     """A parameter direction of a surface."""
 
@@ -291,43 +264,53 @@ class Direction(str, Enum):
     v = "v"  # along each row
 
 
-@node("nurbs.insert_knot_surface", version=1)
-def insert_knot_surface(
-    surface: NurbsSurface,
+@node("nurbs.insert_knot", version=2)
+def insert_knot(
+    curve: NurbsCurve | NurbsSurface,
     t: float,
-    direction: Direction = Direction.u,
     times: Annotated[int, Range(min=0)] = 1,
+    direction: Direction = Direction.u,
     *,
     ctx: Context,
-) -> NurbsSurface:
-    """The same surface with the knot t inserted in u or in v (A5.3): one more row (u) or
-    column (v) of control points per insertion, shape unchanged.
+) -> Annotated[NurbsCurve | NurbsSurface, SameAs("curve")]:
+    """The same curve (or surface) with the knot t inserted: one more control point per
+    insertion, shape unchanged (Boehm's algorithm, A5.1; on a surface A5.3, in u or v).
 
-    The surface counterpart of nurbs.insert_knot (a separate node because a node's output
-    has one type). A knot's multiplicity may not exceed that direction's degree.
+    A knot's multiplicity may not exceed the degree. Useful before editing control points
+    locally, or to split a curve. Given a surface, the knot goes into its u or v knot
+    vector (``direction``), adding a row (u) or a column (v) of control points per
+    insertion; the output is a surface then.
 
     Parameters
     ----------
-    surface : NurbsSurface
-        The surface.
+    curve : NurbsCurve | NurbsSurface
+        The curve, or a surface.
     t : float
-        Parameter of the new knot, inside the surface's domain in that direction.
-    direction : Direction
-        u (across the rows) or v (along the rows).
+        Parameter of the new knot, inside the domain (of the chosen direction).
     times : int
         How many times to insert it.
+    direction : Direction
+        For a surface: u (across the rows of control points) or v (along each row).
     """
-    cp = np.asarray(surface.control_points)
-    nu, nv = cp.shape[:2]
-    ctx.guard(
-        (nu + times) * nv if direction is Direction.u else nu * (nv + times), "control points"
-    )
-    w = np.asarray(surface.weights) if surface.rational else None
-    args = (cp, surface.degree_u, surface.degree_v, surface.knots_u, surface.knots_v, w)
+    if isinstance(curve, NurbsSurface):
+        cp = np.asarray(curve.control_points)
+        nu, nv = cp.shape[:2]
+        grown = (nu + times) * nv if direction is Direction.u else nu * (nv + times)
+        ctx.guard(grown, "control points")
+        w = np.asarray(curve.weights) if curve.rational else None
+        args = (cp, curve.degree_u, curve.degree_v, curve.knots_u, curve.knots_v, w)
+        try:
+            return _surface(K.insert_knot_surface(*args, t, times, direction.value))
+        except ValueError as exc:
+            raise InputError(_knot_port(exc), str(exc)) from None
     try:
-        return _surface(K.insert_knot_surface(*args, t, times, direction.value))
+        return _curve(K.insert_knot(*_tuple(curve), t, times))
     except ValueError as exc:
-        raise InputError("times" if "multiplicity" in str(exc) else "t", str(exc)) from None
+        raise InputError(_knot_port(exc), str(exc)) from None
+
+
+def _knot_port(exc: ValueError) -> str:
+    return "times" if "multiplicity" in str(exc) else "t"
 
 
 @node("nurbs.elevate_degree", version=1)

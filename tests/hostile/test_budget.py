@@ -54,6 +54,6 @@ def test_surface_knot_insertion_is_budgeted():
     g = fg.Graph(budget=19)  # 9 x 2 control points, 10 x 2 after the insertion
     g.add("c", "nurbs.circle")
     g.add("s", "nurbs.extrude", curve="@c")
-    g.add("k", "nurbs.insert_knot_surface", surface="@s", t=0.5, direction="v")
+    g.add("k", "nurbs.insert_knot", curve="@s", t=0.5, direction="v")
     with pytest.raises(fg.BudgetError):
         g.evaluate("k")

@@ -109,7 +109,7 @@ def test_surface_knot_insertion_keeps_the_surface(direction):
     g = fg.Graph()
     g.add("c", "nurbs.circle")
     g.add("s", "nurbs.extrude", curve="@c", direction=[0, 0, 2])
-    g.add("k", "nurbs.insert_knot_surface", surface="@s", t=0.3, direction=direction, times=1)
+    g.add("k", "nurbs.insert_knot", curve="@s", t=0.3, direction=direction, times=1)
     out = g.evaluate(["s", "k"])
     s, k = out["s"], out["k"]
     grow = (1, 0) if direction == "u" else (0, 1)
@@ -124,7 +124,7 @@ def test_surface_knot_insertion_errors_name_the_input():
     g = fg.Graph()
     g.add("c", "nurbs.circle")
     g.add("s", "nurbs.extrude", curve="@c")
-    g.add("k", "nurbs.insert_knot_surface", surface="@s", t=0.5, direction="v", times=2)
+    g.add("k", "nurbs.insert_knot", curve="@s", t=0.5, direction="v", times=2)
     with pytest.raises(fg.NodeError, match=r"input 'times'.*exceed the degree 1"):
         g.evaluate("k")
 
@@ -145,3 +145,17 @@ def test_grid_weights_validate_against_the_json_schema():
         },
     }
     jsonschema.validate(doc, json_schema())
+
+
+def test_a_surface_from_insert_knot_wires_into_tessellate():
+    # the output is typed like the input: a surface in, a surface out, checked at load
+    g = fg.Graph()
+    g.add("c", "nurbs.circle")
+    g.add("s", "nurbs.extrude", curve="@c")
+    g.add("k", "nurbs.insert_knot", curve="@s", t=0.5, direction="v")
+    g.add("m", "nurbs.tessellate", surface="@k", u=8, v=4)
+    assert g.evaluate("m").n_faces == 32
+    g.add("bad", "nurbs.tessellate", surface="@kc", u=8, v=4)
+    g.add("kc", "nurbs.insert_knot", curve="@c", t=0.5)
+    with pytest.raises(fg.GraphError, match=r"input 'surface': expected Surface, got NurbsCurve"):
+        g.evaluate("bad")
