@@ -116,3 +116,29 @@ def test_bad_polygons_are_refused():
         triangulate_polygon(np.zeros((5, 4)))
     with pytest.raises(ValueError, match="finite"):
         triangulate_polygon([[0, 0], [1, 0], [np.nan, 1]])
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    k=st.integers(3, 80),
+    seed=st.integers(0, 10_000),
+    dup=st.booleans(),
+)
+def test_any_loop_gets_k_minus_2_triangles_of_its_corners(k, seed, dup):
+    """Self-intersecting, repeated and collinear corners: no crash, no endless loop."""
+    rng = np.random.default_rng(seed)
+    xy = rng.integers(-3, 4, size=(k, 2)).astype(float)  # many collinear and equal points
+    if dup:
+        xy[k // 2] = xy[0]
+    tris = triangulate_polygon(xy)
+    assert tris.shape == (k - 2, 3)
+    assert tris.min() >= 0 and tris.max() < k
+    assert np.all(
+        (tris[:, 0] != tris[:, 1]) & (tris[:, 1] != tris[:, 2]) & (tris[:, 0] != tris[:, 2])
+    )
+
+
+def test_a_loop_of_no_area_is_fanned_without_error():
+    xy = np.column_stack([np.arange(6.0), np.zeros(6)])
+    assert triangulate_polygon(xy).shape == (4, 3)
+    assert triangulate_polygon(np.zeros((5, 3))).shape == (3, 3)

@@ -1,4 +1,4 @@
-"""Banded and cyclic-banded linear systems, solved in O(n) work and O(log n) array steps.
+"""Banded and cyclic-banded linear systems, solved in O(n) work and memory.
 
 The collocation matrix of interpolation (The NURBS Book A9.1) has at most ``p + 1``
 non-zeros per row, next to the diagonal: banded for an open curve, banded with the
@@ -6,21 +6,23 @@ corners filled in ("cyclic-banded") for a closed one. A dense solve of it costs 
 memory (20,000 points: minutes and gigabytes); these solvers cost a few passes over the
 n x band entries.
 
-- Open systems: the band is cut into b x b blocks (b the half bandwidth), which makes the
-  matrix block tridiagonal, and the blocks are solved by block cyclic reduction (Hockney
-  1965; Buzbee, Golub and Nielson, SIAM J. Numer. Anal. 7, 1970): each level eliminates
-  every other block row at once (batched ``numpy.linalg.solve`` of b x b blocks, with
-  partial pivoting inside each block), so the work is vectorized over the rows and only
-  log2(n / b) levels run one after the other.
+- Open systems: the band is cut into B x B blocks (B = 32, or the bandwidth if larger),
+  which makes the matrix block tridiagonal, and the blocks are eliminated in order (block
+  LU, the "block Thomas" algorithm): each step is one batched LAPACK solve of a B x B block
+  with partial pivoting inside it, so n / B steps run one after the other, each vectorized
+  over its B rows. (Cyclic reduction would need only log n steps, but it pivots on blocks
+  that are not leading principal blocks, and on collocation matrices of very uneven
+  spacing it loses all accuracy; elimination in order keeps the pivots totally positive.)
 - Cyclic systems: the unknowns are renumbered so that the band sits on the diagonal, and
   the last b unknowns are split off (a bordered system, block elimination with a b x b
-  Schur complement): what remains is an open banded system with b + 1 right-hand sides.
+  Schur complement): what remains is an open banded system with b more right-hand sides.
 
 Collocation matrices of B-splines are totally positive (de Boor, *A Practical Guide to
 Splines*, XIII), so elimination needs no pivoting across blocks; each answer is checked by
-its residual (computed from the rows, O(n)) and refined once when it is not at rounding
-level; a system the blocks cannot solve accurately (a tiny pivot) is solved dense when it
-is small, and refused otherwise.
+its residual (computed from the rows, O(n): for interpolation, how far the curve misses
+the data) and refined once when it is not at rounding level; a system whose answer still
+misses by more than 1e-8 of the data's size is solved dense when it is small, and refused
+otherwise (such systems are nearly singular: LAPACK's dense solve does no better).
 """
 
 from __future__ import annotations
@@ -31,6 +33,7 @@ __all__ = ["solve_banded_rows"]
 
 _DENSE_UP_TO = 48  # below this many unknowns a dense solve is as cheap and simplest
 _DENSE_FALLBACK_UP_TO = 3000  # a failed fast solve is redone dense up to this size
+_BLOCK = 32  # rows per elimination step: big enough to amortize the step, small for LAPACK
 
 
 def solve_banded_rows(
@@ -75,25 +78,30 @@ def solve_banded_rows(
             ok = False
         if not ok and n <= _DENSE_FALLBACK_UP_TO:
             # a pivot of the block elimination was too small (possible when the band's
-            # largest entries are off its middle): LAPACK's pivoting solves it
+            # largest entries are off its middle): LAPACK's pivoting may solve it
             try:
                 x = np.linalg.solve(_dense(cols, vals, n), flat)
-                ok = True
+                ok = _small(flat - _apply(cols, vals, x), cols, vals, x, flat, 1e-8)
             except np.linalg.LinAlgError:
                 ok = False
     if not ok or not np.all(np.isfinite(x)):
-        raise ValueError("the interpolation system is singular (points too close together?)")
+        raise ValueError(
+            "the interpolation system is singular or too ill-conditioned to solve (are the "
+            "points very unevenly spaced? a lower degree or centripetal spacing helps)"
+        )
     return x.reshape(b.shape)
 
 
 def _small(r, cols, vals, x, f, tol: float) -> bool:
-    """Whether the residual r is within ``tol`` of the size of the terms it sums (a
-    normwise backward error per right-hand side: ||r|| <= tol (||A|| ||x|| + ||f||))."""
+    """Whether the residual r is within ``tol`` of the right-hand side's size.
+
+    For interpolation the residual is exactly how far the curve misses the data at the
+    parameters, so this is the test that matters (a backward error relative to ``|A||x|``
+    would pass garbage on a nearly singular system, where ``x`` is huge)."""
     if not np.all(np.isfinite(r)):
         return False
-    norm_a = float(np.abs(vals).sum(axis=1).max(initial=0.0))
-    scale = norm_a * np.abs(x).max(axis=0, initial=0.0) + np.abs(f).max(axis=0, initial=0.0)
-    return bool(np.all(np.abs(r).max(axis=0, initial=0.0) <= tol * scale))
+    scale = float(np.abs(f).max(initial=0.0))
+    return bool(np.abs(r).max(initial=0.0) <= tol * max(scale, 1e-300))
 
 
 def _dense(cols: np.ndarray, vals: np.ndarray, n: int) -> np.ndarray:
@@ -117,89 +125,66 @@ def _solve(cols: np.ndarray, vals: np.ndarray, f: np.ndarray, cyclic: bool) -> n
 
 
 def _solve_open(cols: np.ndarray, vals: np.ndarray, f: np.ndarray) -> np.ndarray:
-    """Block cyclic reduction of the banded matrix cut into b x b blocks."""
+    """Block elimination of the banded matrix cut into B x B blocks (B >= the bandwidth)."""
     n = f.shape[0]
     rows = np.broadcast_to(np.arange(n)[:, None], cols.shape)
     live = vals != 0
     reach = np.abs(cols - rows)[live]
-    bw = max(1, int(reach.max(initial=0)))
-    m = -(-n // bw)
-    blocks = np.zeros((m, 3, bw, bw))  # per block row: left, diagonal, right neighbour
+    band = max(1, int(reach.max(initial=0)))
+    size = max(_BLOCK, band)
+    m = -(-n // size)
+    # per block row: left, diagonal, right neighbour (entries summed: bincount, not add.at)
     ri, ci, v = rows[live], cols[live], vals[live]
-    np.add.at(blocks, (ri // bw, ci // bw - ri // bw + 1, ri % bw, ci % bw), v)
-    pad = m * bw - n
+    flat = np.ravel_multi_index(
+        (ri // size, ci // size - ri // size + 1, ri % size, ci % size), (m, 3, size, size)
+    )
+    blocks = np.bincount(flat, weights=v, minlength=m * 3 * size * size)
+    blocks = blocks.reshape(m, 3, size, size)
+    pad = m * size - n
     if pad:  # identity rows for the unknowns past the end
-        k = np.arange(bw - pad, bw)
+        k = np.arange(size - pad, size)
         blocks[-1, 1, k, k] = 1.0
-    F = np.zeros((m * bw, f.shape[1]))
+    F = np.zeros((m * size, f.shape[1]))
     F[:n] = f
-    x = _block_cyclic_reduction(blocks[:, 0], blocks[:, 1], blocks[:, 2], F.reshape(m, bw, -1))
-    return x.reshape(m * bw, -1)[:n]
+    # the coupling blocks are zero but for a band x band corner: left blocks in their top
+    # right, right blocks in their bottom left
+    L = blocks[:, 0, :band, size - band :]
+    U = blocks[:, 2, size - band :, :band]
+    x = _block_tridiagonal(L, blocks[:, 1], U, F.reshape(m, size, -1))
+    return x.reshape(m * size, -1)[:n]
 
 
-def _block_cyclic_reduction(
-    L: np.ndarray, D: np.ndarray, U: np.ndarray, F: np.ndarray
-) -> np.ndarray:
-    """Solve the block tridiagonal system ``L_i x_{i-1} + D_i x_i + U_i x_{i+1} = F_i``.
+def _block_tridiagonal(L: np.ndarray, D: np.ndarray, U: np.ndarray, F: np.ndarray) -> np.ndarray:
+    """Solve ``L_i x_{i-1} + D_i x_i + U_i x_{i+1} = F_i`` by block LU in order.
 
-    L, D, U : (m, b, b); F : (m, b, r); ``L_0`` and ``U_{m-1}`` are ignored. Each level
-    eliminates the odd block rows using their diagonal blocks, halving the system.
+    D : (m, B, B); F : (m, B, r); L, U : (m, c, c), the only non-zero corners of the
+    coupling blocks (L_i's top right, acting on the last c unknowns of block i - 1; U_i's
+    bottom left, acting on the first c of block i + 1). Each step eliminates one block of
+    B rows (a B x B solve with partial pivoting inside the block): the pivot blocks are
+    Schur complements of leading principal blocks, which stay totally positive for a
+    collocation matrix, so the elimination is stable. The steps depend on each other; each
+    is vectorized over its block, and only c x c corners pass from one to the next.
     """
-    m, b = D.shape[0], D.shape[1]
-    if b == 1:  # scalar blocks (a tridiagonal system): plain products and quotients
-        return _scalar_cyclic_reduction(L[:, 0, 0], D[:, 0, 0], U[:, 0, 0], F[:, 0])[:, None]
-    if m == 1:
-        return np.linalg.solve(D[0], F[0])[None]
-    mo, me = m // 2, (m + 1) // 2
-    sol = np.linalg.solve(D[1::2], np.concatenate([L[1::2], U[1::2], F[1::2]], axis=2))
-    XL, XU, XF = sol[..., :b], sol[..., b : 2 * b], sol[..., 2 * b :]
-    Le, De, Ue, Fe = L[0::2], D[0::2].copy(), U[0::2], F[0::2].copy()
-    newL, newU = np.zeros_like(De), np.zeros_like(De)
-    j = np.arange(mo)  # even row 2j has the odd row 2j + 1 on its right
-    right = Ue[:mo] @ sol  # [U XL | U XU | U XF], one product for the three
-    De[j] -= right[..., :b]
-    Fe[j] -= right[..., 2 * b :]
-    jr = j[j + 1 < me]  # ... which has an even row 2j + 2 on its right
-    newU[jr] = -right[jr, :, b : 2 * b]
-    jl = np.arange(1, me)  # even row 2j has the odd row 2j - 1 on its left
-    left = Le[1:me] @ sol[: me - 1]
-    De[jl] -= left[..., b : 2 * b]
-    Fe[jl] -= left[..., 2 * b :]
-    newL[jl] = -left[..., :b]
-    xe = _block_cyclic_reduction(newL, De, newU, Fe)
-    xo = XF - XL @ xe[:mo]
-    xo[jr] -= XU[jr] @ xe[jr + 1]
-    x = np.empty((m, b, F.shape[2]))
-    x[0::2], x[1::2] = xe, xo
-    return x
-
-
-def _scalar_cyclic_reduction(
-    L: np.ndarray, D: np.ndarray, U: np.ndarray, F: np.ndarray
-) -> np.ndarray:
-    """:func:`_block_cyclic_reduction` for 1 x 1 blocks: L, D, U (m,), F (m, r)."""
-    m = D.shape[0]
-    if m == 1:
-        return F / D[0]
-    mo, me = m // 2, (m + 1) // 2
-    inv = 1.0 / D[1::2]
-    XL, XU, XF = L[1::2] * inv, U[1::2] * inv, F[1::2] * inv[:, None]
-    Le, De, Ue, Fe = L[0::2], D[0::2].copy(), U[0::2], F[0::2].copy()
-    newL, newU = np.zeros(me), np.zeros(me)
-    j = np.arange(mo)
-    De[j] -= Ue[j] * XL
-    Fe[j] -= Ue[j, None] * XF
-    jr = j[j + 1 < me]
-    newU[jr] = -Ue[jr] * XU[jr]
-    jl = np.arange(1, me)
-    De[jl] -= Le[jl] * XU[jl - 1]
-    Fe[jl] -= Le[jl, None] * XF[jl - 1]
-    newL[jl] = -Le[jl] * XL[jl - 1]
-    xe = _scalar_cyclic_reduction(newL, De, newU, Fe)
-    xo = XF - XL[:, None] * xe[:mo]
-    xo[jr] -= XU[jr, None] * xe[jr + 1]
-    x = np.empty((m, F.shape[1]))
-    x[0::2], x[1::2] = xe, xo
+    m, size, c = D.shape[0], D.shape[1], L.shape[1]
+    r = F.shape[2]
+    G = np.zeros((m, size, c))  # D'_i^-1 U_i (only U's first c columns are non-zero)
+    Y = np.empty_like(F)  # D'_i^-1 F'_i
+    rhs = np.zeros((size, c + r))
+    for i in range(m):  # one block of rows per step
+        d = D[i]
+        rhs[:, c:] = F[i]
+        rhs[:, :c] = 0.0
+        rhs[size - c :, :c] = U[i]
+        if i:
+            d = d.copy()
+            d[:c, :c] -= L[i] @ G[i - 1, size - c :]
+            rhs[:c, c:] -= L[i] @ Y[i - 1, size - c :]
+        sol = np.linalg.solve(d, rhs)
+        G[i], Y[i] = sol[:, :c], sol[:, c:]
+    x = np.empty_like(F)
+    x[-1] = Y[-1]
+    for i in range(m - 2, -1, -1):
+        x[i] = Y[i] - G[i] @ x[i + 1, :c]
     return x
 
 
@@ -209,7 +194,7 @@ def _solve_cyclic(cols: np.ndarray, vals: np.ndarray, f: np.ndarray) -> np.ndarr
     rows = np.arange(n)[:, None]
     # shift: the median offset of each row's largest entry puts the band on the diagonal
     main = cols[np.arange(n), np.argmax(np.abs(vals), axis=1)]
-    s = int(np.median((main - rows[:, 0]) % n))
+    s = int(np.median((main - rows[:, 0] + n // 2) % n - n // 2)) % n  # signed offsets
     c = (cols - s) % n  # unknown j of the renumbered system is unknown (j + s) % n
     off = (c - rows + n // 2) % n - n // 2  # cyclic offset in [-n/2, n/2)
     live = vals != 0
