@@ -235,7 +235,8 @@ def dxf(
         data = dxf_bytes(splines, polylines, meshes, layer_colors=layer_colors)
     except ValueError as exc:
         if "layer" in str(exc):
-            raise InputError("layers", str(exc)) from None
+            port = "mesh_layer" if str(exc).startswith("mesh") else "layers"
+            raise InputError(port, str(exc)) from None
         raise
     return str(ctx.write(path, data))
 

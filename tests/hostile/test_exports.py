@@ -192,13 +192,15 @@ def test_dxf_default_layers_part_curves_from_the_mesh(tmp_path):
         ({"layers": ["a", "b"], "colors": [1]}, "one colour per entry of layers"),
         ({"layers": ["a"], "colors": [300]}, "1 to 255"),
         ({"layers": ["a", "a"], "colors": [1, 2]}, "two colours"),
-        ({"layers": ["bad:name"]}, "layer name"),
+        ({"layers": ["bad:name"]}, "input 'layers'.*layer name"),
+        ({"mesh_layer": "a/b"}, "input 'mesh_layer'.*layer name"),
     ],
 )
 def test_dxf_bad_layers_are_located_errors(tmp_path, kwargs, match):
     g = fg.Graph(out_dir=tmp_path)
     g.add("c", "nurbs.circle")
-    g.add("dxf", "export.dxf", curves=["@c"], path="a.dxf", **kwargs)
+    g.add("box", "mesh.box")
+    g.add("dxf", "export.dxf", curves=["@c"], mesh="@box", path="a.dxf", **kwargs)
     with pytest.raises(fg.FormgraphError, match=match):
         g.evaluate("dxf")
 
