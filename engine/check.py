@@ -101,7 +101,7 @@ def check_graph(g: Outline, extra: list[Problem] | None = None) -> list[Problem]
                 # the SPEC's form: file:line, then the type (the node is named after it)
                 problems.append(
                     Problem(
-                        Where(file, nd.line),
+                        Where(file, nd.input_lines.get("type", nd.line)),
                         f"unknown node type '{nd.type}'{suggest(nd.type, registry)}"
                         f" in node '{nd.name}'",
                     )
@@ -160,6 +160,8 @@ def _check_input(
             resolved = [_static_value(g, i) for i in value.items]
         except _Unknown as exc:
             return [str(exc)] if str(exc) else []
+        except (ExpressionError, ValueError, TypeError, ZeroDivisionError) as exc:
+            return [f"an expression fails with the param defaults: {exc}"]
         return _coerce_problems(pt, resolved)
     list_kinds = [k for k in pt.kinds if k.is_list]
     if not list_kinds:

@@ -373,7 +373,7 @@ class _Run:
         self.out_path = g.out_dir.resolve()
         self.out_dir = str(self.out_path)
         self.total = 0
-        self.done = 0
+        self.computed = 0  # nodes computed so far, for the progress line
 
     def where(self, name: str, port: str | None = None) -> Where:
         nd = self.g._nodes[name]
@@ -504,8 +504,12 @@ class _Run:
             source = "disk"
             if hit:
                 self.g.memory.put(key, value)
-        if hit and spec.is_export and self.g._written.get(key) != _file_stamp(value):
-            hit = False  # the file is gone or holds something else now: write it again
+        if hit and spec.is_export:
+            # trusted only when this graph wrote the file and it is still what was written; a
+            # fresh process has no record, so it writes again (an identical file stays untouched)
+            stamp = _file_stamp(value)
+            if stamp is None or self.g._written.get(key) != stamp:
+                hit = False
         if hit and spec.multi_output and not isinstance(value, spec.output_class):
             value = spec.output_class(*value)  # the disk cache stores the outputs as a list
         if hit and key not in self.g._identity:
@@ -533,8 +537,7 @@ class _Run:
         if spec.wants_context:
             kwargs["ctx"] = Context(name, self.out_path, self.g.budget, warnings)
         if self.g.progress is not None:
-            computed = sum(1 for s in self.stats.values() if s.status == "computed")
-            self.g.progress(name, computed, self.total)
+            self.g.progress(name, self.computed, self.total)
         t0 = time.perf_counter()
         try:
             value = spec.func(**kwargs)
@@ -571,6 +574,7 @@ class _Run:
         if spec.is_export:
             self.g._written[key] = _file_stamp(value)
         self.stats[name] = NodeStat("computed", seconds, size, warnings)
+        self.computed += 1
         return value
 
     def cutoff_identity(self, name: str, key: str, value: Any) -> str:

@@ -265,9 +265,14 @@ def _coerce_kind(k: Kind, value: Any) -> Any:
         try:
             return base(value)
         except ValueError:
-            options = ", ".join(repr(m.value) for m in base)
+            import difflib
+
+            values = [str(m.value) for m in base]
+            options = ", ".join(repr(v) for v in values)
+            close = difflib.get_close_matches(str(value), values, n=1, cutoff=0.6)
+            hint = f" (did you mean {close[0]!r}?)" if close else ""
             raise TypeMismatch(
-                f"{value!r} is not a valid option, must be one of {options}"
+                f"{value!r} is not a valid option{hint}, must be one of {options}"
             ) from None
     if base is Points and not isinstance(value, Geometry):
         try:
