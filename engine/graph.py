@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import os
 import time
+import warnings as _warnings
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -24,6 +25,7 @@ from .errors import (
     BudgetError,
     CycleError,
     ExpressionError,
+    FormgraphWarning,
     GraphError,
     InputError,
     NodeError,
@@ -33,7 +35,7 @@ from .errors import (
 )
 from .model import Expr, Input, Items, Literal, NodeDef, ParamDef, Wire, parse_input
 from .registry import DEFAULT_BUDGET, Context, NodeSpec, node_types
-from .types import TypeMismatch, type_by_name
+from .types import TypeMismatch, describe, type_by_name
 from .yamlio import MAX_BYTES, dump, parse
 
 __all__ = ["Graph", "NodeStat", "load"]
@@ -68,6 +70,9 @@ def load(
     GraphError
         With every problem found, each naming file, line, node and input.
     """
+    if not isinstance(path, (str, os.PathLike)):
+        raise GraphError(f"load() takes the path of a graph file, got {describe(path)}")
+    _check_budgets(budget, memory_bytes)
     path = Path(path)
     try:
         with open(path, "rb") as fh:  # never read more than the format allows
@@ -112,6 +117,7 @@ class Graph:
         description: str = "",
         file: str | None = None,
     ):
+        _check_budgets(budget, memory_bytes)
         self.file = file
         self.description = description
         self.out_dir = Path(out_dir)
@@ -164,17 +170,31 @@ class Graph:
         type: str | None = None,
     ) -> None:
         """Declare a graph param (``type`` names a geometry type for a Python input slot)."""
+        if not isinstance(name, str):
+            raise ParamError(f"add_param() takes a param name (a string), got {describe(name)}")
+        for bound, b in (("min", min), ("max", max)):
+            if b is not None and (isinstance(b, bool) or not isinstance(b, (int, float))):
+                raise ParamError(f"param '{name}': {bound} must be a number, got {describe(b)}")
         long_form = any(x is not None for x in (min, max, type)) or bool(doc)
         default = _plain(default)
         p = ParamDef(name, default, None, type, min, max, doc, None, long_form)
         if type is not None:
-            p.type = type_by_name(type)
+            if not isinstance(type, str):
+                raise ParamError(f"param '{name}': type must be a name such as 'Mesh'")
+            try:
+                p.type = type_by_name(type)
+            except TypeMismatch as exc:
+                raise ParamError(f"param '{name}': {exc}") from None
         self._params[name] = p
         self._values[name] = default
         self._checked = False
 
     def add(self, name: str, type: str, **inputs: Any) -> None:
         """Add (or replace) node ``name`` of node type ``type`` with its inputs."""
+        if not isinstance(name, str) or not isinstance(type, str):
+            what = "node name" if not isinstance(name, str) else "node type"
+            bad = name if not isinstance(name, str) else type
+            raise GraphError(f"add() takes a {what} (a string), got {describe(bad)}")
         self._nodes[name] = NodeDef.make(name, type, {k: _plain(v) for k, v in inputs.items()})
         self._checked = False
 
@@ -267,7 +287,7 @@ class Graph:
             self.check()
         values = dict(self._values)
         values.update(self._checked_params(params))
-        names = [nodes] if isinstance(nodes, str) else list(nodes)
+        names = _node_names(nodes)
         for n in names:
             if n not in self._nodes:
                 from .check import suggest
@@ -335,6 +355,29 @@ class Graph:
 
     def __repr__(self) -> str:
         return f"Graph({self.file_label!r}, {len(self._nodes)} nodes, params={self._values})"
+
+
+def _node_names(nodes: Any) -> list[str]:
+    """The names asked for by ``evaluate(nodes)``: one name or an iterable of names."""
+    if isinstance(nodes, str):
+        return [nodes]
+    names = None
+    if isinstance(nodes, Iterable) and not isinstance(nodes, (bytes, dict)):
+        names = list(nodes)
+    if names is None or not all(isinstance(n, str) for n in names):
+        raise GraphError(
+            f"evaluate() takes a node name or a list of node names, got {describe(nodes)}"
+        )
+    return names
+
+
+def _check_budgets(budget: Any, memory_bytes: Any) -> None:
+    for what, value, least in (("budget", budget, 1), ("memory_bytes", memory_bytes, 0)):
+        if isinstance(value, bool) or not isinstance(value, int) or value < least:
+            raise GraphError(
+                f"{what} must be a whole number of {'elements' if what == 'budget' else 'bytes'}"
+                f" (at least {least}), got {describe(value)}"
+            )
 
 
 def _plain(value: Any) -> Any:
@@ -540,7 +583,14 @@ class _Run:
             self.g.progress(name, self.computed, self.total)
         t0 = time.perf_counter()
         try:
-            value = spec.func(**kwargs)
+            with np.errstate(all="ignore"), _warnings.catch_warnings():
+                # numpy's overflow/invalid-value chatter never reaches a user: a result that
+                # is not finite is refused below, with the node's name and line
+                _warnings.simplefilter("ignore", RuntimeWarning)
+                value = spec.func(**kwargs)
+                value = self.check_output(name, nd, spec, value)
+        except NodeError:
+            raise
         except BudgetError as exc:
             raise BudgetError(
                 [Problem(self.where(name), p.message) for p in exc.problems]
@@ -559,7 +609,8 @@ class _Run:
         except Exception as exc:
             raise NodeError(self.where(name), nd.type, f"{type(exc).__name__}: {exc}") from exc
         seconds = time.perf_counter() - t0
-        value = self.check_output(name, nd, spec, value)
+        for w in warnings:
+            _warnings.warn(f"{self.where(name).prefix()}: {w}", FormgraphWarning, stacklevel=5)
         key = self.key(name)
         identity = self.cutoff_identity(name, key, value)
         size = _cache.sizeof(value)
@@ -606,6 +657,13 @@ class _Run:
 
     def check_output(self, name: str, nd: NodeDef, spec: NodeSpec, value: Any) -> Any:
         if spec.multi_output:
+            for field_name, v in zip(spec.outputs, value):
+                if isinstance(v, float) and not np.isfinite(v):
+                    raise NodeError(
+                        self.where(name),
+                        nd.type,
+                        f"output '{field_name}' is not finite ({v}): an input is too extreme",
+                    )
             return value
         out_type = spec.outputs["out"]
         try:

@@ -203,6 +203,8 @@ def describe(value: Any) -> str:
     """A short description of a value for error messages: its type and a glimpse."""
     if isinstance(value, Geometry):
         return type(value).__name__
+    if value is None:
+        return "None (null)"
     if isinstance(value, bool):
         return f"bool {value}"
     if isinstance(value, (int, float)):
