@@ -114,9 +114,7 @@ def parse_sets(graph: Any, items: Sequence[str]) -> dict[str, Any]:
         name, sep, text = item.partition("=")
         name = name.strip()
         if not sep or not name:
-            raise UsageError(
-                f"--set takes NAME=VALUE, got {item!r} (node names go before --set)"
-            )
+            raise UsageError(f"--set takes NAME=VALUE, got {item!r} (node names go before --set)")
         if name not in defs:
             from .check import suggest
 
@@ -237,9 +235,8 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 
 def cmd_check(args: argparse.Namespace) -> int:
-    from .graph import load
-
     from .check import param_warnings
+    from .graph import load
 
     g = load(args.graph)
     for p in param_warnings(g.param_defs, g.file_label):

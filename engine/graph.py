@@ -657,7 +657,7 @@ class _Run:
 
     def check_output(self, name: str, nd: NodeDef, spec: NodeSpec, value: Any) -> Any:
         if spec.multi_output:
-            for field_name, v in zip(spec.outputs, value):
+            for field_name, v in zip(spec.outputs, value, strict=False):
                 if isinstance(v, float) and not np.isfinite(v):
                     raise NodeError(
                         self.where(name),

@@ -44,7 +44,9 @@ def path_problem(relpath: str) -> str | None:
         return f"output path {relpath!r} leaves the output directory ('..')"
     shown = relpath if len(relpath) <= 60 else relpath[:57] + "..."
     if len(relpath) > MAX_PATH_CHARS:
-        return f"output path {shown!r} is {len(relpath):,} characters long (at most {MAX_PATH_CHARS})"
+        return (
+            f"output path {shown!r} is {len(relpath):,} characters long (at most {MAX_PATH_CHARS})"
+        )
     parts = [p for p in relpath.replace("\\", "/").split("/") if p not in ("", ".")]
     if len(parts) > MAX_PATH_PARTS:
         return f"output path {shown!r} is {len(parts):,} folders deep (at most {MAX_PATH_PARTS})"

@@ -14,10 +14,9 @@ reading is bounded by what is accepted, not by the size limit alone.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 from typing import Any
-
-import re
 
 import yaml
 
@@ -326,8 +325,10 @@ def _value(node: yaml.Node, problem: Any, where_node: str | None, port: str | No
         return _construct(node)
     except yaml.YAMLError as exc:
         why = getattr(exc, "problem", None) or exc
-        hint = "" if str(why).startswith("'") or "too long" in str(why) else (
-            " (only plain YAML data is allowed; no !!python tags)"
+        hint = (
+            ""
+            if str(why).startswith("'") or "too long" in str(why)
+            else (" (only plain YAML data is allowed; no !!python tags)")
         )
         problem(f"cannot read this value: {why}{hint}", _line(node), where_node, port)
         return None
