@@ -332,7 +332,14 @@ def _value(node: yaml.Node, problem: Any, where_node: str | None, port: str | No
         )
         problem(f"cannot read this value: {why}{hint}", _line(node), where_node, port)
         return None
-    except (ValueError, TypeError, OverflowError, RecursionError) as exc:
+    except (
+        ValueError,
+        TypeError,
+        OverflowError,
+        RecursionError,
+        AttributeError,
+        IndexError,
+    ) as exc:
         # the safe constructor's own readers (e.g. a malformed !!binary or !!timestamp)
         problem(f"cannot read this value: {exc}", _line(node), where_node, port)
         return None
