@@ -277,6 +277,8 @@ def _coerce_kind(k: Kind, value: Any) -> Any:
                 f"{value!r} is not a valid option{hint}, must be one of {options}"
             ) from None
     if base is Points and not isinstance(value, Geometry):
+        if _holds_bool(value):
+            raise TypeMismatch(f"expected Points (numbers), got true/false in {describe(value)}")
         try:
             return Points(value)
         except ValueError as exc:
@@ -315,7 +317,18 @@ def _faces(value: Any) -> Faces:
     return out
 
 
+def _holds_bool(rows: Any) -> bool:
+    """Whether a list of coordinate rows holds a bool (numpy would read True as 1)."""
+    if not isinstance(rows, (list, tuple)):
+        return False
+    return any(
+        type(x) is bool for row in rows for x in (row if isinstance(row, (list, tuple)) else (row,))
+    )
+
+
 def _vec_list(value: Any) -> np.ndarray:
+    if _holds_bool(value):
+        raise TypeMismatch(f"expected [x, y, z] numbers, got true/false in {describe(value)}")
     try:
         return as_xyz(value, "coordinates")
     except ValueError as exc:
