@@ -10,8 +10,7 @@ from pathlib import Path
 import pytest
 
 import formgraph as fg
-from formgraph import cli
-from formgraph import safety
+from formgraph import cli, safety
 
 BOX = """\
 formgraph: 1
