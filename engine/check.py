@@ -76,9 +76,8 @@ def param_warnings(params: Mapping[str, ParamDef], file: str) -> list[Problem]:
             out.append(
                 Problem(
                     Where(file, p.line),
-                    f"param '{p.name}' is read as a whole number (int), since its default, "
-                    f"min and max are written as whole numbers; write 'type: int' to say so, "
-                    f"or 'default: {p.default}.0' (or 'type: float') if it may take fractions",
+                    f"param '{p.name}' is read as int (its default, min and max are whole "
+                    f"numbers); write 'type: int' to confirm, or 'type: float' to allow fractions",
                 )
             )
     return out

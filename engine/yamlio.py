@@ -37,20 +37,27 @@ _FLOAT = re.compile(
 )
 
 
+_PLAIN = re.compile(
+    rf"(?P<int>{_INT.pattern})|(?P<float>{_FLOAT.pattern})"
+    r"|(?P<bool>true|True|TRUE|false|False|FALSE)|(?P<null>~|null|Null|NULL|)"
+    r"|(?P<merge><<)"  # not YAML 1.2, but anchors with merge keys are common in graphs
+)
+_TAGS = {name: f"tag:yaml.org,2002:{name}" for name in ("int", "float", "bool", "null", "merge")}
+
+
 class _Resolver(yaml.resolver.Resolver):
-    """YAML 1.2 core schema tags for plain scalars (PyYAML alone speaks YAML 1.1)."""
+    """YAML 1.2 core schema tags for plain scalars (PyYAML alone speaks YAML 1.1).
 
-    yaml_implicit_resolvers: dict[str, list[tuple[str, re.Pattern[str]]]] = {}
+    One regular expression decides a plain scalar's tag (PyYAML's table of resolvers per
+    first character costs several times more per scalar).
+    """
 
+    def resolve(self, kind: Any, value: Any, implicit: Any) -> str:
+        if kind is yaml.ScalarNode and implicit[0]:
+            m = _PLAIN.fullmatch(value)
+            return _TAGS[m.lastgroup] if m else self.DEFAULT_SCALAR_TAG
+        return super().resolve(kind, value, implicit)
 
-for _tag, _regexp, _first in (
-    ("bool", r"^(?:true|True|TRUE|false|False|FALSE)$", "tTfF"),
-    ("int", rf"^(?:{_INT.pattern})$", "-+0123456789"),
-    ("float", rf"^(?:{_FLOAT.pattern})$", "-+0123456789."),
-    ("null", r"^(?:~|null|Null|NULL|)$", ["~", "n", "N", ""]),
-    ("merge", r"^(?:<<)$", "<"),  # not 1.2, but anchors with merge keys are common in graphs
-):
-    _Resolver.add_implicit_resolver(f"tag:yaml.org,2002:{_tag}", re.compile(_regexp), list(_first))
 
 try:
     from yaml.cyaml import CParser as _CParser  # libyaml: 20 times faster than pure Python
@@ -69,10 +76,8 @@ if _CParser is not None:
 
 else:  # pragma: no cover - PyYAML without libyaml
 
-    class _Loader(yaml.SafeLoader, _Resolver):  # type: ignore[no-redef]
+    class _Loader(_Resolver, yaml.SafeLoader):  # type: ignore[no-redef]
         """Composing in pure Python, YAML 1.2 numbers."""
-
-        yaml_implicit_resolvers = _Resolver.yaml_implicit_resolvers
 
 
 class _Constructor(yaml.constructor.SafeConstructor):

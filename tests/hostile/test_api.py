@@ -114,7 +114,7 @@ def test_set_says_where_node_names_go(graph_file, capsys):
 def test_check_warns_when_it_guesses_int(graph_file, capsys):
     assert cli.main(["check", str(graph_file)]) == 0
     err = capsys.readouterr().err
-    assert "g.yaml:4: warning: param 'height' is read as a whole number (int)" in err
+    assert "g.yaml:4: warning: param 'height' is read as int" in err
     assert "'waist'" not in err and "'n'" not in err  # a float, and a declared int
 
 
