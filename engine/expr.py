@@ -125,7 +125,13 @@ class Compiled:
                 f"expression {self.text!r} needs a value for {', '.join(sorted(missing))}"
             )
         with np.errstate(all="ignore"):
-            return self._fn(scope)
+            try:
+                return self._fn(scope)
+            except OverflowError:  # a Python int too large for a float64, e.g. a param
+                raise ValueError(
+                    f"{_glimpse(self.text)}: a number is too large (numbers in expressions "
+                    f"are floats, up to about 1.8e308)"
+                ) from None
 
     @property
     def is_bare_name(self) -> bool:

@@ -167,3 +167,20 @@ def test_values_read_from_the_disk_cache_are_frozen(tmp_path):
     assert again.stats["b"].source == "disk"
     for a in _arrays(m):
         _cannot_be_made_writable(a)
+
+
+def test_a_huge_integer_param_in_an_expression_is_located():
+    text = "formgraph: 1\nparams:\n  n: 2\nnodes:\n  c: {type: nurbs.circle, radius: '=n * 2'}\n"
+    g = fg.Graph.from_text(text, file="h.yaml")
+    with pytest.raises(fg.GraphError, match=r"h.yaml:5: node 'c', input 'radius': .*too large"):
+        g.evaluate("c", n=10**400)
+    g.add("x", "curves.parametric", x="n * t", y="t")
+    with pytest.raises(fg.NodeError, match=r"node 'x' .*too large"):
+        g.evaluate("x", n=10**400)
+
+
+def test_a_budget_message_stays_readable_for_absurd_counts():
+    g = fg.Graph()
+    g.add("p", "points.circle", count=10**400)
+    with pytest.raises(fg.BudgetError, match=r"would make about 10\^400 points"):
+        g.evaluate("p")
