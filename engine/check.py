@@ -18,7 +18,7 @@ from .errors import ExpressionError, Problem, Where
 from .expr import compile_expression
 from .model import Expr, Input, Items, Literal, NodeDef, ParamDef, Wire
 from .registry import NodeSpec, node_types
-from .types import Kind, PortType, TypeMismatch, describe
+from .types import Kind, PortType, TypeMismatch, describe, number_text
 
 
 def suggest(name: str, options: Any) -> str:
@@ -61,9 +61,9 @@ def check_param_value(p: ParamDef, value: Any) -> Any:
         out = value
     if isinstance(out, (int, float)) and not isinstance(out, bool):
         if p.min is not None and out < p.min:
-            raise TypeMismatch(f"must be >= {p.min:g}, got {out:g}")
+            raise TypeMismatch(f"must be >= {number_text(p.min)}, got {number_text(out)}")
         if p.max is not None and out > p.max:
-            raise TypeMismatch(f"must be <= {p.max:g}, got {out:g}")
+            raise TypeMismatch(f"must be <= {number_text(p.max)}, got {number_text(out)}")
     return out
 
 

@@ -48,6 +48,15 @@ class OutputPath(str):
     """A relative output path, checked not to leave the output directory."""
 
 
+def number_text(x: float) -> str:
+    """A number for a message: ``%g`` style, and an int too large for a float by its size."""
+    if isinstance(x, int) and not -(10**15) < x < 10**15:
+        import math
+
+        return f"{'a negative' if x < 0 else 'an'} integer of {int(math.log10(abs(x))) + 1} digits"
+    return f"{x:g}"
+
+
 @dataclass(frozen=True)
 class Range:
     """Inclusive bounds of a numeric port, checked at load."""
@@ -57,9 +66,9 @@ class Range:
 
     def check(self, value: float) -> str | None:
         if self.min is not None and value < self.min:
-            return f"must be >= {self.min:g}, got {value:g}"
+            return f"must be >= {number_text(self.min)}, got {number_text(value)}"
         if self.max is not None and value > self.max:
-            return f"must be <= {self.max:g}, got {value:g}"
+            return f"must be <= {number_text(self.max)}, got {number_text(value)}"
         return None
 
 

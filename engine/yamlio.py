@@ -14,6 +14,7 @@ reading is bounded by what is accepted, not by the size limit alone.
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass, field
 from typing import Any
@@ -22,7 +23,7 @@ import yaml
 
 from .errors import Problem, Where
 from .model import NodeDef, ParamDef
-from .types import TypeMismatch, type_by_name
+from .types import TypeMismatch, describe, type_by_name
 
 FORMAT_VERSION = 1
 MAX_BYTES = 16 * 1024 * 1024
@@ -232,6 +233,8 @@ def parse(text: str, file: str = "<graph>") -> Document:
         return doc
 
     top: dict[str, tuple[yaml.Node, yaml.Node]] = {}
+    if not _merged(root, problem):
+        return doc
     for k, v in root.value:
         key = _scalar_key(k)
         if key in top:
@@ -259,7 +262,7 @@ def parse(text: str, file: str = "<graph>") -> Document:
     if "params" in top:
         k, v = top["params"]
         if isinstance(v, yaml.MappingNode):
-            for pk, pv in v.value:
+            for pk, pv in v.value if _merged(v, problem) else ():
                 name = _scalar_key(pk)
                 if name in doc.params:
                     problem(f"param '{name}' is declared twice", _line(pk))
@@ -277,7 +280,7 @@ def parse(text: str, file: str = "<graph>") -> Document:
     if not isinstance(v, yaml.MappingNode):
         problem("'nodes' must be a mapping of node name to {type: ..., inputs...}", _line(k))
         return doc
-    for nk, nv in v.value:
+    for nk, nv in v.value if _merged(v, problem) else ():
         name = _scalar_key(nk)
         line = _line(nk)
         if name in doc.nodes:
@@ -296,7 +299,7 @@ def parse(text: str, file: str = "<graph>") -> Document:
         lines: dict[str, int] = {}
         unreadable: dict[str, str] = {}
         node_type = None
-        for ik, iv in nv.value:
+        for ik, iv in nv.value if _merged(nv, problem) else ():
             port = _scalar_key(ik)
             if port in raw or (port == "type" and node_type is not None):
                 problem("input appears twice", _line(ik), name, port)
@@ -312,13 +315,30 @@ def parse(text: str, file: str = "<graph>") -> Document:
             lines[port] = _line(ik)
             if bad:
                 unreadable[port] = bad[0]
-        if not isinstance(node_type, str):
+        if node_type is not None and not isinstance(node_type, str):
+            problem(
+                f"'type' must be a node type name such as points.circle, got {describe(node_type)}",
+                lines["type"],
+                name,
+            )
+            node_type = ""
+        elif not isinstance(node_type, str):
             problem("missing 'type:' (e.g. type: points.circle)", line, name)
             node_type = ""
         nd = NodeDef.make(name, node_type, raw, line, lines)
         nd.parse_errors.update(unreadable)
         doc.nodes[name] = nd
     return doc
+
+
+def _merged(node: yaml.MappingNode, problem: Any) -> bool:
+    """Resolve the merge keys (``<<: *base``) of a mapping in place; False when it cannot."""
+    try:
+        _Constructor().flatten_mapping(node)
+    except yaml.YAMLError as exc:
+        problem(f"cannot merge: {getattr(exc, 'problem', None) or exc}", _line(node))
+        return False
+    return True
 
 
 def _scalar_key(node: yaml.Node) -> str:
@@ -369,6 +389,8 @@ def _param(name: str, node: yaml.Node, problem: Any) -> ParamDef | None:
         b = value.get(bound)
         if b is not None and (isinstance(b, bool) or not isinstance(b, (int, float))):
             problem(f"param '{name}': {bound} must be a number, got {b!r}", line)
+        elif isinstance(b, float) and not math.isfinite(b):
+            problem(f"param '{name}': {bound} must be a finite number, got {b!r}", line)
         else:
             setattr(p, bound, b)
     if "type" in value:

@@ -184,3 +184,21 @@ def test_a_budget_message_stays_readable_for_absurd_counts():
     g.add("p", "points.circle", count=10**400)
     with pytest.raises(fg.BudgetError, match=r"would make about 10\^400 points"):
         g.evaluate("p")
+
+
+@pytest.mark.parametrize("count", [-(10**400), "=-1"])
+def test_out_of_range_huge_numbers_are_located(count):
+    g = fg.Graph()
+    g.add("p", "points.circle", count=count)
+    with pytest.raises(fg.GraphError, match=r"node 'p', input 'count': .*must be >= "):
+        g.evaluate("p")
+
+
+def test_a_param_out_of_range_by_a_huge_number_is_a_param_error():
+    text = (
+        "formgraph: 1\nparams:\n  n: {default: 3, min: 1, max: 9}\n"
+        "nodes:\n  p: {type: points.circle, count: '=n'}\n"
+    )
+    g = fg.Graph.from_text(text, file="h.yaml")
+    with pytest.raises(fg.ParamError, match="must be <= 9, got an integer of 401 digits"):
+        g.evaluate("p", n=10**400)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import time
 
+import numpy as np
 import pytest
 
 import formgraph as fg
@@ -119,3 +120,27 @@ def test_deep_flow_nesting_is_refused():
     text += "]" * 50_000 + "}\n"
     with pytest.raises(fg.GraphError, match="nest"):
         fg.Graph.from_text(text, file="h.yaml")
+
+
+def test_merge_keys_give_a_node_its_base_inputs():
+    g = fg.Graph.from_text(
+        "formgraph: 1\nnodes:\n  base: &b {type: points.circle, count: 3}\n"
+        "  q: {<<: *b, radius: 2}\n",
+        file="h.yaml",
+    )
+    assert np.abs(g.evaluate("q").xyz).max() == pytest.approx(2.0)
+
+
+@pytest.mark.parametrize("value", ["[points.circle]", "{x: 1}", "3"])
+def test_a_type_that_is_not_a_name_says_so(value):
+    with pytest.raises(fg.GraphError, match=r"h.yaml:3: node 'a': 'type' must be a node type"):
+        fg.Graph.from_text(f"formgraph: 1\nnodes:\n  a: {{type: {value}}}\n", file="h.yaml")
+
+
+@pytest.mark.parametrize("bound", [".nan", ".inf", "-.inf"])
+def test_param_bounds_must_be_finite(bound):
+    with pytest.raises(fg.GraphError, match=r"param 'a': min must be a finite number"):
+        fg.Graph.from_text(
+            f"formgraph: 1\nparams:\n  a: {{default: 3, min: {bound}}}\nnodes: {{}}\n",
+            file="h.yaml",
+        )
