@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from . import cache as _cache
+from . import safety
 from .check import Outline, check_graph, check_param_value
 from .errors import (
     BudgetError,
@@ -30,6 +31,7 @@ from .errors import (
     InputError,
     NodeError,
     ParamError,
+    PathError,
     Problem,
     Where,
 )
@@ -413,7 +415,10 @@ class _Run:
         self.keys: dict[str, str] = {}
         self.results: dict[str, Any] = {}
         self.stats: dict[str, NodeStat] = {}
-        self.out_path = g.out_dir.resolve()
+        try:
+            self.out_path = safety.output_root(g.out_dir)
+        except PathError:  # only an export needs it: each says why, at its own line
+            self.out_path = Path(os.path.abspath(g.out_dir))
         self.out_dir = str(self.out_path)
         self.total = 0
         self.computed = 0  # nodes computed so far, for the progress line

@@ -55,6 +55,25 @@ def path_problem(relpath: str) -> str | None:
     return None
 
 
+def output_root(out_dir: str | os.PathLike[str]) -> Path:
+    """The output directory, absolute, symlinks followed (it need not exist yet).
+
+    Raises
+    ------
+    PathError
+        When it cannot be followed (a symlink loop) or is something other than a folder.
+    """
+    try:
+        root = Path(out_dir).resolve()
+    except (OSError, RuntimeError) as exc:  # RuntimeError: a symlink loop (Python < 3.13)
+        raise PathError(
+            f"the output directory {str(out_dir)!r} cannot be followed: {exc}"
+        ) from None
+    if root.exists() and not root.is_dir():
+        raise PathError(f"the output directory {str(out_dir)!r} is not a folder")
+    return root
+
+
 def resolve_output(out_dir: str | os.PathLike[str], relpath: str) -> Path:
     """The absolute path of ``relpath`` inside ``out_dir``, refusing any escape.
 
@@ -66,8 +85,8 @@ def resolve_output(out_dir: str | os.PathLike[str], relpath: str) -> Path:
     problem = path_problem(relpath)
     if problem:
         raise PathError(problem)
+    root = output_root(out_dir)
     try:
-        root = Path(out_dir).resolve()
         target = root / PurePosixPath(relpath.replace("\\", "/"))
         real = target.resolve()  # follows any symlinks that exist along the way
     except (OSError, RuntimeError) as exc:  # RuntimeError: a symlink loop (Python < 3.13)
@@ -89,7 +108,10 @@ def write_atomic(out_dir: str | os.PathLike[str], relpath: str, data: bytes) -> 
     On any failure the previous file (if any) is intact and no temp file is left behind.
     """
     target = resolve_output(out_dir, relpath)
-    target.parent.mkdir(parents=True, exist_ok=True)
+    try:
+        target.parent.mkdir(parents=True, exist_ok=True)
+    except FileExistsError:
+        raise PathError(f"output path {relpath!r} runs through a file, not a folder") from None
     target = resolve_output(out_dir, relpath)  # a folder made meanwhile could be a symlink
     try:
         if target.is_file() and target.stat().st_size == len(data) and target.read_bytes() == data:

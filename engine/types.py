@@ -243,7 +243,9 @@ def _coerce_kind(k: Kind, value: Any) -> Any:
     if base is bool:
         if isinstance(value, (bool, np.bool_)):
             return bool(value)
-        raise TypeMismatch(f"expected bool, got {describe(value)}")
+        yaml11 = isinstance(value, str) and value.lower() in ("yes", "no", "on", "off", "y", "n")
+        hint = " (YAML 1.2 reads it as text: write true or false)" if yaml11 else ""
+        raise TypeMismatch(f"expected bool, got {describe(value)}{hint}")
     if base is int:
         if isinstance(value, (bool, np.bool_)):
             raise TypeMismatch(f"expected int, got {describe(value)}")

@@ -142,3 +142,29 @@ def test_a_temp_file_of_a_running_writer_is_kept(tmp_path):
     os.utime(live, (old, old))  # a day old: stale whoever wrote it
     assert safety.remove_stale_temps(tmp_path) == [live]
     assert foreign.exists()
+
+
+def test_an_output_directory_that_is_a_file_is_a_located_error(tmp_path):
+    (tmp_path / "afile").write_text("x")
+    _graph(tmp_path)
+    g = fg.load(tmp_path / "box.yaml", out_dir=tmp_path / "afile")
+    assert g.evaluate("box").n_faces == 6  # nothing to write: no complaint
+    with pytest.raises(fg.PathError, match=r"box.yaml:\d+: node 'stl': .* is not a folder"):
+        g.evaluate_all()
+
+
+def test_an_output_directory_in_a_symlink_loop_is_a_located_error(tmp_path):
+    os.symlink("loop", tmp_path / "loop")
+    _graph(tmp_path)
+    g = fg.load(tmp_path / "box.yaml", out_dir=tmp_path / "loop")
+    with pytest.raises(fg.PathError, match=r"node 'stl': .*cannot be followed"):
+        g.evaluate_all()
+
+
+def test_an_output_path_through_a_file_is_a_located_error(tmp_path):
+    (tmp_path / "out").mkdir()
+    (tmp_path / "out" / "afile").write_text("x")
+    _graph(tmp_path, "afile/box.stl")
+    g = fg.load(tmp_path / "box.yaml", out_dir=tmp_path / "out")
+    with pytest.raises(fg.PathError, match=r"node 'stl': .*runs through a file"):
+        g.evaluate_all()

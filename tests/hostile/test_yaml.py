@@ -144,3 +144,12 @@ def test_param_bounds_must_be_finite(bound):
             f"formgraph: 1\nparams:\n  a: {{default: 3, min: {bound}}}\nnodes: {{}}\n",
             file="h.yaml",
         )
+
+
+def test_a_yaml_1_1_bool_gets_a_hint():
+    with pytest.raises(fg.GraphError, match=r"got string 'on' \(YAML 1.2 reads it as text"):
+        fg.Graph.from_text(
+            "formgraph: 1\nnodes:\n  p: {type: points.circle, count: 4}\n"
+            "  c: {type: curves.polyline, points: '@p', closed: on}\n",
+            file="h.yaml",
+        )
