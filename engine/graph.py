@@ -10,6 +10,7 @@ cached). Outputs are hashed only for that comparison, never on a cold run.
 from __future__ import annotations
 
 import os
+import sys
 import time
 import warnings as _warnings
 from collections.abc import Callable, Iterable
@@ -359,6 +360,17 @@ class Graph:
         return f"Graph({self.file_label!r}, {len(self._nodes)} nodes, params={self._values})"
 
 
+_PACKAGE = os.path.dirname(os.path.abspath(__file__))
+
+
+def _warn(message: str) -> None:
+    """Emit a :class:`FormgraphWarning` attributed to the first caller outside formgraph."""
+    frame, level = sys._getframe(0), 1
+    while frame is not None and frame.f_code.co_filename.startswith(_PACKAGE):
+        frame, level = frame.f_back, level + 1
+    _warnings.warn(message, FormgraphWarning, stacklevel=level)
+
+
 def _node_names(nodes: Any) -> list[str]:
     """The names asked for by ``evaluate(nodes)``: one name or an iterable of names."""
     if isinstance(nodes, str):
@@ -615,7 +627,7 @@ class _Run:
             raise NodeError(self.where(name), nd.type, f"{type(exc).__name__}: {exc}") from exc
         seconds = time.perf_counter() - t0
         for w in warnings:
-            _warnings.warn(f"{self.where(name).prefix()}: {w}", FormgraphWarning, stacklevel=5)
+            _warn(f"{self.where(name).prefix()}: {w}")
         key = self.key(name)
         identity = self.cutoff_identity(name, key, value)
         size = _cache.sizeof(value)

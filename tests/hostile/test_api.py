@@ -125,8 +125,9 @@ def test_node_warnings_go_through_the_warnings_module(tmp_path):
     g = fg.Graph(out_dir=tmp_path)
     g.add("m", "mesh.from_faces", **OPEN_BOX)
     g.add("stl", "export.stl", mesh="@m", path="open.stl")
-    with pytest.warns(fg.FormgraphWarning, match=r"node 'stl': mesh is not watertight"):
-        g.evaluate("stl")
+    with pytest.warns(fg.FormgraphWarning, match=r"node 'stl': mesh is not watertight") as rec:
+        g.evaluate_all()
+    assert rec[0].filename == __file__  # attributed to the caller, not to formgraph's insides
     assert g.stats["stl"].warnings  # still in the stats too
     with warnings.catch_warnings():
         warnings.simplefilter("error", fg.FormgraphWarning)
