@@ -123,7 +123,7 @@ def parse_sets(graph: Any, items: Sequence[str]) -> dict[str, Any]:
                 f"{', '.join(defs) or 'none'}"
             )
         from .check import param_kind
-        from .yamlio import load_value
+        from .yamlread import load_value
 
         kind = param_kind(defs[name])
         if kind is str:

@@ -1,26 +1,21 @@
 """Reading and writing graph files.
 
-Reading uses PyYAML's safe loader only (libyaml's parser when it is installed): the text is
-composed into a node tree (to keep the line of every node and input), then each value is
-built by the safe constructor, so a ``!!python/...`` tag is refused with its line. Duplicate
-keys, which YAML would silently resolve to the last one, are reported.
-
-Plain scalars are resolved as YAML 1.2's core schema does, not as PyYAML's YAML 1.1: ``1e-3``
-and ``1.0e308`` are numbers, ``1:30`` (1.1's base 60) and ``yes``/``on`` are text, ``012``
-is twelve, and a date is text. Before anything is built, a cheap count of the text's
-structure refuses a file that holds far more values than a graph needs, so the cost of
-reading is bounded by what is accepted, not by the size limit alone.
+Reading uses PyYAML's safe loading only, through :mod:`formgraph.yamlread` (libyaml, YAML 1.2
+numbers, a cost bounded by what is accepted): the text is composed into a node tree (to keep
+the line of every node and input), then each value is built, so a ``!!python/...`` tag is
+refused with its line. Duplicate keys, which YAML would silently resolve to the last one, are
+reported; merge keys (``<<: *base``) are resolved.
 """
 
 from __future__ import annotations
 
 import math
-import re
 from dataclasses import dataclass, field
 from typing import Any
 
 import yaml
 
+from . import yamlread
 from .errors import Problem, Where
 from .model import NodeDef, ParamDef
 from .types import TypeMismatch, describe, type_by_name
@@ -31,114 +26,6 @@ MAX_VALUES = 400_000  # scalars and collections, with aliases expanded: a few se
 MAX_DEPTH = 64
 TOP_KEYS = ("formgraph", "description", "params", "nodes")
 
-_INT = re.compile(r"[-+]?[0-9]+|0o[0-7]+|0x[0-9a-fA-F]+")
-_FLOAT = re.compile(
-    r"[-+]?(?:\.[0-9]+|[0-9]+(?:\.[0-9]*)?)(?:[eE][-+]?[0-9]+)?|[-+]?\.(?:inf|Inf|INF)"
-    r"|\.(?:nan|NaN|NAN)"
-)
-
-
-_PLAIN = re.compile(
-    rf"(?P<int>{_INT.pattern})|(?P<float>{_FLOAT.pattern})"
-    r"|(?P<bool>true|True|TRUE|false|False|FALSE)|(?P<null>~|null|Null|NULL|)"
-    r"|(?P<merge><<)"  # not YAML 1.2, but anchors with merge keys are common in graphs
-)
-_TAGS = {name: f"tag:yaml.org,2002:{name}" for name in ("int", "float", "bool", "null", "merge")}
-
-
-class _Resolver(yaml.resolver.Resolver):
-    """YAML 1.2 core schema tags for plain scalars (PyYAML alone speaks YAML 1.1).
-
-    One regular expression decides a plain scalar's tag (PyYAML's table of resolvers per
-    first character costs several times more per scalar).
-    """
-
-    def resolve(self, kind: Any, value: Any, implicit: Any) -> str:
-        if kind is yaml.ScalarNode and implicit[0]:
-            m = _PLAIN.fullmatch(value)
-            return _TAGS[m.lastgroup] if m else self.DEFAULT_SCALAR_TAG
-        return super().resolve(kind, value, implicit)
-
-
-try:
-    from yaml.cyaml import CParser as _CParser  # libyaml: 20 times faster than pure Python
-except ImportError:  # pragma: no cover - PyYAML without libyaml
-    _CParser = None
-
-if _CParser is not None:
-
-    class _Loader(_CParser, yaml.constructor.SafeConstructor, _Resolver):
-        """Composing with libyaml, YAML 1.2 numbers."""
-
-        def __init__(self, stream: str):
-            _CParser.__init__(self, stream)
-            yaml.constructor.SafeConstructor.__init__(self)
-            _Resolver.__init__(self)
-
-else:  # pragma: no cover - PyYAML without libyaml
-
-    class _Loader(_Resolver, yaml.SafeLoader):  # type: ignore[no-redef]
-        """Composing in pure Python, YAML 1.2 numbers."""
-
-
-class _Constructor(yaml.constructor.SafeConstructor):
-    """The safe constructor with YAML 1.2 numbers (also for explicit ``!!int``/``!!float``)."""
-
-    def construct_yaml_int(self, node: yaml.Node) -> int:
-        text = str(self.construct_scalar(node))
-        if not _INT.fullmatch(text):
-            raise yaml.constructor.ConstructorError(
-                None, None, f"{text!r} is not an integer", node.start_mark
-            )
-        try:
-            if text.startswith(("0o", "0x")):
-                return int(text[2:], 8 if text[1] == "o" else 16)
-            return int(text)
-        except ValueError:  # Python refuses to read more than 4300 digits
-            raise yaml.constructor.ConstructorError(
-                None, None, f"an integer of {len(text)} digits is too long", node.start_mark
-            ) from None
-
-    def construct_yaml_float(self, node: yaml.Node) -> float:
-        text = str(self.construct_scalar(node))
-        if not (_FLOAT.fullmatch(text) or _INT.fullmatch(text)):
-            raise yaml.constructor.ConstructorError(
-                None, None, f"{text!r} is not a number", node.start_mark
-            )
-        if text.lstrip("+-").lower() == ".inf":
-            return float("-inf") if text.startswith("-") else float("inf")
-        if text.lower() == ".nan":
-            return float("nan")
-        if text.startswith(("0o", "0x")):
-            return float(self.construct_yaml_int(node))
-        return float(text)
-
-
-_Constructor.add_constructor("tag:yaml.org,2002:int", _Constructor.construct_yaml_int)
-_Constructor.add_constructor("tag:yaml.org,2002:float", _Constructor.construct_yaml_float)
-
-
-def load_value(text: str) -> Any:
-    """One YAML value read as a graph file reads it (YAML 1.2 numbers), e.g. for ``--set``.
-
-    Raises
-    ------
-    yaml.YAMLError
-        For text that is not YAML.
-    """
-    node = yaml.compose(text, Loader=_Loader)
-    return None if node is None else _construct(node)
-
-
-def _estimate_values(text: str) -> int:
-    """A cheap over-estimate of how many values the text holds, counted on its characters.
-
-    Every value but the first is introduced by a line break, a ``[``, ``{``, ``,`` or
-    ``: ``; each collection also closes. Counting those costs a few milliseconds for the
-    largest file allowed, while building it could take minutes.
-    """
-    return 1 + sum(text.count(c) for c in ("\n", "[", "{", ",", ": ", "]", "}"))
-
 
 @dataclass
 class Document:
@@ -148,48 +35,8 @@ class Document:
     problems: list[Problem] = field(default_factory=list)
 
 
-def _expansion_problem(root: yaml.Node | None) -> str | None:
-    """Why the composed tree is too big to read (an alias bomb, absurd nesting), or None.
-
-    Walks the tree without recursion, counting every node as often as aliases repeat it.
-    """
-    if root is None:
-        return None
-    count = 0
-    distinct: set[int] = set()
-    stack: list[tuple[yaml.Node, int]] = [(root, 0)]
-    while stack:
-        node, depth = stack.pop()
-        count += 1
-        distinct.add(id(node))
-        if count > MAX_VALUES and len(distinct) > MAX_VALUES:
-            return (
-                f"the file holds more than {MAX_VALUES:,} values (numbers, strings, lists and "
-                f"mappings); a graph this large is better built in Python"
-            )
-        # only aliases make the tree larger than the text
-        if count > MAX_VALUES or (count > 100_000 and count > 4 * len(distinct)):
-            return (
-                f"the YAML's aliases expand to more than {min(count, MAX_VALUES):,} values "
-                f"(aliases of aliases?); refusing to read it"
-            )
-        if depth > MAX_DEPTH:
-            return f"the YAML is nested too deeply (more than {MAX_DEPTH} levels)"
-        if isinstance(node, yaml.SequenceNode):
-            stack.extend((v, depth + 1) for v in node.value)
-        elif isinstance(node, yaml.MappingNode):
-            for k, v in node.value:
-                stack.append((k, depth + 1))
-                stack.append((v, depth + 1))
-    return None
-
-
 def _line(node: yaml.Node) -> int:
     return node.start_mark.line + 1
-
-
-def _construct(node: yaml.Node) -> Any:
-    return _Constructor().construct_document(node)
 
 
 def parse(text: str, file: str = "<graph>") -> Document:
@@ -204,7 +51,7 @@ def parse(text: str, file: str = "<graph>") -> Document:
     if len(text.encode()) > MAX_BYTES:
         problem(f"the file is larger than {MAX_BYTES // (1024 * 1024)} MiB")
         return doc
-    estimate = _estimate_values(text)
+    estimate = yamlread.estimate_values(text)
     if estimate > 2 * MAX_VALUES:  # well over the exact limit, which is checked after composing
         problem(
             f"the file holds about {estimate:,} values (numbers, strings, lists and mappings), "
@@ -213,7 +60,12 @@ def parse(text: str, file: str = "<graph>") -> Document:
         )
         return doc
     try:
-        root = yaml.compose(text, Loader=_Loader)
+        try:
+            root, bulk = yamlread.compose(text)
+            too_big = yamlread.expansion_problem(root, bulk, MAX_VALUES, MAX_DEPTH)
+        except (yaml.YAMLError, ValueError):  # a lifted array was not a plain value: as written
+            root, bulk = yaml.compose(text, Loader=yamlread.Loader), yamlread.Bulk()
+            too_big = yamlread.expansion_problem(root, bulk, MAX_VALUES, MAX_DEPTH)
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         problem(
@@ -224,7 +76,6 @@ def parse(text: str, file: str = "<graph>") -> Document:
     except RecursionError:
         problem(f"the YAML is nested too deeply (more than {MAX_DEPTH} levels)")
         return doc
-    too_big = _expansion_problem(root)
     if too_big:
         problem(too_big)
         return doc
@@ -267,7 +118,7 @@ def parse(text: str, file: str = "<graph>") -> Document:
                 if name in doc.params:
                     problem(f"param '{name}' is declared twice", _line(pk))
                     continue
-                param = _param(name, pv, problem)
+                param = _param(name, pv, problem, bulk)
                 if param is not None:
                     doc.params[name] = param
         elif not (isinstance(v, yaml.ScalarNode) and v.value in ("", "null", "~")):
@@ -305,7 +156,7 @@ def parse(text: str, file: str = "<graph>") -> Document:
                 problem("input appears twice", _line(ik), name, port)
                 continue
             bad: list[str] = []
-            value = _value(iv, lambda msg, *a, bad=bad: bad.append(msg), name, port)
+            value = _value(iv, lambda msg, *a, bad=bad: bad.append(msg), name, port, bulk)
             if port == "type":
                 node_type = value
                 lines["type"] = _line(ik)  # an unknown type is reported at its own line
@@ -334,7 +185,7 @@ def parse(text: str, file: str = "<graph>") -> Document:
 def _merged(node: yaml.MappingNode, problem: Any) -> bool:
     """Resolve the merge keys (``<<: *base``) of a mapping in place; False when it cannot."""
     try:
-        _Constructor().flatten_mapping(node)
+        yamlread.Constructor().flatten_mapping(node)
     except yaml.YAMLError as exc:
         problem(f"cannot merge: {getattr(exc, 'problem', None) or exc}", _line(node))
         return False
@@ -345,9 +196,15 @@ def _scalar_key(node: yaml.Node) -> str:
     return str(node.value) if isinstance(node, yaml.ScalarNode) else "<complex key>"
 
 
-def _value(node: yaml.Node, problem: Any, where_node: str | None, port: str | None) -> Any:
+def _value(
+    node: yaml.Node,
+    problem: Any,
+    where_node: str | None,
+    port: str | None,
+    bulk: yamlread.Bulk | None = None,
+) -> Any:
     try:
-        return _construct(node)
+        return yamlread.construct(node, bulk)
     except yaml.YAMLError as exc:
         why = getattr(exc, "problem", None) or exc
         hint = (
@@ -370,9 +227,11 @@ def _value(node: yaml.Node, problem: Any, where_node: str | None, port: str | No
         return None
 
 
-def _param(name: str, node: yaml.Node, problem: Any) -> ParamDef | None:
+def _param(
+    name: str, node: yaml.Node, problem: Any, bulk: yamlread.Bulk | None = None
+) -> ParamDef | None:
     line = _line(node)
-    value = _value(node, problem, None, None)
+    value = _value(node, problem, None, None, bulk)
     if not isinstance(value, dict):
         return ParamDef(name, value, line=line)
     unknown = set(value) - {"default", "min", "max", "doc", "type"}

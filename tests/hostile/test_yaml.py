@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import formgraph as fg
-from formgraph import yamlio
+from formgraph import yamlio, yamlread
 
 
 def _graph(inputs: str, node_type: str = "points.circle") -> fg.Graph:
@@ -35,8 +35,8 @@ def _graph(inputs: str, node_type: str = "points.circle") -> fg.Graph:
     ],
 )
 def test_plain_scalars_read_as_yaml_1_2(text, value):
-    assert yamlio.load_value(text) == value
-    assert type(yamlio.load_value(text)) is type(value)
+    assert yamlread.load_value(text) == value
+    assert type(yamlread.load_value(text)) is type(value)
 
 
 def test_base_60_is_not_a_count():
@@ -153,3 +153,62 @@ def test_a_yaml_1_1_bool_gets_a_hint():
             "  c: {type: curves.polyline, points: '@p', closed: on}\n",
             file="h.yaml",
         )
+
+
+# ------------------------------------------ long number arrays read by json, equivalently
+
+A = "[[1, 2, 3], [4.5, -6e-1, 7E+2],\n   [0, -0, 1e400]]"  # spans lines on purpose
+
+
+@pytest.mark.parametrize(
+    "body",
+    [
+        f"nodes:\n  p:\n    type: points.list\n    points: {A}\n  q: {{type: nope}}\n",
+        f"nodes:\n  p: {{type: points.list, points: {A}}}\n  q: {{type: nope}}\n",
+        f"params:\n  pts: &a {A}\nnodes:\n  p: {{type: points.list, points: *a}}\n",
+        f"nodes:\n  p: {{type: points.list, points: !!seq {A}}}\n",
+        f"nodes:\n  p: {{type: points.list, points: !!str {A}}}\n",
+        f"nodes:\n  p: {{type: points.list, points: [[1, 2, 3]]}}  # {A.replace(chr(10), ' ')}\n",
+        f"nodes:\n  p: {{type: points.list, points: [[1, 2, 3]]}}  # {A}\n",
+        f'description: "{A}"\nnodes: {{}}\n',
+        f"description: |\n  {A.replace(chr(10), chr(10) + '  ')}\nnodes: {{}}\n",
+        f"description: see {A}\nnodes: {{}}\n",
+        f"params:\n  ? {A}\n  : 1\nnodes: {{}}\n",
+        "nodes:\n  p: {type: points.list, points: [[.5, 012, +1], [1, 2, 3], [4, 5, 6]]}\n",
+        "nodes:\n  p: {type: points.list, points: [[1, 2, 3], [4, 5, 6], [7, 8, 9],]}\n",
+        "nodes:\n  p: {type: points.list, points: [[1" + "1" * 5000 + ", 2, 3], [4, 5, 6]]}\n",
+        "nodes:\n  p: {type: points.list, points: [[[[[[1, 2, 3]]]]], [[[[[4, 5, 6]]]]]]}\n",
+        f"nodes:\n  p:\n    type: points.list\n    points:\n      - {A}\n      - {A}\n  q: {{}}\n",
+        f"nodes:\n  b: &b {{type: points.list, points: {A}}}\n  p: {{<<: *b}}\n  q: {{type: x}}\n",
+        "nodes:\n  p: {type: points.list, points: [           \n\n     ]}\n  q: {type: x}\n",
+        f"nodes:\n  p: {{type: points.list, points: {A}, points: {A}}}\n",
+    ],
+)
+def test_lifted_number_arrays_read_exactly_as_yaml_would(monkeypatch, body):
+    def read(bulk_chars: int) -> object:
+        monkeypatch.setattr(yamlread, "BULK_CHARS", bulk_chars)
+        doc = yamlio.parse("formgraph: 1\n" + body, "h.yaml")
+        nodes = {
+            n: (nd.type, nd.raw, nd.line, nd.input_lines, nd.parse_errors)
+            for n, nd in doc.nodes.items()
+        }
+        params = {n: (p.default, p.line) for n, p in doc.params.items()}
+        return doc.description, nodes, params, [str(p) for p in doc.problems]
+
+    assert read(8) == read(10**9)
+
+
+def test_a_lifted_array_counts_as_the_values_it_holds(monkeypatch):
+    monkeypatch.setattr(yamlio, "MAX_VALUES", 1000)
+    rows = ", ".join("[1, 2, 3]" for _ in range(300))  # 1,201 values in one long array
+    with pytest.raises(fg.GraphError, match=r"holds more than 1,000 values"):
+        fg.Graph.from_text(f"formgraph: 1\nnodes:\n  p: {{type: points.list, points: [{rows}]}}\n")
+
+
+def test_long_arrays_are_lifted_and_keep_their_lines(monkeypatch):
+    monkeypatch.setattr(yamlread, "BULK_CHARS", 8)
+    text = f"formgraph: 1\nnodes:\n  p: {{type: points.list, points: {A}}}\n  q: {{type: nope}}\n"
+    lifted, bulk = yamlread.lift_number_arrays(text)
+    assert len(bulk) == 1 and lifted.count("\n") == text.count("\n")
+    with pytest.raises(fg.GraphError, match=r"h.yaml:6: unknown node type 'nope'"):
+        fg.Graph.from_text(text, file="h.yaml")
