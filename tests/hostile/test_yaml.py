@@ -210,5 +210,5 @@ def test_long_arrays_are_lifted_and_keep_their_lines(monkeypatch):
     text = f"formgraph: 1\nnodes:\n  p: {{type: points.list, points: {A}}}\n  q: {{type: nope}}\n"
     lifted, bulk = yamlread.lift_number_arrays(text)
     assert len(bulk) == 1 and lifted.count("\n") == text.count("\n")
-    with pytest.raises(fg.GraphError, match=r"h.yaml:6: unknown node type 'nope'"):
+    with pytest.raises(fg.GraphError, match=r"h.yaml:5: unknown node type 'nope'"):
         fg.Graph.from_text(text, file="h.yaml")
