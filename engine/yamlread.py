@@ -270,6 +270,9 @@ def expansion_problem(
 # ------------------------------------------------------------------------- construction
 
 
+_NO_BULK = Bulk()
+
+
 def construct(node: yaml.Node, bulk: Bulk | None = None) -> Any:
     """The Python value of a composed node (plain data fast, anything else safely).
 
@@ -278,7 +281,7 @@ def construct(node: yaml.Node, bulk: Bulk | None = None) -> Any:
     yaml.YAMLError, ValueError, TypeError, ...
         From the safe constructor, for values it cannot read.
     """
-    bulk = bulk or Bulk()
+    bulk = _NO_BULK if bulk is None else bulk
     try:
         return _build(node, {}, bulk)
     except _Slow:  # tags, merge keys, complex keys: the full safe constructor
