@@ -148,3 +148,15 @@ def test_the_cli_prints_a_node_warning_once(tmp_path, capsys):
         warnings.simplefilter("always")
         assert cli.main(["run", str(p), "--no-cache", "--out", str(tmp_path / "out")]) == 0
     assert capsys.readouterr().err.count("not watertight") == 1
+
+
+def test_a_subgraph_param_follows_the_same_int_rule(tmp_path):
+    (tmp_path / "part.yaml").write_text(
+        "formgraph: 1\nparams:\n  waist: {default: 3, min: 0.5, max: 10}\n"
+        "nodes:\n  c: {type: nurbs.circle, radius: '=waist'}\noutputs: {curve: '@c'}\n"
+    )
+    (tmp_path / "top.yaml").write_text(
+        "formgraph: 1\nnodes:\n  ring: {type: part.yaml, waist: 1.5}\n"
+    )
+    g = fg.load(tmp_path / "top.yaml")
+    assert g.evaluate("ring").evaluate(0.0)[0] == pytest.approx(1.5)
