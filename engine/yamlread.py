@@ -133,7 +133,9 @@ def estimate_values(text: str) -> int:
 
 BULK_CHARS = 4096  # arrays shorter than this are left to the YAML parser
 _MARK = "\ufdd0"  # a Unicode noncharacter: printable in YAML, never in a real graph
-_ARRAY = re.compile(r"\[[0-9eE.,+\-\s\[\]]*\]")
+# a run of the characters a number array is made of, from a '[': greedy with nothing after
+# it, so it never backtracks (linear in the text); trimmed to its last ']' below
+_ARRAY = re.compile(r"\[[0-9eE.,+\-\s\[\]]*")
 _ARRAY_DEPTH = 4  # [[x, y, z], ...] and grids of them
 
 
@@ -159,6 +161,9 @@ def lift_number_arrays(text: str) -> tuple[str, Bulk]:
         span = m.group()
         if len(span) < BULK_CHARS:
             continue
+        span = span[: span.rfind("]") + 1]
+        if len(span) < BULK_CHARS:
+            continue
         if any(t.startswith("!") for t in text[max(0, m.start() - 200) : m.start()].split()[-2:]):
             continue  # a tag applies to the sequence, not to a placeholder
         depth = _bracket_depth(span)
@@ -171,7 +176,7 @@ def lift_number_arrays(text: str) -> tuple[str, Bulk]:
         mark = f"{_MARK}{len(bulk)}{_MARK}"
         bulk[mark] = (value, _count(value))
         pieces += [text[last : m.start()], mark, "\n" * span.count("\n")]
-        last = m.end()
+        last = m.start() + len(span)
     if not bulk:
         return text, bulk
     pieces.append(text[last:])

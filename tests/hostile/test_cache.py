@@ -112,3 +112,9 @@ def test_a_graph_recomputes_over_a_hostile_entry(tmp_path):
     g = graph()
     assert g.evaluate("b").n_faces == 6
     assert g.stats["b"].status == "computed"
+
+
+def test_a_description_full_of_escaped_quotes_is_a_miss(tmp_path):
+    text = '{"format": 1, "key": "' + '\\"' * 200_000  # never closed
+    _entry(tmp_path, {"meta": _npy(np.frombuffer(text.encode(), dtype=np.uint8))})
+    _miss(tmp_path)

@@ -212,3 +212,16 @@ def test_long_arrays_are_lifted_and_keep_their_lines(monkeypatch):
     assert len(bulk) == 1 and lifted.count("\n") == text.count("\n")
     with pytest.raises(fg.GraphError, match=r"h.yaml:5: unknown node type 'nope'"):
         fg.Graph.from_text(text, file="h.yaml")
+
+
+@pytest.mark.parametrize(
+    "points",
+    [
+        "[" * 200_000,  # unclosed: the array scan must not backtrack over it from every '['
+        "[1, 2, 3], " * 2_000 + "x",
+        "[" * 1000 + "1" + "]" * 1000,
+    ],
+)
+def test_pathological_arrays_are_refused_promptly(points):
+    with pytest.raises(fg.GraphError):
+        fg.Graph.from_text(f"formgraph: 1\nnodes:\n  p: {{type: points.list, points: {points}}}\n")
