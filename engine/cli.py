@@ -135,8 +135,10 @@ def parse_sets(graph: Any, items: Sequence[str]) -> dict[str, Any]:
         else:
             try:
                 value = load_value(text)  # YAML 1.2 numbers, as in the graph file
-            except yaml.YAMLError:
-                raise UsageError(f"--set {name}: cannot read {text!r}") from None
+            except (yaml.YAMLError, ValueError, TypeError, RecursionError) as exc:
+                shown = text if len(text) <= 40 else text[:37] + "..."
+                why = getattr(exc, "problem", None) or exc
+                raise UsageError(f"--set {name}: cannot read {shown!r}: {why}") from None
         out[name] = value
     return out
 

@@ -113,9 +113,12 @@ def load_value(text: str) -> Any:
     Raises
     ------
     yaml.YAMLError
-        For text that is not YAML.
+        For text that is not YAML, or too big or deep to be a value.
     """
     node = yaml.compose(text, Loader=Loader)
+    too_big = expansion_problem(node, Bulk(), 100_000, 64)
+    if too_big:
+        raise yaml.YAMLError(too_big)
     return None if node is None else construct(node)
 
 

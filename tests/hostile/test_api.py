@@ -160,3 +160,17 @@ def test_a_subgraph_param_follows_the_same_int_rule(tmp_path):
     )
     g = fg.load(tmp_path / "top.yaml")
     assert g.evaluate("ring").evaluate(0.0)[0] == pytest.approx(1.5)
+
+
+@pytest.mark.parametrize(
+    ("value", "why"),
+    [("[" * 900 + "]" * 900, "nested too deeply"), ("!!float abc", "'abc' is not a number")],
+)
+def test_set_refuses_hostile_yaml_values(tmp_path, capsys, value, why):
+    p = tmp_path / "v.yaml"
+    p.write_text(
+        "formgraph: 1\nparams:\n  v: [1, 2]\nnodes:\n  p: {type: points.circle, count: 3, "
+        "center: '=v'}\n"
+    )
+    assert cli.main(["run", str(p), "--no-cache", "--set", f"v={value}"]) == 2
+    assert why in capsys.readouterr().err
