@@ -33,7 +33,7 @@ from .registry import DEFAULT_BUDGET, NodeSpec, node_types
 from .run import NodeStat, _Run
 from .subgraph import Includes, SubgraphSpec, is_graph_type
 from .types import TypeMismatch, describe, type_by_name
-from .yamlio import MAX_BYTES, dump, parse
+from .yamlio import MAX_BYTES, MAX_DEPTH, dump, parse
 
 __all__ = ["Graph", "NodeStat", "load"]
 
@@ -207,7 +207,7 @@ class Graph:
             if b is not None and (isinstance(b, bool) or not isinstance(b, (int, float))):
                 raise ParamError(f"param '{name}': {bound} must be a number, got {describe(b)}")
         long_form = any(x is not None for x in (min, max, type)) or bool(doc)
-        default = _plain(default)
+        default = _plain(default, f"param '{name}'")
         p = ParamDef(name, default, None, type, min, max, doc, None, long_form)
         if type is not None:
             if not isinstance(type, str):
@@ -226,7 +226,9 @@ class Graph:
             what = "node name" if not isinstance(name, str) else "node type"
             bad = name if not isinstance(name, str) else type
             raise GraphError(f"add() takes a {what} (a string), got {describe(bad)}")
-        self._nodes[name] = NodeDef.make(name, type, {k: _plain(v) for k, v in inputs.items()})
+        self._nodes[name] = NodeDef.make(
+            name, type, {k: _plain(v, f"input '{k}' of '{name}'") for k, v in inputs.items()}
+        )
         self._checked = False
 
     def remove(self, name: str) -> None:
@@ -251,7 +253,7 @@ class Graph:
     def set_input(self, node: str, port: str, value: Any) -> None:
         """Change one input of a node as authored (a literal, wire or expression)."""
         nd = self._nodes[node]
-        value = _plain(value)
+        value = _plain(value, f"input '{port}' of '{node}'")
         if port == "repeat":  # not an input: the node's loop
             nd.set_repeat(value)
             self._checked = False
@@ -293,6 +295,14 @@ class Graph:
                         f"unknown param '{name}'"
                         f"{suggest(name, self._params)}; params are "
                         f"{', '.join(self._params) or 'none'}",
+                    )
+                )
+                continue
+            if _nesting(value) > MAX_DEPTH:
+                problems.append(
+                    Problem(
+                        Where(self.file_label, p.line),
+                        f"param '{name}': the value is nested more than {MAX_DEPTH} levels deep",
                     )
                 )
                 continue
@@ -424,15 +434,40 @@ def _check_budgets(budget: Any, memory_bytes: Any) -> None:
             )
 
 
-def _plain(value: Any) -> Any:
+def _nesting(value: Any) -> int:
+    """How deeply lists, tuples and dicts nest in ``value``, without recursion."""
+    deepest, stack = 0, [(value, 0)]
+    while stack:
+        v, d = stack.pop()
+        if isinstance(v, (list, tuple, dict)):
+            if d + 1 > MAX_DEPTH:
+                return d + 1  # deep enough to refuse: no need to walk the rest
+            deepest = max(deepest, d + 1)
+            stack.extend((c, d + 1) for c in (v.values() if isinstance(v, dict) else v))
+        elif isinstance(v, np.ndarray):
+            deepest = max(deepest, d + v.ndim)
+    return deepest
+
+
+def _plain(value: Any, what: str = "a value", depth: int = 0) -> Any:
     """Inputs given from Python as the YAML they save to: tuples and arrays become lists,
-    numpy numbers Python numbers (geometry objects stay as they are)."""
+    numpy numbers Python numbers (geometry objects stay as they are).
+
+    Raises
+    ------
+    GraphError
+        For a value nested deeper than a graph file may be.
+    """
+    if depth > MAX_DEPTH:
+        raise GraphError(f"{what} is nested more than {MAX_DEPTH} levels deep")
     if isinstance(value, np.ndarray):
+        if value.ndim > MAX_DEPTH:
+            raise GraphError(f"{what} is nested more than {MAX_DEPTH} levels deep")
         return value.tolist()
     if isinstance(value, np.generic):
         return value.item()
     if isinstance(value, (list, tuple)):
-        return [_plain(v) for v in value]
+        return [_plain(v, what, depth + 1) for v in value]
     if isinstance(value, dict):
-        return {k: _plain(v) for k, v in value.items()}
+        return {k: _plain(v, what, depth + 1) for k, v in value.items()}
     return value

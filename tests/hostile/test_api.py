@@ -174,3 +174,22 @@ def test_set_refuses_hostile_yaml_values(tmp_path, capsys, value, why):
     )
     assert cli.main(["run", str(p), "--no-cache", "--set", f"v={value}"]) == 2
     assert why in capsys.readouterr().err
+
+
+def _deep(levels: int) -> list:
+    value: list = []
+    for _ in range(levels):
+        value = [value]
+    return value
+
+
+def test_deeply_nested_python_values_are_graph_errors():
+    g = fg.Graph()
+    with pytest.raises(fg.GraphError, match="input 'points' of 'p' is nested more than 64"):
+        g.add("p", "points.list", points=_deep(5000))
+    with pytest.raises(fg.GraphError, match="param 'v' is nested more than 64"):
+        g.add_param("v", _deep(5000))
+    g.add_param("v", [1, 2])
+    g.add("c", "points.circle", count=3, center="=v")
+    with pytest.raises(fg.ParamError, match="param 'v': the value is nested more than 64"):
+        g.evaluate("c", v=_deep(5000))
