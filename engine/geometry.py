@@ -114,6 +114,14 @@ class Geometry:
         """What determines this value, for content hashes (its state, by default)."""
         return self.state()
 
+    def __reduce_ex__(self, protocol: Any) -> Any:
+        # pickled (e.g. to a worker process) as its state and rebuilt through the
+        # constructor, so the copy is validated and as frozen as the original
+        name = type(self).__name__
+        if STORABLE.get(name) is type(self):
+            return from_state, (name, self.state())
+        return super().__reduce_ex__(protocol)
+
 
 # ---------------------------------------------------------------------------------- points
 

@@ -202,3 +202,16 @@ def test_a_param_out_of_range_by_a_huge_number_is_a_param_error():
     g = fg.Graph.from_text(text, file="h.yaml")
     with pytest.raises(fg.ParamError, match="must be <= 9, got an integer of 401 digits"):
         g.evaluate("p", n=10**400)
+
+
+def test_a_pickled_value_comes_back_frozen():
+    import pickle
+
+    c = fg.NurbsCurve([[0, 0], [1, 1], [2, 0]], 2, [0, 0, 0, 1, 1, 1], [1, 2, 1])
+    m = fg.Mesh([[0, 0], [1, 0], [0, 1]], [[0, 1, 2]])
+    for value in (fg.Points([[1, 2, 3]]), c, m):
+        copy = pickle.loads(pickle.dumps(value))
+        assert type(copy) is type(value)
+        for a, b in zip(_arrays(copy), _arrays(value), strict=True):
+            assert np.array_equal(a, b)
+            _cannot_be_made_writable(a)
