@@ -123,11 +123,12 @@ def load_value(text: str) -> Any:
 
 
 def estimate_values(text: str) -> int:
-    """A cheap over-estimate of how many values the text holds, counted on its characters.
+    """About how many values the text holds, counted on its characters (a refusal only
+    when it is twice the limit; the exact count comes after composing).
 
-    Every value but the first is introduced by a line break, a ``[``, ``{``, ``,`` or
-    ``: ``; each collection also closes. Counting those costs a few milliseconds for the
-    largest file allowed, while building it could take minutes.
+    Nearly every value is introduced by a line break, a ``[``, ``{``, ``,`` or ``: ``, and
+    each collection also closes. Counting those costs a few milliseconds for the largest
+    file allowed, while building it could take minutes.
     """
     return 1 + sum(text.count(c) for c in ("\n", "[", "{", ",", ": ", "]", "}"))
 
@@ -156,7 +157,7 @@ def lift_number_arrays(text: str) -> tuple[str, Bulk]:
     string), and the caller composes the original text again when one did not.
     """
     bulk = Bulk()
-    if len(text) < BULK_CHARS:
+    if len(text) < BULK_CHARS or _MARK in text:  # the text's own noncharacters stay its own
         return text, bulk
     pieces: list[str] = []
     last = 0

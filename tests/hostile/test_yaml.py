@@ -182,6 +182,7 @@ A = "[[1, 2, 3], [4.5, -6e-1, 7E+2],\n   [0, -0, 1e400]]"  # spans lines on purp
         f"nodes:\n  b: &b {{type: points.list, points: {A}}}\n  p: {{<<: *b}}\n  q: {{type: x}}\n",
         "nodes:\n  p: {type: points.list, points: [           \n\n     ]}\n  q: {type: x}\n",
         f"nodes:\n  p: {{type: points.list, points: {A}, points: {A}}}\n",
+        f"description: \ufdd00\ufdd0\nnodes:\n  p: {{type: points.list, points: {A}}}\n",
     ],
 )
 def test_lifted_number_arrays_read_exactly_as_yaml_would(monkeypatch, body):
