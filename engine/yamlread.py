@@ -144,7 +144,7 @@ _ARRAY_DEPTH = 4  # [[x, y, z], ...] and grids of them
 
 
 class Bulk(dict):
-    """Placeholder text -> (the array it stands for, how many values it holds)."""
+    """Placeholder text -> (the array it stands for, how many values it holds, its depth)."""
 
 
 def lift_number_arrays(text: str) -> tuple[str, Bulk]:
@@ -178,7 +178,7 @@ def lift_number_arrays(text: str) -> tuple[str, Bulk]:
         except (ValueError, RecursionError):
             continue
         mark = f"{_MARK}{len(bulk)}{_MARK}"
-        bulk[mark] = (value, _count(value))
+        bulk[mark] = (value, _count(value), depth)
         pieces += [text[last : m.start()], mark, "\n" * span.count("\n")]
         last = m.start() + len(span)
     if not bulk:
@@ -241,13 +241,13 @@ def expansion_problem(
     stack: list[tuple[yaml.Node, int, bool]] = [] if root is None else [(root, 0, False)]
     while stack:
         node, depth, is_key = stack.pop()
-        weight = 1
+        weight, inner = 1, 0
         if bulk and isinstance(node, yaml.ScalarNode) and _MARK in node.value:
             # a whole plain value ("" is libyaml's plain style), never a key
             if node.value not in bulk or node.style not in (None, "") or is_key:
                 raise ValueError("a placeholder inside other text")
             found.add(node.value)
-            weight = bulk[node.value][1]
+            _, weight, inner = bulk[node.value]
         count += weight
         if id(node) not in distinct:
             distinct.add(id(node))
@@ -263,7 +263,7 @@ def expansion_problem(
                 f"the YAML's aliases expand to more than {min(count, max_values):,} values "
                 f"(aliases of aliases?); refusing to read it"
             )
-        if depth > max_depth:
+        if depth + inner > max_depth:  # a lifted array's own levels count too
             return f"the YAML is nested too deeply (more than {max_depth} levels)"
         if isinstance(node, yaml.SequenceNode):
             stack.extend((v, depth + 1, False) for v in node.value)

@@ -226,3 +226,15 @@ def test_long_arrays_are_lifted_and_keep_their_lines(monkeypatch):
 def test_pathological_arrays_are_refused_promptly(points):
     with pytest.raises(fg.GraphError):
         fg.Graph.from_text(f"formgraph: 1\nnodes:\n  p: {{type: points.list, points: {points}}}\n")
+
+
+@pytest.mark.parametrize("levels", [58, 59, 60, 61, 62])
+def test_a_lifted_array_nests_as_deep_as_it_is(monkeypatch, levels):
+    body = "params:\n  x: " + "{a: " * levels + A + "}" * levels + "\nnodes: {}\n"
+
+    def problems(bulk_chars: int) -> list[str]:
+        monkeypatch.setattr(yamlread, "BULK_CHARS", bulk_chars)
+        return [str(p) for p in yamlio.parse("formgraph: 1\n" + body, "h.yaml").problems]
+
+    assert problems(10**9) == problems(8)
+    assert len(yamlread.lift_number_arrays("formgraph: 1\n" + body)[1]) == 1  # it was lifted
