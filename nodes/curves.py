@@ -280,7 +280,11 @@ def resample(
 
 @node("curves.offset", version=1)
 def offset(
-    curve: Curve, distance: float, miter_limit: Annotated[float, Range(min=1)] = 4.0
+    curve: Curve,
+    distance: float,
+    miter_limit: Annotated[float, Range(min=1)] = 4.0,
+    *,
+    ctx: Context,
 ) -> NurbsCurve:
     """The bisector offset of a polyline in the XY plane (mitred corners), as a polyline.
 
@@ -293,8 +297,11 @@ def offset(
     (use curves.resample first to choose the resolution).
 
     This is a local construction: where the distance exceeds the local size of the shape
-    the result loops over itself; ``offset.marching_squares`` is the node that resolves
-    self-intersections (and islands and holes).
+    the result loops over itself (a warning says how many edges folded);
+    ``offset.marching_squares`` is the node that resolves self-intersections (and islands
+    and holes). An inward offset of a closed curve past its inradius, where nothing is
+    left, is an error pointing there (the construction would turn the polygon inside out:
+    an 8-gon of radius 1 offset by -2 would come out with radius 1.16).
 
     Parameters
     ----------
@@ -311,7 +318,27 @@ def offset(
         p, closed = np.asarray(curve.display_points()), curve.closed
         if closed:
             p = p[:-1]
-    out = _kernel(
-        "curve", kc.bisector_offset, p, closed=closed, distance=distance, miter_limit=miter_limit
+    out, source = _kernel(
+        "curve",
+        kc.bisector_offset,
+        p,
+        closed=closed,
+        distance=distance,
+        miter_limit=miter_limit,
+        return_source=True,
     )
+    inside_out, folded = kc.offset_folds(p, out, source, closed, inward=closed and distance < 0)
+    if inside_out:
+        raise InputError(
+            "distance",
+            f"an inward offset by {abs(distance):g} turns the curve inside out: the distance "
+            "is past the curve's inradius (nothing is left inside) or past half its width "
+            "somewhere, where the bisector offset cannot be right; offset.marching_squares "
+            "gives the true offset (no loops when nothing is left)",
+        )
+    if folded:
+        ctx.warn(
+            f"the offset folds over itself at {folded} edge(s): the distance exceeds the "
+            "local size of the curve there; offset.marching_squares resolves the loops"
+        )
     return _polyline(out, closed=closed)
