@@ -18,7 +18,16 @@ from .errors import ExpressionError, Problem, Where
 from .expr import compile_expression
 from .model import Expr, Input, Items, Literal, NodeDef, ParamDef, Wire
 from .registry import NodeSpec, node_types
-from .types import Kind, PortType, TypeMismatch, Vec3, as_list, describe, number_text
+from .types import (
+    Kind,
+    PortType,
+    TypeMismatch,
+    Vec3,
+    as_list,
+    describe,
+    loop_item_problem,
+    number_text,
+)
 
 
 def suggest(name: str, options: Any) -> str:
@@ -311,6 +320,9 @@ def _check_repeat(
             return [f"repeat '{name}': a count must be >= 0, got {value}"], _Loop(name)
         return [], _Loop(name, PortType((Kind(int),)))
     if isinstance(value, list):
+        problem = loop_item_problem(value)
+        if problem:
+            return [f"repeat '{name}': {problem}"], _Loop(name)
         return [], _Loop(name, _item_type(value))
     return [f"repeat '{name}' runs over {how}, got {describe(value)}"], _Loop(name)
 

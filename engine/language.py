@@ -27,6 +27,7 @@ from .geometry import Points
 from .model import Expr, Input, Items, Literal, NodeDef, Wire, wires_of
 from .registry import NodeSpec
 from .subgraph import Includes, SubgraphSpec
+from .types import loop_item_problem
 
 __all__ = ["LanguageRun", "child_graph", "file_stamp", "input_names", "node_spec_of", "reads_loop"]
 
@@ -136,6 +137,9 @@ class LanguageRun:
                 raise GraphError([Problem(where, f"a repeat count must be >= 0, got {value}")])
             count = value
         elif isinstance(value, (list, tuple)):
+            problem = loop_item_problem(value)
+            if problem:
+                raise GraphError([Problem(where, f"repeat '{r.name}': {problem}")])
             count = len(value)
         else:
             raise GraphError(

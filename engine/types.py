@@ -242,6 +242,31 @@ def describe(value: Any) -> str:
     return type(value).__name__
 
 
+def loop_item_problem(items: Any) -> str | None:
+    """Why a ``repeat:`` list cannot feed expressions (a bool or a string among its items).
+
+    A loop's items reach the node's expressions, which compute on numbers only; a bool
+    would silently count as 1 or 0 there, as it would nowhere else in a graph.
+    """
+    if not isinstance(items, (list, tuple)):
+        return None
+    for k, item in enumerate(items):
+        stack = [item]
+        while stack:
+            v = stack.pop()
+            if isinstance(v, (list, tuple)):
+                stack.extend(v)
+            elif isinstance(v, (bool, np.bool_, str)):
+                return (
+                    f"item {k} is {describe(item)}: a loop's items are numbers, points or "
+                    "geometry (write 1 and 0, not true and false)"
+                    if not isinstance(v, str)
+                    else f"item {k} is {describe(item)}: a loop's items are numbers, points "
+                    "or geometry, since its name is read by expressions"
+                )
+    return None
+
+
 def _coerce_kind(k: Kind, value: Any) -> Any:
     if k.is_list:
         if isinstance(value, (list, tuple)):
@@ -327,8 +352,11 @@ def _vec3(value: Any) -> np.ndarray:
         a = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError, OverflowError):
         raise TypeMismatch(f"expected [x, y] or [x, y, z], got {describe(value)}") from None
-    if a.shape not in ((2,), (3,)) or not np.all(np.isfinite(a)):
+    if a.shape not in ((2,), (3,)):
         raise TypeMismatch(f"expected [x, y] or [x, y, z], got {describe(value)}")
+    if not np.all(np.isfinite(a)):
+        shown = ", ".join(f"{x:g}" for x in a)
+        raise TypeMismatch(f"expected [x, y] or [x, y, z] finite numbers, got [{shown}]")
     return frozen_array(np.append(a, 0.0) if a.size == 2 else a)
 
 

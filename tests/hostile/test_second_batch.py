@@ -1,0 +1,185 @@
+"""Hostile use of the second batch: repeat:, subgraph files, solids. Each case ends as a
+located sentence (file, line, node, input) or a correct result."""
+
+from __future__ import annotations
+
+import os
+import warnings
+from pathlib import Path
+
+import pytest
+
+import formgraph as fg
+from formgraph import cli
+
+
+def _graph(text: str) -> fg.Graph:
+    return fg.Graph.from_text("formgraph: 1\nnodes:\n" + text, file="h.yaml")
+
+
+# ---------------------------------------------------------------------------- repeat:
+
+
+@pytest.mark.parametrize(
+    ("items", "what"),
+    [
+        ("[true, false]", "item 0 is bool True"),
+        ("[1, true]", "item 1 is bool True"),
+        ("[[0, 0, 0], [1, false, 0]]", "item 1 is list of 3"),
+        ("[a, b]", "item 0 is string 'a'"),
+    ],
+)
+def test_a_loop_over_bools_or_strings_is_refused(items, what):
+    text = f"  c: {{type: nurbs.circle, repeat: {{i: {items}}}, radius: 1}}\n"
+    with pytest.raises(fg.GraphError, match=rf"h.yaml:3: node 'c', input 'repeat': .*{what}"):
+        _graph(text).evaluate("c")
+
+
+def test_a_loop_over_bools_is_refused_in_python_too():
+    g = fg.Graph()
+    g.add("c", "nurbs.circle", repeat={"i": [True, False]}, radius="=1 + i")
+    with pytest.raises(fg.GraphError, match="node 'c', input 'repeat': .*write 1 and 0"):
+        g.evaluate("c")
+
+
+def test_a_loop_over_points_and_numbers_still_runs():
+    g = fg.Graph()
+    g.add("c", "nurbs.circle", repeat={"p": [[0, 0, 0], [1, 2, 3]]}, radius=1, center="=p")
+    assert len(g.evaluate("c")) == 2
+
+
+@pytest.mark.parametrize("count", ["1e9", "100000000000000000000000000000000000000000"])
+def test_a_huge_loop_is_over_the_budget(count):
+    text = f"  c: {{type: nurbs.circle, repeat: {{i: {count}}}, radius: '=1 + i'}}\n"
+    with pytest.raises(fg.BudgetError, match="node 'c', input 'repeat': .*over the budget"):
+        _graph(text).evaluate("c")
+
+
+# ---------------------------------------------------------------------------- subgraphs
+
+
+def _run(folder: Path, name: str, capsys) -> tuple[int, str]:
+    code = cli.main(["run", str(folder / name)])
+    return code, capsys.readouterr().err
+
+
+def test_a_subgraph_path_with_a_nul_byte_is_a_sentence(tmp_path, capsys):
+    (tmp_path / "top.yaml").write_text('formgraph: 1\nnodes:\n  n: {type: "a\\0.yaml"}\n')
+    code, err = _run(tmp_path, "top.yaml", capsys)
+    assert code == 1
+    assert "top.yaml:3: node 'n': cannot use the subgraph path" in err and "NUL" in err
+    assert "internal error" not in err
+
+
+def test_a_subgraph_path_through_a_symlink_loop_is_a_sentence(tmp_path, capsys):
+    os.symlink("b.yaml", tmp_path / "a.yaml")
+    os.symlink("a.yaml", tmp_path / "b.yaml")
+    (tmp_path / "top.yaml").write_text("formgraph: 1\nnodes:\n  n: {type: a.yaml}\n")
+    code, err = _run(tmp_path, "top.yaml", capsys)
+    assert code == 1 and "top.yaml:3: node 'n'" in err and "internal error" not in err
+
+
+def test_a_symlink_out_of_the_folder_is_refused(tmp_path, capsys):
+    top, outside = tmp_path / "top", tmp_path / "outside"
+    top.mkdir()
+    outside.mkdir()
+    (outside / "o.yaml").write_text(
+        "formgraph: 1\noutputs: {c: '@c'}\nnodes:\n  c: {type: nurbs.circle, radius: 1}\n"
+    )
+    os.symlink(outside / "o.yaml", top / "link.yaml")
+    os.symlink(outside, top / "dir")
+    for ref in ("link.yaml", "dir/o.yaml"):
+        (top / "t.yaml").write_text(f"formgraph: 1\nnodes:\n  n: {{type: {ref}}}\n")
+        code, err = _run(top, "t.yaml", capsys)
+        assert code == 1 and "t.yaml:3: node 'n'" in err and "leaves the graph's folder" in err
+
+
+def test_two_files_that_include_each_other_are_a_cycle(tmp_path, capsys):
+    (tmp_path / "a.yaml").write_text(
+        "formgraph: 1\noutputs: {c: '@x'}\nnodes:\n  x: {type: b.yaml}\n"
+    )
+    (tmp_path / "b.yaml").write_text(
+        "formgraph: 1\noutputs: {c: '@y'}\nnodes:\n  y: {type: a.yaml}\n"
+    )
+    (tmp_path / "top.yaml").write_text("formgraph: 1\nnodes:\n  n: {type: a.yaml}\n")
+    code, err = _run(tmp_path, "top.yaml", capsys)
+    assert code == 1
+    assert "b.yaml:4: node 'y': include cycle: a.yaml -> b.yaml -> a.yaml" in err
+
+
+# ---------------------------------------------------------------------------- solids
+
+
+def test_a_non_finite_vector_says_so():
+    with pytest.raises(fg.GraphError, match=r"input 'center': .*finite numbers, got \[nan, 0, 0\]"):
+        _graph("  s: {type: mesh.sphere, radius: 1, center: [.nan, 0, 0]}\n").evaluate("s")
+
+
+@pytest.mark.parametrize("tolerance", [1e-320, 1e-200, 5e-324])
+def test_a_tiny_weld_tolerance_is_called_too_small(tolerance):
+    # the cell numbers used to wrap around int64 and the message said "too coarse"
+    g = fg.Graph()
+    g.add("s", "mesh.sphere", radius=1e10, segments=400)
+    g.add("w", "mesh.weld", mesh="@s", tolerance=tolerance)
+    with pytest.raises(fg.NodeError, match=r"input 'tolerance'.*too small.*0 merges exact"):
+        g.evaluate("w")
+
+
+def test_weld_tolerance_zero_merges_only_exact_duplicates():
+    g = fg.Graph()
+    g.add("b", "mesh.box")
+    g.add("w", "mesh.weld", mesh="@b", tolerance=0)
+    assert g.evaluate("w").n_vertices == 8
+
+
+@pytest.mark.parametrize(
+    ("vertices", "faces"),
+    [
+        # a tetrahedron pair pinched at one point (two vertices, one position)
+        (
+            [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [0, 0, 0], [-1, 0, 0], [0, -1, 0]]
+            + [[0, 0, -1]],
+            [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3], [4, 5, 6], [4, 7, 5], [4, 6, 7]]
+            + [[5, 7, 6]],
+        ),
+        # every vertex at one point: a closed, oriented, zero-volume tetrahedron
+        ([[0, 0, 0]] * 4, [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]]),
+    ],
+)
+def test_degenerate_solids_into_booleans_give_true_volumes(vertices, faces):
+    g = fg.Graph()
+    g.add("b", "mesh.box")
+    g.add("a", "mesh.from_faces", vertices=vertices, faces=faces)
+    g.add("d", "mesh.boolean", a="@a", b="@b", operation="difference")
+    g.add("u", "mesh.union", meshes=["@a", "@b"])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", fg.FormgraphWarning)  # "the difference is empty"
+        d = g.evaluate("d")
+        u = g.evaluate("u")
+    # the tetrahedra of the pair stick out of the unit box by 1/16 each (1/6 - 5/48)
+    outside = 0.0 if d.n_faces == 0 else 1 / 8
+    assert d.n_faces == 0 or (d.is_watertight and d.volume == pytest.approx(outside))
+    assert u.is_watertight and u.volume == pytest.approx(1.0 + outside)
+
+
+def test_an_open_mesh_into_a_boolean_is_a_sentence():
+    g = fg.Graph()
+    g.add("b", "mesh.box")
+    g.add("t", "mesh.cylinder", radius=0.3, height=2, caps=False)
+    g.add("d", "mesh.boolean", a="@b", b="@t", operation="difference")
+    with pytest.raises(fg.NodeError, match=r"input 'b'.*not a closed solid: it has \d+ open"):
+        g.evaluate("d")
+
+
+def test_cap_of_a_non_manifold_boundary_vertex_caps_each_fan():
+    # two triangles touching at vertex 0: its boundary passes vertex 0 twice
+    g = fg.Graph()
+    g.add(
+        "a",
+        "mesh.from_faces",
+        vertices=[[0, 0, 0], [1, 0, 0], [1, 1, 0], [-1, 0, 0], [-1, -1, 0]],
+        faces=[[0, 1, 2], [0, 3, 4]],
+    )
+    g.add("c", "mesh.cap", mesh="@a")
+    m = g.evaluate("c")
+    assert m.n_faces == 4 and m.is_watertight
