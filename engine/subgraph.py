@@ -127,7 +127,12 @@ class Includes:
                     f"{suffix}",
                 )
             ]
-        path = (base_dir / text).resolve()
+        try:
+            if "\0" in text:
+                raise ValueError("it contains a NUL character")
+            path = (base_dir / text).resolve()
+        except (OSError, RuntimeError, ValueError) as exc:  # NUL, a symlink loop, too long
+            return None, [Problem(where, f"cannot use the subgraph path {text!r}: {exc}{suffix}")]
         if not path.is_relative_to(self.root):
             return None, [
                 Problem(
