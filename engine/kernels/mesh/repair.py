@@ -41,12 +41,18 @@ def weld_tolerance(vertices: np.ndarray) -> float:
 def _close_pairs(v: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
     """All pairs ``i < j`` with ``|v[i] - v[j]| <= tol`` (cells of side ``tol``)."""
     lo = v.min(axis=0)
-    q = np.floor((v - lo) / tol).astype(np.int64)
-    dims = q.max(axis=0) + 3  # room for the -1 / +1 neighbours
-    if float(np.prod(dims.astype(np.float64))) >= 2.0**62:
+    # the grid is checked in floats first: a tiny tolerance makes cell numbers that do not
+    # fit an int64 (or are infinite), and the cast would silently wrap them
+    with np.errstate(over="ignore"):
+        qf = np.floor((v - lo) / tol)
+        grid = float(np.prod(qf.max(axis=0) + 3))  # room for the -1 / +1 neighbours
+    if not np.isfinite(grid) or grid >= 2.0**62:
         raise ValueError(
-            f"weld tolerance {tol:g} is too small for a mesh this large (cell grid overflow)"
+            f"weld tolerance {tol:g} is too small for a mesh this large (its cells would "
+            "number more than 2^62); 0 merges exact duplicates only"
         )
+    q = qf.astype(np.int64)
+    dims = q.max(axis=0) + 3
     q += 1
     key = (q[:, 0] * dims[1] + q[:, 1]) * dims[2] + q[:, 2]
     cells, cell_of, counts = np.unique(key, return_inverse=True, return_counts=True)
