@@ -31,7 +31,62 @@ from .scene import Scene
 __all__ = ["ScreenshotWatcher", "Watcher", "display_problem", "watch"]
 
 
-class Watcher:
+class _Watched:
+    """What both watchers share: the files to watch, their stamps, and loading a version."""
+
+    def __init__(
+        self,
+        path: str | os.PathLike[str],
+        node: str | Iterable[str] | None,
+        sets: Sequence[str],
+        out_dir: str | os.PathLike[str],
+        budget: int,
+        layout: str,
+        edges: bool | None,
+    ):
+        self.path = Path(path)
+        self.node = node
+        self.sets = list(sets)
+        self.out_dir = out_dir
+        self.budget = budget
+        self.layout = layout
+        self.edges = edges
+        self.stamp: tuple[Any, ...] | None = None
+        self.files: list[Path] = [self.path]  # the graph's file and its subgraph files
+
+    def _stamp(self) -> tuple[Any, ...] | None:
+        return _stamps(self.path, self.files)
+
+    def poll(self) -> bool | None:
+        """Reload if a watched file changed since the last look; None when none did."""
+        stamp = self._stamp()
+        if stamp is None or stamp == self.stamp:
+            return None
+        return self.reload()
+
+    def reload(self) -> bool:
+        raise NotImplementedError
+
+    def _load(self, memory: Any) -> tuple[Any, dict[str, Any]]:
+        """The file's graph (sharing ``memory``, the previous version's cache) and the
+        ``--set`` params read against it; the files to watch become its files."""
+        from formgraph.cli import parse_sets
+
+        graph = load(self.path, out_dir=self.out_dir, budget=self.budget)
+        self.files = [self.path, *graph.files[1:]]
+        self.stamp = self._stamp()
+        if memory is not None:
+            graph.memory = memory  # an edit recomputes what it reaches
+        return graph, parse_sets(graph, self.sets)
+
+    def _watch_files_of(self, exc: Exception) -> None:
+        """A broken subgraph file is watched too."""
+        if getattr(exc, "files", None):
+            self.files = [self.path, *exc.files[1:]]  # type: ignore[attr-defined]
+            self.stamp = self._stamp()
+
+
+class Watcher(_Watched):
     """A graph file drawn in a plotter and redrawn when the file changes.
 
     Parameters
@@ -61,17 +116,9 @@ class Watcher:
         layout: str = "overlay",
         edges: bool | None = None,
     ):
-        self.path = Path(path)
-        self.layout = layout
-        self.edges = edges
-        self.node = node
+        super().__init__(path, node, sets, out_dir, budget, layout, edges)
         self.plotter = plotter
-        self.sets = list(sets)
-        self.out_dir = out_dir
-        self.budget = budget
         self.session: Session | None = None
-        self.stamp: tuple[Any, ...] | None = None
-        self.files: list[Path] = [self.path]  # the graph's file and its subgraph files
         self.reloads = 0
         self._blank: Scene | None = None  # shows the error of a broken first version
 
@@ -79,33 +126,19 @@ class Watcher:
     def scene(self) -> Any:
         return self.session.scene if self.session is not None else None
 
-    def _stamp(self) -> tuple[Any, ...] | None:
-        return _stamps(self.path, self.files)
-
-    def poll(self) -> bool | None:
-        """Reload if the file changed since the last look; None when it did not."""
-        stamp = self._stamp()
-        if stamp is None or stamp == self.stamp:
-            return None
-        return self.reload()
-
     def reload(self) -> bool:
         """Read, check and evaluate the file again and redraw.
 
         Returns True when the new version is drawn; False when it is broken, in which case
         its error is shown in the window and on stderr and the last good geometry stays.
         """
-        from formgraph.cli import UsageError, parse_sets
+        from formgraph.cli import UsageError
 
         self.stamp = self._stamp()
         self.reloads += 1
         try:
-            graph = load(self.path, out_dir=self.out_dir, budget=self.budget)
-            self.files = [self.path, *graph.files[1:]]
-            self.stamp = self._stamp()
-            if self.session is not None and self.session.graph is not None:
-                graph.memory = self.session.graph.memory  # an edit recomputes what it reaches
-            params = parse_sets(graph, self.sets)
+            previous = self.session.graph if self.session is not None else None
+            graph, params = self._load(previous.memory if previous is not None else None)
             if self.session is None:
                 self.session = Session(
                     graph,
@@ -120,9 +153,7 @@ class Watcher:
             else:
                 self.session.replace_graph(graph, params)
         except (FormgraphError, UsageError) as exc:
-            if getattr(exc, "files", None):  # a broken subgraph file is watched too
-                self.files = [self.path, *exc.files[1:]]
-                self.stamp = self._stamp()
+            self._watch_files_of(exc)
             self._report(str(exc))
             return False
         except Exception as exc:  # a bug of ours must not close the designer's window
@@ -228,7 +259,7 @@ def display_problem() -> str | None:
     return None
 
 
-class ScreenshotWatcher:
+class ScreenshotWatcher(_Watched):
     """Watch a graph file without a window: a PNG and a status line per good version.
 
     Each change is loaded, checked and evaluated (sharing the memory cache with the
@@ -263,47 +294,24 @@ class ScreenshotWatcher:
         out: Any = None,
         err: Any = None,
     ):
-        self.path = Path(path)
+        super().__init__(path, node, sets, out_dir, budget, layout, edges)
         self.screenshot = Path(screenshot)
-        self.node = node
-        self.sets = list(sets)
-        self.out_dir = out_dir
-        self.budget = budget
         self.size = size
-        self.layout = layout
-        self.edges = edges
         self.out = out if out is not None else sys.stdout
         self.err = err if err is not None else sys.stderr
-        self.stamp: tuple[Any, ...] | None = None
-        self.files: list[Path] = [self.path]  # the graph's file and its subgraph files
         self.memory: Any = None  # the cache shared by successive versions
         self.written = 0  # PNGs written
         self.last_error: str | None = None
 
-    def _stamp(self) -> tuple[Any, ...] | None:
-        return _stamps(self.path, self.files)
-
-    def poll(self) -> bool | None:
-        """Render if the file changed since the last look; None when it did not."""
-        stamp = self._stamp()
-        if stamp is None or stamp == self.stamp:
-            return None
-        return self.reload()
-
     def reload(self) -> bool:
         """Load, evaluate and render the file once; True when a new PNG was written."""
-        from formgraph.cli import UsageError, parse_sets
+        from formgraph.cli import UsageError
 
         from .entry import make_plotter
 
         self.stamp = self._stamp()
         try:
-            graph = load(self.path, out_dir=self.out_dir, budget=self.budget)
-            self.files = [self.path, *graph.files[1:]]
-            self.stamp = self._stamp()
-            if self.memory is not None:
-                graph.memory = self.memory
-            params = parse_sets(graph, self.sets)
+            graph, params = self._load(self.memory)
             views = 1
             if self.layout == "side":
                 from .entry import view_count
@@ -327,9 +335,7 @@ class ScreenshotWatcher:
             finally:
                 plotter.close()
         except (FormgraphError, UsageError) as exc:
-            if getattr(exc, "files", None):  # a broken subgraph file is watched too
-                self.files = [self.path, *exc.files[1:]]
-                self.stamp = self._stamp()
+            self._watch_files_of(exc)
             return self._failed(str(exc))
         except Exception as exc:  # a bug of ours must not end the watch
             return self._failed(f"internal error: {type(exc).__name__}: {exc}")
