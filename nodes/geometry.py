@@ -24,6 +24,7 @@ from formgraph.geometry import (
     ParametricSurface,
     Points,
     Surface,
+    frozen_array,
 )
 from formgraph.kernels.geometry import affine, instancing
 from formgraph.kernels.mesh import meshops
@@ -235,17 +236,16 @@ def mesh_copy_to_points(
 
 def _valid_mesh(v: np.ndarray, fi: np.ndarray, fo: np.ndarray) -> Mesh:
     """A Mesh of fresh arrays that are valid by construction (copies of a valid mesh's
-    faces, shifted): frozen in place instead of copied and validated again, which for
-    10,000 copies would cost more than building them."""
+    faces, shifted): frozen (one copy into an immutable buffer, so no one can make them
+    writable again) but not validated again, which for 10,000 copies would cost more than
+    building them."""
     out = Mesh.__new__(Mesh)
     for name, a, dtype in (
         ("vertices", v, np.float64),
         ("face_indices", fi, np.int64),
         ("face_offsets", fo, np.int64),
     ):
-        a = np.ascontiguousarray(a, dtype=dtype)
-        a.flags.writeable = False
-        object.__setattr__(out, name, a)
+        object.__setattr__(out, name, frozen_array(a, dtype))
     return out
 
 

@@ -7,6 +7,7 @@ import os
 import warnings
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import formgraph as fg
@@ -183,3 +184,26 @@ def test_cap_of_a_non_manifold_boundary_vertex_caps_each_fan():
     g.add("c", "mesh.cap", mesh="@a")
     m = g.evaluate("c")
     assert m.n_faces == 4 and m.is_watertight
+
+
+@pytest.mark.parametrize(
+    ("type_", "inputs"),
+    [
+        ("mesh.copy_to_points", {"mesh": "@b", "points": [[0, 0, 0], [3, 0, 0]]}),
+        ("mesh.copy_to_points", {"mesh": "@b", "points": []}),
+        ("mesh.weld", {"mesh": "@b"}),
+        ("mesh.cap", {"mesh": "@b"}),
+        ("mesh.union", {"meshes": ["@b"]}),
+        ("geometry.transform", {"geometry": "@b", "scale": 2}),
+    ],
+)
+def test_new_nodes_give_arrays_that_cannot_be_made_writable(type_, inputs):
+    g = fg.Graph()
+    g.add("b", "mesh.box")
+    g.add("x", type_, **inputs)
+    m = g.evaluate("x")
+    for a in (m.vertices, m.face_indices, m.face_offsets):
+        while isinstance(a, np.ndarray):
+            with pytest.raises(ValueError):
+                a.flags.writeable = True
+            a = a.base
