@@ -353,24 +353,7 @@ def cmd_watch(args: argparse.Namespace) -> int:
     for item in args.set:
         if "=" not in item:
             raise UsageError(f"--set takes NAME=VALUE, got {item!r}")
-    if args.screenshot:
-        watcher = viewer.ScreenshotWatcher(
-            args.graph,
-            args.screenshot,
-            nodes,
-            sets=args.set,
-            out_dir=args.out,
-            budget=args.budget,
-            size=size,
-            layout=args.layout,
-            edges=edges,
-        )
-        watcher.run(interval=args.interval)
-        return 0
-    _no_window("watch", args)
-    viewer.watch(
-        args.graph,
-        node=nodes,
+    options = dict(
         sets=args.set,
         out_dir=args.out,
         budget=args.budget,
@@ -378,6 +361,13 @@ def cmd_watch(args: argparse.Namespace) -> int:
         layout=args.layout,
         edges=edges,
     )
+    if args.screenshot:
+        viewer.ScreenshotWatcher(args.graph, args.screenshot, nodes, **options).run(
+            interval=args.interval
+        )
+        return 0
+    _no_window("watch", args)
+    viewer.watch(args.graph, node=nodes, **options)
     return 0
 
 
