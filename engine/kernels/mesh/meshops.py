@@ -11,6 +11,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from .halfedge import HalfEdges, build_halfedges
+from .measure import face_vectors
 from .polygon import WorkLimitError, triangulate_polygon  # noqa: F401 (re-exported)
 
 _BATCH_UP_TO = 32  # concave faces up to this size are clipped together (O(k^3) each)
@@ -232,14 +233,7 @@ def face_normals(
     (n_faces, 3) float64
         Zero for a face of zero area.
     """
-    v = np.asarray(vertices, dtype=np.float64)
-    fi = np.asarray(face_indices, dtype=np.int64)
-    fo = np.asarray(face_offsets, dtype=np.int64)
-    if fo.size < 2:
-        return np.zeros((0, 3))
-    nxt = np.arange(1, fi.size + 1)
-    nxt[fo[1:] - 1] = fo[:-1]
-    n = np.add.reduceat(np.cross(v[fi], v[fi[nxt]]), fo[:-1], axis=0)
+    n = face_vectors(vertices, face_indices, face_offsets)
     length = np.linalg.norm(n, axis=1, keepdims=True)
     return np.divide(n, length, out=np.zeros_like(n), where=length > 0)
 
