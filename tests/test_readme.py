@@ -8,6 +8,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
 import yaml
 
 import formgraph as fg
@@ -37,3 +38,15 @@ def test_yaml_example_is_the_spiral_tube_graph():
     assert g.params == {"turns": 3, "radius": 2.0}
     assert set(g.nodes) == {"spiral", "section", "tube", "mesh", "closed", "solid", "print"}
     assert yaml.safe_load(example)["nodes"]["print"]["type"] == "export.stl"
+
+
+def test_solids_example_runs_to_watertight_solids(tmp_path):
+    (example,) = [b for b in blocks("yaml") if "A pot, as a capped solid" in b]
+    g = fg.Graph.from_text(example, out_dir=tmp_path)
+    for node in ("solid", "shell", "holes"):
+        assert g.evaluate(node).is_watertight, node
+    size = g.evaluate("size")
+    assert size.watertight and size.volume == pytest.approx(g.evaluate("solid").volume)
+    assert g.evaluate("holes").volume < g.evaluate("shell").volume
+    g.evaluate_all()
+    assert (tmp_path / "pot.stl").is_file()
