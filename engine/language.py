@@ -29,7 +29,21 @@ from .registry import NodeSpec
 from .subgraph import Includes, SubgraphSpec
 from .types import loop_item_problem
 
-__all__ = ["LanguageRun", "child_graph", "file_stamp", "input_names", "node_spec_of", "reads_loop"]
+# What one item of a repeated node costs against the element budget. An item is a whole
+# node run (some 0.2 ms of bookkeeping even for a tiny node), so a count the budget would
+# allow as elements (50 million) would run for hours: the default budget allows 50,000
+# items, about ten seconds of the cheapest node.
+ITEM_ELEMENTS = 1000
+
+__all__ = [
+    "ITEM_ELEMENTS",
+    "LanguageRun",
+    "child_graph",
+    "file_stamp",
+    "input_names",
+    "node_spec_of",
+    "reads_loop",
+]
 
 
 def input_names(value: Input, pt: Any) -> set[str]:
@@ -151,13 +165,16 @@ class LanguageRun:
                     )
                 ]
             )
-        if count > self.g.budget:
+        if count * ITEM_ELEMENTS > self.g.budget:
             raise BudgetError(
                 [
                     Problem(
                         where,
                         f"repeat '{r.name}' would run {count:,} items, over the budget of "
-                        f"{self.g.budget:,} (raise it with budget= or --budget if you mean it)",
+                        f"{self.g.budget:,} (each item is a node run and counts as "
+                        f"{ITEM_ELEMENTS:,} elements, so at most {self.g.budget // ITEM_ELEMENTS:,}"
+                        " items; raise it with budget= or --budget if you mean it, or place "
+                        "copies with mesh.copy_to_points)",
                     )
                 ]
             )

@@ -207,3 +207,19 @@ def test_new_nodes_give_arrays_that_cannot_be_made_writable(type_, inputs):
             with pytest.raises(ValueError):
                 a.flags.writeable = True
             a = a.base
+
+
+def test_a_loop_the_element_budget_allows_but_would_run_for_hours_is_refused():
+    # 49 million items fit 50 million elements, but each item is a node run (~0.2 ms)
+    text = "  c: {type: nurbs.circle, repeat: {i: 49000000}, radius: '=1 + i'}\n"
+    with pytest.raises(fg.BudgetError, match=r"each item is a node run .* at most 50,000 items"):
+        _graph(text).evaluate("c")
+
+
+def test_a_loop_within_the_item_budget_runs():
+    g = fg.Graph(budget=3000)
+    g.add("c", "nurbs.circle", repeat={"i": 3}, radius="=1 + i")
+    assert len(g.evaluate("c")) == 3
+    g.add("d", "nurbs.circle", repeat={"i": 4}, radius="=1 + i")
+    with pytest.raises(fg.BudgetError, match="would run 4 items, over the budget of 3,000"):
+        g.evaluate("d")
