@@ -41,6 +41,15 @@ def _topology(port: str, fn: Callable[..., Any], *args: Any) -> Any:
         raise InputError(port, f"{exc}; {hint}") from None
 
 
+def _clipping(ctx: Context, fn: Callable[..., Any], *args: Any) -> Any:
+    """Call a kernel that may ear-clip faces, with the budget as its work limit."""
+    try:
+        return fn(*args, max_tests=ctx.budget)
+    except meshops.WorkLimitError as exc:
+        ctx.guard(exc.work, "triangle-corner tests of ear clipping")
+        raise
+
+
 # ------------------------------------------------------------------------------ primitives
 
 
@@ -243,7 +252,7 @@ def flip(mesh: Mesh) -> Mesh:
 
 
 @node("mesh.cap", version=1)
-def cap(mesh: Mesh) -> Mesh:
+def cap(mesh: Mesh, *, ctx: Context) -> Mesh:
     """Fill every boundary loop, so an open tube comes out watertight.
 
     A planar loop becomes its polygon, triangulated by ear clipping in its plane (concave
@@ -255,7 +264,7 @@ def cap(mesh: Mesh) -> Mesh:
     mesh : Mesh
         An oriented manifold mesh (mesh.weld and mesh.orient make one).
     """
-    return Mesh(*_topology("mesh", kr.cap, *_arrays(mesh)))
+    return Mesh(*_topology("mesh", _clipping, ctx, kr.cap, *_arrays(mesh)))
 
 
 @node("mesh.solidify", version=1)
@@ -339,14 +348,8 @@ def boolean(
     operation : Operation
         union, difference or intersection.
     """
-    try:
-        ma = kb.to_manifold(*_arrays(a), "the mesh")
-    except kb.NotSolidError as exc:
-        raise InputError("a", str(exc)) from None
-    try:
-        mb = kb.to_manifold(*_arrays(b), "the mesh")
-    except kb.NotSolidError as exc:
-        raise InputError("b", str(exc)) from None
+    ma = _solid("a", _clipping, ctx, kb.to_manifold, *_arrays(a), "the mesh")
+    mb = _solid("b", _clipping, ctx, kb.to_manifold, *_arrays(b), "the mesh")
     out = Mesh(*kb.from_manifold(kb.combine(ma, mb, operation)))
     if out.n_faces == 0:
         ctx.warn(f"the {kb.Operation(operation).value} is empty")
@@ -363,7 +366,7 @@ def union(meshes: list[Mesh], *, ctx: Context) -> Mesh:
         Closed, manifold, outward meshes; they may overlap.
     """
     ctx.guard(sum(m.n_faces for m in meshes), "faces")
-    return Mesh(*_solid("meshes", kb.union, [_arrays(m) for m in meshes]))
+    return Mesh(*_solid("meshes", _clipping, ctx, kb.union, [_arrays(m) for m in meshes]))
 
 
 # -------------------------------------------------------------------------------- measures

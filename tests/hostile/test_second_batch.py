@@ -223,3 +223,33 @@ def test_a_loop_within_the_item_budget_runs():
     g.add("d", "nurbs.circle", repeat={"i": 4}, radius="=1 + i")
     with pytest.raises(fg.BudgetError, match="would run 4 items, over the budget of 3,000"):
         g.evaluate("d")
+
+
+def _star_prism(k: int) -> tuple[list[list[float]], list[list[int]]]:
+    """A k-corner star (concave) as the floor and roof of a closed prism."""
+    a = np.linspace(0, 2 * np.pi, k, endpoint=False)
+    r = np.where(np.arange(k) % 2 == 0, 1.0, 0.5)
+    ring = np.c_[r * np.cos(a), r * np.sin(a)]
+    v = np.r_[np.c_[ring, np.zeros(k)], np.c_[ring, np.ones(k)]]
+    j = np.arange(k)
+    sides = np.c_[j, (j + 1) % k, (j + 1) % k + k, j + k].tolist()
+    return v.tolist(), [list(range(k))[::-1], list(range(k, 2 * k)), *sides]
+
+
+@pytest.mark.parametrize("type_", ["mesh.cap", "mesh.boolean", "mesh.union"])
+def test_ear_clipping_inside_solids_counts_against_the_budget(type_):
+    # mesh.triangulate refused this work; cap and the booleans clipped it unbounded
+    v, faces = _star_prism(2000)
+    g = fg.Graph(budget=100_000)
+    if type_ == "mesh.cap":
+        g.add("m", "mesh.from_faces", vertices=v[:2000], faces=[faces[0]])  # an open star
+        g.add("x", "mesh.cap", mesh="@m")
+    else:
+        g.add("m", "mesh.from_faces", vertices=v, faces=faces)
+        g.add("b", "mesh.box")
+        inputs = {"a": "@m", "b": "@b"} if type_ == "mesh.boolean" else {"meshes": ["@m"]}
+        g.add("x", type_, **inputs)
+    with pytest.raises(fg.BudgetError, match="node 'x': would make .* triangle-corner tests"):
+        g.evaluate("x")
+    g.budget = 10**9
+    assert g.evaluate("x").is_watertight

@@ -85,14 +85,23 @@ def _alias(a: np.ndarray) -> np.ndarray:
 
 
 def to_manifold(
-    vertices: np.ndarray, face_indices: np.ndarray, face_offsets: np.ndarray, what: str = "the mesh"
+    vertices: np.ndarray,
+    face_indices: np.ndarray,
+    face_offsets: np.ndarray,
+    what: str = "the mesh",
+    max_tests: int | None = None,
 ) -> object:
     """A ``manifold3d.Manifold`` of a closed outward mesh (float64, no copy of triangles).
+
+    ``max_tests`` limits the ear clipping of faces that are not triangles (see
+    :func:`~.meshops.triangulate`).
 
     Raises
     ------
     NotSolidError
         Open, non-manifold, misoriented or inside-out input, as a sentence.
+    WorkLimitError
+        Triangulating its faces would need more than ``max_tests`` corner tests.
     """
     import manifold3d
 
@@ -106,7 +115,7 @@ def to_manifold(
         raise NotSolidError(_why_not_solid(v, fi, fo, what))
     tris = fi
     if not (fo[-1] == 3 * (fo.size - 1) and np.all(np.diff(fo) == 3)):
-        _, tris, _ = triangulate(v, fi, fo)
+        _, tris, _ = triangulate(v, fi, fo, max_tests=max_tests)
     tris = np.ascontiguousarray(tris).view(np.uint64).reshape(-1, 3)
     m = manifold3d.Manifold(manifold3d.Mesh64(vert_properties=_alias(v), tri_verts=_alias(tris)))
     if m.status() != manifold3d.Error.NoError:
@@ -161,7 +170,7 @@ def combine(a: object, b: object, operation: Operation | str = "union") -> objec
     return a ^ b  # type: ignore[operator]
 
 
-def union(meshes: Sequence[MeshArrays]) -> MeshArrays:
+def union(meshes: Sequence[MeshArrays], max_tests: int | None = None) -> MeshArrays:
     """Union of several closed outward meshes, and of the separate parts within each.
 
     Each mesh is split into its connected parts first, so parts of one mesh that overlap
@@ -170,7 +179,11 @@ def union(meshes: Sequence[MeshArrays]) -> MeshArrays:
     """
     import manifold3d
 
-    parts = [p for i, m in enumerate(meshes) for p in to_manifold(*m, what=f"mesh {i}").decompose()]
+    parts = [
+        p
+        for i, m in enumerate(meshes)
+        for p in to_manifold(*m, what=f"mesh {i}", max_tests=max_tests).decompose()
+    ]
     if not parts:
         return np.zeros((0, 3)), np.zeros(0, np.int64), np.zeros(1, np.int64)
     return from_manifold(manifold3d.Manifold.batch_boolean(parts, manifold3d.OpType.Add))

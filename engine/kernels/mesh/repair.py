@@ -352,6 +352,7 @@ def cap(
     face_indices: np.ndarray,
     face_offsets: np.ndarray,
     planar_tolerance: float = 1e-6,
+    max_tests: int | None = None,
 ) -> MeshArrays:
     """Fill every boundary loop; the new faces are oriented with their neighbours.
 
@@ -369,6 +370,8 @@ def cap(
         An oriented manifold mesh (see :func:`orient`).
     planar_tolerance : float
         Largest distance from the plane, as a fraction of the loop's bounding-box diagonal.
+    max_tests : int, optional
+        Work limit of the ear clipping of planar loops (see ``triangulate``).
 
     Returns
     -------
@@ -381,6 +384,8 @@ def cap(
     ------
     MeshTopologyError
         Non-manifold or inconsistently oriented input.
+    WorkLimitError
+        The ear clipping would need more than ``max_tests`` triangle-corner tests.
     """
     v = np.asarray(vertices, dtype=np.float64)
     fi = np.asarray(face_indices, dtype=np.int64)
@@ -407,7 +412,7 @@ def cap(
     planar |= lo_sizes == 3
     corner_planar = planar.repeat(lo_sizes)
     pf, pfo = ring[corner_planar], np.concatenate([[0], np.cumsum(lo_sizes[planar])])
-    _, tri, _ = triangulate(v, pf, pfo)
+    _, tri, _ = triangulate(v, pf, pfo, max_tests=max_tests)
     # the fans: (centroid, a, b) for each edge a -> b of a non-planar loop
     fan = np.flatnonzero(~planar)
     new_v = centre[fan]
