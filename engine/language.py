@@ -113,6 +113,23 @@ def child_graph(self: Any, spec: SubgraphSpec) -> Any:
     return child
 
 
+def _check_count(loop: str, where: Any, count: int, budget: int) -> None:
+    """Refuse a repeat whose items would cost more than the element budget."""
+    if count * ITEM_ELEMENTS > budget:
+        raise BudgetError(
+            [
+                Problem(
+                    where,
+                    f"repeat '{loop}' would run {count:,} items, over the budget of "
+                    f"{budget:,} (each item is a node run and counts as {ITEM_ELEMENTS:,} "
+                    f"elements, so at most {budget // ITEM_ELEMENTS:,} items; raise it with "
+                    "budget= or --budget if you mean it, or place copies with "
+                    "mesh.copy_to_points)",
+                )
+            ]
+        )
+
+
 class LanguageRun:
     """Repeated and subgraph nodes, for the evaluation run (``self`` is a ``_Run``)."""
 
@@ -143,6 +160,7 @@ class LanguageRun:
             value = self.resolve(name, "repeat", src)
             token = None if isinstance(src, (Literal, Expr)) else self.key_part_items(name, src)
         if isinstance(value, Points):
+            _check_count(r.name, where, len(value), self.g.budget)  # before a list of lists
             value = value.xyz.tolist()
         elif isinstance(value, float) and value.is_integer():
             value = int(value)
@@ -151,6 +169,7 @@ class LanguageRun:
                 raise GraphError([Problem(where, f"a repeat count must be >= 0, got {value}")])
             count = value
         elif isinstance(value, (list, tuple)):
+            _check_count(r.name, where, len(value), self.g.budget)
             problem = loop_item_problem(value)
             if problem:
                 raise GraphError([Problem(where, f"repeat '{r.name}': {problem}")])
@@ -165,19 +184,7 @@ class LanguageRun:
                     )
                 ]
             )
-        if count * ITEM_ELEMENTS > self.g.budget:
-            raise BudgetError(
-                [
-                    Problem(
-                        where,
-                        f"repeat '{r.name}' would run {count:,} items, over the budget of "
-                        f"{self.g.budget:,} (each item is a node run and counts as "
-                        f"{ITEM_ELEMENTS:,} elements, so at most {self.g.budget // ITEM_ELEMENTS:,}"
-                        " items; raise it with budget= or --budget if you mean it, or place "
-                        "copies with mesh.copy_to_points)",
-                    )
-                ]
-            )
+        _check_count(r.name, where, count, self.g.budget)
         values = list(range(count)) if isinstance(value, int) else list(value)
         if token is None:
             tokens = values

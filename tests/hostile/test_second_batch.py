@@ -253,3 +253,11 @@ def test_ear_clipping_inside_solids_counts_against_the_budget(type_):
         g.evaluate("x")
     g.budget = 10**9
     assert g.evaluate("x").is_watertight
+
+
+def test_a_loop_over_too_many_points_is_refused_by_their_count():
+    g = fg.Graph(budget=1_000_000)
+    g.add("p", "points.random", count=200_000)
+    g.add("c", "nurbs.circle", repeat={"p": "@p"}, radius=1, center="=p")
+    with pytest.raises(fg.BudgetError, match="would run 200,000 items, .* at most 1,000 items"):
+        g.evaluate("c")
