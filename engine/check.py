@@ -108,6 +108,10 @@ class Outline:
     subgraphs: Mapping[str, NodeSpec] = field(default_factory=dict)
     outputs: Mapping[str, Any] = field(default_factory=dict)
     output_lines: Mapping[str, int] = field(default_factory=dict)
+    # output types found so far, (node, output) -> type: each is worked out once
+    types: dict[tuple[str, str | None], PortType | None] = field(
+        default_factory=dict, compare=False, repr=False
+    )
 
 
 @dataclass(frozen=True)
@@ -148,6 +152,12 @@ def check_graph(g: Outline, extra: list[Problem] | None = None) -> list[Problem]
             check_param_value(p, p.default)
         except TypeMismatch as exc:
             problems.append(Problem(Where(file, p.line), f"param '{p.name}': default {exc}"))
+
+    for name in _kahn_order(g):  # output types upstream first (see output_type)
+        spec = registry.get(g.nodes[name].type)
+        if spec is not None:
+            for out in spec.outputs if spec.multi_output else [None]:
+                output_type(g, Wire(name, out), registry)
 
     for nd in g.nodes.values():
         spec = registry.get(nd.type)
@@ -208,7 +218,23 @@ def output_type(
     g: Outline, wire: Wire, registry: Mapping[str, NodeSpec], seen: frozenset[str] = frozenset()
 ) -> PortType | None:
     """The type a (valid) wire carries: a repeated node gives a list, and an output typed
-    like one of its node's inputs (``SameAs``) is followed upstream. None when unknown."""
+    like one of its node's inputs (``SameAs``) is followed upstream. None when unknown.
+
+    Memoized in ``g.types``; :func:`check_graph` asks for the nodes in dependency order
+    first, so a long chain of ``SameAs`` nodes is followed one step at a time, not by a
+    recursion as deep as the chain."""
+    key = (wire.node, wire.output)
+    if key in g.types:
+        return g.types[key]
+    t = _output_type(g, wire, registry, seen)
+    if not seen:  # a type found along a path (seen) may be cut short by a cycle
+        g.types[key] = t
+    return t
+
+
+def _output_type(
+    g: Outline, wire: Wire, registry: Mapping[str, NodeSpec], seen: frozenset[str]
+) -> PortType | None:
     nd = g.nodes.get(wire.node)
     spec = registry.get(nd.type) if nd is not None else None
     if spec is None or wire.node in seen:
@@ -534,7 +560,13 @@ def _coercible(pt: PortType, item: PortType) -> bool:
 
 
 def _acyclic(g: Outline) -> bool:
-    """Kahn's algorithm: True when every node can be ordered after its inputs."""
+    """True when every node can be ordered after its inputs."""
+    return len(_kahn_order(g)) == len(g.nodes)
+
+
+def _kahn_order(g: Outline) -> list[str]:
+    """Kahn's algorithm: the nodes each after its inputs (those on or after a cycle left
+    out)."""
     indegree = {n: 0 for n in g.nodes}
     users: dict[str, list[str]] = {n: [] for n in g.nodes}
     for nd in g.nodes.values():
@@ -543,15 +575,15 @@ def _acyclic(g: Outline) -> bool:
                 indegree[nd.name] += 1
                 users[up].append(nd.name)
     ready = [n for n, d in indegree.items() if d == 0]
-    ordered = 0
+    ordered = []
     while ready:
         n = ready.pop()
-        ordered += 1
+        ordered.append(n)
         for user in users[n]:
             indegree[user] -= 1
             if indegree[user] == 0:
                 ready.append(user)
-    return ordered == len(indegree)
+    return ordered
 
 
 def _check_cycles(g: Outline) -> list[Problem]:
