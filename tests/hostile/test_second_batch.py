@@ -261,3 +261,32 @@ def test_a_loop_over_too_many_points_is_refused_by_their_count():
     g.add("c", "nurbs.circle", repeat={"p": "@p"}, radius=1, center="=p")
     with pytest.raises(fg.BudgetError, match="would run 200,000 items, .* at most 1,000 items"):
         g.evaluate("c")
+
+
+# ---------------------------------------------------------------------------- long chains
+
+
+def test_a_long_chain_of_same_type_nodes_checks_without_recursing(tmp_path, capsys):
+    # geometry.transform's output type follows its input: the checker recursed once per
+    # node and hit Python's recursion limit (an internal error) near 1,000 nodes
+    lines = ["formgraph: 1", "nodes:", "  n0: {type: points.circle, count: 4}"]
+    lines += [
+        f"  n{i}: {{type: geometry.transform, geometry: '@n{i - 1}', translate: [1, 0, 0]}}"
+        for i in range(1, 3000)
+    ]
+    (tmp_path / "chain.yaml").write_text("\n".join(lines[:2] + lines[:1:-1]) + "\n")  # sinks first
+    assert cli.main(["check", str(tmp_path / "chain.yaml")]) == 0, capsys.readouterr().err
+    g = fg.load(tmp_path / "chain.yaml")
+    assert g.evaluate("n2999").xyz[0, 0] == pytest.approx(1 + 2999)
+
+
+@pytest.mark.parametrize(
+    "d", [[0.0, 3.7332462518125146e-162, -1.0], [0.0, 1e-310, -1.0], [1e-200, -1e-200, -1.0]]
+)
+def test_align_onto_almost_minus_z_is_a_rotation(d):
+    # found by hypothesis: x^2 + y^2 underflowed to a subnormal and the matrix came out NaN
+    from formgraph.kernels.geometry import affine
+
+    r = affine.align_z(np.array([d]))[0]
+    np.testing.assert_allclose(r @ [0, 0, 1], np.array(d) / np.linalg.norm(d), atol=1e-12)
+    np.testing.assert_allclose(r @ r.T, np.eye(3), atol=1e-12)

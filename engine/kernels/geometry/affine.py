@@ -100,17 +100,22 @@ def align_z(directions: np.ndarray) -> np.ndarray:
     d = d / length[:, None]
     x, y, z = d.T
     c = z
-    r2 = x * x + y * y
-    flip = (c < 0) & (r2 == 0)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        k = np.where(c >= 0, 1.0 / (1.0 + c), (1.0 - c) / np.where(r2 > 0, r2, 1.0))
+    rho = np.hypot(x, y)
+    flip = (c < 0) & (rho == 0)
+    # [v]x^2 / (1 + c) needs x^2 k, x y k, y^2 k with k = 1 / (1 + c); for c < 0 they are
+    # (x / rho)^2 (1 - c), ...: x^2 + y^2 itself can underflow to a subnormal whose
+    # reciprocal overflows (then 0 * inf made NaN)
+    below = c < 0
+    safe = np.where(rho > 0, rho, 1.0)
+    sx = np.where(below, (x / safe) * np.sqrt(1.0 - c), x / np.sqrt(np.where(below, 1.0, 1.0 + c)))
+    sy = np.where(below, (y / safe) * np.sqrt(1.0 - c), y / np.sqrt(np.where(below, 1.0, 1.0 + c)))
     # v = (-y, x, 0); [v]x^2 / (1 + c) written out
     m = np.empty((len(d), 3, 3))
-    m[:, 0, 0] = 1.0 - x * x * k
-    m[:, 0, 1] = -x * y * k
+    m[:, 0, 0] = 1.0 - sx * sx
+    m[:, 0, 1] = -sx * sy
     m[:, 0, 2] = x
-    m[:, 1, 0] = -x * y * k
-    m[:, 1, 1] = 1.0 - y * y * k
+    m[:, 1, 0] = -sx * sy
+    m[:, 1, 1] = 1.0 - sy * sy
     m[:, 1, 2] = y
     m[:, 2, 0] = -x
     m[:, 2, 1] = -y
