@@ -71,13 +71,18 @@ def _registry(graph: Any) -> dict[str, Any]:
     return node_types()
 
 
+def _type_of(graph: Any, name: str) -> str:
+    """A node's type, without building ``graph.nodes`` (a new dict on every call)."""
+    return graph._nodes[name].type
+
+
 def _export_mark(graph: Any, name: str) -> list[str]:
-    spec = _registry(graph).get(graph.nodes[name])
+    spec = _registry(graph).get(_type_of(graph, name))
     return ["export"] if spec is not None and spec.is_export else []
 
 
 def _subgraph_mark(graph: Any, name: str) -> list[str]:
-    return ["subgraph"] if graph.nodes[name].endswith((".yaml", ".yml")) else []
+    return ["subgraph"] if _type_of(graph, name).endswith((".yaml", ".yml")) else []
 
 
 def _repeat_mark(graph: Any, name: str) -> list[str]:
@@ -214,7 +219,8 @@ def _model(graph: Any, marks: Iterable[Mark] | None) -> tuple[dict[str, Box], li
                 sub += f" [{lo}..{hi}]"
         boxes[f"p:{name}"] = Box(f"p:{name}", name, sub, family="param")
     edges: list[Edge] = []
-    for name, type_name in graph.nodes.items():
+    types = graph.nodes
+    for name, type_name in types.items():
         spec = registry.get(type_name)
         nd = graph._nodes[name]
         box = Box(f"n:{name}", name, type_name, family=type_name.split(".", 1)[0])
@@ -234,7 +240,7 @@ def _model(graph: Any, marks: Iterable[Mark] | None) -> tuple[dict[str, Box], li
             port_type = spec.inputs[port].type if spec is not None and port in spec.inputs else None
             used = False
             for w in wires_of(value):
-                if w.node not in graph.nodes:
+                if w.node not in types:
                     continue
                 edges.append(Edge(f"n:{w.node}", w.output or "", f"n:{name}", port, ""))
                 used = True

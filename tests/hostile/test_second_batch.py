@@ -290,3 +290,17 @@ def test_align_onto_almost_minus_z_is_a_rotation(d):
     r = affine.align_z(np.array([d]))[0]
     np.testing.assert_allclose(r @ [0, 0, 1], np.array(d) / np.linalg.norm(d), atol=1e-12)
     np.testing.assert_allclose(r @ r.T, np.eye(3), atol=1e-12)
+
+
+def test_drawing_a_graph_reads_its_node_table_a_fixed_number_of_times(monkeypatch):
+    # graph.nodes builds a new dict; drawing read it for every node and wire (quadratic:
+    # 92 s for a 20,000-node chain)
+    g = fg.Graph()
+    g.add("n0", "points.circle", count=4)
+    for i in range(1, 200):
+        g.add(f"n{i}", "geometry.transform", geometry=f"@n{i - 1}", translate=[1, 0, 0])
+    calls = []
+    table = fg.Graph.nodes.fget
+    monkeypatch.setattr(fg.Graph, "nodes", property(lambda self: calls.append(1) or table(self)))
+    fg.draw_graph(g)
+    assert len(calls) < 10
