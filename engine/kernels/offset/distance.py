@@ -25,6 +25,8 @@ import numpy as np
 
 __all__ = ["Nearest", "RowParity", "SegmentTree", "point_segment"]
 
+_PAIRS = 1024  # (point, node) pairs a query tests per visited level, about
+
 
 def point_segment(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Distance from points to segments, pairwise (broadcasting over leading axes).
@@ -101,14 +103,14 @@ class SegmentTree:
 
         # Leaf capsules: axis from the first segment's start to the last one's end, radius
         # the farthest segment end from that axis (a capsule is convex, so it then holds
-        # every segment whole).
+        # every segment whole). Coordinates one by one: contiguous, and squared distances
+        # until the one square root of the maximum.
         ca = self.a.reshape(n_leaves, leaf, 2)
         cb = self.b.reshape(n_leaves, leaf, 2)
         axa = ca[:, 0]
         axb = cb[:, -1]
         ends = np.concatenate([ca, cb], axis=1)
-        da, _ = point_segment(ends, axa[:, None], axb[:, None])
-        rad = da.max(axis=1)
+        rad = np.sqrt(_farthest2(ends[..., 0], ends[..., 1], axa, axb))
         # Missing leaves copy the last real axis (a true curve point keeps the upper bound
         # valid) with radius -inf, so their lower bound is +inf and they are never entered.
         extra = width - n_leaves
@@ -131,7 +133,13 @@ class SegmentTree:
             levels.append((la, pb, np.maximum(left, right)))
         # Per level, contiguous node fields (gathered one by one, which numpy does far
         # faster than rows): start x, y, axis vector x, y, 1 / |axis|^2 (0 if none), radius.
-        self._levels = [_fields(axa, axb) + (rad,) for axa, axb, rad in levels[::-1]]
+        # The radius carries a hair of slack, as does the bound in `query` (the node holding
+        # the bound's own point must never be lost to rounding); a missing node's is NaN,
+        # which no test passes.
+        self._levels = [
+            _fields(axa, axb) + (np.where(np.isneginf(rad), np.nan, rad * (1 + 1e-12)),)
+            for axa, axb, rad in levels[::-1]
+        ]
         self._segs = _fields(self.a, self.b)
 
     def query(
@@ -164,70 +172,115 @@ class SegmentTree:
         hi2 = np.square(np.maximum(hi, 0.0))
         lo2 = np.where(lo > 0, np.square(lo), -1.0)
         best2 = np.full(q, np.inf)  # squared distance to the nearest curve point seen
-        # Few points: start a few levels down (all their nodes), saving numpy calls.
-        start = min(self.depth, max(0, int(np.log2(max(4096 // max(q, 1), 1)))))
-        qi = np.repeat(np.arange(q), 2**start)
-        node = np.tile(np.arange(2**start), q)
-        # For few points, every other level only: four children a step halves the numpy
-        # calls (which then cost more than the arithmetic) for a few more capsules tested.
-        visit = list(range(start, self.depth + 1, 2 if q < 512 else 1))
-        if visit[-1] != self.depth:
-            visit.append(self.depth)
-        for k, level in enumerate(visit):
+        # Levels are visited in jumps that keep about _PAIRS (point, node) pairs per visit:
+        # few points start deep and skip levels (numpy calls cost more than the few more
+        # capsules tested), many go two levels a step.
+        level = min(self.depth, max(0, int(np.log2(max(_PAIRS // q, 1)))))
+        qi = np.arange(q).repeat(2**level)
+        node = np.tile(np.arange(2**level), q)
+        while True:
             ax, ay, ux, uy, inv, rad = self._levels[level]
-            if k:
-                fan = 2 ** (level - visit[k - 1])
-                qi = np.repeat(qi, fan)
-                node = (node[:, None] * fan + np.arange(fan)).reshape(-1)
-            if qi.size == 0:
-                break
-            ux_, uy_ = ux.take(node), uy.take(node)
-            dx = px.take(qi) - ax.take(node)
-            dy = py.take(qi) - ay.take(node)
-            t = np.clip((dx * ux_ + dy * uy_) * inv.take(node), 0.0, 1.0)
-            ex = dx - t * ux_
-            ey = dy - t * uy_
+            nux, nuy = ux.take(node), uy.take(node)
+            dx = px.take(qi)
+            dx -= ax.take(node)
+            dy = py.take(qi)
+            dy -= ay.take(node)
+            t = dx * nux
+            t += dy * nuy
+            t *= inv.take(node)
+            np.minimum(np.maximum(t, 0.0, out=t), 1.0, out=t)
             # The axis start is a curve point: an upper bound. (Its end is the next node's
             # start, so it adds little.)
-            np.minimum.at(best2, qi, dx * dx + dy * dy)
+            d2 = dx * dx
+            d2 += dy * dy
+            np.minimum.at(best2, qi, d2)
+            nux *= t
+            dx -= nux
+            nuy *= t
+            dy -= nuy
+            dx *= dx
+            dy *= dy
+            dx += dy  # squared distance to the capsule's axis
             # Drop a node whose capsule is farther than the best upper bound (or the band's
-            # top), and every node of a point already certified below the band.
+            # top), and every node of a point already certified below the band (NaN).
             cut = np.sqrt(np.minimum(best2, hi2))
-            cut[best2 < lo2] = -np.inf
-            # (A hair of slack: the node holding the bound's own point must never be lost
-            # to rounding.)
-            thr = (cut.take(qi) + rad.take(node)) * (1 + 1e-12)
-            keep = np.flatnonzero((thr >= 0) & (ex * ex + ey * ey <= thr * thr))
+            cut *= 1 + 1e-12
+            cut[best2 < lo2] = np.nan
+            thr = cut.take(qi)
+            thr += rad.take(node)
+            thr *= thr
+            keep = (dx <= thr).nonzero()[0]
             qi, node = qi.take(keep), node.take(keep)
+            if level == self.depth or qi.size == 0:
+                break
+            jump = int(np.log2(max(_PAIRS // max(qi.size, 1), 1)))
+            jump = min(self.depth - level, max(jump, 2))
+            fan = 2**jump
+            level += jump
+            qi = qi.repeat(fan)
+            node = np.add.outer(node * fan, np.arange(fan)).ravel()
 
         # Leaves: brute force over their segments.
-        seg = (node[:, None] * self.leaf + np.arange(self.leaf)).reshape(-1)
-        qs = np.repeat(qi, self.leaf)
-        ax, ay, ux, uy, inv = (f.take(seg) for f in self._segs)
-        dx = px.take(qs) - ax
-        dy = py.take(qs) - ay
-        t = np.clip((dx * ux + dy * uy) * inv, 0.0, 1.0)
-        ex = dx - t * ux
-        ey = dy - t * uy
-        d2 = ex * ex + ey * ey
+        seg = np.add.outer(node * self.leaf, np.arange(self.leaf)).ravel()
+        qs = qi.repeat(self.leaf)
+        ax, ay, ux, uy, inv = self._segs
+        dx = px.take(qs)
+        dx -= ax.take(seg)
+        dy = py.take(qs)
+        dy -= ay.take(seg)
+        nux, nuy = ux.take(seg), uy.take(seg)
+        t = dx * nux
+        t += dy * nuy
+        t *= inv.take(seg)
+        np.minimum(np.maximum(t, 0.0, out=t), 1.0, out=t)
+        nux *= t
+        dx -= nux
+        nuy *= t
+        dy -= nuy
+        dx *= dx
+        dy *= dy
+        dx += dy
+        d2 = dx
         dist2 = np.full(q, np.inf)
         np.minimum.at(dist2, qs, d2)
-        hit = np.flatnonzero(d2 == dist2.take(qs))
+        hit = (d2 == dist2.take(qs)).nonzero()[0]
         segment = np.full(q, -1, dtype=np.int64)
         param = np.zeros(q)
         # Ties give several hits per point; any one of them is a nearest segment.
-        segment[qs[hit]] = np.minimum(seg[hit], self.n - 1)
-        param[qs[hit]] = t[hit]
+        at = qs.take(hit)
+        segment[at] = np.minimum(seg.take(hit), self.n - 1)
+        param[at] = t.take(hit)
         dist = np.sqrt(dist2)
-        best = np.sqrt(best2)
-        found = np.isfinite(dist)
+        found = dist2 < np.inf
         exact = found & (dist <= hi)
-        out = np.where(found, dist, best)
-        near = ~found & (best2 < lo2)
-        far = ~found & ~near
-        out[far] = np.maximum(best[far], np.nextafter(hi[far], np.inf))
+        if found.all():
+            out = dist
+        else:
+            best = np.sqrt(best2)
+            out = np.where(found, dist, best)
+            far = ~found & ~(best2 < lo2)
+            out[far] = np.maximum(best[far], np.nextafter(hi[far], np.inf))
         segment[~exact] = -1
         return Nearest(out, exact, segment, param)
+
+
+def _farthest2(ex: np.ndarray, ey: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Largest squared distance from points ``(ex[k], ey[k])`` (rows) to segment ``a[k] -> b[k]``."""
+    ax, ay = a[:, 0:1], a[:, 1:2]
+    ux, uy = b[:, 0:1] - ax, b[:, 1:2] - ay
+    len2 = ux * ux + uy * uy
+    inv = np.divide(1.0, len2, out=np.zeros_like(len2), where=len2 > 0)
+    dx, dy = ex - ax, ey - ay
+    t = dx * ux
+    t += dy * uy
+    t *= inv
+    np.clip(t, 0.0, 1.0, out=t)
+    dx -= t * ux
+    dy -= t * uy
+    dx *= dx
+    dy *= dy
+    dx += dy
+    return dx.max(axis=1)
 
 
 def _fields(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, ...]:
