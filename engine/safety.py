@@ -58,9 +58,7 @@ def resolve_output(out_dir: str | os.PathLike[str], relpath: str) -> Path:
     return real
 
 
-def write_atomic(
-    out_dir: str | os.PathLike[str], relpath: str, data: bytes | memoryview
-) -> Path:
+def write_atomic(out_dir: str | os.PathLike[str], relpath: str, data: bytes | memoryview) -> Path:
     """Write ``data`` to ``relpath`` inside ``out_dir``, atomically; returns the path.
 
     Creates sub-folders; leaves an existing file untouched when it already holds ``data``.

@@ -265,7 +265,7 @@ class SegmentTree:
 
 
 def _farthest2(ex: np.ndarray, ey: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Largest squared distance from points ``(ex[k], ey[k])`` (rows) to segment ``a[k] -> b[k]``."""
+    """Largest squared distance from the points of row k to the segment ``a[k] -> b[k]``."""
     ax, ay = a[:, 0:1], a[:, 1:2]
     ux, uy = b[:, 0:1] - ax, b[:, 1:2] - ay
     len2 = ux * ux + uy * uy
