@@ -70,8 +70,45 @@ def _token(value: Any) -> str:
 
 
 def key_of(parts: Any) -> str:
-    text = json.dumps(canonical(parts), sort_keys=True, separators=(",", ":"))
-    return hashlib.blake2b(text.encode(), digest_size=20).hexdigest()
+    """The cache key of ``parts``: a hash of the JSON text of ``canonical(parts)``."""
+    return hashlib.blake2b(key_text(parts).encode(), digest_size=20).hexdigest()
+
+
+def key_text(value: Any) -> str:
+    """``json.dumps(canonical(value), sort_keys=True, separators=(",", ":"))``, in one pass.
+
+    Every node's key is built from this text on every run, so the plain values that inputs
+    are made of (str, int, bool, None, float, lists and str-keyed dicts of them) are written
+    directly; anything else goes through `canonical` and `json`. The text is the same either
+    way, so keys do not change.
+    """
+    t = type(value)
+    if t is str:
+        return _quote(value)
+    if t is float:
+        return '{"f":"' + value.hex() + '"}'
+    if t is dict:
+        try:
+            keys = sorted(value)
+        except TypeError:  # mixed key types: canonical says so
+            return _JSON.encode(canonical(value))
+        for k in keys:
+            if type(k) is not str:
+                return _JSON.encode(canonical(value))
+        return "{" + ",".join([_quote(k) + ":" + key_text(value[k]) for k in keys]) + "}"
+    if t is bool:
+        return "true" if value else "false"
+    if t is int:
+        return str(value)
+    if value is None:
+        return "null"
+    if t is list or t is tuple:
+        return "[" + ",".join([key_text(v) for v in value]) + "]"
+    return _JSON.encode(canonical(value))
+
+
+_quote = json.encoder.encode_basestring_ascii  # what json.dumps writes a str as
+_JSON = json.JSONEncoder(sort_keys=True, separators=(",", ":"))
 
 
 def _hash_bytes(a: np.ndarray) -> str:

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import enum
 import functools
+import math
 import types as _pytypes
 import typing
 from dataclasses import dataclass
@@ -250,7 +251,7 @@ def _coerce_kind(k: Kind, value: Any) -> Any:
             raise TypeMismatch(
                 f"expected a float, got a number too large ({describe(value)[:40]})"
             ) from None
-        if not np.isfinite(f):
+        if not math.isfinite(f):
             raise TypeMismatch(f"expected a finite float, got {f}")
         return f
     if base in (str, Expression, OutputPath):
