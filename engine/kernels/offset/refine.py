@@ -214,7 +214,7 @@ def _corner(tree, s1, s2, start, radius, tol, chases=2, iterations=6):
     return found, point, n1_all, s1, n2_all, s2
 
 
-_TRACK = 4  # neighbours on either side a corner's pair member may move to each step
+_TRACK = 16  # neighbours on either side a corner's pair member may move to each step
 
 
 def _foot(tree: SegmentTree, seg: np.ndarray, t: np.ndarray) -> np.ndarray:
