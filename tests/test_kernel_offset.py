@@ -89,6 +89,23 @@ def test_clockwise_input_gives_the_same_result():
     assert abs(area(ccw) - area(cw)) < 1e-9
 
 
+@pytest.mark.parametrize("d", [0.05, -0.05])
+def test_sparse_sample_store_gives_the_same_loops(monkeypatch, d):
+    # Big grids keep their band of samples sorted and searched instead of in a dense table;
+    # both stores must give the very same offset.
+    import formgraph.kernels.offset.marching as marching
+
+    t = np.linspace(0, 2 * np.pi, 400, endpoint=False)
+    r = 1 + 0.1 * np.sin(9 * t)
+    pts = np.c_[r * np.cos(t), r * np.sin(t)]
+    dense = offset_polylines([pts], [True], d)
+    monkeypatch.setattr(marching, "_DENSE", 0)
+    sparse = offset_polylines([pts], [True], d)
+    assert len(dense) == len(sparse)
+    for a, b in zip(dense, sparse, strict=True):
+        np.testing.assert_array_equal(a, b)
+
+
 def test_inward_offset_splits_a_dumbbell_into_two_islands():
     # Two 1 x 1 squares joined by a bar 0.2 wide.
     shape = np.array(

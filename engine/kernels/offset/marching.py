@@ -142,7 +142,23 @@ class _Field:
         return sign * f, feet
 
 
+_DENSE = 1 << 22  # grids of up to this many samples look values up in a dense table
+
+
 def _store_lookup(ids: np.ndarray, values: np.ndarray):
+    """``value(q)``: the ``values`` of sample ids ``q``, each one of the sorted ``ids``. A dense
+    table of positions while the ids stay below `_DENSE` (two gathers a call), a binary
+    search beyond (only a band of a big grid is stored)."""
+    size = int(ids[-1]) + 1 if ids.size else 1
+    if size <= _DENSE:
+        table = np.zeros(size, dtype=np.int64)
+        table[ids] = np.arange(ids.size)
+
+        def dense(q: np.ndarray) -> np.ndarray:
+            return values[table[q]]
+
+        return dense
+
     def value(q: np.ndarray) -> np.ndarray:
         perm = np.argsort(q)
         pos = np.empty(q.size, dtype=np.int64)
