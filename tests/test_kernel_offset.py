@@ -100,6 +100,7 @@ def test_sparse_sample_store_gives_the_same_loops(monkeypatch, d):
     pts = np.c_[r * np.cos(t), r * np.sin(t)]
     dense = offset_polylines([pts], [True], d)
     monkeypatch.setattr(marching, "_DENSE", 0)
+    monkeypatch.setattr(marching, "_DENSE_MIN", 0)
     sparse = offset_polylines([pts], [True], d)
     assert len(dense) == len(sparse)
     for a, b in zip(dense, sparse, strict=True):

@@ -142,17 +142,20 @@ class _Field:
         return sign * f, feet
 
 
-_DENSE = 1 << 22  # grids of up to this many samples look values up in a dense table
+# Sample values are found through a dense table of positions while the grid has at most
+# _DENSE samples per stored one, or at most _DENSE_MIN samples.
+_DENSE = 32
+_DENSE_MIN = 1 << 16
 
 
 def _store_lookup(ids: np.ndarray, values: np.ndarray):
     """``value(q)``: the ``values`` of sample ids ``q``, each one of the sorted ``ids``. A dense
-    table of positions while the ids stay below `_DENSE` (two gathers a call), a binary
-    search beyond (only a band of a big grid is stored)."""
+    table of positions while the ids span a small grid or one the stored band fills well
+    (two gathers a call), else a binary search (only a band of a big grid is stored)."""
     size = int(ids[-1]) + 1 if ids.size else 1
-    if size <= _DENSE:
-        table = np.zeros(size, dtype=np.int64)
-        table[ids] = np.arange(ids.size)
+    if size <= max(_DENSE_MIN, _DENSE * ids.size):
+        table = np.empty(size, dtype=np.int32)  # (only stored ids are ever asked)
+        table[ids] = np.arange(ids.size, dtype=np.int32)
 
         def dense(q: np.ndarray) -> np.ndarray:
             return values[table[q]]
