@@ -109,37 +109,44 @@ class SegmentTree:
         cb = self.b.reshape(n_leaves, leaf, 2)
         axa = ca[:, 0]
         axb = cb[:, -1]
-        ends = np.concatenate([ca, cb], axis=1)
-        rad = np.sqrt(_farthest2(ends[..., 0], ends[..., 1], axa, axb))
+        ends = np.ascontiguousarray(np.concatenate([ca, cb], axis=1).transpose(1, 2, 0))
+        ax, ay, bx, by = (np.ascontiguousarray(c) for c in (*axa.T, *axb.T))
+        d2 = _dist2(ends[:, 0], ends[:, 1], ax, ay, bx, by)  # ends: (2 leaf, 2, n_leaves)
+        rad = np.sqrt(d2.max(axis=0))
         # Missing leaves copy the last real axis (a true curve point keeps the upper bound
         # valid) with radius -inf, so their lower bound is +inf and they are never entered.
         extra = width - n_leaves
         axa = np.concatenate([axa, np.repeat(axa[-1:], extra, axis=0)])
         axb = np.concatenate([axb, np.repeat(axb[-1:], extra, axis=0)])
         rad = np.concatenate([rad, np.full(extra, -np.inf)])
-        levels = [(axa, axb, rad)]
+        levels = [(axa[:, 0], axa[:, 1], axb[:, 0], axb[:, 1], rad)]
         # Parents: axis from the left child's start to the right child's end (the left
         # child's end if the right one is missing); a radius that holds both child capsules
-        # (distance to a segment is convex, so a child's axis ends bound its whole axis).
+        # (distance to a segment is convex, so a child's axis ends bound its whole axis; the
+        # left child's start lies on the parent's axis).
         while levels[-1][0].shape[0] > 1:
-            ca, cb, cr = levels[-1]
-            la, lb, lr = ca[0::2], cb[0::2], cr[0::2]
-            ra, rb, rr = ca[1::2], cb[1::2], cr[1::2]
+            ax, ay, bx, by, r = levels[-1]
+            lax, lay, lbx, lby, lr = ax[0::2], ay[0::2], bx[0::2], by[0::2], r[0::2]
+            rax, ray, rbx, rby, rr = ax[1::2], ay[1::2], bx[1::2], by[1::2], r[1::2]
             missing = np.isneginf(rr)
-            pb = np.where(missing[:, None], lb, rb)
-            d, _ = point_segment(np.stack([la, lb, ra, rb]), la, pb)
-            left = lr + np.maximum(d[0], d[1])
-            right = rr + np.maximum(d[2], d[3])
-            levels.append((la, pb, np.maximum(left, right)))
+            pbx, pby = np.where(missing, lbx, rbx), np.where(missing, lby, rby)
+            d = np.sqrt(
+                _dist2(np.stack([lbx, rax, rbx]), np.stack([lby, ray, rby]), lax, lay, pbx, pby)
+            )
+            right = rr + np.maximum(d[1], d[2])
+            levels.append((lax, lay, pbx, pby, np.maximum(lr + d[0], right)))
         # Per level, contiguous node fields (gathered one by one, which numpy does far
-        # faster than rows): start x, y, axis vector x, y, 1 / |axis|^2 (0 if none), radius.
-        # The radius carries a hair of slack, as does the bound in `query` (the node holding
-        # the bound's own point must never be lost to rounding); a missing node's is NaN,
-        # which no test passes.
-        self._levels = [
-            _fields(axa, axb) + (np.where(np.isneginf(rad), np.nan, rad * (1 + 1e-12)),)
-            for axa, axb, rad in levels[::-1]
-        ]
+        # faster than rows): start x, y, axis vector x, y, 1 / |axis|^2 (0 if none), radius;
+        # computed for all levels at once. The radius carries a hair of slack, as does the
+        # bound in `query` (the node holding the bound's own point must never be lost to
+        # rounding); a missing node's is NaN, which no test passes.
+        levels = levels[::-1]
+        cut = np.cumsum([lv[0].shape[0] for lv in levels])[:-1]
+        ax, ay, bx, by, rad = (np.concatenate([lv[k] for lv in levels]) for k in range(5))
+        rad = np.where(np.isneginf(rad), np.nan, rad * (1 + 1e-12))
+        fields = _fields(np.stack([ax, ay], axis=1), np.stack([bx, by], axis=1)) + (rad,)
+        split = [np.split(f, cut) for f in fields]
+        self._levels = [tuple(f[k] for f in split) for k in range(len(levels))]
         self._segs = _fields(self.a, self.b)
 
     def query(
@@ -264,23 +271,26 @@ class SegmentTree:
         return Nearest(out, exact, segment, param)
 
 
-def _farthest2(ex: np.ndarray, ey: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Largest squared distance from the points of row k to the segment ``a[k] -> b[k]``."""
-    ax, ay = a[:, 0:1], a[:, 1:2]
-    ux, uy = b[:, 0:1] - ax, b[:, 1:2] - ay
+def _dist2(
+    ex: np.ndarray, ey: np.ndarray, ax: np.ndarray, ay: np.ndarray, bx: np.ndarray, by: np.ndarray
+) -> np.ndarray:
+    """Squared distances (k, m) from points ``(ex[i, j], ey[i, j])`` to the segments
+    ``(ax[j], ay[j]) -> (bx[j], by[j])``: segments along the last axis, so numpy's inner
+    loops run over all of them (a short last axis would make them crawl)."""
+    ux, uy = bx - ax, by - ay
     len2 = ux * ux + uy * uy
     inv = np.divide(1.0, len2, out=np.zeros_like(len2), where=len2 > 0)
     dx, dy = ex - ax, ey - ay
     t = dx * ux
     t += dy * uy
     t *= inv
-    np.clip(t, 0.0, 1.0, out=t)
+    np.minimum(np.maximum(t, 0.0, out=t), 1.0, out=t)
     dx -= t * ux
     dy -= t * uy
     dx *= dx
     dy *= dy
     dx += dy
-    return dx.max(axis=1)
+    return dx
 
 
 def _fields(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, ...]:
