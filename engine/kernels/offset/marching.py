@@ -197,9 +197,9 @@ def _band_cells(field: _Field, ncx: int, ncy: int, levels: int):
             pi, pj = np.mgrid[0 : ncy // step + 1, 0 : ncx // step + 1]
             pid = (pi * w + pj).ravel()
         else:
-            # Children of the surviving parents, and their 3 x 3 samples.
-            ci = (2 * ci[:, None] + np.array([0, 0, 1, 1])).ravel()
-            cj = (2 * cj[:, None] + np.array([0, 1, 0, 1])).ravel()
+            # Children of the surviving parents, and their samples; a child goes unsampled
+            # where the parent's corners already rule it out (`_children`).
+            ci, cj = _children(ci, cj, gaps, step * field.cell)
             pid = unique_ids(
                 (ci[:, None] + np.array([0, 0, 1, 1])) * w + cj[:, None] + np.array([0, 1, 0, 1])
             )
@@ -219,14 +219,45 @@ def _band_cells(field: _Field, ncx: int, ncy: int, levels: int):
         value = _store_lookup(pid, values)
         foot = _store_lookup(pid, feet)
         corner = ci * w + cj
-        gap = np.abs(
+        corners = np.abs(
             np.stack([value(corner), value(corner + 1), value(corner + w), value(corner + w + 1)])
             - d
-        ).min(axis=0)
+        )
+        gap = corners.min(axis=0)
         # A cell can hold a point at the level only if a corner is within half a diagonal.
-        keep = gap <= step * field.cell * (np.sqrt(0.5) * (1 + 1e-9))
-        ci, cj = ci[keep], cj[keep]
+        keep = gap <= step * field.cell * _HALF_DIAGONAL
+        # (Values outside the band are only certified beyond it: clamped there, the gaps
+        # stay lower bounds for `_children`.)
+        ci, cj, gaps = ci[keep], cj[keep], np.minimum(corners[:, keep], band)
     return pid, values, feet, ci * (ncx + 1) + cj
+
+
+_HALF_DIAGONAL = np.sqrt(0.5) * (1 + 1e-9)  # a hair of slack against rounding
+# For the 3 x 3 samples of a split cell (row-major, parent corners at 0, 2, 6, 8): which
+# parent corner each child's corners are (in order 00, 01, 10, 11), and how far each of the
+# 9 samples is from each parent corner, in child cells.
+_CHILD_SAMPLES = np.array([[0, 1, 3, 4], [1, 2, 4, 5], [3, 4, 6, 7], [4, 5, 7, 8]])
+_SAMPLE_TO_CORNER = np.linalg.norm(
+    np.array(np.divmod(np.arange(9), 3)).T[:, None] - np.array([[0, 0], [0, 2], [2, 0], [2, 2]]),
+    axis=2,
+)  # (9 samples, 4 parent corners)
+
+
+def _children(ci: np.ndarray, cj: np.ndarray, gaps: np.ndarray, h: float):
+    """The four children of each cell ``(ci, cj)``, less those its corners rule out.
+
+    ``gaps`` (4, m) holds lower bounds of ``|f - level|`` at each parent's corners 00, 01,
+    10, 11. ``f`` being 1-Lipschitz, ``|f(y) - level| >= gap(c) - |y - c|`` at every sample ``y`` of the
+    parent; a child whose four corners are all bounded above half its diagonal ``h`` would
+    be dropped once sampled, so it is dropped now (the cells kept are the same, with
+    fewer samples to evaluate).
+    """
+    bound = (gaps.T[:, None, :] - h * _SAMPLE_TO_CORNER[None]).max(axis=2)  # (m, 9)
+    child_bound = bound[:, _CHILD_SAMPLES].min(axis=2)  # (m, 4)
+    keep = child_bound <= h * _HALF_DIAGONAL
+    ci = (2 * ci[:, None] + np.array([0, 0, 1, 1]))[keep]
+    cj = (2 * cj[:, None] + np.array([0, 1, 0, 1]))[keep]
+    return ci, cj
 
 
 def grid_cells(lo: np.ndarray, hi: np.ndarray, distance: float, cell: float) -> int:
