@@ -189,7 +189,7 @@ def _band_cells(field: _Field, ncx: int, ncy: int, levels: int):
     # Level `levels`: the whole coarse grid.
     ci, cj = np.mgrid[0 : ncy // step, 0 : ncx // step]
     ci, cj = ci.ravel(), cj.ravel()
-    value = foot = None
+    value = foot = gaps = None
     for lev in range(levels, -1, -1):
         step = 2**lev
         w = ncx // step + 1
@@ -247,10 +247,10 @@ def _children(ci: np.ndarray, cj: np.ndarray, gaps: np.ndarray, h: float):
     """The four children of each cell ``(ci, cj)``, less those its corners rule out.
 
     ``gaps`` (4, m) holds lower bounds of ``|f - level|`` at each parent's corners 00, 01,
-    10, 11. ``f`` being 1-Lipschitz, ``|f(y) - level| >= gap(c) - |y - c|`` at every sample ``y`` of the
-    parent; a child whose four corners are all bounded above half its diagonal ``h`` would
-    be dropped once sampled, so it is dropped now (the cells kept are the same, with
-    fewer samples to evaluate).
+    10, 11. ``f`` being 1-Lipschitz, ``|f(y) - level| >= gap(c) - |y - c|`` at every sample
+    ``y`` of the parent; a child whose four corners are all bounded above half its diagonal
+    ``h`` would be dropped once sampled, so it is dropped now (the cells kept are the same,
+    with fewer samples to evaluate).
     """
     bound = (gaps.T[:, None, :] - h * _SAMPLE_TO_CORNER[None]).max(axis=2)  # (m, 9)
     child_bound = bound[:, _CHILD_SAMPLES].min(axis=2)  # (m, 4)
