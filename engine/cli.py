@@ -149,11 +149,16 @@ class _ProgressLine:
         self.stream = stream
         self.enabled = hasattr(stream, "isatty") and stream.isatty()
         self.start = time.perf_counter()
+        self.last = -float("inf")
         self.shown = False
 
     def __call__(self, node: str, done: int, total: int) -> None:
-        if not self.enabled or time.perf_counter() - self.start < 0.5:
+        # Quiet for the first half second, then at most 20 updates a second (a write per
+        # node would cost a chain of small nodes more than the nodes themselves).
+        now = time.perf_counter()
+        if not self.enabled or now - self.start < 0.5 or now - self.last < 0.05:
             return
+        self.last = now
         self.stream.write(f"\r\x1b[Kcooking '{node}' ({done + 1}/{total} nodes)")
         self.stream.flush()
         self.shown = True
