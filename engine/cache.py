@@ -79,23 +79,32 @@ def key_text(value: Any) -> str:
 
     Every node's key is built from this text on every run, so the plain values that inputs
     are made of (str, int, bool, None, float, lists and str-keyed dicts of them) are written
-    directly; anything else goes through `canonical` and `json`. The text is the same either
-    way, so keys do not change.
+    directly, the leaves of a container without a call of their own; anything else goes
+    through `canonical` and `json`. The text is the same either way, so keys do not change.
     """
     t = type(value)
-    if t is str:
-        return _quote(value)
-    if t is float:
-        return '{"f":"' + value.hex() + '"}'
     if t is dict:
         try:
             keys = sorted(value)
         except TypeError:  # mixed key types: canonical says so
             return _JSON.encode(canonical(value))
+        out = []
         for k in keys:
             if type(k) is not str:
                 return _JSON.encode(canonical(value))
-        return "{" + ",".join([_quote(k) + ":" + key_text(value[k]) for k in keys]) + "}"
+            v = value[k]
+            tv = type(v)
+            if tv is str:
+                out.append(_quote(k) + ":" + _quote(v))
+            elif tv is float:
+                out.append(_quote(k) + ':{"f":"' + v.hex() + '"}')
+            else:
+                out.append(_quote(k) + ":" + key_text(v))
+        return "{" + ",".join(out) + "}"
+    if t is str:
+        return _quote(value)
+    if t is float:
+        return '{"f":"' + value.hex() + '"}'
     if t is bool:
         return "true" if value else "false"
     if t is int:

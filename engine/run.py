@@ -69,6 +69,7 @@ class _Run(LanguageRun):
         self.out_dir = str(self.out_path)
         self.total = 0
         self.done = 0
+        self.computed = 0  # nodes computed so far (for progress: counting stats is O(n))
 
     def where(self, name: str, port: str | None = None) -> Where:
         nd = self.g._nodes[name]
@@ -298,8 +299,7 @@ class _Run(LanguageRun):
         if spec.wants_context:
             kwargs["ctx"] = Context(name, self.out_path, self.g.budget, warnings)
         if self.g.progress is not None:
-            computed = sum(1 for s in self.stats.values() if s.status == "computed")
-            self.g.progress(name, computed, self.total)
+            self.g.progress(name, self.computed, self.total)
         t0 = time.perf_counter()
         try:
             if isinstance(spec, SubgraphSpec):
@@ -348,6 +348,7 @@ class _Run(LanguageRun):
             self.g._written[key] = file_stamp(value)
         self.stats[name] = NodeStat("computed", seconds, size, warnings)
         self.stats[name].inner = self.inner.pop(name, None)
+        self.computed += 1
         return value
 
     def cutoff_identity(self, name: str, key: str, value: Any) -> str:
