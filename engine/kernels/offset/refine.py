@@ -215,6 +215,7 @@ def _corner(tree, s1, s2, start, radius, tol, chases=2, iterations=6):
 
 
 _TRACK = 16  # neighbours on either side a corner's pair member may move to each step
+_OFFSETS = np.concatenate([[0], np.arange(-_TRACK, 0), np.arange(1, _TRACK + 1)])
 
 
 def _foot(tree: SegmentTree, seg: np.ndarray, t: np.ndarray) -> np.ndarray:
@@ -223,19 +224,41 @@ def _foot(tree: SegmentTree, seg: np.ndarray, t: np.ndarray) -> np.ndarray:
 
 
 def _track(tree: SegmentTree, x: np.ndarray, seg: np.ndarray, other: np.ndarray):
-    """The segment nearest ``x`` among ``seg``'s index neighbours (up to `_TRACK` either
-    side, none at or past ``other``), with its distance and nearest-point parameter."""
-    window = seg[:, None] + np.arange(-_TRACK, _TRACK + 1)
+    """The segment nearest ``x`` among ``seg``'s index neighbours, with its distance and
+    nearest-point parameter.
+
+    The neighbours are those up to `_TRACK` either side on the same smooth run of the input
+    as ``seg`` (`_smooth_runs`: a member follows its own stretch of curve, never around a
+    sharp vertex of the input, where another feature begins), none at or past ``other``.
+    """
+    run = _smooth_runs(tree)
+    window = seg[:, None] + _OFFSETS  # seg itself first: it stays unless another is nearer
+    window = np.minimum(np.maximum(window, 0), tree.n - 1)
     gap = other[:, None] - seg[:, None]
     # Keep strictly on seg's side of other (other itself, and beyond, belong to it).
-    allowed = (window >= 0) & (window < tree.n)
-    allowed &= np.where(gap > 0, window < other[:, None], window > other[:, None])
-    allowed |= window == seg[:, None]
+    allowed = np.where(gap > 0, window < other[:, None], window > other[:, None])
+    allowed &= run[window] == run[seg][:, None]
     window = np.where(allowed, window, seg[:, None])
     d, t = point_segment(x[:, None], tree.a[window], tree.b[window])
     best = np.argmin(d, axis=1)
     rows = np.arange(x.shape[0])
     return window[rows, best], d[rows, best], t[rows, best]
+
+
+def _smooth_runs(tree: SegmentTree) -> np.ndarray:
+    """Run id of each segment: consecutive segments share one while each starts where the
+    previous one ends and turns from it by less than 30 degrees (computed once per tree)."""
+    run = getattr(tree, "_smooth_run", None)
+    if run is None:
+        a, b = tree.a[: tree.n], tree.b[: tree.n]
+        u = b - a
+        joined = (b[:-1] == a[1:]).all(axis=1)
+        length = np.hypot(u[:, 0], u[:, 1])
+        cos = np.einsum("ij,ij->i", u[:-1], u[1:])
+        smooth = joined & (cos > COS30 * length[:-1] * length[1:]) & (length[:-1] > 0)
+        run = np.concatenate([[0], np.cumsum(~smooth)])
+        tree._smooth_run = run
+    return run
 
 
 def _between(u: np.ndarray, c: np.ndarray, p: np.ndarray) -> np.ndarray:
