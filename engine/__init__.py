@@ -9,12 +9,17 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterable
+from typing import Any
+
 from . import geometry
+from .drawgraph import draw_graph
 from .errors import (
     BudgetError,
     CycleError,
     ExpressionError,
     FormgraphError,
+    FormgraphWarning,
     GraphError,
     InputError,
     NodeError,
@@ -34,6 +39,18 @@ from .geometry import (
 from .graph import Graph, NodeStat, load
 from .registry import node_types
 
+
+def show(source: Any, node: str | Iterable[str] | None = None, **kwargs: Any) -> Any:
+    """Open the viewer on a graph (or file, or geometry): :func:`formgraph.viewer.show`.
+
+    ``fg.show(g, ["ds", "cc"], layout="side")`` shows two nodes side by side; pyvista is
+    imported only now.
+    """
+    from .viewer import show as _show
+
+    return _show(source, node, **kwargs)
+
+
 __version__ = "0.1.0"
 
 __all__ = [
@@ -42,6 +59,7 @@ __all__ = [
     "CycleError",
     "ExpressionError",
     "FormgraphError",
+    "FormgraphWarning",
     "Graph",
     "GraphError",
     "InputError",
@@ -56,7 +74,9 @@ __all__ = [
     "PathError",
     "Points",
     "Surface",
+    "draw_graph",
     "geometry",
     "load",
     "node_types",
+    "show",
 ]

@@ -12,17 +12,28 @@ import os
 import sys
 import time
 import traceback
+import warnings
 from collections.abc import Sequence
 from typing import Any
 
 import yaml
 
-from .errors import FormgraphError, GraphError
+from .errors import FormgraphError, FormgraphWarning, GraphError
 from .registry import DEFAULT_BUDGET
 
 
 class UsageError(Exception):
     """A command line that does not make sense (exit code 2)."""
+
+
+def _budget(text: str) -> int:
+    try:
+        value = int(text.replace("_", ""))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be at least 1, got {value}")
+    return value
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -35,14 +46,16 @@ def _parser() -> argparse.ArgumentParser:
     def graph_options(p: argparse.ArgumentParser) -> None:
         p.add_argument(
             "--set",
-            action="append",
+            action="extend",
+            nargs="+",
             default=[],
             metavar="NAME=VALUE",
-            help="override a graph param (parsed by the param's type)",
+            help="override graph params (parsed by each param's type); several may follow "
+            "one --set",
         )
         p.add_argument(
             "--budget",
-            type=int,
+            type=_budget,
             default=DEFAULT_BUDGET,
             help=f"element budget per node (default {DEFAULT_BUDGET:,})",
         )
@@ -58,6 +71,9 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--no-cache", action="store_true", help="do not use the on-disk cache")
     run.add_argument("--cache-dir", default=None, help=argparse.SUPPRESS)
     run.add_argument("--profile", action="store_true", help="print a table of node timings")
+    run.add_argument(
+        "--strict", action="store_true", help="treat warnings as errors (exit 1 if any)"
+    )
 
     chk = sub.add_parser("check", help="validate a graph; exit 1 with every problem")
     chk.add_argument("graph")
@@ -65,19 +81,53 @@ def _parser() -> argparse.ArgumentParser:
         "--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS
     )
 
-    view = sub.add_parser("view", help="show a node's output (window, or PNG with --screenshot)")
-    view.add_argument("graph")
-    view.add_argument("node", nargs="?")
-    graph_options(view)
-    view.add_argument("--screenshot", metavar="FILE.png")
-    view.add_argument("--size", default="1024x768", metavar="WxH")
-    view.add_argument("--out", default="out", metavar="DIR", help=argparse.SUPPRESS)
+    def view_options(p: argparse.ArgumentParser) -> None:
+        p.add_argument("graph")
+        p.add_argument(
+            "nodes", nargs="*", metavar="NODE", help="nodes to show (default: the results)"
+        )
+        graph_options(p)
+        p.add_argument(
+            "--layout",
+            choices=("overlay", "side"),
+            default="overlay",
+            help="several nodes in one view (overlay) or side by side, one view each",
+        )
+        p.add_argument(
+            "--edges", action="store_true", help="draw every mesh face's edges (default: coarse)"
+        )
+        p.add_argument("--size", default="1024x768", metavar="WxH")
+        p.add_argument("--out", default="out", metavar="DIR", help=argparse.SUPPRESS)
+
+    view = sub.add_parser("view", help="show nodes' outputs (window, or PNG with --screenshot)")
+    view_options(view)
+    view.add_argument("--screenshot", metavar="FILE.png", help="render off screen to a PNG")
 
     watch = sub.add_parser("watch", help="re-evaluate and redraw when the file changes")
-    watch.add_argument("graph")
-    watch.add_argument("node", nargs="?")
-    graph_options(watch)
-    watch.add_argument("--out", default="out", metavar="DIR", help=argparse.SUPPRESS)
+    view_options(watch)
+    watch.add_argument(
+        "--screenshot",
+        metavar="FILE.png",
+        help="no window: write FILE.png on every good save and print a status line",
+    )
+    watch.add_argument("--interval", type=float, default=0.3, help=argparse.SUPPRESS)
+
+    draw = sub.add_parser("graph", help="draw the graph itself (SVG or PNG)")
+    draw.add_argument("graph")
+    draw.add_argument("nodes", nargs="*", metavar="NODE", help="with --run: the nodes to evaluate")
+    draw.add_argument(
+        "-o", "--output", metavar="FILE", help="FILE.svg or FILE.png (default: GRAPH.svg here)"
+    )
+    graph_options(draw)
+    draw.add_argument(
+        "--run",
+        action="store_true",
+        help="evaluate first (the nodes given, else every sink, exports included) and colour "
+        "each node computed or cached, with its seconds",
+    )
+    draw.add_argument("--out", default="out", metavar="DIR", help="output directory (./out)")
+    draw.add_argument("--no-cache", action="store_true", help="do not use the on-disk cache")
+    draw.add_argument("--cache-dir", default=None, help=argparse.SUPPRESS)
 
     nodes = sub.add_parser("nodes", help="the node catalogue, or one node type's ports")
     nodes.add_argument("type", nargs="?")
@@ -101,7 +151,7 @@ def parse_sets(graph: Any, items: Sequence[str]) -> dict[str, Any]:
         name, sep, text = item.partition("=")
         name = name.strip()
         if not sep or not name:
-            raise UsageError(f"--set takes NAME=VALUE, got {item!r}")
+            raise UsageError(f"--set takes NAME=VALUE, got {item!r} (node names go before --set)")
         if name not in defs:
             from .check import suggest
 
@@ -109,22 +159,23 @@ def parse_sets(graph: Any, items: Sequence[str]) -> dict[str, Any]:
                 f"--set {name}: unknown param{suggest(name, defs)}; params are "
                 f"{', '.join(defs) or 'none'}"
             )
-        default = defs[name].default
-        if isinstance(default, str):
+        from .check import param_kind
+        from .yamlread import load_value
+
+        kind = param_kind(defs[name])
+        if kind is str:
             value: Any = text
-        elif isinstance(default, (int, float)) and not isinstance(default, bool):
+        elif kind in (int, float):
             value = _number(text)
+            if kind is float and isinstance(value, int):
+                value = float(value)
         else:
             try:
-                value = yaml.safe_load(text)
-            except yaml.YAMLError:
-                raise UsageError(f"--set {name}: cannot read {text!r}") from None
-            if (
-                isinstance(default, float)
-                and isinstance(value, int)
-                and not isinstance(value, bool)
-            ):
-                value = float(value)
+                value = load_value(text)  # YAML 1.2 numbers, as in the graph file
+            except (yaml.YAMLError, ValueError, TypeError, RecursionError) as exc:
+                shown = text if len(text) <= 40 else text[:37] + "..."
+                why = getattr(exc, "problem", None) or exc
+                raise UsageError(f"--set {name}: cannot read {shown!r}: {why}") from None
         out[name] = value
     return out
 
@@ -199,7 +250,9 @@ def _size(n: int) -> str:
 
 def _describe(value: Any) -> str:
     if isinstance(value, str) and os.path.isabs(value):
-        return f"wrote {os.path.relpath(value)}"
+        if os.path.isfile(value):
+            return f"wrote {os.path.relpath(value)}"
+        return f"{os.path.relpath(value)} is missing (it was not written)"
     return repr(value)
 
 
@@ -216,23 +269,34 @@ def cmd_run(args: argparse.Namespace) -> int:
         outs = g.evaluate(args.nodes, **params) if args.nodes else g.evaluate_all(**params)
     finally:
         progress.clear()
+    label = "error" if args.strict else "warning"
     for name, value in outs.items():
         print(f"{name}: {_describe(value)}")
         for w in g.stats.get(name).warnings if name in g.stats else []:
-            print(f"  warning: {w}", file=sys.stderr)
+            print(f"  {label}: {w}", file=sys.stderr)
     for name, st in g.stats.items():
         if name not in outs:
             for w in st.warnings:
-                print(f"{name}: warning: {w}", file=sys.stderr)
+                print(f"{name}: {label}: {w}", file=sys.stderr)
     if args.profile:
         print(_profile_table(g.stats, g.nodes))
+    count = sum(len(st.warnings) for st in g.stats.values())
+    if args.strict and count:
+        print(
+            f"formgraph: --strict: {count} warning{'s' if count != 1 else ''} (see above)",
+            file=sys.stderr,
+        )
+        return 1
     return 0
 
 
 def cmd_check(args: argparse.Namespace) -> int:
+    from .check import param_warnings
     from .graph import load
 
     g = load(args.graph)
+    for p in param_warnings(g.param_defs, g.file_label):
+        print(f"{p.where.prefix()}: warning: {p.message}", file=sys.stderr)
     print(f"{args.graph}: ok ({len(g.nodes)} nodes, {len(g.params)} params)")
     return 0
 
@@ -247,6 +311,20 @@ def _size_arg(text: str) -> tuple[int, int]:
     return w, h
 
 
+def _no_window(command: str, args: argparse.Namespace) -> None:
+    """Refuse a window where none can open, saying what to do instead (exit 2)."""
+    from formgraph.viewer import display_problem
+
+    problem = display_problem()
+    if problem is None:
+        return
+    raise UsageError(
+        f"{command} opens a window, but {problem}. Add --screenshot FILE.png to render "
+        f"off screen instead{' (a new PNG on every save)' if command == 'watch' else ''}, "
+        f"or run it under a virtual display: xvfb-run formgraph {command} {args.graph} ..."
+    )
+
+
 def cmd_view(args: argparse.Namespace) -> int:
     from . import graph as _graph
 
@@ -255,20 +333,95 @@ def cmd_view(args: argparse.Namespace) -> int:
     except ImportError as exc:  # pragma: no cover - pyvista is a dependency
         raise GraphError(f"the viewer needs pyvista: {exc}") from None
     size = _size_arg(args.size)
+    if not args.screenshot:
+        _no_window("view", args)
     g = _graph.load(args.graph, out_dir=args.out, budget=args.budget)
     params = parse_sets(g, args.set)
+    nodes = args.nodes or None
+    edges = True if args.edges else None
     if args.screenshot:
-        path = viewer.screenshot(g, args.screenshot, node=args.node, size=size, **params)
+        path = viewer.screenshot(
+            g, args.screenshot, node=nodes, size=size, layout=args.layout, edges=edges, **params
+        )
         print(f"wrote {path}")
         return 0
-    viewer.show(g, node=args.node, size=size, **params)
+    viewer.show(g, node=nodes, size=size, layout=args.layout, edges=edges, **params)
     return 0
 
 
 def cmd_watch(args: argparse.Namespace) -> int:
     from formgraph import viewer
 
-    viewer.watch(args.graph, node=args.node, sets=args.set, out_dir=args.out, budget=args.budget)
+    size = _size_arg(args.size)
+    nodes = args.nodes or None
+    edges = True if args.edges else None
+    for item in args.set:
+        if "=" not in item:
+            raise UsageError(f"--set takes NAME=VALUE, got {item!r}")
+    if args.screenshot:
+        watcher = viewer.ScreenshotWatcher(
+            args.graph,
+            args.screenshot,
+            nodes,
+            sets=args.set,
+            out_dir=args.out,
+            budget=args.budget,
+            size=size,
+            layout=args.layout,
+            edges=edges,
+        )
+        watcher.run(interval=args.interval)
+        return 0
+    _no_window("watch", args)
+    viewer.watch(
+        args.graph,
+        node=nodes,
+        sets=args.set,
+        out_dir=args.out,
+        budget=args.budget,
+        size=size,
+        layout=args.layout,
+        edges=edges,
+    )
+    return 0
+
+
+def cmd_graph(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from .cache import default_cache_dir
+    from .drawgraph import draw_graph, failed_nodes
+    from .graph import load
+
+    output = args.output or f"{Path(args.graph).stem}.svg"
+    if output != "-" and Path(output).suffix.lower() not in (".svg", ".png"):
+        raise UsageError(f"-o {output}: the drawing is written as .svg or .png")
+    cache_dir = None if args.no_cache else (args.cache_dir or default_cache_dir())
+    g = load(args.graph, out_dir=args.out, cache_dir=cache_dir, budget=args.budget)
+    g.set(**parse_sets(g, args.set))  # the param boxes show the values used
+    failure: FormgraphError | None = None
+    if args.run:
+        progress = _ProgressLine(sys.stderr)
+        g.progress = progress
+        try:
+            g.evaluate(args.nodes) if args.nodes else g.evaluate_all()
+        except FormgraphError as exc:  # still draw: how far the run got, the failure red
+            failure = exc
+        finally:
+            progress.clear()
+    elif args.nodes:
+        raise UsageError("NODE names are what --run evaluates; add --run")
+    failed = failed_nodes(failure) if failure is not None else []
+    drawing = draw_graph(g, failed=failed)
+    if output == "-":
+        sys.stdout.write(drawing.svg)
+    else:
+        path = drawing.save(output)
+        run = f", after a run of {len(g.stats)} nodes" if args.run else ""
+        run += f", {', '.join(failed)} failed" if failed else ""
+        print(f"wrote {path} ({len(g.nodes)} nodes, {len(g.params)} params{run})")
+    if failure is not None:
+        raise failure
     return 0
 
 
@@ -309,6 +462,7 @@ COMMANDS = {
     "check": cmd_check,
     "view": cmd_view,
     "watch": cmd_watch,
+    "graph": cmd_graph,
     "nodes": cmd_nodes,
     "schema": cmd_schema,
 }
@@ -318,7 +472,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     ap = _parser()
     args = ap.parse_args(argv)  # exits 2 on a usage error
     try:
-        return COMMANDS[args.command](args)
+        with warnings.catch_warnings():
+            # the commands print node warnings themselves, once, next to the node's output
+            warnings.simplefilter("ignore", FormgraphWarning)
+            return COMMANDS[args.command](args)
     except UsageError as exc:
         print(f"formgraph: {exc}", file=sys.stderr)
         return 2

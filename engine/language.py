@@ -254,7 +254,6 @@ class LanguageRun:
         self.stats[name] = NodeStat(
             "computed", seconds, size, warnings, items=len(items), computed_items=computed
         )
-        self.computed += 1
         return self.assemble(spec, [found[k] for k in range(len(items))])
 
     def run_subgraph(

@@ -49,6 +49,15 @@ class OutputPath(str):
     """A relative output path, checked not to leave the output directory."""
 
 
+def number_text(x: float) -> str:
+    """A number for a message: ``%g`` style, and an int too large for a float by its size."""
+    if isinstance(x, int) and not -(10**15) < x < 10**15:
+        import math
+
+        return f"{'a negative' if x < 0 else 'an'} integer of {int(math.log10(abs(x))) + 1} digits"
+    return f"{x:g}"
+
+
 @dataclass(frozen=True)
 class Range:
     """Inclusive bounds of a numeric port, checked at load."""
@@ -58,9 +67,9 @@ class Range:
 
     def check(self, value: float) -> str | None:
         if self.min is not None and value < self.min:
-            return f"must be >= {self.min:g}, got {value:g}"
+            return f"must be >= {number_text(self.min)}, got {number_text(value)}"
         if self.max is not None and value > self.max:
-            return f"must be <= {self.max:g}, got {value:g}"
+            return f"must be <= {number_text(self.max)}, got {number_text(value)}"
         return None
 
 
@@ -107,7 +116,12 @@ class Kind:
 
     @property
     def name(self) -> str:
-        n = getattr(self.base, "port_name", None) or getattr(self.base, "__name__", str(self.base))
+        if typing.get_origin(self.base) is list:  # a nested list, e.g. list[list[float]]
+            n = Kind(typing.get_args(self.base)[0], True).name
+        else:
+            n = getattr(self.base, "port_name", None) or getattr(
+                self.base, "__name__", str(self.base)
+            )
         return f"list[{n}]" if self.is_list else n
 
 
@@ -214,6 +228,8 @@ def describe(value: Any) -> str:
     """A short description of a value for error messages: its type and a glimpse."""
     if isinstance(value, Geometry):
         return type(value).__name__
+    if value is None:
+        return "None (null)"
     if isinstance(value, bool):
         return f"bool {value}"
     if isinstance(value, (int, float)):
@@ -240,10 +256,16 @@ def _coerce_kind(k: Kind, value: Any) -> Any:
     base = k.base
     if base is Any:
         return value
+    if typing.get_origin(base) is list:  # an item that is itself a list (list[list[float]])
+        if not isinstance(value, (list, tuple)):
+            raise TypeMismatch(f"expected {Kind(base).name}, got {describe(value)}")
+        return _coerce_kind(Kind(typing.get_args(base)[0], True), value)
     if base is bool:
         if isinstance(value, (bool, np.bool_)):
             return bool(value)
-        raise TypeMismatch(f"expected bool, got {describe(value)}")
+        yaml11 = isinstance(value, str) and value.lower() in ("yes", "no", "on", "off", "y", "n")
+        hint = " (YAML 1.2 reads it as text: write true or false)" if yaml11 else ""
+        raise TypeMismatch(f"expected bool, got {describe(value)}{hint}")
     if base is int:
         if isinstance(value, (bool, np.bool_)):
             raise TypeMismatch(f"expected int, got {describe(value)}")
@@ -276,11 +298,18 @@ def _coerce_kind(k: Kind, value: Any) -> Any:
         try:
             return base(value)
         except ValueError:
-            options = ", ".join(repr(m.value) for m in base)
+            import difflib
+
+            values = [str(m.value) for m in base]
+            options = ", ".join(repr(v) for v in values)
+            close = difflib.get_close_matches(str(value), values, n=1, cutoff=0.6)
+            hint = f" (did you mean {close[0]!r}?)" if close else ""
             raise TypeMismatch(
-                f"{value!r} is not a valid option, must be one of {options}"
+                f"{value!r} is not a valid option{hint}, must be one of {options}"
             ) from None
     if base is Points and not isinstance(value, Geometry):
+        if _holds_bool(value):
+            raise TypeMismatch(f"expected Points (numbers), got true/false in {describe(value)}")
         try:
             return Points(value)
         except ValueError as exc:
@@ -319,7 +348,18 @@ def _faces(value: Any) -> Faces:
     return out
 
 
+def _holds_bool(rows: Any) -> bool:
+    """Whether a list of coordinate rows holds a bool (numpy would read True as 1)."""
+    if not isinstance(rows, (list, tuple)):
+        return False
+    return any(
+        type(x) is bool for row in rows for x in (row if isinstance(row, (list, tuple)) else (row,))
+    )
+
+
 def _vec_list(value: Any) -> np.ndarray:
+    if _holds_bool(value):
+        raise TypeMismatch(f"expected [x, y, z] numbers, got true/false in {describe(value)}")
     try:
         return as_xyz(value, "coordinates")
     except ValueError as exc:
