@@ -3,12 +3,14 @@
 `SegmentTree` is a bounding-volume hierarchy of capsules (a segment's axis grown by a
 radius) over runs of consecutive segments: for curve samples these capsules are thin, so
 a nearest-segment query prunes almost everything at every level. Queries run breadth
-first for all points at once (one numpy pass per level over the surviving
-(point, node) pairs), with branch-and-bound: a node is dropped when its capsule's lower
-bound exceeds the best upper bound found so far, as in the nearest-neighbour search of
-Roussopoulos, Kelley & Vincent (SIGMOD 1995). A query may also carry a band
-``[lo, hi]``: the distance is exact inside it, and outside it only certified to be below
-``lo`` or above ``hi`` -- which is all a contour at one level needs, and far cheaper.
+first for all points at once (one numpy pass per visited level over the surviving
+(point, node) pairs; levels are visited in jumps that keep about a thousand pairs a pass,
+so a query of a few points makes few numpy calls), with branch-and-bound: a node is
+dropped when its capsule's lower bound exceeds the best upper bound found so far, as in
+the nearest-neighbour search of Roussopoulos, Kelley & Vincent (SIGMOD 1995). A query
+may also carry a band ``[lo, hi]``: the distance is exact inside it, and outside it only
+certified to be below ``lo`` or above ``hi`` -- which is all a contour at one level needs,
+and far cheaper.
 
 `RowParity` answers the even-odd (crossing number) test for the points of a grid:
 the crossings of every closed segment with every grid row are computed once, and a point
