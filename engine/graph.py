@@ -36,7 +36,7 @@ from .registry import DEFAULT_BUDGET, Context, NodeSpec, node_types
 from .types import TypeMismatch, type_by_name
 from .yamlio import MAX_BYTES, dump, parse
 
-__all__ = ["Graph", "NodeStat", "load"]
+__all__ = ["Graph", "NodeStat", "Step", "load"]
 
 
 @dataclass
@@ -48,6 +48,16 @@ class NodeStat:
     nbytes: int = 0
     warnings: list[str] = field(default_factory=list)
     source: str = ""  # where a cached value came from: 'memory' or 'disk'
+
+
+@dataclass(frozen=True)
+class Step:
+    """One node of an evaluation plan (see :meth:`Graph.plan`)."""
+
+    name: str
+    key: str  # the node's cache key for the planned params
+    upstream: tuple[str, ...]  # the nodes whose outputs it reads, each once
+    export: bool  # an export node (writes a file into the output directory)
 
 
 Progress = Callable[[str, int, int], None]
@@ -288,6 +298,79 @@ class Graph:
         """Evaluate every sink (so every export writes its file)."""
         return self.evaluate(self.sinks(), **params)
 
+    def plan(self, targets: str | Iterable[str], **params: Any) -> list[Step]:
+        """The nodes that ``targets`` need, in evaluation order, each with its cache key.
+
+        Keys are those of a cold evaluation with these params: they depend only on what goes
+        into each node (no early cutoff, which needs earlier outputs), so a sweep can key
+        every variant's nodes before anything runs and share the nodes whose keys agree.
+        Nothing is evaluated.
+        """
+        if not self._checked:
+            self.check()
+        values = dict(self._values)
+        values.update(self._checked_params(params))
+        run = _Run(self, values, pure=True)
+        names = [targets] if isinstance(targets, str) else list(targets)
+        return [
+            Step(
+                n,
+                run.key(n),
+                tuple(dict.fromkeys(self._nodes[n].upstream())),
+                run.registry[self._nodes[n].type].is_export,
+            )
+            for n in self._order(names)
+        ]
+
+    def compute_step(
+        self,
+        step: Step,
+        inputs: dict[str, Any],
+        *,
+        out_dir: str | os.PathLike[str] | None = None,
+        **params: Any,
+    ) -> tuple[Any, NodeStat]:
+        """Node ``step.name``'s output from its inputs' outputs, through the caches.
+
+        ``step`` comes from :meth:`plan` with the same params; ``inputs`` maps each of
+        ``step.upstream`` to its output. A value cached under ``step.key`` is returned as it
+        is; a computed one is cached under it. Exports always run, writing into ``out_dir``
+        (default :attr:`out_dir`).
+
+        Raises
+        ------
+        NodeError, GraphError
+            As :meth:`evaluate` does for the node.
+        """
+        values = dict(self._values)
+        values.update(self._checked_params(params))
+        run = _Run(self, values, pure=True)
+        if out_dir is not None:
+            run.out_path = Path(out_dir).resolve()
+            run.out_dir = str(run.out_path)
+        run.keys[step.name] = step.key
+        run.results.update(inputs)
+        nd = self._nodes[step.name]
+        spec = run.registry[nd.type]
+        if not spec.is_export:
+            t0 = time.perf_counter()
+            hit, value, source = run.lookup(step.key, spec)
+            if hit:
+                return value, NodeStat("cached", time.perf_counter() - t0, source=source)
+        value = run.compute(step.name, nd, spec)
+        return value, run.stats[step.name]
+
+    def cached(self, step: Step) -> tuple[bool, Any]:
+        """(True, output) when a cache holds planned ``step``'s output, else (False, None).
+
+        Exports are never answered from the cache (their file may be gone).
+        """
+        spec = node_types()[self._nodes[step.name].type]
+        if spec.is_export:
+            return False, None
+        hit, value, _ = _Run(self, dict(self._values), pure=True).lookup(step.key, spec)
+        return hit, value
+
     def upstream(self, name: str) -> list[str]:
         """All ancestors of ``name`` and itself, in evaluation order."""
         return self._order([name])
@@ -363,9 +446,10 @@ def _file_stamp(path: Any) -> tuple[int, int] | None:
 class _Run:
     """One evaluation call: memoized keys, identities and values, and the run record."""
 
-    def __init__(self, g: Graph, values: dict[str, Any]):
+    def __init__(self, g: Graph, values: dict[str, Any], pure: bool = False):
         self.g = g
         self.values = values
+        self.pure = pure  # identities are keys: no early cutoff (for plans)
         self.registry = node_types()
         self.keys: dict[str, str] = {}
         self.results: dict[str, Any] = {}
@@ -400,6 +484,8 @@ class _Run:
     def identity(self, name: str) -> str:
         # identity of the value that flows out of a node: its key, or an earlier identical
         # output's (early cutoff); known for every upstream node by the time it is asked
+        if self.pure:
+            return self.key(name)
         return self.g._identity[self.keys[name]]
 
     def key(self, name: str) -> str:
@@ -558,7 +644,7 @@ class _Run:
         seconds = time.perf_counter() - t0
         value = self.check_output(name, nd, spec, value)
         key = self.key(name)
-        identity = self.cutoff_identity(name, key, value)
+        identity = key if self.pure else self.cutoff_identity(name, key, value)
         size = _cache.sizeof(value)
         self.g.memory.put(key, value, size)
         if self.g.disk is not None:
@@ -567,7 +653,8 @@ class _Run:
             self.g._identity.clear()
             self.g._digests.clear()
         self.g._identity[key] = identity
-        self.g._last[name] = (key, identity)
+        if not self.pure:
+            self.g._last[name] = (key, identity)
         if spec.is_export:
             self.g._written[key] = _file_stamp(value)
         self.stats[name] = NodeStat("computed", seconds, size, warnings)
