@@ -33,6 +33,7 @@ from .geometry import (
 )
 from .graph import Graph, NodeStat, load
 from .registry import node_types
+from .sweep import Sweep, sweep
 
 __version__ = "0.1.0"
 
@@ -56,7 +57,9 @@ __all__ = [
     "PathError",
     "Points",
     "Surface",
+    "Sweep",
     "geometry",
     "load",
     "node_types",
+    "sweep",
 ]
