@@ -90,6 +90,10 @@ def _parser() -> argparse.ArgumentParser:
     schema.add_argument(
         "--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS
     )
+
+    from .cli_sweep import add_parsers
+
+    add_parsers(sub, graph_options)
     return ap
 
 
@@ -296,7 +300,15 @@ COMMANDS = {
     "watch": cmd_watch,
     "nodes": cmd_nodes,
     "schema": cmd_schema,
+    "sweep": lambda args: _sweep_command("cmd_sweep", args),
+    "cache": lambda args: _sweep_command("cmd_cache", args),
 }
+
+
+def _sweep_command(name: str, args: argparse.Namespace) -> int:
+    from . import cli_sweep
+
+    return getattr(cli_sweep, name)(args)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

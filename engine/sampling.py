@@ -188,13 +188,21 @@ def domain(g: Graph, name: str, spec: Any) -> Domain:
         d = Domain("", tuple(spec))
     if d.values is not None and not d.values:
         raise problem("no values")
+    raw = d.values if d.values is not None else (d.low, d.high)
+    numbers = [v for v in raw if isinstance(v, (int, float, np.number)) and not isinstance(v, bool)]
+    if numbers and kind in (int, float):  # the whole range named at once, before each value
+        low, high = min(numbers), max(numbers)
+        if p.min is not None and low < p.min:
+            raise problem(f"goes down to {low:g}, below the param's min {p.min:g}")
+        if p.max is not None and high > p.max:
+            raise problem(f"reaches {high:g}, above the param's max {p.max:g}")
     choices = enum_choices(g, name) if kind is str else None
     checked = []
-    for v in d.values if d.values is not None else (d.low, d.high):
+    for v in raw:
         try:
             v = check_param_value(p, v.item() if isinstance(v, np.generic) else v)
         except TypeMismatch as exc:
-            raise problem(f"{_short(v)} {exc}" if "must be" in str(exc) else str(exc)) from None
+            raise problem(str(exc)) from None
         if choices is not None and v not in choices:
             raise problem(f"{v!r} is not one of its choices {', '.join(choices)}")
         checked.append(v)

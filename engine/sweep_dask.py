@@ -430,8 +430,19 @@ def run(
     seen: dict[str, tuple[float, str]] = {}
     with connect(client, workers) as c:
         futures = c.get(dsk, list(rows), sync=False, optimize_graph=False)
+        pending = as_completed(futures)
+        resubmitted: dict[str, int] = {}
         try:
-            for fut in as_completed(futures):
+            for fut in pending:
+                if fut.cancelled() and resubmitted.get(fut.key, 0) < 3:
+                    # the same keys of an interrupted sweep, still being cancelled on a shared
+                    # scheduler, cancel ours too: ask again (we never cancel while running)
+                    resubmitted[fut.key] = resubmitted.get(fut.key, 0) + 1
+                    time.sleep(0.1 * resubmitted[fut.key])
+                    (again,) = c.get(dsk, [fut.key], sync=False, optimize_graph=False)
+                    futures.append(again)
+                    pending.add(again)
+                    continue
                 result = _row_result(fut)
                 fut.release()
                 seen.update(result.costs)
