@@ -1,15 +1,17 @@
-"""Running a sweep's variants as one Dask graph whose task keys are the nodes' cache keys.
+"""Running a sweep's variants as one Dask graph keyed by the nodes' cache keys.
 
 Every variant is planned on the client (:meth:`formgraph.Graph.plan`): each node it needs,
-keyed as a cold evaluation keys it. Variants that share a node (a profile the varied param
-never reaches) share its key, hence its task, so shared work runs once in the whole sweep.
-A node the client sees in the disk cache becomes a task that loads it (and, on a worker
-without that entry, evaluates it there), so a rerun does not even schedule its ancestors.
+keyed as a cold evaluation keys it. A node that two or more variants need (a profile the
+varied param never reaches) is a task under its cache key, so shared work runs once in the
+whole sweep. A variant's own nodes run in its row task, ``row-<hash of its target keys>``
+(identical variants share it): Dask's linear fusion, done by what variants share, so the
+per-task overhead is paid once per variant. A node the client sees in the disk cache is
+loaded instead (evaluated on a worker that lacks it), and its ancestors are not scheduled.
 
 Workers receive the graph once, as its YAML text (a task of its own, ``graph-<token>``),
-never a file path: nothing here assumes a shared filesystem. Node outputs travel between
-workers as Dask data; measured values, exported files (their bytes) and rendered cells come
-back to the client in one small result per variant (``row-<hash>``), which the client writes.
+never a file path: nothing here assumes a shared filesystem. Shared nodes' outputs travel
+between workers as Dask data; measured values, exported files (their bytes) and rendered
+cells come back to the client in one small result per variant, which the client writes.
 
 A node that fails makes an :class:`Outcome` with its one-line error instead of raising, so
 its dependents finish at once with the same error and the sweep goes on. A worker that dies
@@ -35,7 +37,7 @@ from .cache import DiskCache, default_cache_dir, key_of
 from .errors import FormgraphError
 from .graph import Graph, Step
 
-__all__ = ["Outcome", "RowResult", "Targets", "Totals", "run"]
+__all__ = ["Outcome", "RowResult", "SweepError", "Targets", "Totals", "run"]
 
 BLAS_ENV = {
     "OMP_NUM_THREADS": "1",
@@ -62,6 +64,9 @@ class Blueprint:
     budget: int
     cache_dir: str | None  # a path on the worker, or None: no disk cache
     worker_cache: bool  # each worker's own default cache folder instead of cache_dir
+
+    def __dask_tokenize__(self) -> str:  # Dask names the graph by hashing it: keep it cheap
+        return self.token
 
 
 @dataclass
@@ -159,6 +164,9 @@ class Job:
     step: Step
     params: dict[str, Any]
 
+    def __dask_tokenize__(self) -> str:
+        return self.step.key
+
 
 def _merged(inputs: Sequence[Outcome]) -> tuple[dict[str, tuple[float, str]], str | None]:
     costs: dict[str, tuple[float, str]] = {}
@@ -200,73 +208,109 @@ def cached_step(bp: Blueprint, job: Job) -> Outcome:
     return Outcome(value, None, {job.step.key: (time.perf_counter() - t0, status)})
 
 
+def _export(g: Graph, step: Step, inputs: dict[str, Any], params: dict[str, Any]) -> Any:
+    """An export node written into a scratch folder: (main file, {file: bytes}), and stat."""
+    with tempfile.TemporaryDirectory(prefix="formgraph-sweep-") as tmp:
+        root = Path(tmp).resolve()
+        path, stat = g.compute_step(step, inputs, out_dir=root, **params)
+        files = {
+            p.relative_to(root).as_posix(): p.read_bytes()
+            for p in sorted(root.rglob("*"))
+            if p.is_file() and not p.name.startswith(".")
+        }
+        return (Path(path).resolve().relative_to(root).as_posix(), files), stat
+
+
 def run_export(bp: Blueprint, job: Job, *inputs: Outcome) -> Outcome:
-    """Task: an export node written into a scratch folder; its files come back as bytes."""
+    """Task: an export that several variants share; its files come back as bytes."""
     costs, error = _merged(inputs)
     if error is not None:
         return Outcome(None, error, costs)
     values = {u: o.value for u, o in zip(job.step.upstream, inputs, strict=True)}
     t0 = time.perf_counter()
-    with tempfile.TemporaryDirectory(prefix="formgraph-sweep-") as tmp:
-        root = Path(tmp).resolve()
-        try:
-            path, stat = _graph(bp).compute_step(job.step, values, out_dir=root, **job.params)
-            files = {
-                p.relative_to(root).as_posix(): p.read_bytes()
-                for p in sorted(root.rglob("*"))
-                if p.is_file() and not p.name.startswith(".")
-            }
-            main = Path(path).resolve().relative_to(root).as_posix()
-        except Exception as exc:
-            costs[job.step.key] = (time.perf_counter() - t0, "failed")
-            return Outcome(None, one_line(exc), costs)
-    costs[job.step.key] = (stat.seconds, "computed")
-    return Outcome((main, files), None, costs)
-
-
-def run_render(size: tuple[int, int], node: Outcome) -> Outcome:
-    """Task: an off-screen picture (PNG bytes) of a node's output."""
-    if node.error is not None:
-        return node
     try:
-        from formgraph.viewer.sheet import render_cell
-
-        png = render_cell(node.value, size)
+        value, stat = _export(_graph(bp), job.step, values, job.params)
     except Exception as exc:
-        return Outcome(None, f"render: {one_line(exc)}", node.costs)
-    return Outcome(png, None, node.costs)
+        costs[job.step.key] = (time.perf_counter() - t0, "failed")
+        return Outcome(None, one_line(exc), costs)
+    costs[job.step.key] = (stat.seconds, "computed")
+    return Outcome(value, None, costs)
 
 
 @dataclass(frozen=True)
 class RowJob:
-    """The literal part of a row task: how its inputs map to columns."""
+    """What a variant's row holds: how its targets map to columns (the same for all rows)."""
 
     measures: tuple[tuple[str, str | None, str], ...]
-    nodes: tuple[str, ...]  # the measured nodes, in the order of the first inputs
     exports: tuple[str, ...]
-    render: bool
-    build: int  # trailing inputs only built
+    render: str | None
+    size: tuple[int, int]
+
+    def __dask_tokenize__(self) -> str:
+        return key_of([list(m) for m in self.measures] + [list(self.exports), self.render])
 
 
-def make_row(job: RowJob, *inputs: Outcome) -> RowResult:
-    """Task: a variant's row from its targets' outcomes."""
-    costs, error = _merged(inputs)
-    n = len(job.nodes)
-    values: dict[str, Any] = {}
-    exports: dict[str, tuple[str, dict[str, bytes]]] = {}
+@dataclass(frozen=True)
+class RowPlan:
+    """One variant's own nodes (no other variant needs them), computed in its row task."""
+
+    steps: tuple[Step, ...]  # in evaluation order
+    shared: tuple[str, ...]  # the shared nodes whose outcomes are the task's inputs, in order
+    params: dict[str, Any]
+    key: str
+
+    def __dask_tokenize__(self) -> str:
+        return self.key
+
+
+def run_row(bp: Blueprint, job: RowJob, plan: RowPlan, *shared: Outcome) -> RowResult:
+    """Task: a variant's own nodes from the shared ones' outcomes, then its row.
+
+    Fusing a variant's private chain into one task is Dask's own linear fusion, keyed by
+    what the variant needs: it pays the per-task overhead once per variant while every node
+    that variants share stays a task of its own under its cache key.
+    """
+    costs, error = _merged(shared)
+    values = {n: o.value for n, o in zip(plan.shared, shared, strict=True)}
+    if error is None:
+        g = _graph(bp)
+        for step in plan.steps:
+            t0 = time.perf_counter()
+            try:
+                if any(u not in values for u in step.upstream):  # seen cached by the client
+                    hit, value = g.cached(step)
+                    if not hit:  # not on this worker's disk: evaluate it here
+                        value = g.evaluate(step.name, **plan.params)
+                    stat_of = (time.perf_counter() - t0, "cached" if hit else "computed")
+                else:
+                    inputs = {u: values[u] for u in step.upstream}
+                    if step.export:
+                        value, stat = _export(g, step, inputs, plan.params)
+                    else:
+                        value, stat = g.compute_step(step, inputs, **plan.params)
+                    stat_of = (stat.seconds, stat.status)
+            except Exception as exc:  # recorded as the variant's error, never lost
+                costs[step.key] = (time.perf_counter() - t0, "failed")
+                error = one_line(exc)
+                break
+            values[step.name] = value
+            costs[step.key] = stat_of
+    seconds = sum(s for s, _ in costs.values())
+    measured: dict[str, Any] = {}
     image = None
     if error is None:
-        by_node = dict(zip(job.nodes, inputs[:n], strict=True))
         for node, output, column in job.measures:
-            v = by_node[node].value
-            v = getattr(v, output) if output else v
-            values[column] = v.item() if hasattr(v, "item") else v
-        for name, o in zip(job.exports, inputs[n : n + len(job.exports)], strict=True):
-            exports[name] = o.value
-        if job.render:
-            image = inputs[n + len(job.exports)].value
-    seconds = sum(s for s, _ in costs.values())
-    return RowResult(error, seconds, values, exports, image, costs)
+            v = getattr(values[node], output) if output else values[node]
+            measured[column] = v.item() if hasattr(v, "item") else v
+        if job.render is not None:
+            try:
+                from formgraph.viewer.sheet import render_cell
+
+                image = render_cell(values[job.render], job.size)
+            except Exception as exc:
+                error = f"render: {one_line(exc)}"
+    exports = {n: values[n] for n in job.exports} if error is None else {}
+    return RowResult(error, seconds, measured, exports, image, costs)
 
 
 # --------------------------------------------------------------------- client side
@@ -321,42 +365,60 @@ def build(
     targets: Targets,
     visible: DiskCache | None,
 ) -> tuple[dict[str, Any], dict[str, list[int]], Totals]:
-    """The Dask graph of every variant, the variants of each row key, and the totals."""
-    dsk: dict[str, Any] = {}
-    rows: dict[str, list[int]] = {}
-    totals = Totals(variants=len(variants))
+    """The Dask graph of every variant, the variants of each row key, and the totals.
+
+    A node two or more variants need is a task under its cache key, computed once; a
+    variant's own nodes run inside its row task (``row-<hash of its target keys>``, so
+    identical variants share a row). A node the client sees in the disk cache is loaded
+    instead of computed, and its ancestors are not needed at all.
+    """
     names = targets.nodes
-    measured = tuple(dict.fromkeys(m[0] for m in targets.measures))
-    job = RowJob(targets.measures, measured, targets.exports, targets.render is not None, 0)
+    plans: list[tuple[str, list[Step], dict[str, Any]]] = []
+    rows: dict[str, list[int]] = {}
+    users: dict[str, int] = {}  # node key -> how many distinct rows need it
+    cached: set[str] = set()
+    totals = Totals(variants=len(variants))
     for index, params in variants:
         steps = g.plan(names, **params)
         totals.naive += len(steps)
         by_name = {s.name: s for s in steps}
+        row_key = "row-" + key_of([by_name[n].key for n in names] + [list(targets.size)])
+        if row_key in rows:
+            rows[row_key].append(index)
+            continue
+        rows[row_key] = [index]
         needed = set(names)
+        kept = []
         for s in reversed(steps):  # from the targets up: a cached node needs no ancestors
-            if s.name not in needed or s.key in dsk:
+            if s.name not in needed:
                 continue
-            ups = [by_name[u].key for u in s.upstream]
-            if s.export:
-                dsk[s.key] = (run_export, bp_key, Job(s, params), *ups)
-            elif visible is not None and visible.has(s.key):
-                dsk[s.key] = (cached_step, bp_key, Job(s, params))
+            kept.append(s)
+            if not s.export and visible is not None and visible.has(s.key):
+                cached.add(s.key)
                 continue
-            else:
-                dsk[s.key] = (run_step, bp_key, Job(s, params), *ups)
             needed.update(s.upstream)
-        refs = [by_name[n].key for n in measured] + [by_name[n].key for n in targets.exports]
-        if targets.render is not None:
-            node_key = by_name[targets.render].key
-            render_key = "render-" + key_of([node_key, list(targets.size)])
-            dsk.setdefault(render_key, (run_render, targets.size, node_key))
-            refs.append(render_key)
-        refs += [by_name[n].key for n in targets.build]
-        row_key = "row-" + key_of(refs)
-        if row_key not in dsk:
-            dsk[row_key] = (make_row, job, *refs)
-        rows.setdefault(row_key, []).append(index)
-    totals.needed = sum(1 for k in dsk if not k.startswith(("row-", "render-")))
+        kept.reverse()
+        for s in kept:
+            users[s.key] = users.get(s.key, 0) + 1
+        plans.append((row_key, kept, params))
+    dsk: dict[str, Any] = {}
+    job = RowJob(targets.measures, targets.exports, targets.render, targets.size)
+    for row_key, steps, params in plans:
+        by_name = {s.name: s for s in steps}
+        own = tuple(s for s in steps if users[s.key] == 1)
+        for s in steps:
+            if users[s.key] == 1 or s.key in dsk:
+                continue
+            if s.key in cached:
+                dsk[s.key] = (cached_step, bp_key, Job(s, params))
+            else:
+                ups = [by_name[u].key for u in s.upstream]
+                dsk[s.key] = (run_export if s.export else run_step, bp_key, Job(s, params), *ups)
+        wanted = [u for s in own if s.key not in cached for u in s.upstream] + names
+        shared = tuple(n for n in dict.fromkeys(wanted) if users[by_name[n].key] > 1)
+        plan = RowPlan(own, shared, params, row_key)
+        dsk[row_key] = (run_row, bp_key, job, plan, *[by_name[n].key for n in shared])
+    totals.needed = len(users)
     return dsk, rows, totals
 
 
@@ -383,16 +445,23 @@ def connect(client: Any, workers: int | None) -> Iterator[Any]:
         finally:
             c.close()
         return
+    import dask
+
     n = workers or os.cpu_count() or 1
-    cluster = LocalCluster(
-        n_workers=n,
-        threads_per_worker=1,
-        processes=True,
-        host="127.0.0.1",
-        dashboard_address=None,
-        silence_logs=logging.ERROR,
-        env=BLAS_ENV,
-    )
+    # distributed sets MALLOC_TRIM_THRESHOLD_ in workers to hand memory back early; for
+    # numpy kernels whose temporaries are megabytes that costs a page-fault storm (the spiral
+    # tube builds 1.4x slower), and a sweep's workers end with the sweep anyway
+    with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}):
+        cluster = LocalCluster(
+            n_workers=n,
+            threads_per_worker=1,
+            processes=True,
+            host="127.0.0.1",
+            dashboard_address=None,
+            scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},  # its HTTP routes, off 8787
+            silence_logs=logging.ERROR,
+            env=BLAS_ENV,
+        )
     try:
         c = Client(cluster)
         try:
@@ -433,21 +502,27 @@ def run(
         pending = as_completed(futures)
         resubmitted: dict[str, int] = {}
         try:
-            for fut in pending:
-                if fut.cancelled() and resubmitted.get(fut.key, 0) < 3:
-                    # the same keys of an interrupted sweep, still being cancelled on a shared
-                    # scheduler, cancel ours too: ask again (we never cancel while running)
-                    resubmitted[fut.key] = resubmitted.get(fut.key, 0) + 1
-                    time.sleep(0.1 * resubmitted[fut.key])
-                    (again,) = c.get(dsk, [fut.key], sync=False, optimize_graph=False)
-                    futures.append(again)
-                    pending.add(again)
-                    continue
-                result = _row_result(fut)
-                fut.release()
-                seen.update(result.costs)
-                for index in rows[fut.key]:
-                    on_row(index, result)
+            for batch in pending.batches():  # one gather per batch: no round trip per row
+                done = [f for f in batch if f.status == "finished"]
+                try:
+                    results = dict(zip([f.key for f in done], c.gather(done), strict=True))
+                except Exception:  # lost meanwhile (a worker died): each on its own below
+                    results = {}
+                for fut in batch:
+                    if fut.cancelled() and resubmitted.get(fut.key, 0) < 3:
+                        # the same keys of an interrupted sweep, still being cancelled on a
+                        # shared scheduler, cancel ours too: ask again (we never cancel ours)
+                        resubmitted[fut.key] = resubmitted.get(fut.key, 0) + 1
+                        time.sleep(0.1 * resubmitted[fut.key])
+                        (again,) = c.get(dsk, [fut.key], sync=False, optimize_graph=False)
+                        futures.append(again)
+                        pending.add(again)
+                        continue
+                    result = results[fut.key] if fut.key in results else _row_result(fut)
+                    fut.release()
+                    seen.update(result.costs)
+                    for index in rows[fut.key]:
+                        on_row(index, result)
         finally:
             c.cancel(futures)
     totals.computed = sum(1 for _, st in seen.values() if st == "computed")

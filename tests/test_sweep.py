@@ -37,6 +37,7 @@ def cluster(n: int = 2) -> LocalCluster:
         processes=True,
         host="127.0.0.1",
         dashboard_address=None,
+        scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},  # its HTTP routes, off 8787
         silence_logs=40,
     )
 
@@ -189,6 +190,17 @@ def test_an_interrupted_sweep_resumes_with_every_row_once(client, tmp_path):
         assert calls.count(f"per:{v + 1}") == 1
 
 
+def scheduler_address(path: Path) -> str:
+    """The address in a scheduler file, once the scheduler has written it whole."""
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline:
+        try:
+            return json.loads(path.read_text())["address"]
+        except (OSError, ValueError, KeyError):
+            time.sleep(0.1)
+    raise AssertionError("the Dask scheduler did not start")
+
+
 def test_a_sweep_against_a_scheduler_on_loopback(tmp_path):
     graph = tmp_path / "ring.yaml"
     graph.write_text(
@@ -230,10 +242,7 @@ def test_a_sweep_against_a_scheduler_on_loopback(tmp_path):
         )
     ]
     try:
-        deadline = time.monotonic() + 60
-        while not address_file.exists() and time.monotonic() < deadline:
-            time.sleep(0.1)
-        address = json.loads(address_file.read_text())["address"]
+        address = scheduler_address(address_file)
         assert address.startswith("tcp://127.0.0.1:")
         procs.append(
             subprocess.Popen(
