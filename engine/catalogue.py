@@ -19,6 +19,20 @@ WIRE = {
     "description": "a wire: '@node' or '@node.output'",
 }
 EXPR = {"type": "string", "pattern": "^=", "description": "an expression over the graph params"}
+REPEAT = {
+    "type": "object",
+    "minProperties": 1,
+    "maxProperties": 1,
+    "additionalProperties": {
+        "anyOf": [{"type": "integer", "minimum": 0}, EXPR, WIRE, {"type": "array"}]
+    },
+    "description": "run the node once per item: {name: count | list | '@list' | '@points'}",
+}
+GRAPH_FILE = {
+    "type": "string",
+    "pattern": r"\.ya?ml$",
+    "description": "a subgraph: a graph file, relative to this one",
+}
 ESCAPED = {
     "type": "object",
     "properties": {"value": {}},
@@ -100,6 +114,7 @@ def json_schema() -> dict[str, Any]:
                     "description": spec.summary,
                     "properties": {
                         "type": {"const": name},
+                        "repeat": REPEAT,
                         **{p.name: port_schema(p) for p in spec.inputs.values()},
                     },
                     "required": ["type", *[p.name for p in spec.inputs.values() if p.required]],
@@ -134,12 +149,20 @@ def json_schema() -> dict[str, Any]:
                     "anyOf": [param_long, {"type": ["number", "string", "boolean", "array"]}]
                 },
             },
+            "outputs": {
+                "type": "object",
+                "additionalProperties": WIRE,
+                "description": "the outputs of this graph when another uses it as a node",
+            },
             "nodes": {
                 "type": "object",
                 "additionalProperties": {
                     "type": "object",
                     "required": ["type"],
-                    "properties": {"type": {"enum": list(registry)}},
+                    "properties": {
+                        "type": {"anyOf": [{"enum": list(registry)}, GRAPH_FILE]},
+                        "repeat": REPEAT,
+                    },
                     "allOf": branches,
                 },
             },
@@ -167,6 +190,11 @@ def _type_text(t: PortType) -> str:
     return t.name + (" | None" if t.optional else "")
 
 
+def _out_text(t: PortType) -> str:
+    """An output type; one that follows an input says so."""
+    return f"same type as {t.same_as}" if t.same_as else t.name
+
+
 def node_text(spec: NodeSpec) -> str:
     """One node type's ports and outputs, for ``formgraph nodes TYPE``."""
     lines = [f"{spec.name}  (version {spec.version})", "", spec.summary, "", "inputs:"]
@@ -175,7 +203,7 @@ def node_text(spec: NodeSpec) -> str:
     lines.append("outputs:")
     for name, t in spec.outputs.items():
         label = "(single)" if not spec.multi_output else name
-        lines.append(f"  {label:<12} {t.name}")
+        lines.append(f"  {label:<12} {_out_text(t)}")
     return "\n".join(lines)
 
 
@@ -188,7 +216,7 @@ def catalogue_text() -> str:
             family = spec.family
             out.append(f"\n{family}" if out else family)
         ports = ", ".join(p.name if p.required else f"[{p.name}]" for p in spec.inputs.values())
-        ret = " | ".join(t.name for t in spec.outputs.values())
+        ret = " | ".join(_out_text(t) for t in spec.outputs.values())
         out.append(f"  {name}({ports}) -> {ret}\n      {spec.summary}")
     return "\n".join(out)
 
@@ -211,7 +239,8 @@ def markdown() -> str:
             family = spec.family
             lines += ["", f"## {family}", ""]
         ret = ", ".join(
-            f"{k}: {t.name}" if spec.multi_output else t.name for k, t in spec.outputs.items()
+            f"{k}: {_out_text(t)}" if spec.multi_output else _out_text(t)
+            for k, t in spec.outputs.items()
         )
         lines += [f"### `{name}` -> {ret}", "", spec.summary, ""]
         if spec.inputs:
@@ -233,7 +262,7 @@ def readme_table() -> str:
     rows = ["| node | inputs ([optional]) | output | what it does |", "|---|---|---|---|"]
     for name, spec in node_types().items():
         ports = ", ".join(p.name if p.required else f"[{p.name}]" for p in spec.inputs.values())
-        ret = ", ".join(t.name for t in spec.outputs.values())
+        ret = ", ".join(_out_text(t) for t in spec.outputs.values())
         summary = spec.summary.replace("|", "\\|")
         rows.append(f"| `{name}` | {ports} | {ret} | {summary} |")
     return "\n".join(rows)

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import difflib
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 from . import safety
@@ -18,7 +18,7 @@ from .errors import ExpressionError, Problem, Where
 from .expr import compile_expression
 from .model import Expr, Input, Items, Literal, NodeDef, ParamDef, Wire
 from .registry import NodeSpec, node_types
-from .types import Kind, PortType, TypeMismatch, describe
+from .types import Kind, PortType, TypeMismatch, Vec3, as_list, describe
 
 
 def suggest(name: str, options: Any) -> str:
@@ -55,19 +55,32 @@ class Outline:
     """What the checker reads of a graph: where it came from, its params and its nodes.
 
     The checker needs nothing else (no caches, no evaluation), so it depends on this
-    narrow view instead of on :class:`formgraph.Graph`.
+    narrow view instead of on :class:`formgraph.Graph`. ``subgraphs`` holds the node types
+    of the graph files its nodes name (type string -> spec), ``outputs`` the graph's own
+    ``outputs:`` mapping (name -> wire text), for use as a subgraph.
     """
 
     file_label: str
     params: Mapping[str, ParamDef]
     nodes: Mapping[str, NodeDef]
+    subgraphs: Mapping[str, NodeSpec] = field(default_factory=dict)
+    outputs: Mapping[str, Any] = field(default_factory=dict)
+    output_lines: Mapping[str, int] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class _Loop:
+    """A repeated node's loop name, and the type of its items when known before running."""
+
+    name: str
+    item: PortType | None = None
 
 
 def check_graph(g: Outline, extra: list[Problem] | None = None) -> list[Problem]:
     """Every problem of graph ``g`` (an empty list when it can run)."""
     problems = list(extra or [])
     file = g.file_label
-    registry = node_types()
+    registry = {**node_types(), **g.subgraphs}
 
     from .expr import CONSTANTS, FUNCTIONS
 
@@ -97,6 +110,8 @@ def check_graph(g: Outline, extra: list[Problem] | None = None) -> list[Problem]
     for nd in g.nodes.values():
         spec = registry.get(nd.type)
         if spec is None:
+            if nd.type.endswith((".yaml", ".yml")):
+                continue  # a graph file: its problems come from reading it
             if nd.type:
                 # the SPEC's form: file:line, then the type (the node is named after it)
                 problems.append(
@@ -109,8 +124,162 @@ def check_graph(g: Outline, extra: list[Problem] | None = None) -> list[Problem]
             continue
         problems.extend(_check_node(g, nd, spec, registry))
 
+    problems.extend(_check_outputs(g, registry))
     problems.extend(_check_cycles(g))
     return problems
+
+
+def _check_outputs(g: Outline, registry: dict[str, NodeSpec]) -> list[Problem]:
+    from .model import parse_input
+
+    out = []
+    for name, text in g.outputs.items():
+        where = Where(g.file_label, g.output_lines.get(name))
+        try:
+            wire = parse_input(text)
+        except ExpressionError as exc:
+            out.append(Problem(where, f"output '{name}': {exc.problems[0].message}"))
+            continue
+        if not str(name).isidentifier() or not isinstance(wire, Wire):
+            out.append(
+                Problem(
+                    where, f"output '{name}': an output is a name and a wire, e.g. mesh: '@tess'"
+                )
+            )
+            continue
+        msgs = _check_wire(g, PortType((Kind(Any),)), wire, registry)
+        out.extend(Problem(where, f"output '{name}': {m}") for m in msgs)
+        target = g.nodes.get(wire.node)
+        spec = registry.get(target.type) if target is not None else None
+        if spec is not None and spec.is_export:
+            out.append(
+                Problem(
+                    where,
+                    f"output '{name}': '{wire}' is an export; a subgraph's exports "
+                    f"do not run when it is used as a node",
+                )
+            )
+    return out
+
+
+def output_type(
+    g: Outline, wire: Wire, registry: Mapping[str, NodeSpec], seen: frozenset[str] = frozenset()
+) -> PortType | None:
+    """The type a (valid) wire carries: a repeated node gives a list, and an output typed
+    like one of its node's inputs (``SameAs``) is followed upstream. None when unknown."""
+    nd = g.nodes.get(wire.node)
+    spec = registry.get(nd.type) if nd is not None else None
+    if spec is None or wire.node in seen:
+        return None
+    if (wire.output is not None and wire.output not in spec.outputs) or (
+        wire.output is None and spec.multi_output
+    ):
+        return None
+    t = spec.output_type(wire.output)
+    if t.same_as is not None:
+        value = nd.inputs.get(t.same_as)
+        follows = _input_type(g, value, registry, seen | {wire.node})
+        r = nd.repeat
+        if r is not None and isinstance(value, Expr) and value.text.strip() == r.name:
+            loop = _check_repeat(g, nd, registry, seen | {wire.node})[1]  # the loop's item
+            follows = loop.item if loop is not None else None
+        t = follows if follows is not None else PortType(t.kinds, t.optional)
+    return as_list(t) if nd.repeat is not None else t
+
+
+def _input_type(
+    g: Outline, value: Input | None, registry: Mapping[str, NodeSpec], seen: frozenset[str]
+) -> PortType | None:
+    if isinstance(value, Wire):
+        return output_type(g, value, registry, seen)
+    if isinstance(value, Expr) and value.compiled.is_bare_name:
+        p = g.params.get(value.text.strip())
+        return p.type if p is not None else None
+    if isinstance(value, Items):
+        types = [_input_type(g, i, registry, seen) for i in value.items]
+        if any(t is None for t in types):
+            return None
+        bases = [k.base for t in types for k in t.kinds if t is not None]
+        from .types import _common_base
+
+        return PortType((Kind(_common_base(bases), True),))
+    return None
+
+
+def _item_type(value: Any) -> PortType | None:
+    """The type of the items of a literal list, when they share one."""
+    if not isinstance(value, list) or not value:
+        return None
+    if all(isinstance(v, int) and not isinstance(v, bool) for v in value):
+        return PortType((Kind(int),))
+    if all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value):
+        return PortType((Kind(float),))
+    try:
+        for v in value:
+            PortType((Kind(Vec3),)).coerce(v)
+    except TypeMismatch:
+        return None
+    return PortType((Kind(Vec3),))
+
+
+def _check_repeat(
+    g: Outline,
+    nd: NodeDef,
+    registry: Mapping[str, NodeSpec],
+    seen: frozenset[str] = frozenset(),
+) -> tuple[list[str], _Loop | None]:
+    """Problems of a node's ``repeat:``, and its loop."""
+    from .expr import CONSTANTS, FUNCTIONS
+
+    r = nd.repeat
+    if r is None:
+        return [], None
+    name = r.name
+    if not name.isidentifier() or name.startswith("_"):
+        return [
+            f"loop name '{name}' must be letters, digits and '_', not starting with a digit or '_'"
+        ], None
+    if name in g.params or name in CONSTANTS or name in FUNCTIONS:
+        what = "a param" if name in g.params else "an expression name"
+        return [f"loop name '{name}' would hide {what}; choose another"], None
+    src = r.source
+    how = "a count (int), a list, or a wire to a list or to Points"
+    if isinstance(src, Wire):
+        msgs = _check_wire(g, PortType((Kind(Any),)), src, registry)
+        if msgs:
+            return msgs, _Loop(name)
+        t = output_type(g, src, registry, seen)
+        if t is None:
+            return [], _Loop(name)
+        if all(k.is_list for k in t.kinds):
+            return [], _Loop(name, PortType(tuple(Kind(k.base) for k in t.kinds)))
+        if all(getattr(k.base, "__name__", "") == "Points" for k in t.kinds):
+            return [], _Loop(name, PortType((Kind(Vec3),)))
+        return [f"repeat '{name}' runs over {how}; '{src}' gives {t.name}"], _Loop(name)
+    if isinstance(src, Items):
+        msgs = [m for i in src.items if isinstance(i, Expr) for m in [_expr_names_problem(g, i)]]
+        return [m for m in msgs if m], _Loop(name)
+    if isinstance(src, Expr):
+        msg = _expr_names_problem(g, src)
+        if msg:
+            return [msg], _Loop(name)
+        try:
+            value = _static_value(g, src)
+        except _Unknown:
+            return [], _Loop(name)
+        except (ExpressionError, ValueError, TypeError, ZeroDivisionError) as exc:
+            return [f"expression '={src.text}' fails with the param defaults: {exc}"], _Loop(name)
+    else:
+        value = src.value
+    if isinstance(value, float) and value.is_integer():
+        value = int(value)
+    if isinstance(value, int) and not isinstance(value, bool):
+        if value < 0:
+            return [f"repeat '{name}': a count must be >= 0, got {value}"], _Loop(name)
+        return [], _Loop(name, PortType((Kind(int),)))
+    if isinstance(value, list):
+        return [], _Loop(name, _item_type(value))
+    return [f"repeat '{name}' runs over {how}, got {describe(value)}"], _Loop(name)
 
 
 def _check_node(
@@ -125,6 +294,9 @@ def _check_node(
 
     for port, message in nd.parse_errors.items():
         add(message, port)
+    repeat_problems, loop = _check_repeat(g, nd, registry)
+    for message in repeat_problems:
+        add(message, "repeat")
     for port in nd.raw:
         if port not in spec.inputs:
             add(
@@ -139,25 +311,30 @@ def _check_node(
             continue
         if port in nd.parse_errors:
             continue
-        for message in _check_input(g, nd, p.type, nd.inputs[port], registry):
+        for message in _check_input(g, nd, p.type, nd.inputs[port], registry, loop):
             add(message, port)
     return out
 
 
 def _check_input(
-    g: Outline, nd: NodeDef, pt: PortType, value: Input, registry: dict[str, NodeSpec]
+    g: Outline,
+    nd: NodeDef,
+    pt: PortType,
+    value: Input,
+    registry: dict[str, NodeSpec],
+    loop: _Loop | None = None,
 ) -> list[str]:
     if isinstance(value, Wire):
         return _check_wire(g, pt, value, registry)
     if isinstance(value, Literal):
-        return _check_literal(g, pt, value.value)
+        return _check_literal(g, pt, value.value, loop)
     if isinstance(value, Expr):
-        return _check_expr(g, pt, value)
+        return _check_expr(g, pt, value, loop)
     # Items: a list holding wires and/or expressions
     wires = [i for i in value.items if isinstance(i, Wire)]
     if not wires:
         try:
-            resolved = [_static_value(g, i) for i in value.items]
+            resolved = [_static_value(g, i, loop) for i in value.items]
         except _Unknown as exc:
             return [str(exc)] if str(exc) else []
         return _coerce_problems(pt, resolved)
@@ -169,7 +346,7 @@ def _check_input(
     problems: list[str] = []
     for item in value.items:
         # a wire carrying a list joins the list (flattened): ["@paths", "@outline"]
-        as_item = _check_input(g, nd, item_type, item, registry)
+        as_item = _check_input(g, nd, item_type, item, registry, loop)
         if as_item and isinstance(item, Wire) and not _check_wire(g, list_type, item, registry):
             continue
         problems.extend(as_item)
@@ -200,17 +377,24 @@ def _check_wire(g: Outline, pt: PortType, wire: Wire, registry: dict[str, NodeSp
             f"'{target.type}' has several outputs; pick one: "
             f"{', '.join('@' + wire.node + '.' + o for o in spec.outputs)}"
         ]
-    produced = spec.output_type(wire.output)
+    produced = output_type(g, wire, registry) or spec.output_type(wire.output)
     if not pt.accepts(produced):
-        return [f"expected {pt.name}, got {produced.name} from '{wire}'"]
+        why = ""
+        item = PortType(tuple(Kind(k.base) for k in produced.kinds))
+        if target.repeat is not None and pt.accepts(item):
+            why = (
+                f" ('{wire.node}' is repeated over '{target.repeat.name}': it gives a list, "
+                f"one item per {target.repeat.name})"
+            )
+        return [f"expected {pt.name}, got {produced.name} from '{wire}'{why}"]
     return []
 
 
-def _check_literal(g: Outline, pt: PortType, value: Any) -> list[str]:
+def _check_literal(g: Outline, pt: PortType, value: Any, loop: _Loop | None = None) -> list[str]:
     if pt.is_expression:
         if not isinstance(value, str):
             return [f"expected an expression (text), got {describe(value)}"]
-        allowed = set(g.params) | set(pt.variables)
+        allowed = set(g.params) | set(pt.variables) | ({loop.name} if loop else set())
         try:
             compile_expression(value, allowed)
         except ExpressionError as exc:
@@ -238,35 +422,43 @@ class _Unknown(Exception):
     """A value that cannot be known before running (a geometry param with no default)."""
 
 
-def _static_value(g: Outline, item: Input) -> Any:
+def _static_value(g: Outline, item: Input, loop: _Loop | None = None) -> Any:
     if isinstance(item, Literal):
         return item.value
     if isinstance(item, Items):
-        return [_static_value(g, i) for i in item.items]
+        return [_static_value(g, i, loop) for i in item.items]
     if isinstance(item, Expr):
-        msg = _expr_names_problem(g, item)
+        msg = _expr_names_problem(g, item, loop)
         if msg:
             raise _Unknown(msg)
+        if loop is not None and loop.name in item.compiled.names:
+            raise _Unknown("")  # known item by item, when it runs
         if any(g.params[n].default is None for n in item.compiled.names):
             raise _Unknown("")
         return item.value({n: p.default for n, p in g.params.items()})
     raise _Unknown("")
 
 
-def _expr_names_problem(g: Outline, e: Expr) -> str | None:
-    unknown = sorted(e.compiled.names - set(g.params))
+def _expr_names_problem(g: Outline, e: Expr, loop: _Loop | None = None) -> str | None:
+    unknown = sorted(e.compiled.names - set(g.params) - ({loop.name} if loop else set()))
     if unknown:
+        known = [*g.params, *([loop.name] if loop else [])]
         return (
             f"expression '={e.text}' names unknown param '{unknown[0]}'"
-            f"{suggest(unknown[0], g.params)}; params are {', '.join(g.params) or 'none'}"
+            f"{suggest(unknown[0], known)}; params are {', '.join(g.params) or 'none'}"
+            + (f" (and the loop name '{loop.name}')" if loop else "")
         )
     return None
 
 
-def _check_expr(g: Outline, pt: PortType, e: Expr) -> list[str]:
-    msg = _expr_names_problem(g, e)
+def _check_expr(g: Outline, pt: PortType, e: Expr, loop: _Loop | None = None) -> list[str]:
+    msg = _expr_names_problem(g, e, loop)
     if msg:
         return [msg]
+    if loop is not None and e.compiled.is_bare_name and e.text.strip() == loop.name:
+        if loop.item is not None and not (pt.accepts(loop.item) or _coercible(pt, loop.item)):
+            return [f"expected {pt.name}, got {loop.item.name} from the loop name '{loop.name}'"]
+        return []
     if e.compiled.is_bare_name:
         p = g.params[e.text.strip()]
         if p.type is not None:
@@ -274,7 +466,7 @@ def _check_expr(g: Outline, pt: PortType, e: Expr) -> list[str]:
                 return [f"expected {pt.name}, got {p.type.name} from param '{p.name}'"]
             return []
     try:
-        value = _static_value(g, e)
+        value = _static_value(g, e, loop)
     except _Unknown as exc:
         return [str(exc)] if str(exc) else []
     except (ExpressionError, ValueError, TypeError, ZeroDivisionError) as exc:
@@ -286,6 +478,12 @@ def _check_expr(g: Outline, pt: PortType, e: Expr) -> list[str]:
             else [f"expected an expression (text), got {describe(value)}"]
         )
     return [f"{m} (from '={e.text}')" for m in _coerce_problems(pt, value)]
+
+
+def _coercible(pt: PortType, item: PortType) -> bool:
+    """Whether literal values of type ``item`` (int, float, Vec3) fit port ``pt``."""
+    sample = {int: 1, float: 1.5, Vec3: [0.0, 0.0, 0.0]}.get(item.kinds[0].base)
+    return sample is not None and not _coerce_problems(pt, sample)
 
 
 def _acyclic(g: Outline) -> bool:

@@ -176,9 +176,13 @@ def _profile_table(stats: dict[str, Any], nodes: dict[str, str]) -> str:
     for name, st in stats.items():
         total += st.seconds
         size = _size(st.nbytes)
+        items = getattr(st, "items", None)
+        notes = list(st.warnings)
+        if items is not None:  # a repeated node: one row, with how many of its items ran
+            notes.insert(0, f"{items} items, {st.computed_items}/{items} computed")
         rows.append(
             f"{name:<24} {nodes.get(name, ''):<24} {st.status:<9} {st.seconds:>9.4f} "
-            f"{size:>10}  {'; '.join(st.warnings)}"
+            f"{size:>10}  {'; '.join(notes)}"
         )
     rows.append(f"{'total':<24} {'':<24} {'':<9} {total:>9.4f}")
     return "\n".join(rows)
@@ -274,6 +278,12 @@ def cmd_nodes(args: argparse.Namespace) -> int:
 
     if args.markdown:
         sys.stdout.write(markdown())
+        return 0
+    if args.type and args.type.endswith((".yaml", ".yml")):  # a graph file's interface
+        from .graph import load
+
+        g = load(args.type)
+        print(node_text(g.as_node_spec()))
         return 0
     if args.type:
         registry = node_types()

@@ -1,4 +1,5 @@
-"""The graph: params and nodes, checked whole, evaluated on demand through the caches.
+"""The graph: params and nodes, checked whole, evaluated on demand through the caches
+(one evaluation call is a run of :mod:`formgraph.run`).
 
 Evaluation is pull-based: asking for a node evaluates only its ancestors. Each node's cache
 key hashes its type, implementation version, resolved literal inputs and the identities of
@@ -12,7 +13,6 @@ from __future__ import annotations
 import os
 import time
 from collections.abc import Callable, Iterable
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -21,43 +21,22 @@ import numpy as np
 from . import cache as _cache
 from .check import Outline, check_graph, check_param_value
 from .errors import (
-    BudgetError,
     CycleError,
     ExpressionError,
     GraphError,
-    InputError,
-    NodeError,
     ParamError,
     Problem,
     Where,
 )
-from .model import Expr, Input, Items, Literal, NodeDef, ParamDef, Wire, parse_input
-from .registry import DEFAULT_BUDGET, Context, NodeSpec, node_types
+from .language import child_graph, node_spec_of
+from .model import NodeDef, ParamDef, parse_input
+from .registry import DEFAULT_BUDGET, NodeSpec, node_types
+from .run import NodeStat, Step, _Run
+from .subgraph import Includes, SubgraphSpec, is_graph_type
 from .types import TypeMismatch, type_by_name
 from .yamlio import MAX_BYTES, dump, parse
 
 __all__ = ["Graph", "NodeStat", "Step", "load"]
-
-
-@dataclass
-class NodeStat:
-    """What happened to one node in the last evaluation."""
-
-    status: str  # 'computed' or 'cached'
-    seconds: float = 0.0
-    nbytes: int = 0
-    warnings: list[str] = field(default_factory=list)
-    source: str = ""  # where a cached value came from: 'memory' or 'disk'
-
-
-@dataclass(frozen=True)
-class Step:
-    """One node of an evaluation plan (see :meth:`Graph.plan`)."""
-
-    name: str
-    key: str  # the node's cache key for the planned params
-    upstream: tuple[str, ...]  # the nodes whose outputs it reads, each once
-    export: bool  # an export node (writes a file into the output directory)
 
 
 Progress = Callable[[str, int, int], None]
@@ -136,6 +115,11 @@ class Graph:
         self._digests: dict[str, str | None] = {}  # cache key -> content digest, when computed
         self._written: dict[str, tuple[int, int] | None] = {}  # export key -> file stamp
         self._parse_problems: list[Problem] = []
+        self.outputs: dict[str, Any] = {}  # the `outputs:` mapping, for use as a subgraph
+        self._output_lines: dict[str, int] = {}
+        self._subgraphs: dict[str, SubgraphSpec] = {}  # graph-file node types -> specs
+        self._includes: Includes | None = None
+        self._children: dict[Any, Graph] = {}  # subgraph path -> its graph, caches shared
         self._checked = False
         self.stats: dict[str, NodeStat] = {}
         self.progress: Progress | None = None
@@ -152,8 +136,14 @@ class Graph:
         g._values = {n: p.default for n, p in doc.params.items()}
         g._nodes = doc.nodes
         g._parse_problems = doc.problems
+        g.outputs = doc.outputs
+        g._output_lines = doc.output_lines
         if check:
-            g.check()
+            try:
+                g.check()
+            except GraphError as exc:
+                exc.files = g.files  # type: ignore[attr-defined]  (what watch must watch)
+                raise
         return g
 
     @property
@@ -161,7 +151,41 @@ class Graph:
         return self.file if self.file else "<graph>"
 
     def _outline(self) -> Outline:
-        return Outline(self.file_label, self._params, self._nodes)
+        self._subgraphs, problems = self._resolve_includes()
+        self._include_problems = problems
+        return Outline(
+            self.file_label,
+            self._params,
+            self._nodes,
+            self._subgraphs,
+            self.outputs,
+            self._output_lines,
+        )
+
+    def _resolve_includes(self) -> tuple[dict[str, SubgraphSpec], list[Problem]]:
+        if not any(is_graph_type(nd.type) for nd in self._nodes.values()):
+            return {}, []
+        if self._includes is None:
+            top = Path(self.file) if self.file else None
+            root = top.resolve().parent if top is not None else Path.cwd()
+            self._includes = Includes(root, top)
+        base = Path(self.file).resolve().parent if self.file else Path.cwd()
+        return self._includes.resolve_all(self._nodes, self.file_label, base)
+
+    @property
+    def files(self) -> list[Path]:
+        """The graph's file and every subgraph file it reads (what ``watch`` watches)."""
+        own = [Path(self.file)] if self.file else []
+        return own + (list(self._includes.files) if self._includes is not None else [])
+
+    def as_node_spec(self) -> SubgraphSpec:
+        """This graph as a node type, as another graph using its file sees it (its params
+        as inputs, its ``outputs:`` as outputs): what ``formgraph nodes part.yaml`` prints."""
+        return node_spec_of(self)
+
+    def _child(self, spec: SubgraphSpec) -> Graph:
+        """The graph of a subgraph file, sharing this graph's caches and settings."""
+        return child_graph(self, spec)
 
     def add_param(
         self,
@@ -192,6 +216,12 @@ class Graph:
         del self._nodes[name]
         self._checked = False
 
+    def node_types(self) -> dict[str, NodeSpec]:
+        """The node types this graph can use: the registry, and the graph files it names."""
+        if not self._checked:
+            self._outline()  # reads the subgraph files
+        return {**node_types(), **self._subgraphs}
+
     @property
     def nodes(self) -> dict[str, str]:
         """Node name -> node type, in author order."""
@@ -205,6 +235,10 @@ class Graph:
         """Change one input of a node as authored (a literal, wire or expression)."""
         nd = self._nodes[node]
         value = _plain(value)
+        if port == "repeat":  # not an input: the node's loop
+            nd.set_repeat(value)
+            self._checked = False
+            return
         nd.raw[port] = value
         nd.parse_errors.pop(port, None)
         try:
@@ -257,14 +291,16 @@ class Graph:
 
     def check(self) -> None:
         """Check the whole graph; raise one GraphError listing every problem."""
-        problems = check_graph(self._outline(), self._parse_problems)
+        outline = self._outline()
+        problems = check_graph(outline, self._parse_problems + self._include_problems)
         if problems:
             cycles = all(p.message.startswith("cycle: ") for p in problems)
             raise (CycleError if cycles else GraphError)(problems)
         self._checked = True
 
     def problems(self) -> list[Problem]:
-        return check_graph(self._outline(), self._parse_problems)
+        outline = self._outline()
+        return check_graph(outline, self._parse_problems + self._include_problems)
 
     # ----------------------------------------------------------------------- evaluate
 
@@ -298,13 +334,15 @@ class Graph:
         """Evaluate every sink (so every export writes its file)."""
         return self.evaluate(self.sinks(), **params)
 
+    # ------------------------------------------------------------------ plans (sweeps)
+
     def plan(self, targets: str | Iterable[str], **params: Any) -> list[Step]:
         """The nodes that ``targets`` need, in evaluation order, each with its cache key.
 
         Keys are those of a cold evaluation with these params: they depend only on what goes
         into each node (no early cutoff, which needs earlier outputs), so a sweep can key
         every variant's nodes before anything runs and share the nodes whose keys agree.
-        Nothing is evaluated.
+        Nothing is evaluated (except the inputs a repeat count is read from).
         """
         if not self._checked:
             self.check()
@@ -312,15 +350,12 @@ class Graph:
         values.update(self._checked_params(params))
         run = _Run(self, values, pure=True)
         names = [targets] if isinstance(targets, str) else list(targets)
-        return [
-            Step(
-                n,
-                run.key(n),
-                tuple(dict.fromkeys(self._nodes[n].upstream())),
-                run.registry[self._nodes[n].type].is_export,
-            )
-            for n in self._order(names)
-        ]
+        steps = []
+        for n in self._order(names):
+            up = tuple(dict.fromkeys(self._nodes[n].upstream()))
+            export = run.registry[self._nodes[n].type].is_export
+            steps.append(Step(n, run.key(n), up, export, tuple(run.keys[u] for u in up)))
+        return steps
 
     def compute_step(
         self,
@@ -348,27 +383,39 @@ class Graph:
         if out_dir is not None:
             run.out_path = Path(out_dir).resolve()
             run.out_dir = str(run.out_path)
-        run.keys[step.name] = step.key
+        run.keys.update(zip(step.upstream, step.upstream_keys, strict=True))
         run.results.update(inputs)
         nd = self._nodes[step.name]
         spec = run.registry[nd.type]
+        if nd.repeat is None:
+            run.keys[step.name] = step.key
+        else:
+            run.key(step.name)  # its items' keys (the count may come from an input)
+        t0 = time.perf_counter()
         if not spec.is_export:
-            t0 = time.perf_counter()
-            hit, value, source = run.lookup(step.key, spec)
+            if nd.repeat is None:
+                hit, value, source = run.lookup(step.key, spec)
+            else:
+                hit, value, source = run.lookup_items(step.name, spec)
             if hit:
                 return value, NodeStat("cached", time.perf_counter() - t0, source=source)
-        value = run.compute(step.name, nd, spec)
+        if nd.repeat is None:
+            value = run.compute(step.name, nd, spec)
+        else:
+            value = run.compute_items(step.name, nd, spec)
         return value, run.stats[step.name]
 
     def cached(self, step: Step) -> tuple[bool, Any]:
         """(True, output) when a cache holds planned ``step``'s output, else (False, None).
 
-        Exports are never answered from the cache (their file may be gone).
+        Exports (their file may be gone) and repeated nodes are never answered this way.
         """
-        spec = node_types()[self._nodes[step.name].type]
-        if spec.is_export:
+        nd = self._nodes[step.name]
+        run = _Run(self, dict(self._values), pure=True)
+        spec = run.registry[nd.type]
+        if spec.is_export or nd.repeat is not None:
             return False, None
-        hit, value, _ = _Run(self, dict(self._values), pure=True).lookup(step.key, spec)
+        hit, value, _ = run.lookup(step.key, spec)
         return hit, value
 
     def upstream(self, name: str) -> list[str]:
@@ -399,7 +446,7 @@ class Graph:
     # ------------------------------------------------------------------------ saving
 
     def to_yaml(self) -> str:
-        return dump(self.description, self._params, self._nodes)
+        return dump(self.description, self._params, self._nodes, self.outputs)
 
     def save(self, path: str | os.PathLike[str]) -> None:
         """Write the graph as YAML (author order kept); ``load`` reads back an equal graph."""
@@ -411,6 +458,7 @@ class Graph:
             self.description,
             {n: p.to_yaml() for n, p in self._params.items()},
             [(n, nd.to_yaml()) for n, nd in self._nodes.items()],
+            dict(self.outputs),
         )
 
     def __eq__(self, other: object) -> bool:
@@ -432,270 +480,3 @@ def _plain(value: Any) -> Any:
     if isinstance(value, dict):
         return {k: _plain(v) for k, v in value.items()}
     return value
-
-
-def _file_stamp(path: Any) -> tuple[int, int] | None:
-    """(size, mtime in ns) of a written file, or None when it is gone."""
-    try:
-        st = os.stat(path)
-    except (OSError, TypeError, ValueError):
-        return None
-    return st.st_size, st.st_mtime_ns
-
-
-class _Run:
-    """One evaluation call: memoized keys, identities and values, and the run record."""
-
-    def __init__(self, g: Graph, values: dict[str, Any], pure: bool = False):
-        self.g = g
-        self.values = values
-        self.pure = pure  # identities are keys: no early cutoff (for plans)
-        self.registry = node_types()
-        self.keys: dict[str, str] = {}
-        self.results: dict[str, Any] = {}
-        self.stats: dict[str, NodeStat] = {}
-        self.out_path = g.out_dir.resolve()
-        self.out_dir = str(self.out_path)
-        self.total = 0
-        self.done = 0
-
-    def where(self, name: str, port: str | None = None) -> Where:
-        nd = self.g._nodes[name]
-        line = nd.input_lines.get(port, nd.line) if port else nd.line
-        return Where(self.g.file_label, line, name, port)
-
-    def run(self, targets: list[str]) -> None:
-        """Key every ancestor in topological order, then fetch the targets' values.
-
-        A node whose key already has an identity (from an earlier run) is not even fetched
-        unless a node that must compute needs its value.
-        """
-        order = self.g._order(targets)
-        self.total = len(order)
-        for n in order:
-            key = self.key(n)
-            if key in self.g._identity and not self.registry[self.g._nodes[n].type].is_export:
-                self.stats.setdefault(n, NodeStat("cached", 0.0, source="identity"))
-            else:
-                self.fetch(n)
-        for t in targets:
-            self.fetch(t)
-
-    def identity(self, name: str) -> str:
-        # identity of the value that flows out of a node: its key, or an earlier identical
-        # output's (early cutoff); known for every upstream node by the time it is asked
-        if self.pure:
-            return self.key(name)
-        return self.g._identity[self.keys[name]]
-
-    def key(self, name: str) -> str:
-        if name in self.keys:
-            return self.keys[name]
-        nd = self.g._nodes[name]
-        spec = self.registry[nd.type]
-        parts: dict[str, Any] = {"type": nd.type, "version": spec.version, "inputs": {}}
-        for port, value in nd.inputs.items():
-            parts["inputs"][port] = self.key_part(name, port, spec, value)
-        if spec.is_export:
-            parts["out_dir"] = self.out_dir
-        self.keys[name] = _cache.key_of(parts)
-        return self.keys[name]
-
-    def key_part(self, name: str, port: str, spec: NodeSpec, value: Input) -> Any:
-        if isinstance(value, Wire):
-            return {"wire": self.identity(value.node), "output": value.output}
-        if isinstance(value, Items):
-            return [self.key_part(name, port, spec, i) for i in value.items]
-        pt = spec.inputs[port].type
-        if pt.is_expression:  # the text, and the values of the params the text reads
-            from .expr import compile_expression
-
-            text = self.resolve(name, port, value)
-            try:
-                names = compile_expression(text).names & set(self.values)
-            except ExpressionError as exc:
-                raise GraphError(
-                    [Problem(self.where(name, port), exc.problems[0].message)]
-                ) from None
-            return {"expr": text, "params": {n: self.values[n] for n in sorted(names)}}
-        return self.resolve(name, port, value)
-
-    def resolve(self, name: str, port: str, value: Input) -> Any:
-        if isinstance(value, Literal):
-            return value.value
-        if isinstance(value, Wire):
-            out = self.results[value.node]
-            return getattr(out, value.output) if value.output else out
-        if isinstance(value, Expr):
-            missing = [n for n in value.compiled.names if self.values.get(n) is None]
-            if missing:
-                raise GraphError(
-                    [
-                        Problem(
-                            self.where(name, port),
-                            f"param '{missing[0]}' has no value; pass it as "
-                            f"evaluate(..., {missing[0]}=...)",
-                        )
-                    ]
-                )
-            try:
-                return value.value(self.values)
-            except (ValueError, TypeError, ZeroDivisionError, ExpressionError) as exc:
-                raise GraphError([Problem(self.where(name, port), str(exc))]) from None
-        out: list[Any] = []
-        for item in value.items:
-            v = self.resolve(name, port, item)
-            if isinstance(item, Wire) and isinstance(v, list):
-                out.extend(v)  # a list from a wire joins the list (checked at load)
-            else:
-                out.append(v)
-        return out
-
-    def fetch(self, target: str) -> Any:
-        """The value of ``target``: from a cache, or computed after its inputs (no recursion)."""
-        stack = [target]
-        missed: set[str] = set()
-        while stack:
-            n = stack[-1]
-            if n in self.results:
-                stack.pop()
-                continue
-            nd = self.g._nodes[n]
-            spec = self.registry[nd.type]
-            if n not in missed:
-                t0 = time.perf_counter()
-                hit, value, source = self.lookup(self.keys[n], spec)
-                if hit:
-                    self.results[n] = value
-                    self.stats[n] = NodeStat(
-                        "cached", time.perf_counter() - t0, _cache.sizeof(value), source=source
-                    )
-                    stack.pop()
-                    continue
-                missed.add(n)
-            pending = [u for u in dict.fromkeys(nd.upstream()) if u not in self.results]
-            if pending:
-                stack.extend(pending)
-                continue
-            self.results[n] = self.compute(n, nd, spec)
-            stack.pop()
-        return self.results[target]
-
-    def lookup(self, key: str, spec: NodeSpec) -> tuple[bool, Any, str]:
-        hit, value = self.g.memory.get(key)
-        identity = None
-        source = "memory"
-        if not hit and self.g.disk is not None:
-            hit, value, identity = self.g.disk.get_entry(key)
-            source = "disk"
-            if hit:
-                self.g.memory.put(key, value)
-        if hit and spec.is_export and self.g._written.get(key) != _file_stamp(value):
-            hit = False  # the file is gone or holds something else now: write it again
-        if hit and spec.multi_output and not isinstance(value, spec.output_class):
-            value = spec.output_class(*value)  # the disk cache stores the outputs as a list
-        if hit and key not in self.g._identity:
-            self.g._identity[key] = identity or key
-        return hit, value, source
-
-    def compute(self, name: str, nd: NodeDef, spec: NodeSpec) -> Any:
-        kwargs: dict[str, Any] = {}
-        for port, p in spec.inputs.items():
-            if port not in nd.inputs:  # defaults reach the node typed like any input
-                if p.type.is_expression and p.default is not None:
-                    kwargs[port] = self.bind_expression(name, port, p.type, p.default)
-                else:
-                    kwargs[port] = p.type.coerce(p.default)
-                continue
-            raw = self.resolve(name, port, nd.inputs[port])
-            if p.type.is_expression:
-                kwargs[port] = self.bind_expression(name, port, p.type, raw)
-                continue
-            try:
-                kwargs[port] = p.type.coerce(raw)
-            except (TypeMismatch, ValueError) as exc:
-                raise GraphError([Problem(self.where(name, port), str(exc))]) from None
-        warnings: list[str] = []
-        if spec.wants_context:
-            kwargs["ctx"] = Context(name, self.out_path, self.g.budget, warnings)
-        if self.g.progress is not None:
-            computed = sum(1 for s in self.stats.values() if s.status == "computed")
-            self.g.progress(name, computed, self.total)
-        t0 = time.perf_counter()
-        try:
-            value = spec.func(**kwargs)
-        except BudgetError as exc:
-            raise BudgetError(
-                [Problem(self.where(name), p.message) for p in exc.problems]
-            ) from None
-        except GraphError as exc:
-            raise type(exc)(
-                [
-                    Problem(self.where(name, getattr(exc, "port", None)), p.message)
-                    for p in exc.problems
-                ]
-            ) from None
-        except InputError as exc:
-            raise NodeError(self.where(name, exc.port), nd.type, str(exc)) from exc
-        except (ValueError, ZeroDivisionError) as exc:
-            raise NodeError(self.where(name), nd.type, str(exc)) from exc
-        except Exception as exc:
-            raise NodeError(self.where(name), nd.type, f"{type(exc).__name__}: {exc}") from exc
-        seconds = time.perf_counter() - t0
-        value = self.check_output(name, nd, spec, value)
-        key = self.key(name)
-        identity = key if self.pure else self.cutoff_identity(name, key, value)
-        size = _cache.sizeof(value)
-        self.g.memory.put(key, value, size)
-        if self.g.disk is not None:
-            self.g.disk.put(key, value, identity)
-        if len(self.g._identity) > 1_000_000:  # bounded: forgetting only costs cache hits
-            self.g._identity.clear()
-            self.g._digests.clear()
-        self.g._identity[key] = identity
-        if not self.pure:
-            self.g._last[name] = (key, identity)
-        if spec.is_export:
-            self.g._written[key] = _file_stamp(value)
-        self.stats[name] = NodeStat("computed", seconds, size, warnings)
-        return value
-
-    def cutoff_identity(self, name: str, key: str, value: Any) -> str:
-        """The identity of a freshly computed output: the previous one when identical."""
-        prev = self.g._last.get(name)
-        if prev is None or prev[0] == key:
-            return key
-        hit, prev_value = self.g.memory.get(prev[0])
-        if not hit:
-            return key
-        new = self.digest(key, value)
-        return prev[1] if new is not None and new == self.digest(prev[0], prev_value) else key
-
-    def digest(self, key: str, value: Any) -> str | None:
-        if key not in self.g._digests:
-            self.g._digests[key] = _cache.digest(value)
-        return self.g._digests[key]
-
-    def bind_expression(self, name: str, port: str, pt: Any, text: Any) -> Any:
-        from .expr import Bound, compile_expression
-
-        allowed = set(self.values) | set(pt.variables)
-        try:
-            compiled = compile_expression(text, allowed)
-        except ExpressionError as exc:
-            raise GraphError([Problem(self.where(name, port), exc.problems[0].message)]) from None
-        params = {n: self.values[n] for n in compiled.names if n in self.values}
-        return Bound(compiled, params)
-
-    def check_output(self, name: str, nd: NodeDef, spec: NodeSpec, value: Any) -> Any:
-        if spec.multi_output:
-            return value
-        out_type = spec.outputs["out"]
-        try:
-            return out_type.coerce(value)
-        except (TypeMismatch, ValueError) as exc:
-            raise NodeError(
-                self.where(name),
-                nd.type,
-                f"returned a value that does not fit its output {out_type.name}: {exc}",
-            ) from None

@@ -130,6 +130,37 @@ def exprs_of(value: Input) -> list[Expr]:
     return []
 
 
+@dataclass(frozen=True)
+class Repeat:
+    """A node's ``repeat: {name: source}``: the loop name and what it runs over.
+
+    ``source`` is a count (an int, or an expression giving one: items 0 .. n-1), a list
+    (literal, or holding expressions), or a wire to a list or to Points (each point a
+    [x, y, z] item).
+    """
+
+    name: str
+    source: Input
+
+
+def parse_repeat(raw: Any) -> Repeat:
+    """Parse an authored ``repeat:`` mapping.
+
+    Raises
+    ------
+    ExpressionError
+        For anything but one ``name: source`` pair, or a malformed wire or expression.
+    """
+    if not isinstance(raw, dict) or len(raw) != 1:
+        raise ExpressionError(
+            "repeat takes one loop name and what it runs over, e.g. repeat: {i: 5}, "
+            '{i: "=n"}, {r: [1, 2, 5]} or {p: "@points"}'
+        )
+    ((name, source),) = raw.items()
+    name = str(name)
+    return Repeat(name, parse_input(source))
+
+
 @dataclass
 class ParamDef:
     """A graph parameter: default, optional declared type, range and doc."""
@@ -172,6 +203,8 @@ class NodeDef:
     line: int | None = None
     input_lines: dict[str, int] = field(default_factory=dict)
     parse_errors: dict[str, str] = field(default_factory=dict)
+    repeat: Repeat | None = None
+    repeat_raw: Any = None  # as authored, for save()
 
     @classmethod
     def make(
@@ -182,7 +215,10 @@ class NodeDef:
         line: int | None = None,
         input_lines: dict[str, int] | None = None,
     ) -> NodeDef:
-        nd = cls(name, type_, dict(raw), {}, line, dict(input_lines or {}))
+        raw = dict(raw)
+        nd = cls(name, type_, raw, {}, line, dict(input_lines or {}))
+        if "repeat" in raw:
+            nd.set_repeat(raw.pop("repeat"))
         for port, value in raw.items():
             try:
                 nd.inputs[port] = parse_input(value)
@@ -190,8 +226,24 @@ class NodeDef:
                 nd.parse_errors[port] = str(exc.problems[0].message)
         return nd
 
+    def set_repeat(self, raw: Any) -> None:
+        """Set (or with None, remove) the node's ``repeat:``."""
+        self.parse_errors.pop("repeat", None)
+        self.repeat, self.repeat_raw = None, raw
+        if raw is None:
+            return
+        try:
+            self.repeat = parse_repeat(raw)
+        except ExpressionError as exc:
+            self.parse_errors["repeat"] = str(exc.problems[0].message)
+
     def upstream(self) -> list[str]:
-        return [w.node for v in self.inputs.values() for w in wires_of(v)]
+        wires = [w.node for v in self.inputs.values() for w in wires_of(v)]
+        if self.repeat is not None:
+            wires += [w.node for w in wires_of(self.repeat.source)]
+        return wires
 
     def to_yaml(self) -> dict[str, Any]:
-        return {"type": self.type, **self.raw}
+        if self.repeat_raw is None:
+            return {"type": self.type, **self.raw}
+        return {"type": self.type, "repeat": self.repeat_raw, **self.raw}

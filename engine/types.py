@@ -64,6 +64,14 @@ class Range:
 
 
 @dataclass(frozen=True)
+class SameAs:
+    """An output whose type is the type of what flows into input ``port`` (e.g. a transform
+    gives back a Curve for a Curve, a list[Mesh] for a list[Mesh]); the checker follows it."""
+
+    port: str
+
+
+@dataclass(frozen=True)
 class Variables:
     """The variables an :class:`Expression` port's text may use besides the params."""
 
@@ -78,6 +86,7 @@ class TypeMismatch(ValueError):
 
 
 GEOMETRY_TYPES: dict[str, type] = {
+    "Geometry": Geometry,
     "Points": Points,
     "Curve": Curve,
     "NurbsCurve": NurbsCurve,
@@ -109,6 +118,7 @@ class PortType:
     optional: bool = False
     range: Range | None = None
     variables: tuple[str, ...] = ()
+    same_as: str | None = None  # an output typed like one of the node's inputs
 
     @property
     def name(self) -> str:
@@ -319,6 +329,7 @@ def port_type(hint: Any) -> PortType:
     """Turn a type hint into a :class:`PortType`."""
     rng: Range | None = None
     variables: tuple[str, ...] = ()
+    same_as: str | None = None
     if typing.get_origin(hint) is typing.Annotated:
         hint, *extras = typing.get_args(hint)
         for x in extras:
@@ -326,6 +337,8 @@ def port_type(hint: Any) -> PortType:
                 rng = x
             elif isinstance(x, Variables):
                 variables = x.names
+            elif isinstance(x, SameAs):
+                same_as = x.port
     optional = False
     alternatives = [hint]
     if typing.get_origin(hint) in (typing.Union, _pytypes.UnionType):
@@ -340,7 +353,7 @@ def port_type(hint: Any) -> PortType:
             kinds.append(Kind(item, True))
         else:
             kinds.append(Kind(alt, False))
-    return PortType(tuple(kinds), optional, rng, variables)
+    return PortType(tuple(kinds), optional, rng, variables, same_as)
 
 
 def type_by_name(name: str) -> PortType:
@@ -353,6 +366,11 @@ def type_by_name(name: str) -> PortType:
         known = ", ".join([*GEOMETRY_TYPES, *SCALARS, "Vec3"])
         raise TypeMismatch(f"unknown type {name!r} (known: {known}, and list[...] of them)")
     return PortType((Kind(base, is_list),))
+
+
+def as_list(t: PortType) -> PortType:
+    """The type of a list of ``t`` (a list of lists flattens: list[T] stays list[T])."""
+    return PortType(tuple(dict.fromkeys(Kind(k.base, True) for k in t.kinds)))
 
 
 def type_of_value(value: Any) -> PortType:

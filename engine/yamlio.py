@@ -21,7 +21,7 @@ FORMAT_VERSION = 1
 MAX_BYTES = 16 * 1024 * 1024
 MAX_VALUES = 2_000_000  # scalars and collections, with aliases expanded
 MAX_DEPTH = 64
-TOP_KEYS = ("formgraph", "description", "params", "nodes")
+TOP_KEYS = ("formgraph", "description", "params", "nodes", "outputs")
 
 
 @dataclass
@@ -30,6 +30,8 @@ class Document:
     params: dict[str, ParamDef] = field(default_factory=dict)
     nodes: dict[str, NodeDef] = field(default_factory=dict)
     problems: list[Problem] = field(default_factory=list)
+    outputs: dict[str, Any] = field(default_factory=dict)  # name -> wire, used as a subgraph
+    output_lines: dict[str, int] = field(default_factory=dict)
 
 
 def _expansion_problem(root: yaml.Node | None) -> str | None:
@@ -143,6 +145,18 @@ def parse(text: str, file: str = "<graph>") -> Document:
         elif not (isinstance(v, yaml.ScalarNode) and v.value in ("", "null", "~")):
             problem("'params' must be a mapping of name: default or name: {default: ...}", _line(k))
 
+    if "outputs" in top:
+        k, v = top["outputs"]
+        if isinstance(v, yaml.MappingNode):
+            for ok, ov in v.value:
+                name = _scalar_key(ok)
+                if name in doc.outputs:
+                    problem(f"output '{name}' appears twice", _line(ok))
+                doc.outputs[name] = _value(ov, problem, None, None)
+                doc.output_lines[name] = _line(ok)
+        else:
+            problem("'outputs' must be a mapping of output name to a wire ('@node')", _line(k))
+
     if "nodes" not in top:
         problem("missing 'nodes:' (a mapping of node name to its type and inputs)", 1)
         return doc
@@ -243,13 +257,20 @@ def _param(name: str, node: yaml.Node, problem: Any) -> ParamDef | None:
     return p
 
 
-def dump(description: str, params: dict[str, ParamDef], nodes: dict[str, NodeDef]) -> str:
+def dump(
+    description: str,
+    params: dict[str, ParamDef],
+    nodes: dict[str, NodeDef],
+    outputs: dict[str, Any] | None = None,
+) -> str:
     """The YAML text of a graph, in author order, that :func:`parse` reads back equal."""
     data: dict[str, Any] = {"formgraph": FORMAT_VERSION}
     if description:
         data["description"] = description
     if params:
         data["params"] = {n: p.to_yaml() for n, p in params.items()}
+    if outputs:
+        data["outputs"] = dict(outputs)
     data["nodes"] = {n: nd.to_yaml() for n, nd in nodes.items()}
     return yaml.safe_dump(
         data, sort_keys=False, default_flow_style=None, allow_unicode=True, width=100

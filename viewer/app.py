@@ -19,7 +19,6 @@ from typing import Any
 from formgraph.errors import FormgraphError, GraphError, Problem, Where
 from formgraph.graph import Graph, load
 from formgraph.model import Items, Wire, parse_input
-from formgraph.registry import node_types
 
 from .scene import PALETTE, TEXT_COLOR, Scene
 
@@ -34,7 +33,7 @@ def shown_nodes(graph: Graph, node: str | Iterable[str] | None = None) -> list[s
     The results are the nodes wired into its export nodes (``@mesh`` feeding
     ``export.stl``), in author order; a graph without exports shows its sinks.
     """
-    registry = node_types()
+    registry = graph.node_types()  # subgraph files too
     if node is not None:
         names = [node] if isinstance(node, str) else list(node)
         for n in names:

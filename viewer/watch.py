@@ -1,6 +1,6 @@
-"""Watch mode: redraw a graph whenever its YAML file is saved.
+"""Watch mode: redraw a graph whenever its YAML file (or a subgraph file it uses) is saved.
 
-A :class:`Watcher` polls the file's modification stamp from the plotter's timer. Each
+A :class:`Watcher` polls the files' modification stamps from the plotter's timer. Each
 :meth:`Watcher.reload` reads, checks and evaluates the file again; a broken edit puts the
 error in the window (and on stderr) and leaves the last good geometry on screen. Successive
 versions share one memory cache, so an edit recomputes only the nodes it reaches.
@@ -59,7 +59,8 @@ class Watcher:
         self.out_dir = out_dir
         self.budget = budget
         self.session: Session | None = None
-        self.stamp: tuple[int, int] | None = None
+        self.stamp: tuple[Any, ...] | None = None
+        self.files: list[Path] = [self.path]  # the graph's file and its subgraph files
         self.reloads = 0
         self._blank: Scene | None = None  # shows the error of a broken first version
 
@@ -67,12 +68,18 @@ class Watcher:
     def scene(self) -> Any:
         return self.session.scene if self.session is not None else None
 
-    def _stamp(self) -> tuple[int, int] | None:
-        try:
-            st = self.path.stat()
-        except OSError:
-            return None  # mid-save (an editor's rename): look again on the next tick
-        return st.st_mtime_ns, st.st_size
+    def _stamp(self) -> tuple[Any, ...] | None:
+        stamps: list[Any] = []
+        for f in self.files:
+            try:
+                st = f.stat()
+            except OSError:
+                if f == self.path:
+                    return None  # mid-save (an editor's rename): look again on the next tick
+                stamps.append(None)
+                continue
+            stamps.append((st.st_mtime_ns, st.st_size))
+        return tuple(stamps)
 
     def poll(self) -> bool | None:
         """Reload if the file changed since the last look; None when it did not."""
@@ -93,6 +100,8 @@ class Watcher:
         self.reloads += 1
         try:
             graph = load(self.path, out_dir=self.out_dir, budget=self.budget)
+            self.files = [self.path, *graph.files[1:]]
+            self.stamp = self._stamp()
             if self.session is not None and self.session.graph is not None:
                 graph.memory = self.session.graph.memory  # an edit recomputes what it reaches
             params = parse_sets(graph, self.sets)
@@ -103,6 +112,9 @@ class Watcher:
             else:
                 self.session.replace_graph(graph, params)
         except (FormgraphError, UsageError) as exc:
+            if getattr(exc, "files", None):  # a broken subgraph file is watched too
+                self.files = [self.path, *exc.files[1:]]
+                self.stamp = self._stamp()
             self._report(str(exc))
             return False
         except Exception as exc:  # a bug of ours must not close the designer's window

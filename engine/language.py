@@ -1,0 +1,296 @@
+"""Evaluating the graph language beyond single nodes: repeated nodes and subgraph nodes.
+
+A repeated node's items each have their own cache key, ``key({"node": base, "item":
+token})``, where ``base`` hashes the node's inputs as written (an input that reads the loop
+name enters as its text and the params it reads) and ``token`` is the item itself (a count's
+index, a literal list's value) or, for an item from a wire, the wire's identity and the
+index, never the data. So one more item computes one more item, and the node's own key (the
+list of its items' keys) is what its users' keys see.
+
+A subgraph node runs its file's graph (sharing the caches) with the node's inputs as params;
+a wired input enters the subgraph's keys as the wire's identity.
+
+:class:`LanguageRun` is a mixin of the evaluation run in :mod:`formgraph.graph`.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from . import cache as _cache
+from .errors import BudgetError, ExpressionError, GraphError, NodeError, Problem
+from .geometry import Points
+from .model import Expr, Input, Items, Literal, NodeDef, Wire, wires_of
+from .registry import NodeSpec
+from .subgraph import Includes, SubgraphSpec
+
+__all__ = ["LanguageRun", "child_graph", "file_stamp", "input_names", "node_spec_of", "reads_loop"]
+
+
+def input_names(value: Input, pt: Any) -> set[str]:
+    """The names an input's expressions read (an expression port's text too)."""
+    if isinstance(value, Expr):
+        return set(value.compiled.names)
+    if isinstance(value, Items):
+        return {n for i in value.items for n in input_names(i, pt)}
+    if isinstance(value, Literal) and pt.is_expression and isinstance(value.value, str):
+        from .expr import compile_expression
+
+        try:
+            return set(compile_expression(value.value).names)
+        except ExpressionError:
+            return set()
+    return set()
+
+
+def reads_loop(value: Input, loop: str, pt: Any) -> bool:
+    """Whether an input reads the loop name (and so differs item by item)."""
+    return loop in input_names(value, pt)
+
+
+def file_stamp(path: Any) -> tuple[int, int] | None:
+    """(size, mtime in ns) of a written file, or None when it is gone."""
+    try:
+        st = os.stat(path)
+    except (OSError, TypeError, ValueError):
+        return None
+    return st.st_size, st.st_mtime_ns
+
+
+def node_spec_of(self: Any) -> SubgraphSpec:
+    """This graph as a node type, as another graph using its file sees it (its params
+    as inputs, its ``outputs:`` as outputs): what ``formgraph nodes part.yaml`` prints."""
+    if not self.file:
+        raise GraphError("only a graph read from a file can be used as a node")
+    path = Path(self.file)
+    nd = NodeDef.make(path.name, path.name, {})
+    spec, problems = Includes(path.resolve().parent).load(
+        nd, str(path), path.resolve().parent, [], ()
+    )
+    if spec is None:
+        raise GraphError(problems)
+    return spec
+
+
+def child_graph(self: Any, spec: SubgraphSpec) -> Any:
+    """The graph of a subgraph file, sharing this graph's caches and settings."""
+    child = self._children.get(spec.path)
+    if child is None:
+        doc = spec.document
+        assert doc is not None
+        child = type(self)(file=spec.label, description=doc.description, out_dir=self.out_dir)
+        child.budget = self.budget
+        child.memory, child.disk = self.memory, self.disk
+        child._identity, child._digests, child._written = (
+            self._identity,
+            self._digests,
+            self._written,
+        )
+        child._params, child._nodes, child.outputs = doc.params, doc.nodes, doc.outputs
+        child._values = {n: p.default for n, p in doc.params.items()}
+        child._subgraphs = dict(spec.subgraphs)
+        child._checked = True  # checked with this graph
+        self._children[spec.path] = child
+    return child
+
+
+class LanguageRun:
+    """Repeated and subgraph nodes, for the evaluation run (``self`` is a ``_Run``)."""
+
+    g: Any
+    values: dict[str, Any]
+    tokens: dict[str, Any]
+    keys: dict[str, str]
+    item_keys: dict[str, list[str]]
+    items: dict[str, tuple[list[Any], list[Any]]]
+    item_values: dict[str, dict[int, Any]]
+    inner: dict[str, Any]
+    stats: dict[str, Any]
+
+    def repeat_items(self, name: str) -> tuple[list[Any], list[Any]]:
+        """The items of a repeated node and their key tokens (memoized; budget checked)."""
+        if name in self.items:
+            return self.items[name]
+        r = self.g._nodes[name].repeat
+        assert r is not None
+        src = r.source
+        where = self.where(name, "repeat")
+        for w in wires_of(src):  # the count is known only from the value
+            self.fetch(w.node)
+        if isinstance(src, Wire):
+            value = self.resolve(name, "repeat", src)
+            token: Any = {"wire": self.identity(src.node), "output": src.output}
+        else:
+            value = self.resolve(name, "repeat", src)
+            token = None if isinstance(src, (Literal, Expr)) else self.key_part_items(name, src)
+        if isinstance(value, Points):
+            value = value.xyz.tolist()
+        elif isinstance(value, float) and value.is_integer():
+            value = int(value)
+        if isinstance(value, int) and not isinstance(value, bool):
+            if value < 0:
+                raise GraphError([Problem(where, f"a repeat count must be >= 0, got {value}")])
+            count = value
+        elif isinstance(value, (list, tuple)):
+            count = len(value)
+        else:
+            raise GraphError(
+                [
+                    Problem(
+                        where,
+                        f"repeat '{r.name}' runs over a count, a list or Points, got "
+                        f"{type(value).__name__}",
+                    )
+                ]
+            )
+        if count > self.g.budget:
+            raise BudgetError(
+                [
+                    Problem(
+                        where,
+                        f"repeat '{r.name}' would run {count:,} items, over the budget of "
+                        f"{self.g.budget:,} (raise it with budget= or --budget if you mean it)",
+                    )
+                ]
+            )
+        values = list(range(count)) if isinstance(value, int) else list(value)
+        if token is None:
+            tokens = values
+        else:
+            tokens = [{"source": token, "index": k} for k in range(count)]
+        self.items[name] = (values, tokens)
+        return self.items[name]
+
+    def key_part_items(self, name: str, src: Input) -> Any:
+        if isinstance(src, Wire):
+            return {"wire": self.identity(src.node), "output": src.output}
+        if isinstance(src, Items):
+            return [self.key_part_items(name, i) for i in src.items]
+        return _cache.canonical(self.resolve(name, "repeat", src))
+
+    def lookup_items(self, name: str, spec: NodeSpec) -> tuple[bool, Any, str]:
+        """A repeated node's value when every item is cached (the hits are remembered)."""
+        found = self.item_values.setdefault(name, {})
+        source = "memory"
+        for k, key in enumerate(self.item_keys[name]):
+            if k in found:
+                continue
+            hit, value, src = self.lookup(key, spec)
+            if hit:
+                found[k] = value
+                source = src if src == "disk" else source
+        if len(found) < len(self.item_keys[name]):
+            return False, None, ""
+        value = self.assemble(spec, [found[k] for k in range(len(found))])
+        self.g._identity.setdefault(self.keys[name], self.keys[name])
+        return True, value, source
+
+    def assemble(self, spec: NodeSpec, values: list[Any]) -> Any:
+        """The items' outputs as the node's list (items that are lists are joined)."""
+
+        def join(column: list[Any], t: Any) -> list[Any]:
+            listed = all(k.is_list for k in t.kinds)
+            out: list[Any] = []
+            for v in column:
+                if isinstance(v, list) or (listed and isinstance(v, np.ndarray)):
+                    out.extend(v)
+                else:
+                    out.append(v)
+            return out
+
+        if spec.multi_output:
+            return spec.output_class(
+                *(join([v[i] for v in values], t) for i, t in enumerate(spec.outputs.values()))
+            )
+        return join(values, spec.output_type(None))
+
+    def compute_items(self, name: str, nd: NodeDef, spec: NodeSpec) -> Any:
+        """Compute the items of a repeated node that no cache holds, each under its own key."""
+        assert nd.repeat is not None
+        loop = nd.repeat.name
+        items, _ = self.repeat_items(name)
+        found = self.item_values.setdefault(name, {})
+        keys = self.item_keys[name]
+        static = {
+            port: v
+            for port, v in nd.inputs.items()
+            if not reads_loop(v, loop, spec.inputs[port].type)
+        }
+        base = self.inputs(name, nd, spec, None, skip=set(nd.inputs) - set(static))
+        seconds = 0.0
+        size = 0
+        warnings: list[str] = []
+        computed = 0
+        for k, item in enumerate(items):
+            if k in found:
+                continue
+            env = dict(self.values)
+            env[loop] = item
+            kwargs = dict(base)
+            kwargs.update(self.inputs(name, nd, spec, env, only=set(nd.inputs) - set(static)))
+            value, dt, w = self.call(name, nd, spec, kwargs, env)
+            value = self.check_output(name, nd, spec, value)
+            seconds += dt
+            warnings.extend(f"item {k}: {m}" for m in w)
+            n = _cache.sizeof(value)
+            size += n
+            self.g.memory.put(keys[k], value, n)
+            if self.g.disk is not None:
+                self.g.disk.put(keys[k], value, keys[k])
+            self.g._identity[keys[k]] = keys[k]
+            if spec.is_export:
+                self.g._written[keys[k]] = file_stamp(value)
+            found[k] = value
+            computed += 1
+        from .run import NodeStat
+
+        key = self.keys[name]
+        self.g._identity[key] = key
+        self.g._last[name] = (key, key)
+        self.stats[name] = NodeStat(
+            "computed", seconds, size, warnings, items=len(items), computed_items=computed
+        )
+        return self.assemble(spec, [found[k] for k in range(len(items))])
+
+    def run_subgraph(
+        self,
+        name: str,
+        nd: NodeDef,
+        spec: SubgraphSpec,
+        kwargs: dict[str, Any],
+        env: dict[str, Any] | None,
+    ) -> Any:
+        """Evaluate a subgraph's outputs with the node's inputs as its params.
+
+        A wired input enters the subgraph's keys as the wire's identity, never hashed.
+        """
+        child = self.g._child(spec)
+        values = dict(child._values)
+        values.update(kwargs)
+        tokens = {
+            port: self.key_part(name, port, spec, v)
+            for port, v in nd.inputs.items()
+            if wires_of(v)
+            and not (
+                nd.repeat is not None and reads_loop(v, nd.repeat.name, spec.inputs[port].type)
+            )
+        }
+        run = type(self)(child, values, tokens)
+        targets = list(dict.fromkeys(w.node for w in spec.output_wires.values()))
+        chain = f" (in the subgraph '{name}' of {self.g.file_label})"
+        try:
+            run.run(targets)
+        except NodeError as exc:
+            message = str(exc)[len(f"{exc.where.prefix()} ({exc.node_type}): ") :]
+            raise NodeError(exc.where, exc.node_type, message + chain) from exc.__cause__
+        except GraphError as exc:
+            raise type(exc)([Problem(p.where, p.message + chain) for p in exc.problems]) from None
+        self.inner[name] = run.stats
+        outs = []
+        for wire in spec.output_wires.values():
+            outs.append(run.resolve(targets[0], "outputs", wire))
+        return spec.output_class(*outs) if spec.multi_output else outs[0]

@@ -1,0 +1,415 @@
+"""One evaluation call: cache keys in topological order, then values fetched or computed.
+
+Pull-based: only the targets' ancestors are keyed. A node whose key already has an
+identity from an earlier run is not even fetched unless a node that must compute needs its
+value. Each node's cache key hashes its type, implementation version, resolved literal
+inputs and the identities of its wired inputs; a node recomputed to an output identical to
+its previous one keeps its previous identity (early cutoff). Repeated and subgraph nodes
+are evaluated by the :class:`formgraph.language.LanguageRun` mixin.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+from . import cache as _cache
+from .errors import (
+    BudgetError,
+    ExpressionError,
+    GraphError,
+    InputError,
+    NodeError,
+    Problem,
+    Where,
+)
+from .language import LanguageRun, file_stamp, input_names, reads_loop
+from .model import Expr, Input, Items, Literal, NodeDef, Wire, wires_of
+from .registry import Context, NodeSpec, node_types
+from .subgraph import SubgraphSpec
+from .types import TypeMismatch
+
+if TYPE_CHECKING:
+    from .graph import Graph
+
+__all__ = ["NodeStat", "Step"]
+
+
+@dataclass
+class NodeStat:
+    """What happened to one node in the last evaluation."""
+
+    status: str  # 'computed' or 'cached'
+    seconds: float = 0.0
+    nbytes: int = 0
+    warnings: list[str] = field(default_factory=list)
+    source: str = ""  # where a cached value came from: 'memory' or 'disk'
+    items: int | None = None  # a repeated node: how many items it has
+    computed_items: int = 0  # ... and how many of them were computed (not cached)
+    inner: dict[str, NodeStat] | None = None  # a subgraph node: its own nodes' stats
+
+
+@dataclass(frozen=True)
+class Step:
+    """One node of an evaluation plan (see :meth:`formgraph.Graph.plan`)."""
+
+    name: str
+    key: str  # the node's cache key for the planned params
+    upstream: tuple[str, ...]  # the nodes whose outputs it reads, each once
+    export: bool  # an export node (writes a file into the output directory)
+    upstream_keys: tuple[str, ...] = ()  # their keys, in the same order
+
+
+class _Run(LanguageRun):
+    """One evaluation call: memoized keys, identities and values, and the run record."""
+
+    def __init__(
+        self,
+        g: Graph,
+        values: dict[str, Any],
+        tokens: dict[str, Any] | None = None,
+        pure: bool = False,
+    ):
+        self.g = g
+        self.values = values
+        self.pure = pure  # identities are keys: no early cutoff (for plans)
+        self.tokens = tokens or {}  # key stand-ins of params that hold wired values
+        self.registry = {**node_types(), **g._subgraphs}
+        self.keys: dict[str, str] = {}
+        self.item_keys: dict[str, list[str]] = {}  # repeated node -> its items' keys
+        self.items: dict[str, tuple[list[Any], list[Any]]] = {}  # -> (items, key tokens)
+        self.item_values: dict[str, dict[int, Any]] = {}  # -> items found or computed
+        self.inner: dict[str, dict[str, NodeStat]] = {}  # subgraph node -> its run's stats
+        self.results: dict[str, Any] = {}
+        self.stats: dict[str, NodeStat] = {}
+        self.out_path = g.out_dir.resolve()
+        self.out_dir = str(self.out_path)
+        self.total = 0
+        self.done = 0
+
+    def where(self, name: str, port: str | None = None) -> Where:
+        nd = self.g._nodes[name]
+        line = nd.input_lines.get(port, nd.line) if port else nd.line
+        return Where(self.g.file_label, line, name, port)
+
+    def run(self, targets: list[str]) -> None:
+        """Key every ancestor in topological order, then fetch the targets' values.
+
+        A node whose key already has an identity (from an earlier run) is not even fetched
+        unless a node that must compute needs its value.
+        """
+        order = self.g._order(targets)
+        self.total = len(order)
+        for n in order:  # the budget applies to every count known before anything runs
+            r = self.g._nodes[n].repeat
+            if r is not None and not wires_of(r.source):
+                self.repeat_items(n)
+        for n in order:
+            key = self.key(n)
+            if key in self.g._identity and not self.registry[self.g._nodes[n].type].is_export:
+                st = self.stats.setdefault(n, NodeStat("cached", 0.0, source="identity"))
+                if n in self.item_keys:
+                    st.items = len(self.item_keys[n])
+            else:
+                self.fetch(n)
+        for t in targets:
+            self.fetch(t)
+
+    def identity(self, name: str) -> str:
+        # identity of the value that flows out of a node: its key, or an earlier identical
+        # output's (early cutoff); known for every upstream node by the time it is asked
+        if self.pure:
+            return self.key(name)
+        return self.g._identity[self.keys[name]]
+
+    def key(self, name: str) -> str:
+        if name in self.keys:
+            return self.keys[name]
+        nd = self.g._nodes[name]
+        spec = self.registry[nd.type]
+        parts: dict[str, Any] = {"type": nd.type, "version": spec.version, "inputs": {}}
+        digest = getattr(spec, "digest", None)
+        if digest is not None:  # a subgraph: its file tree's content
+            parts["file"] = digest
+        loop = nd.repeat.name if nd.repeat is not None else None
+        for port, value in nd.inputs.items():
+            if loop is not None and reads_loop(value, loop, spec.inputs[port].type):
+                # known item by item: the authored text and the params it reads here, the
+                # item's own token in the item's key
+                names = sorted(input_names(value, spec.inputs[port].type) & set(self.values))
+                parts["inputs"][port] = {
+                    "loop": nd.raw[port],
+                    "params": {n: self.tokens.get(n, self.values[n]) for n in names},
+                    "wires": [self.key_part(name, port, spec, w) for w in wires_of(value)],
+                }
+                continue
+            parts["inputs"][port] = self.key_part(name, port, spec, value)
+        if spec.is_export:
+            parts["out_dir"] = self.out_dir
+        if nd.repeat is None:
+            self.keys[name] = _cache.key_of(parts)
+            return self.keys[name]
+        base = _cache.key_of(parts)
+        _, tokens = self.repeat_items(name)
+        items = [_cache.key_of({"node": base, "item": t}) for t in tokens]
+        self.item_keys[name] = items
+        self.keys[name] = _cache.key_of({"repeat": items})
+        return self.keys[name]
+
+    def key_part(self, name: str, port: str, spec: NodeSpec, value: Input) -> Any:
+        if isinstance(value, Wire):
+            return {"wire": self.identity(value.node), "output": value.output}
+        if isinstance(value, Items):
+            return [self.key_part(name, port, spec, i) for i in value.items]
+        pt = spec.inputs[port].type
+        if pt.is_expression:  # the text, and the values of the params the text reads
+            from .expr import compile_expression
+
+            text = self.resolve(name, port, value)
+            try:
+                names = compile_expression(text).names & set(self.values)
+            except ExpressionError as exc:
+                raise GraphError(
+                    [Problem(self.where(name, port), exc.problems[0].message)]
+                ) from None
+            return {
+                "expr": text,
+                "params": {n: self.tokens.get(n, self.values[n]) for n in sorted(names)},
+            }
+        if isinstance(value, Expr) and value.compiled.names & self.tokens.keys():
+            names = sorted(value.compiled.names)  # reads a wired subgraph param: its identity
+            return {
+                "expr": value.text,
+                "params": {n: self.tokens.get(n, self.values[n]) for n in names},
+            }
+        return self.resolve(name, port, value)
+
+    def resolve(self, name: str, port: str, value: Input, env: dict[str, Any] | None = None) -> Any:
+        if isinstance(value, Literal):
+            return value.value
+        if isinstance(value, Wire):
+            out = self.results[value.node]
+            if value.output and self.registry[self.g._nodes[value.node].type].multi_output:
+                return getattr(out, value.output)
+            return out
+        values = self.values if env is None else env
+        if isinstance(value, Expr):
+            missing = [n for n in value.compiled.names if values.get(n) is None]
+            if missing:
+                raise GraphError(
+                    [
+                        Problem(
+                            self.where(name, port),
+                            f"param '{missing[0]}' has no value; pass it as "
+                            f"evaluate(..., {missing[0]}=...)",
+                        )
+                    ]
+                )
+            try:
+                return value.value(values)
+            except (ValueError, TypeError, ZeroDivisionError, ExpressionError) as exc:
+                raise GraphError([Problem(self.where(name, port), str(exc))]) from None
+        out: list[Any] = []
+        for item in value.items:
+            v = self.resolve(name, port, item, env)
+            if isinstance(item, Wire) and isinstance(v, list):
+                out.extend(v)  # a list from a wire joins the list (checked at load)
+            else:
+                out.append(v)
+        return out
+
+    def fetch(self, target: str) -> Any:
+        """The value of ``target``: from a cache, or computed after its inputs (no recursion)."""
+        stack = [target]
+        missed: set[str] = set()
+        while stack:
+            n = stack[-1]
+            if n in self.results:
+                stack.pop()
+                continue
+            nd = self.g._nodes[n]
+            spec = self.registry[nd.type]
+            if n not in missed:
+                t0 = time.perf_counter()
+                if nd.repeat is not None:
+                    hit, value, source = self.lookup_items(n, spec)
+                else:
+                    hit, value, source = self.lookup(self.keys[n], spec)
+                if hit:
+                    self.results[n] = value
+                    self.stats[n] = NodeStat(
+                        "cached", time.perf_counter() - t0, _cache.sizeof(value), source=source
+                    )
+                    if nd.repeat is not None:
+                        self.stats[n].items = len(self.item_keys[n])
+                    stack.pop()
+                    continue
+                missed.add(n)
+            pending = [u for u in dict.fromkeys(nd.upstream()) if u not in self.results]
+            if pending:
+                stack.extend(pending)
+                continue
+            if nd.repeat is not None:
+                self.results[n] = self.compute_items(n, nd, spec)
+            else:
+                self.results[n] = self.compute(n, nd, spec)
+            stack.pop()
+        return self.results[target]
+
+    def lookup(self, key: str, spec: NodeSpec) -> tuple[bool, Any, str]:
+        hit, value = self.g.memory.get(key)
+        identity = None
+        source = "memory"
+        if not hit and self.g.disk is not None:
+            hit, value, identity = self.g.disk.get_entry(key)
+            source = "disk"
+            if hit:
+                self.g.memory.put(key, value)
+        if hit and spec.is_export and self.g._written.get(key) != file_stamp(value):
+            hit = False  # the file is gone or holds something else now: write it again
+        if hit and spec.multi_output and not isinstance(value, spec.output_class):
+            value = spec.output_class(*value)  # the disk cache stores the outputs as a list
+        if hit and key not in self.g._identity:
+            self.g._identity[key] = identity or key
+        return hit, value, source
+
+    def inputs(
+        self,
+        name: str,
+        nd: NodeDef,
+        spec: NodeSpec,
+        env: dict[str, Any] | None,
+        *,
+        only: set[str] | None = None,
+        skip: set[str] = frozenset(),  # type: ignore[assignment]
+    ) -> dict[str, Any]:
+        """The node function's keyword arguments (``env``: the values expressions see)."""
+        kwargs: dict[str, Any] = {}
+        for port, p in spec.inputs.items():
+            if (only is not None and port not in only) or port in skip:
+                continue
+            if port not in nd.inputs:  # defaults reach the node typed like any input
+                if p.type.is_expression and p.default is not None:
+                    kwargs[port] = self.bind_expression(name, port, p.type, p.default, env)
+                else:
+                    kwargs[port] = p.type.coerce(p.default)
+                continue
+            raw = self.resolve(name, port, nd.inputs[port], env)
+            if p.type.is_expression:
+                kwargs[port] = self.bind_expression(name, port, p.type, raw, env)
+                continue
+            try:
+                kwargs[port] = p.type.coerce(raw)
+            except (TypeMismatch, ValueError) as exc:
+                raise GraphError([Problem(self.where(name, port), str(exc))]) from None
+        return kwargs
+
+    def call(
+        self,
+        name: str,
+        nd: NodeDef,
+        spec: NodeSpec,
+        kwargs: dict[str, Any],
+        env: dict[str, Any] | None = None,
+    ) -> tuple[Any, float, list[str]]:
+        """Run the node function (or the subgraph) on ``kwargs``: (value, seconds, warnings)."""
+        warnings: list[str] = []
+        if spec.wants_context:
+            kwargs["ctx"] = Context(name, self.out_path, self.g.budget, warnings)
+        if self.g.progress is not None:
+            computed = sum(1 for s in self.stats.values() if s.status == "computed")
+            self.g.progress(name, computed, self.total)
+        t0 = time.perf_counter()
+        try:
+            if isinstance(spec, SubgraphSpec):
+                value = self.run_subgraph(name, nd, spec, kwargs, env)
+            else:
+                value = spec.func(**kwargs)
+        except BudgetError as exc:
+            raise BudgetError(
+                [Problem(self.where(name), p.message) for p in exc.problems]
+            ) from None
+        except (NodeError, GraphError) as exc:
+            if isinstance(spec, SubgraphSpec):
+                raise  # already names the subgraph's file, line and node
+            if isinstance(exc, NodeError):
+                raise
+            raise type(exc)(
+                [
+                    Problem(self.where(name, getattr(exc, "port", None)), p.message)
+                    for p in exc.problems
+                ]
+            ) from None
+        except InputError as exc:
+            raise NodeError(self.where(name, exc.port), nd.type, str(exc)) from exc
+        except (ValueError, ZeroDivisionError) as exc:
+            raise NodeError(self.where(name), nd.type, str(exc)) from exc
+        except Exception as exc:
+            raise NodeError(self.where(name), nd.type, f"{type(exc).__name__}: {exc}") from exc
+        return value, time.perf_counter() - t0, warnings
+
+    def compute(self, name: str, nd: NodeDef, spec: NodeSpec) -> Any:
+        kwargs = self.inputs(name, nd, spec, None)
+        value, seconds, warnings = self.call(name, nd, spec, kwargs)
+        value = self.check_output(name, nd, spec, value)
+        key = self.key(name)
+        identity = key if self.pure else self.cutoff_identity(name, key, value)
+        size = _cache.sizeof(value)
+        self.g.memory.put(key, value, size)
+        if self.g.disk is not None:
+            self.g.disk.put(key, value, identity)
+        if len(self.g._identity) > 1_000_000:  # bounded: forgetting only costs cache hits
+            self.g._identity.clear()
+            self.g._digests.clear()
+        self.g._identity[key] = identity
+        if not self.pure:
+            self.g._last[name] = (key, identity)
+        if spec.is_export:
+            self.g._written[key] = file_stamp(value)
+        self.stats[name] = NodeStat("computed", seconds, size, warnings)
+        self.stats[name].inner = self.inner.pop(name, None)
+        return value
+
+    def cutoff_identity(self, name: str, key: str, value: Any) -> str:
+        """The identity of a freshly computed output: the previous one when identical."""
+        prev = self.g._last.get(name)
+        if prev is None or prev[0] == key:
+            return key
+        hit, prev_value = self.g.memory.get(prev[0])
+        if not hit:
+            return key
+        new = self.digest(key, value)
+        return prev[1] if new is not None and new == self.digest(prev[0], prev_value) else key
+
+    def digest(self, key: str, value: Any) -> str | None:
+        if key not in self.g._digests:
+            self.g._digests[key] = _cache.digest(value)
+        return self.g._digests[key]
+
+    def bind_expression(
+        self, name: str, port: str, pt: Any, text: Any, env: dict[str, Any] | None = None
+    ) -> Any:
+        from .expr import Bound, compile_expression
+
+        values = self.values if env is None else env
+        allowed = set(values) | set(pt.variables)
+        try:
+            compiled = compile_expression(text, allowed)
+        except ExpressionError as exc:
+            raise GraphError([Problem(self.where(name, port), exc.problems[0].message)]) from None
+        params = {n: values[n] for n in compiled.names if n in values}
+        return Bound(compiled, params)
+
+    def check_output(self, name: str, nd: NodeDef, spec: NodeSpec, value: Any) -> Any:
+        if spec.multi_output:
+            return value
+        out_type = spec.output_type(None)
+        try:
+            return out_type.coerce(value)
+        except (TypeMismatch, ValueError) as exc:
+            raise NodeError(
+                self.where(name),
+                nd.type,
+                f"returned a value that does not fit its output {out_type.name}: {exc}",
+            ) from None
