@@ -61,9 +61,7 @@ def param_kind(p: Any) -> type | None:
 
 def enum_choices(g: Graph, name: str) -> list[str] | None:
     """The choices of the enum ports param ``name`` feeds by a bare ``=name``, if any."""
-    from .registry import node_types
-
-    registry = node_types()
+    registry = g.node_types()  # the registry and the graph files it names
     choices: list[str] | None = None
     for node, type_name in g.nodes.items():
         spec = registry.get(type_name)

@@ -56,9 +56,7 @@ def _targets(
     g: Graph, measure: Sequence[str], export: bool, render: str | None
 ) -> tuple[Targets, dict[str, type]]:
     """Measured columns (and their kinds), export nodes and the render node, all checked."""
-    from .registry import node_types
-
-    registry = node_types()
+    registry = g.node_types()  # the registry and the graph files it names
     problems: list[Problem] = []
     here = Where(g.file_label)
     measures: list[tuple[str, str | None, str]] = []

@@ -64,6 +64,9 @@ class Blueprint:
     budget: int
     cache_dir: str | None  # a path on the worker, or None: no disk cache
     worker_cache: bool  # each worker's own default cache folder instead of cache_dir
+    files: dict[str, str] = field(default_factory=dict)  # subgraph files, by path from
+    # the graph's folder: a worker without them (another machine) writes them out
+    path: str = ""  # the graph file's absolute path on the client
 
     def __dask_tokenize__(self) -> str:  # Dask names the graph by hashing it: keep it cheap
         return self.token
@@ -137,7 +140,7 @@ def _graph(bp: Blueprint) -> Graph:
         cache_dir = str(default_cache_dir()) if bp.worker_cache else bp.cache_dir
         g = Graph.from_text(
             bp.text,
-            file=bp.file,
+            file=_graph_file(bp),
             cache_dir=cache_dir,
             budget=bp.budget,
             memory_bytes=0,  # Dask holds the values; a second copy would only cost memory
@@ -148,6 +151,25 @@ def _graph(bp: Blueprint) -> Graph:
             _GRAPHS.clear()
         _GRAPHS[bp.token] = g
     return g
+
+
+def _graph_file(bp: Blueprint) -> str:
+    """The graph's own file when this machine has it and its subgraphs as they were sent,
+    else the same tree written to a scratch folder (kept while the process lives)."""
+    if not bp.files:
+        return bp.file  # only a label: the text is all there is to read
+    root = Path(bp.path).parent
+    try:
+        if all((root / rel).read_text(encoding="utf-8") == text for rel, text in bp.files.items()):
+            return bp.path
+    except (OSError, UnicodeDecodeError):
+        pass
+    scratch = Path(tempfile.mkdtemp(prefix="formgraph-graph-"))
+    for rel, text in bp.files.items():
+        target = scratch / rel
+        target.parent.mkdir(parents=True, exist_ok=True)
+        target.write_text(text, encoding="utf-8")
+    return str(scratch / Path(bp.file).name)
 
 
 def one_line(exc: BaseException) -> str:
@@ -325,9 +347,7 @@ def blueprint(g: Graph, cache_dir: str | None, worker_cache: bool) -> Blueprint:
         When a node type is defined where workers cannot import it (``__main__``), or the
         graph holds Python objects that do not write to YAML.
     """
-    from .registry import node_types
-
-    registry = node_types()
+    registry = g.node_types()  # the registry and the graph files it names
     modules = set()
     for name, type_name in g.nodes.items():
         module = registry[type_name].func.__module__
@@ -346,6 +366,17 @@ def blueprint(g: Graph, cache_dir: str | None, worker_cache: bool) -> Blueprint:
             f"{g.file_label}: the graph cannot be sent to Dask workers as YAML ({exc}); pass "
             f"geometry through a typed param instead of a node input"
         ) from None
+    files: dict[str, str] = {}
+    if g.file and len(g.files) > 1:  # subgraphs: their text travels with the graph
+        root = Path(g.file).resolve().parent
+        for path in g.files[1:]:
+            try:
+                rel = Path(path).resolve().relative_to(root).as_posix()
+                files[rel] = Path(path).read_text(encoding="utf-8")
+            except (OSError, ValueError, UnicodeDecodeError) as exc:
+                raise SweepError(
+                    f"{g.file_label}: cannot send {path} to Dask workers: {exc}"
+                ) from None
     return Blueprint(
         uuid.uuid4().hex,
         text,
@@ -355,6 +386,8 @@ def blueprint(g: Graph, cache_dir: str | None, worker_cache: bool) -> Blueprint:
         g.budget,
         None if cache_dir is None else str(cache_dir),
         worker_cache,
+        files,
+        str(Path(g.file).resolve()) if g.file else "",
     )
 
 

@@ -14,7 +14,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from formgraph.geometry import Curve
+from formgraph.geometry import Curve, Mesh
 from formgraph.registry import node
 
 
@@ -88,3 +88,22 @@ def curve_stats(curve: Curve, samples: int = 200) -> CurveStats:
     pts = np.asarray(curve.sample(samples))
     length = float(np.linalg.norm(np.diff(pts, axis=0), axis=1).sum())
     return CurveStats(length, bool(curve.closed), samples, curve)
+
+
+class MeshStats(NamedTuple):
+    vertices: int
+    faces: int
+    extent: float
+
+
+@node("stub.mesh_stats", version=1)
+def mesh_stats(mesh: Mesh) -> MeshStats:
+    """Counts and the bounding box diagonal of a mesh.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        The mesh.
+    """
+    v = np.asarray(mesh.vertices)
+    return MeshStats(mesh.n_vertices, mesh.n_faces, float(np.linalg.norm(v.max(0) - v.min(0))))

@@ -338,3 +338,38 @@ def test_bad_sweeps_are_refused_before_anything_runs():
     assert "measure: 'c' gives NurbsCurve, not a number" in text
     with pytest.raises(ValueError, match="a grid needs values for 'r': give a count"):
         fg.sweep(g, {"r": "1:2"}, client="tcp://127.0.0.1:1")
+
+
+def test_repeated_and_subgraph_nodes_sweep_like_a_plain_loop(client):
+    lamp = fg.load(ROOT / "graphs" / "lamp.yaml")
+    lamp.add("stats", "stub.mesh_stats", mesh="@lamp")
+    vase = fg.load(ROOT / "graphs" / "vase_repeat.yaml")
+    vase.add("stats", "stub.mesh_stats", mesh="@mesh")
+    cases = [
+        (lamp, {"top": "0.4,0.8", "height": "1:2:2"}),
+        (vase, {"sections": "4:7", "swell": [0.5, 1.0]}),
+        (vase, {"around": "8:64:3"}),  # the repeated sections and the loft: shared
+    ]
+    for g, vary in cases:
+        s = fg.sweep(g, vary, ["stats"], client=client, cache_dir=None)
+        assert [r["status"] for r in s.rows] == ["ok"] * len(s.rows)
+        for row in s.rows:
+            expected = g.evaluate("stats", **{k: row[k] for k in vary})
+            assert row["stats.vertices"] == expected.vertices
+            assert row["stats.extent"] == pytest.approx(expected.extent, rel=1e-12)
+    assert (s.totals.naive, s.totals.needed) == (3 * 4, 2 + 3 * 2)
+
+
+def test_subgraph_files_travel_with_the_graph(tmp_path):
+    from formgraph.sweep_dask import _graph_file, blueprint
+
+    for rel in ("lamp.yaml", "parts/ring.yaml"):
+        (tmp_path / rel).parent.mkdir(exist_ok=True)
+        (tmp_path / rel).write_text((ROOT / "graphs" / rel).read_text())
+    bp = blueprint(fg.load(tmp_path / "lamp.yaml"), None, False)
+    assert set(bp.files) == {"parts/ring.yaml"}
+    assert _graph_file(bp) == bp.path  # this machine has the same files
+    (tmp_path / "parts" / "ring.yaml").unlink()  # another machine would not
+    elsewhere = Path(_graph_file(bp))
+    assert elsewhere != tmp_path / "lamp.yaml"
+    assert (elsewhere.parent / "parts" / "ring.yaml").read_text() == bp.files["parts/ring.yaml"]
