@@ -318,7 +318,9 @@ COMMANDS = {
 def _sweep_command(name: str, args: argparse.Namespace) -> int:
     from . import cli_sweep
 
-    return getattr(cli_sweep, name)(args)
+    # this module's own UsageError and parse_sets: under `python -m formgraph.cli` it runs
+    # as __main__, and an imported copy's UsageError would not be the one main() catches
+    return getattr(cli_sweep, name)(args, UsageError, parse_sets)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

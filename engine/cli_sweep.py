@@ -69,9 +69,11 @@ def add_parsers(sub: Any, graph_options: Callable[[argparse.ArgumentParser], Non
     )
 
 
-def cmd_sweep(args: argparse.Namespace) -> int:
+def cmd_sweep(
+    args: argparse.Namespace, UsageError: type[Exception], parse_sets: Callable[..., Any]
+) -> int:
+    """``formgraph sweep`` (``UsageError`` and ``parse_sets`` are the CLI's own)."""
     from .cache import default_cache_dir
-    from .cli import UsageError, parse_sets
     from .graph import load
     from .sweep import EACH_WORKER, TerminalProgress, sweep
 
@@ -123,9 +125,10 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     return 0
 
 
-def cmd_cache(args: argparse.Namespace) -> int:
+def cmd_cache(args: argparse.Namespace, UsageError: type[Exception], *_: Any) -> int:
+    """``formgraph cache info|clear|prune``."""
     from .cache import DiskCache, default_cache_dir, parse_size
-    from .cli import UsageError, _size
+    from .cli import _size
 
     limit = None
     for text, where in (
