@@ -25,13 +25,24 @@ FAILED = (236, 226, 226)
 
 
 def render_cell(value: Any, size: tuple[int, int] = CELL) -> bytes:
-    """A PNG (bytes) of ``value`` drawn off screen, as ``formgraph view`` draws it."""
-    from .app import screenshot
+    """A PNG (bytes) of ``value`` drawn off screen as ``formgraph view`` draws it, without
+    the bounds grid (its labels do not survive a cell's size); the camera fits the value."""
+    import pyvista as pv
 
-    with tempfile.TemporaryDirectory(prefix="formgraph-cell-") as tmp:
-        path = Path(tmp) / "cell.png"
-        screenshot(value, path, size=size)
-        return path.read_bytes()
+    from .app import Session
+
+    plotter = pv.Plotter(off_screen=True, window_size=list(size))
+    try:
+        session = Session(value, plotter=plotter, timing=False)
+        if session.scene.show_grid:
+            session.scene.toggle_grid()
+            session.scene.fit_camera()
+        with tempfile.TemporaryDirectory(prefix="formgraph-cell-") as tmp:
+            path = Path(tmp) / "cell.png"
+            plotter.screenshot(str(path))
+            return path.read_bytes()
+    finally:
+        plotter.close()
 
 
 def grid_shape(count: int) -> tuple[int, int]:
