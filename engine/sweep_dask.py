@@ -542,7 +542,7 @@ def run(
                 except Exception:  # lost meanwhile (a worker died): each on its own below
                     results = {}
                 for fut in batch:
-                    if fut.cancelled() and resubmitted.get(fut.key, 0) < 3:
+                    if fut.cancelled() and resubmitted.get(fut.key, 0) < 8:
                         # the same keys of an interrupted sweep, still being cancelled on a
                         # shared scheduler, cancel ours too: ask again (we never cancel ours)
                         resubmitted[fut.key] = resubmitted.get(fut.key, 0) + 1

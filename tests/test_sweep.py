@@ -246,7 +246,15 @@ def test_a_sweep_against_a_scheduler_on_loopback(tmp_path):
         assert address.startswith("tcp://127.0.0.1:")
         procs.append(
             subprocess.Popen(
-                [bin_dir / "dask", "worker", address, "--nthreads", "1", "--no-dashboard"],
+                [
+                    bin_dir / "dask",
+                    "worker",
+                    address,
+                    "--nthreads",
+                    "1",
+                    "--no-nanny",
+                    "--no-dashboard",
+                ],
                 cwd=elsewhere,
                 env=env,
                 stderr=subprocess.DEVNULL,
