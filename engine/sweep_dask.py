@@ -277,7 +277,7 @@ class RowPlan:
     """One variant's own nodes (no other variant needs them), computed in its row task."""
 
     steps: tuple[Step, ...]  # in evaluation order
-    shared: tuple[str, ...]  # the shared nodes whose outcomes are the task's inputs, in order
+    shared: tuple[tuple[str, str], ...]  # (name, key) of the shared nodes it reads
     params: dict[str, Any]
     key: str
 
@@ -285,15 +285,35 @@ class RowPlan:
         return self.key
 
 
-def run_row(bp: Blueprint, job: RowJob, plan: RowPlan, *shared: Outcome) -> RowResult:
-    """Task: a variant's own nodes from the shared ones' outcomes, then its row.
+@dataclass(frozen=True)
+class RowChunk:
+    """The literal part of a row task: its variants' plans and the shared keys it reads
+    (a dataclass: Dask would take a bare tuple of keys for references to their values)."""
 
-    Fusing a variant's private chain into one task is Dask's own linear fusion, keyed by
-    what the variant needs: it pays the per-task overhead once per variant while every node
+    plans: tuple[RowPlan, ...]
+    keys: tuple[str, ...]
+
+    def __dask_tokenize__(self) -> str:
+        return key_of([p.key for p in self.plans])
+
+
+def run_rows(
+    bp: Blueprint, job: RowJob, chunk: RowChunk, *shared: Outcome
+) -> list[tuple[str, RowResult]]:
+    """Task: a few variants' rows, each from its own nodes and the shared ones' outcomes.
+
+    Fusing variants' private chains into one task is Dask's own linear fusion, keyed by what
+    the variants need: the per-task overhead is paid once per few variants, while every node
     that variants share stays a task of its own under its cache key.
     """
-    costs, error = _merged(shared)
-    values = {n: o.value for n, o in zip(plan.shared, shared, strict=True)}
+    by_key = dict(zip(chunk.keys, shared, strict=True))
+    return [(plan.key, run_row(bp, job, plan, by_key)) for plan in chunk.plans]
+
+
+def run_row(bp: Blueprint, job: RowJob, plan: RowPlan, shared: dict[str, Outcome]) -> RowResult:
+    """One variant's own nodes from the shared ones' outcomes, then its row."""
+    costs, error = _merged([shared[k] for _, k in plan.shared])
+    values = {n: shared[k].value for n, k in plan.shared}
     if error is None:
         g = _graph(bp)
         for step in plan.steps:
@@ -397,13 +417,15 @@ def build(
     variants: Sequence[tuple[int, dict[str, Any]]],
     targets: Targets,
     visible: DiskCache | None,
-) -> tuple[dict[str, Any], dict[str, list[int]], Totals]:
-    """The Dask graph of every variant, the variants of each row key, and the totals.
+    chunk: int = 1,
+) -> tuple[dict[str, Any], dict[str, list[int]], dict[str, list[str]], Totals]:
+    """The Dask graph of every variant, the variants of each row key, the row keys of each
+    row task, and the totals.
 
     A node two or more variants need is a task under its cache key, computed once; a
     variant's own nodes run inside its row task (``row-<hash of its target keys>``, so
-    identical variants share a row). A node the client sees in the disk cache is loaded
-    instead of computed, and its ancestors are not needed at all.
+    identical variants share a row), ``chunk`` rows to a task. A node the client sees in the
+    disk cache is loaded instead of computed, and its ancestors are not needed at all.
     """
     names = targets.nodes
     plans: list[tuple[str, list[Step], dict[str, Any]]] = []
@@ -436,6 +458,7 @@ def build(
         plans.append((row_key, kept, params))
     dsk: dict[str, Any] = {}
     job = RowJob(targets.measures, targets.exports, targets.render, targets.size)
+    row_plans = []
     for row_key, steps, params in plans:
         by_name = {s.name: s for s in steps}
         own = tuple(s for s in steps if users[s.key] == 1)
@@ -448,11 +471,19 @@ def build(
                 ups = [by_name[u].key for u in s.upstream]
                 dsk[s.key] = (run_export if s.export else run_step, bp_key, Job(s, params), *ups)
         wanted = [u for s in own if s.key not in cached for u in s.upstream] + names
-        shared = tuple(n for n in dict.fromkeys(wanted) if users[by_name[n].key] > 1)
-        plan = RowPlan(own, shared, params, row_key)
-        dsk[row_key] = (run_row, bp_key, job, plan, *[by_name[n].key for n in shared])
+        shared = tuple(
+            (n, by_name[n].key) for n in dict.fromkeys(wanted) if users[by_name[n].key] > 1
+        )
+        row_plans.append(RowPlan(own, shared, params, row_key))
+    chunks: dict[str, list[str]] = {}
+    for i in range(0, len(row_plans), chunk):
+        group = tuple(row_plans[i : i + chunk])
+        keys = tuple(dict.fromkeys(k for p in group for _, k in p.shared))
+        task_key = group[0].key if len(group) == 1 else "rows-" + key_of([p.key for p in group])
+        dsk[task_key] = (run_rows, bp_key, job, RowChunk(group, keys), *keys)
+        chunks[task_key] = [p.key for p in group]
     totals.needed = len(users)
-    return dsk, rows, totals
+    return dsk, rows, chunks, totals
 
 
 @contextlib.contextmanager
@@ -519,23 +550,29 @@ def run(
     """Run ``variants`` (index, params) and call ``on_row`` on the client as each finishes."""
     from distributed import as_completed
 
+    if not variants:  # all done already (a resumed sweep): no cluster needed
+        return Totals()
     bp = blueprint(g, None if cache_dir is None else str(cache_dir), worker_cache)
     bp_key = f"graph-{bp.token}"
     embedded = client is None
     visible = None
     if embedded and (cache_dir is not None or worker_cache):  # the workers' disk is ours
         visible = DiskCache(default_cache_dir() if worker_cache else cache_dir)
-    dsk, rows, totals = build(g, bp_key, variants, targets, visible)
-    if not rows:
-        return totals
-    dsk[bp_key] = bp
     seen: dict[str, tuple[float, str]] = {}
     with connect(client, workers) as c:
-        futures = c.get(dsk, list(rows), sync=False, optimize_graph=False)
+        threads = sum(w.get("nthreads", 1) for w in c.scheduler_info()["workers"].values())
+        # a few variants to a task when there are many per thread: Dask's overhead per task
+        # is paid once per few light variants, and the table still grows steadily
+        chunk = max(1, min(16, len(variants) // (8 * max(threads, 1))))
+        dsk, rows, chunks, totals = build(g, bp_key, variants, targets, visible, chunk)
+        if not rows:
+            return totals
+        dsk[bp_key] = bp
+        futures = c.get(dsk, list(chunks), sync=False, optimize_graph=False)
         pending = as_completed(futures)
         resubmitted: dict[str, int] = {}
         try:
-            for batch in pending.batches():  # one gather per batch: no round trip per row
+            for batch in pending.batches():  # one gather per batch: no round trip per task
                 done = [f for f in batch if f.status == "finished"]
                 try:
                     results = dict(zip([f.key for f in done], c.gather(done), strict=True))
@@ -551,11 +588,15 @@ def run(
                         futures.append(again)
                         pending.add(again)
                         continue
-                    result = results[fut.key] if fut.key in results else _row_result(fut)
+                    if fut.key in results:
+                        finished = results[fut.key]
+                    else:
+                        finished = _chunk_result(fut, chunks[fut.key])
                     fut.release()
-                    seen.update(result.costs)
-                    for index in rows[fut.key]:
-                        on_row(index, result)
+                    for row_key, result in finished:
+                        seen.update(result.costs)
+                        for index in rows[row_key]:
+                            on_row(index, result)
         finally:
             c.cancel(futures)
     totals.computed = sum(1 for _, st in seen.values() if st == "computed")
@@ -563,13 +604,12 @@ def run(
     return totals
 
 
-def _row_result(fut: Any) -> RowResult:
+def _chunk_result(fut: Any, row_keys: list[str]) -> list[tuple[str, RowResult]]:
     try:
         return fut.result()
     except Exception as exc:  # KilledWorker after too many deaths, or a bug of ours
-        name = type(exc).__name__
-        if name == "KilledWorker":
+        if type(exc).__name__ == "KilledWorker":
             msg = "the Dask workers running this variant kept dying (out of memory?)"
         else:
             msg = one_line(exc)
-        return RowResult(msg, 0.0, {}, {}, None, {})
+        return [(k, RowResult(msg, 0.0, {}, {}, None, {})) for k in row_keys]
