@@ -381,3 +381,26 @@ def test_subgraph_files_travel_with_the_graph(tmp_path):
     elsewhere = Path(_graph_file(bp))
     assert elsewhere != tmp_path / "lamp.yaml"
     assert (elsewhere.parent / "parts" / "ring.yaml").read_text() == bp.files["parts/ring.yaml"]
+
+
+def test_the_embedded_cluster_is_started_and_closed_by_the_sweep(tmp_path, capsys):
+    import multiprocessing
+
+    graph = tmp_path / "ring.yaml"
+    graph.write_text(
+        "formgraph: 1\nparams:\n  n: {default: 4, min: 3, max: 32}\nnodes:\n"
+        '  pts: {type: points.circle, count: "=n"}\n'
+        '  ring: {type: curves.polyline, points: "@pts", closed: true}\n'
+    )
+    out = tmp_path / "out"
+    args = ["sweep", str(graph), "--vary", "n=3:6", "--workers", "2", "--out", str(out)]
+    args += ["--cache-dir", str(tmp_path / "cache")]
+    assert cli_main(args) == 0
+    assert not multiprocessing.active_children()  # the workers are gone
+    first = capsys.readouterr().out
+    assert "4 variants: 4 ok, 0 failed" in first
+    assert "node evaluations: 8 needed for 4 variants x their nodes = 8" in first
+    with open(out / "sweep.csv", newline="") as fh:
+        assert [r["n"] for r in csv.DictReader(fh)] == ["3", "4", "5", "6"]
+    assert cli_main(args) == 0  # everything done: kept, no cluster started
+    assert "(4 kept from an earlier run)" in capsys.readouterr().out
