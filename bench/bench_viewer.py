@@ -55,3 +55,44 @@ def run(table) -> None:
         p.close()
 
     table.time(case, "pyvista rebuild", rebuild, note="new plotter per step")
+
+    _graph_drawing(table)
+
+
+def _graph_drawing(table) -> None:
+    """Drawing the largest example graph: ours (SVG, and PNG through Pillow) against
+    networkx's layered layout drawn by matplotlib (plain circles and arrows, no text boxes)."""
+    import io
+    from pathlib import Path
+
+    import networkx as nx
+
+    graphs = Path(__file__).resolve().parents[1] / "graphs"
+    largest = max(graphs.glob("*.yaml"), key=lambda p: len(fg.load(p).nodes))
+    g = fg.load(largest)
+    case = f"drawing the graph of {largest.name} ({len(g.nodes)} nodes, {len(g.params)} params)"
+    table.time(case, "formgraph SVG", lambda: fg.draw_graph(g).svg, note="layout + SVG text")
+    table.time(case, "formgraph PNG", lambda: fg.draw_graph(g).png(), note="Pillow, 2x")
+
+    def reference() -> None:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        dag = nx.DiGraph()
+        for name in g.nodes:
+            dag.add_node(name)
+            for up in g._nodes[name].upstream():
+                dag.add_edge(up, name)
+        for i, gen in enumerate(nx.topological_generations(dag)):
+            for n in gen:
+                dag.nodes[n]["layer"] = i
+        pos = nx.multipartite_layout(dag, subset_key="layer")
+        fig, ax = plt.subplots(figsize=(12, 6))
+        nx.draw_networkx(dag, pos, ax=ax, node_shape="s", font_size=8)
+        buf = io.BytesIO()
+        fig.savefig(buf, format="svg")
+        plt.close(fig)
+
+    table.time(case, "networkx + matplotlib SVG", reference, note="multipartite layout")

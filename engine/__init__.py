@@ -9,7 +9,11 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterable
+from typing import Any
+
 from . import geometry
+from .drawgraph import draw_graph
 from .errors import (
     BudgetError,
     CycleError,
@@ -35,6 +39,18 @@ from .graph import Graph, NodeStat, load
 from .registry import node_types
 from .sweep import Sweep, sweep
 
+
+def show(source: Any, node: str | Iterable[str] | None = None, **kwargs: Any) -> Any:
+    """Open the viewer on a graph (or file, or geometry): :func:`formgraph.viewer.show`.
+
+    ``fg.show(g, ["ds", "cc"], layout="side")`` shows two nodes side by side; pyvista is
+    imported only now.
+    """
+    from .viewer import show as _show
+
+    return _show(source, node, **kwargs)
+
+
 __version__ = "0.1.0"
 
 __all__ = [
@@ -58,8 +74,10 @@ __all__ = [
     "Points",
     "Surface",
     "Sweep",
+    "draw_graph",
     "geometry",
     "load",
     "node_types",
+    "show",
     "sweep",
 ]

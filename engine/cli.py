@@ -65,19 +65,53 @@ def _parser() -> argparse.ArgumentParser:
         "--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS
     )
 
-    view = sub.add_parser("view", help="show a node's output (window, or PNG with --screenshot)")
-    view.add_argument("graph")
-    view.add_argument("node", nargs="?")
-    graph_options(view)
-    view.add_argument("--screenshot", metavar="FILE.png")
-    view.add_argument("--size", default="1024x768", metavar="WxH")
-    view.add_argument("--out", default="out", metavar="DIR", help=argparse.SUPPRESS)
+    def view_options(p: argparse.ArgumentParser) -> None:
+        p.add_argument("graph")
+        p.add_argument(
+            "nodes", nargs="*", metavar="NODE", help="nodes to show (default: the results)"
+        )
+        graph_options(p)
+        p.add_argument(
+            "--layout",
+            choices=("overlay", "side"),
+            default="overlay",
+            help="several nodes in one view (overlay) or side by side, one view each",
+        )
+        p.add_argument(
+            "--edges", action="store_true", help="draw every mesh face's edges (default: coarse)"
+        )
+        p.add_argument("--size", default="1024x768", metavar="WxH")
+        p.add_argument("--out", default="out", metavar="DIR", help=argparse.SUPPRESS)
+
+    view = sub.add_parser("view", help="show nodes' outputs (window, or PNG with --screenshot)")
+    view_options(view)
+    view.add_argument("--screenshot", metavar="FILE.png", help="render off screen to a PNG")
 
     watch = sub.add_parser("watch", help="re-evaluate and redraw when the file changes")
-    watch.add_argument("graph")
-    watch.add_argument("node", nargs="?")
-    graph_options(watch)
-    watch.add_argument("--out", default="out", metavar="DIR", help=argparse.SUPPRESS)
+    view_options(watch)
+    watch.add_argument(
+        "--screenshot",
+        metavar="FILE.png",
+        help="no window: write FILE.png on every good save and print a status line",
+    )
+    watch.add_argument("--interval", type=float, default=0.3, help=argparse.SUPPRESS)
+
+    draw = sub.add_parser("graph", help="draw the graph itself (SVG or PNG)")
+    draw.add_argument("graph")
+    draw.add_argument("nodes", nargs="*", metavar="NODE", help="with --run: the nodes to evaluate")
+    draw.add_argument(
+        "-o", "--output", metavar="FILE", help="FILE.svg or FILE.png (default: GRAPH.svg here)"
+    )
+    graph_options(draw)
+    draw.add_argument(
+        "--run",
+        action="store_true",
+        help="evaluate first (the nodes given, else every sink, exports included) and colour "
+        "each node computed or cached, with its seconds",
+    )
+    draw.add_argument("--out", default="out", metavar="DIR", help="output directory (./out)")
+    draw.add_argument("--no-cache", action="store_true", help="do not use the on-disk cache")
+    draw.add_argument("--cache-dir", default=None, help=argparse.SUPPRESS)
 
     nodes = sub.add_parser("nodes", help="the node catalogue, or one node type's ports")
     nodes.add_argument("type", nargs="?")
@@ -246,6 +280,20 @@ def _size_arg(text: str) -> tuple[int, int]:
     return w, h
 
 
+def _no_window(command: str, args: argparse.Namespace) -> None:
+    """Refuse a window where none can open, saying what to do instead (exit 2)."""
+    from formgraph.viewer import display_problem
+
+    problem = display_problem()
+    if problem is None:
+        return
+    raise UsageError(
+        f"{command} opens a window, but {problem}. Add --screenshot FILE.png to render "
+        f"off screen instead{' (a new PNG on every save)' if command == 'watch' else ''}, "
+        f"or run it under a virtual display: xvfb-run formgraph {command} {args.graph} ..."
+    )
+
+
 def cmd_view(args: argparse.Namespace) -> int:
     from . import graph as _graph
 
@@ -254,20 +302,95 @@ def cmd_view(args: argparse.Namespace) -> int:
     except ImportError as exc:  # pragma: no cover - pyvista is a dependency
         raise GraphError(f"the viewer needs pyvista: {exc}") from None
     size = _size_arg(args.size)
+    if not args.screenshot:
+        _no_window("view", args)
     g = _graph.load(args.graph, out_dir=args.out, budget=args.budget)
     params = parse_sets(g, args.set)
+    nodes = args.nodes or None
+    edges = True if args.edges else None
     if args.screenshot:
-        path = viewer.screenshot(g, args.screenshot, node=args.node, size=size, **params)
+        path = viewer.screenshot(
+            g, args.screenshot, node=nodes, size=size, layout=args.layout, edges=edges, **params
+        )
         print(f"wrote {path}")
         return 0
-    viewer.show(g, node=args.node, size=size, **params)
+    viewer.show(g, node=nodes, size=size, layout=args.layout, edges=edges, **params)
     return 0
 
 
 def cmd_watch(args: argparse.Namespace) -> int:
     from formgraph import viewer
 
-    viewer.watch(args.graph, node=args.node, sets=args.set, out_dir=args.out, budget=args.budget)
+    size = _size_arg(args.size)
+    nodes = args.nodes or None
+    edges = True if args.edges else None
+    for item in args.set:
+        if "=" not in item:
+            raise UsageError(f"--set takes NAME=VALUE, got {item!r}")
+    if args.screenshot:
+        watcher = viewer.ScreenshotWatcher(
+            args.graph,
+            args.screenshot,
+            nodes,
+            sets=args.set,
+            out_dir=args.out,
+            budget=args.budget,
+            size=size,
+            layout=args.layout,
+            edges=edges,
+        )
+        watcher.run(interval=args.interval)
+        return 0
+    _no_window("watch", args)
+    viewer.watch(
+        args.graph,
+        node=nodes,
+        sets=args.set,
+        out_dir=args.out,
+        budget=args.budget,
+        size=size,
+        layout=args.layout,
+        edges=edges,
+    )
+    return 0
+
+
+def cmd_graph(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from .cache import default_cache_dir
+    from .drawgraph import draw_graph, failed_nodes
+    from .graph import load
+
+    output = args.output or f"{Path(args.graph).stem}.svg"
+    if output != "-" and Path(output).suffix.lower() not in (".svg", ".png"):
+        raise UsageError(f"-o {output}: the drawing is written as .svg or .png")
+    cache_dir = None if args.no_cache else (args.cache_dir or default_cache_dir())
+    g = load(args.graph, out_dir=args.out, cache_dir=cache_dir, budget=args.budget)
+    g.set(**parse_sets(g, args.set))  # the param boxes show the values used
+    failure: FormgraphError | None = None
+    if args.run:
+        progress = _ProgressLine(sys.stderr)
+        g.progress = progress
+        try:
+            g.evaluate(args.nodes) if args.nodes else g.evaluate_all()
+        except FormgraphError as exc:  # still draw: how far the run got, the failure red
+            failure = exc
+        finally:
+            progress.clear()
+    elif args.nodes:
+        raise UsageError("NODE names are what --run evaluates; add --run")
+    failed = failed_nodes(failure) if failure is not None else []
+    drawing = draw_graph(g, failed=failed)
+    if output == "-":
+        sys.stdout.write(drawing.svg)
+    else:
+        path = drawing.save(output)
+        run = f", after a run of {len(g.stats)} nodes" if args.run else ""
+        run += f", {', '.join(failed)} failed" if failed else ""
+        print(f"wrote {path} ({len(g.nodes)} nodes, {len(g.params)} params{run})")
+    if failure is not None:
+        raise failure
     return 0
 
 
@@ -308,6 +431,7 @@ COMMANDS = {
     "check": cmd_check,
     "view": cmd_view,
     "watch": cmd_watch,
+    "graph": cmd_graph,
     "nodes": cmd_nodes,
     "schema": cmd_schema,
     "sweep": lambda args: _sweep_command("cmd_sweep", args),

@@ -273,7 +273,9 @@ def test_keys_toggle_overlays_and_grid(plotter):
     assert part.actor.GetVisibility() and session.scene.show_polygons
     press("n")
     assert session.scene.layers[""].parts["net"].actor.GetVisibility()
-    assert plotter.renderer.cube_axes_actor is not None
+    assert plotter.renderer.cube_axes_actor is None  # no grid until asked for
+    press("g")
+    assert plotter.renderer.cube_axes_actor is not None and session.scene.show_grid
     press("g")
     assert plotter.renderer.cube_axes_actor is None and not session.scene.show_grid
 
@@ -377,72 +379,6 @@ def write(path: Path, text: str) -> None:
     path.write_text(text, encoding="utf-8")
     st = path.stat()  # a new stamp even when the clock has not moved
     os.utime(path, ns=(st.st_atime_ns, st.st_mtime_ns + 1_000_000_000))
-
-
-def test_watch_reloads_after_an_edit_and_survives_a_broken_one(tmp_path, plotter, capsys):
-    f = tmp_path / "ring.yaml"
-    write(f, RING.format(count=5))
-    w = viewer.Watcher(f, plotter=plotter, out_dir=tmp_path / "out")
-    assert w.reload() is True
-    assert w.poll() is None  # nothing changed
-    outline = w.scene.layers["outline"].parts["curves"]
-    assert outline.data.n_points == 6
-
-    write(f, RING.format(count=8))
-    assert w.poll() is True
-    assert outline.data.n_points == 9 and w.scene.layers["outline"].parts["curves"] is outline
-    # the new version of the file shares the cache: the untouched grid is not recomputed
-    assert w.session.graph.stats["grid"].status == "cached"
-    assert w.session.graph.stats["ring"].status == "computed"
-
-    write(f, RING.format(count=8).replace("points.circle", "points.circel"))
-    assert w.poll() is False
-    assert "unknown node type 'points.circel'" in w.error_text()
-    assert "points.circel" in w.scene.texts()["error"]
-    assert "unknown node type" in capsys.readouterr().err
-    assert outline.data.n_points == 9  # the last good geometry stays
-
-    write(f, "formgraph: 1\nnodes: [unclosed\n")
-    assert w.poll() is False and w.error_text()
-
-    write(f, RING.format(count=4))
-    assert w.poll() is True
-    assert w.error_text() is None and "error" not in w.scene.texts()
-    assert outline.data.n_points == 5
-
-
-def test_watch_starts_on_a_broken_file_and_recovers(tmp_path, plotter):
-    f = tmp_path / "ring.yaml"
-    write(f, RING.format(count=2))  # the default is below the param's min
-    w = viewer.Watcher(f, plotter=plotter)
-    assert w.reload() is False and w.session is None
-    assert "param 'count': default must be >= 3, got 2" in w.error_text()
-    write(f, RING.format(count=6))
-    assert w.poll() is True and w.error_text() is None
-    assert "error" not in w.scene.texts()
-    assert w.scene.layers["outline"].parts["curves"].data.n_points == 7
-
-
-def test_watch_applies_sets_to_each_version(tmp_path, plotter):
-    f = tmp_path / "ring.yaml"
-    write(f, RING.format(count=5))
-    w = viewer.Watcher(f, "ring", plotter=plotter, sets=["count=9"])
-    assert w.reload() and len(w.session.evaluate()[0][1]) == 9
-    write(
-        f, RING.format(count=5).replace("  count: {", "  corners: {").replace("=count", "=corners")
-    )
-    assert w.poll() is False
-    assert "--set count: unknown param; params are corners" in w.error_text()
-
-
-def test_watch_survives_the_file_disappearing(tmp_path, plotter):
-    f = tmp_path / "ring.yaml"
-    write(f, RING.format(count=5))
-    w = viewer.Watcher(f, plotter=plotter)
-    assert w.reload()
-    f.unlink()
-    assert w.poll() is None  # mid-save: look again later
-    assert w.reload() is False and "cannot read" in w.error_text()
 
 
 # ------------------------------------------------------------------------ CLI, gallery

@@ -15,17 +15,26 @@ from __future__ import annotations
 import os
 import sys
 
-# With no display (CI, a server, a container) VTK would first try X, print a warning and
+# With no X display (CI, a server, a container) VTK would first try X, print a warning and
 # only then fall back; EGL renders off screen directly.
-if (
-    sys.platform.startswith("linux")
-    and not os.environ.get("DISPLAY")
-    and not os.environ.get("WAYLAND_DISPLAY")
-):
+if sys.platform.startswith("linux") and not os.environ.get("DISPLAY"):
     os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
 
-from .app import Session, screenshot, show, shown_nodes
+from .app import LAYOUTS, Session, shown_nodes
+from .entry import make_plotter, screenshot, show
 from .scene import Scene
-from .watch import Watcher, watch
+from .watch import ScreenshotWatcher, Watcher, display_problem, watch
 
-__all__ = ["Scene", "Session", "Watcher", "screenshot", "show", "shown_nodes", "watch"]
+__all__ = [
+    "LAYOUTS",
+    "Scene",
+    "ScreenshotWatcher",
+    "Session",
+    "Watcher",
+    "display_problem",
+    "make_plotter",
+    "screenshot",
+    "show",
+    "shown_nodes",
+    "watch",
+]

@@ -20,11 +20,13 @@ from formgraph.errors import FormgraphError, GraphError, Problem, Where
 from formgraph.graph import Graph, load
 from formgraph.model import Items, Wire, parse_input
 
-from .scene import PALETTE, TEXT_COLOR, Scene
+from .scene import PALETTE, TEXT_COLOR, Scene, fit_scenes
 
-__all__ = ["Session", "Slider", "screenshot", "show", "shown_nodes"]
+__all__ = ["LAYOUTS", "Session", "Slider", "shown_nodes"]
 
-HELP = "c control polygons   n control nets   g grid   f fit   v isometric   q quit"
+HELP = "c control polygons   n control nets   e edges   g grid   f fit   v isometric   q quit"
+HELP_LINES = "c control polygons   n control nets\ne edges   g grid   f fit   v iso   q quit"
+LAYOUTS = ("overlay", "side")
 
 
 def shown_nodes(graph: Graph, node: str | Iterable[str] | None = None) -> list[str]:
@@ -98,7 +100,7 @@ class Slider:
 
 
 class Session:
-    """A graph (or a geometry value) drawn in a plotter, re-evaluated on demand.
+    """A graph (or geometry values) drawn in a plotter, re-evaluated on demand.
 
     Parameters
     ----------
@@ -107,11 +109,18 @@ class Session:
     node : str or list of str, optional
         The nodes to show (``name`` or ``name.output``); default: the graph's results.
     plotter : pyvista.Plotter
-        Where to draw.
+        Where to draw; for ``layout="side"`` one with a subplot per shown node, side by
+        side (see :func:`make_plotter`).
     params : dict
         Param values for the evaluations (sliders change them).
     timing : bool
         Draw the last evaluation time at the top left.
+    layout : {"overlay", "side"}
+        All shown nodes in one view, each in its colour with a legend entry; or one view
+        per node, side by side, with linked cameras, each titled with the node's name, type
+        and size.
+    edges : bool, optional
+        Draw mesh face edges always (True), never (False), or on coarse meshes (None).
     """
 
     def __init__(
@@ -122,29 +131,81 @@ class Session:
         plotter: Any,
         params: dict[str, Any] | None = None,
         timing: bool = True,
+        layout: str = "overlay",
+        edges: bool | None = None,
     ):
+        if layout not in LAYOUTS:
+            raise ValueError(f"layout must be one of {', '.join(LAYOUTS)}, got {layout!r}")
         if isinstance(source, (str, os.PathLike)):
             source = load(source)
         self.graph: Graph | None = source if isinstance(source, Graph) else None
         self.value = None if self.graph is not None else source
         self.node = node
         self.plotter = plotter
-        self.scene = Scene(plotter)
+        self.layout = layout
         self.params: dict[str, Any] = dict(params or {})
         self.timing = timing
         self.seconds: float | None = None
         self.targets = shown_nodes(self.graph, node) if self.graph is not None else []
+        self.controls_x = 0.76  # where the column of sliders starts (fraction of the width)
         self._slider_values: dict[str, float] = {}
         self.widgets: dict[str, Any] = {}  # slider widgets by param name
-        self.scene.update(self.evaluate())
-        self.scene.fit_camera()
+        shown = self.evaluate()
+        self.scenes = self._make_scenes(len(shown), edges)
+        self._draw(shown)
+        self.fit_camera()
         self._status()
+
+    def _make_scenes(self, n: int, edges: bool | None) -> list[Scene]:
+        if self.layout == "overlay":
+            return [Scene(self.plotter, edges=edges)]
+        rows, cols = self.plotter.shape
+        if rows != 1 or cols < n:
+            raise ValueError(
+                f"the side by side layout of {n} views needs a plotter of shape (1, {n}) or "
+                f"wider, got {self.plotter.shape}; make it with make_plotter()"
+            )
+        colors: dict[str, str] = {}
+        scenes = [
+            Scene(self.plotter, (0, i), titled=True, edges=edges, colors=colors) for i in range(n)
+        ]
+        if n > 1:
+            self.plotter.link_views(list(range(n)))
+        if cols > n:  # the last column holds the sliders
+            self.controls_x = self.plotter.renderers[n].GetViewport()[0] + 0.02
+        return scenes
+
+    @property
+    def scene(self) -> Scene:
+        """The (first) view."""
+        return self.scenes[0]
+
+    def _draw(self, shown: list[tuple[str, Any]]) -> None:
+        if self.layout == "overlay":
+            self.scene.update(shown)
+            return
+        if len(shown) != len(self.scenes):
+            raise GraphError(
+                f"{len(shown)} nodes to show side by side, but the window has "
+                f"{len(self.scenes)} views; start the viewer again"
+            )
+        for scene, (label, value) in zip(self.scenes, shown, strict=True):
+            if self.graph is not None:
+                base = _base(self.graph, label) if label else label
+                scene.captions = {base: self.graph.nodes.get(base, "")}
+            scene.update([(label, value)])
+
+    def fit_camera(self) -> None:
+        """Frame what is drawn (every view, with the camera they share)."""
+        fit_scenes(self.scenes)
 
     # ---------------------------------------------------------------------- evaluation
 
     def evaluate(self) -> list[tuple[str, Any]]:
         """``(label, value)`` of every shown node, evaluated with the current params."""
         if self.graph is None:
+            if self.layout == "side" and isinstance(self.value, (list, tuple)):
+                return [(f"{i + 1}", v) for i, v in enumerate(self.value)]
             return [(_label_of(self.value), self.value)]
         bases = list(dict.fromkeys(_base(self.graph, t) for t in self.targets))
         t0 = time.perf_counter()
@@ -177,7 +238,7 @@ class Session:
             self.params = old
             self.report(str(exc))
             return False
-        self.scene.update(shown)
+        self._draw(shown)
         self.scene.set_error(None)
         self._status()
         for name, value in values.items():
@@ -205,14 +266,14 @@ class Session:
             self.graph, self.params = graph, dict(params or {})
             self.targets = shown_nodes(graph, self.node)
             shown = self.evaluate()
+            self._draw(shown)
         except BaseException:
             self.graph, self.targets, self.params, self.seconds = old
             raise
-        self.scene.update(shown)
         self.scene.set_error(None)
         self._status()
         if _camera_lost(old_bounds, self.scene.bounds()):
-            self.scene.fit_camera()
+            self.fit_camera()
         self.plotter.render()
 
     def report(self, message: str) -> None:
@@ -225,13 +286,46 @@ class Session:
     def _status(self) -> None:
         if not self.timing or self.graph is None or self.seconds is None:
             return
-        stats = self.graph.stats
+        name = Path(self.graph.file).name if self.graph.file else "graph"
+        text = f"{name}: {self.status_line()}"
+        if self.layout == "overlay":
+            self.scene.set_status(text)
+        elif self._has_controls_column():  # at the top of the sliders' column
+            self._controls_frame()
+            self.plotter.add_text(
+                text, position="upper_left", font_size=12, color=TEXT_COLOR, name="status"
+            )
+        else:  # under the first view's title
+            scene = self.scenes[0]
+            scene.activate()
+            self.plotter.add_text(
+                text,
+                position=(10, scene.size()[1] - 62),
+                font_size=8,
+                color=TEXT_COLOR,
+                name="status",
+            )
+
+    def _has_controls_column(self) -> bool:
+        return self.layout == "side" and self.plotter.shape[1] > len(self.scenes)
+
+    def _controls_frame(self) -> tuple[float, float, float, float]:
+        """Make the sliders' subplot active: (left, right) of the sliders as fractions of
+        it, and its left edge and width as fractions of the window."""
+        if self._has_controls_column():
+            self.plotter.subplot(0, len(self.scenes))
+            vx0, _, vx1, _ = self.plotter.renderer.GetViewport()
+            return 0.08, 0.92, vx0, vx1 - vx0
+        self.scene.activate()
+        return self.controls_x, 0.97, 0.0, 1.0
+
+    def status_line(self) -> str:
+        """``'evaluated in 8.7 ms (3 computed, 4 cached)'`` for the last evaluation."""
+        stats = self.graph.stats if self.graph is not None else {}
         computed = sum(1 for s in stats.values() if s.status == "computed")
         cached = len(stats) - computed
-        name = Path(self.graph.file).name if self.graph.file else "graph"
-        self.scene.set_status(
-            f"{name}: evaluated in {_ms(self.seconds)} ({computed} computed, {cached} cached)"
-        )
+        seconds = self.seconds or 0.0
+        return f"evaluated in {_ms(seconds)} ({computed} computed, {cached} cached)"
 
     # ------------------------------------------------------------------ interaction
 
@@ -276,20 +370,21 @@ class Session:
         values = {**self.graph.params, **self.params} if self.graph is not None else {}
         width, height = self.plotter.window_size
         box = max(14, int(0.03 * height))
+        left, _, vx0, vw = self._controls_frame()
         for i, name in enumerate(self.toggles()):
             y = top - i * 0.06
             widget = self.plotter.add_checkbox_button_widget(
                 lambda state, name=name: self.on_toggle(name, state),
                 value=bool(values[name]),
-                position=(int(0.76 * width), int(y * height)),
+                position=(int((vx0 + left * vw) * width), int(y * height)),
                 size=box,
                 color_on="steelblue",
                 color_off="white",
                 background_color=TEXT_COLOR,
             )
-            self.plotter.add_text(
+            self.plotter.add_text(  # placed in the subplot's own pixels
                 name,
-                position=(int(0.76 * width) + box + 8, int(y * height)),
+                position=(int(left * vw * width) + box + 8, int(y * height)),
                 font_size=7,
                 color=TEXT_COLOR,
             )
@@ -305,11 +400,11 @@ class Session:
             return
         if not sliders:
             self.add_toggles(0.74)
-            self.scene.view_shift = 0.24
-            self.scene.fit_camera()
+            self._make_room()
             self.plotter.render()
             return
         step = min(0.11, 0.72 / len(sliders))
+        left, right, _, _ = self._controls_frame()
         for i, s in enumerate(sliders):
             y = 0.74 - i * step
             self._slider_values[s.name] = int(s.value) if s.integer else s.value
@@ -318,8 +413,8 @@ class Session:
                 rng=(s.min, s.max),
                 value=s.value,
                 title=f"{s.name}   ({s.min:g} to {s.max:g})",
-                pointa=(0.76, y),
-                pointb=(0.97, y),
+                pointa=(left, y),
+                pointb=(right, y),
                 color=TEXT_COLOR,
                 interaction_event="always",
                 fmt="%.0f" if s.integer else "%.3g",
@@ -329,26 +424,45 @@ class Session:
             self.widgets[s.name] = widget
         if toggles:
             self.add_toggles(0.74 - len(sliders) * step - 0.02)
-        self.scene.view_shift = 0.24
-        self.scene.fit_camera()
+        self._make_room()
         self.plotter.render()
+
+    def _make_room(self) -> None:
+        """Frame the geometry beside the column of sliders."""
+        if self.layout == "overlay":
+            self.scene.view_shift = 1.0 - self.controls_x + 0.01
+        self.fit_camera()
 
     def add_keys(self) -> None:
         """Key toggles: control polygons, control nets, grid, fit."""
         p = self.plotter
 
         def toggle(what: str) -> None:
-            if what == "grid":
-                self.scene.toggle_grid()
-            else:
-                self.scene.toggle(what)
+            for scene in self.scenes:
+                if what == "grid":
+                    scene.toggle_grid()
+                elif what == "edges":
+                    scene.toggle_edges()
+                else:
+                    scene.toggle(what)
+            if what == "grid":  # the grid's labels need room around the geometry
+                self.fit_camera()
             p.render()
 
         p.add_key_event("c", lambda: toggle("polygon"))
         p.add_key_event("n", lambda: toggle("net"))
         p.add_key_event("g", lambda: toggle("grid"))
-        p.add_key_event("f", lambda: (self.scene.fit_camera(), p.render()))
-        self.scene.set_help(HELP)
+        p.add_key_event("e", lambda: toggle("edges"))
+        p.add_key_event("f", lambda: (self.fit_camera(), p.render()))
+        if self.layout == "overlay":
+            self.scene.set_help(HELP)
+            return
+        short = HELP_LINES
+        if self._has_controls_column():
+            self._controls_frame()
+            p.add_text(short, position="lower_left", font_size=8, color="#777777", name="help")
+        else:
+            self.scenes[-1].set_help(short)
 
 
 def _style_slider(rep: Any) -> None:
@@ -374,7 +488,7 @@ def _camera_lost(old: Any, new: Any) -> bool:
     """Whether new bounds no longer suit a camera framed for the old ones."""
     import numpy as np
 
-    from .scene import view_axis
+    from .frame import view_axis
 
     if old is None or new is None:
         return new is not None
@@ -396,84 +510,3 @@ def _label_of(value: Any) -> str:
 
 def _ms(seconds: float) -> str:
     return f"{seconds * 1000:.1f} ms" if seconds < 10 else f"{seconds:.1f} s"
-
-
-def _window_title(source: Any) -> str:
-    if isinstance(source, Graph) and source.file:
-        return f"formgraph - {Path(source.file).name}"
-    if isinstance(source, (str, os.PathLike)):
-        return f"formgraph - {Path(source).name}"
-    return "formgraph"
-
-
-# ---------------------------------------------------------------------- entry points
-
-
-def show(
-    source: Any,
-    node: str | Iterable[str] | None = None,
-    size: tuple[int, int] = (1024, 768),
-    *,
-    jupyter_backend: str | None = None,
-    **params: Any,
-) -> Session:
-    """Open an interactive window on a graph's results (or ``node``) or on geometry values.
-
-    Every numeric graph param with a min and a max gets a slider; moving it re-evaluates
-    through the cache and redraws in place. Keys: ``c`` control polygons, ``n`` control
-    nets, ``g`` grid, ``f`` fit, ``v`` isometric, ``q`` quit. In Jupyter, pass
-    ``jupyter_backend`` (``"static"``, or ``"trame"`` where trame is installed).
-
-    Parameters
-    ----------
-    source : Graph, str, path, geometry or list of geometries
-    node : str or list of str, optional
-        Nodes to show (``name`` or ``name.output``); default: the graph's results.
-    size : (int, int)
-        Window size in pixels.
-    **params
-        Graph param values.
-
-    Example
-    -------
-    >>> import formgraph as fg
-    >>> from formgraph import viewer
-    >>> viewer.show(fg.load("graphs/spiral_tube.yaml"), turns=5)  # doctest: +SKIP
-    """
-    import pyvista as pv
-
-    plotter = pv.Plotter(window_size=list(size), title=_window_title(source))
-    session = Session(source, node, plotter=plotter, params=params)
-    session.add_sliders()
-    session.add_keys()
-    plotter.show(jupyter_backend=jupyter_backend)
-    return session
-
-
-def screenshot(
-    source: Any,
-    path: str | os.PathLike[str],
-    node: str | Iterable[str] | None = None,
-    size: tuple[int, int] = (1024, 768),
-    **params: Any,
-) -> Path:
-    """Render a graph's results (or ``node``, or geometry values) off screen to a PNG.
-
-    The parent folder of ``path`` is created. Returns the path written.
-
-    Example
-    -------
-    >>> viewer.screenshot("graphs/spiral_tube.yaml", "out/tube.png", turns=5)  # doctest: +SKIP
-    PosixPath('out/tube.png')
-    """
-    import pyvista as pv
-
-    path = Path(path)
-    plotter = pv.Plotter(off_screen=True, window_size=list(size))
-    try:
-        Session(source, node, plotter=plotter, params=params, timing=False)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        plotter.screenshot(str(path))
-    finally:
-        plotter.close()
-    return path

@@ -41,7 +41,7 @@ def render_gallery(
     from formgraph.errors import FormgraphError
     from formgraph.graph import load
 
-    from .app import screenshot
+    from .entry import screenshot
 
     graphs = sorted(Path(graphs_dir).glob("*.yaml"))
     entries = []

@@ -1,9 +1,12 @@
 """From node values to pyvista actors: one colour and one legend entry per shown node.
 
 A :class:`Scene` draws a list of ``(label, value)`` pairs, where a value is any geometry, a
-list of geometries or a multi-output tuple. Every label becomes a :class:`Layer` with at
-most one actor per kind of geometry (points, curves, surfaces, meshes), plus the control
-polygons of NURBS curves and the control nets of NURBS surfaces (hidden until toggled).
+list of geometries or a multi-output tuple, in one view (the window, or one subplot of the
+side by side layout). Every label becomes a :class:`Layer` with at most one actor per kind
+of geometry (points, curves, surfaces, meshes), the feature edges of its surfaces and
+meshes, and the control polygons of NURBS curves and control nets of NURBS surfaces
+(hidden until toggled). How each is shaded is in :mod:`.style`, the framing in
+:mod:`.frame`.
 :meth:`Scene.update` redraws in place: an actor that exists keeps its dataset object, which
 is overwritten with the new geometry, so the window is never rebuilt.
 
@@ -21,30 +24,40 @@ import numpy as np
 
 from formgraph.geometry import Curve, Geometry, Mesh, NurbsCurve, NurbsSurface, Points, Surface
 
-__all__ = ["PALETTE", "Layer", "Scene", "expand", "geometry_items", "view_axis"]
-
-# matplotlib's tab10, which reads well on white and keeps neighbours apart
-PALETTE = (
-    "#1f77b4",
-    "#ff7f0e",
-    "#2ca02c",
-    "#d62728",
-    "#9467bd",
-    "#8c564b",
-    "#e377c2",
-    "#17becf",
-    "#bcbd22",
-    "#7f7f7f",
+from .frame import ScaleBar, fit_scenes, nice_range, sample, size_text, view_axis
+from .style import (
+    BACKGROUND,
+    COARSE_FACES,
+    ERROR_COLOR,
+    GRID_COLOR,
+    PALETTE,
+    TEXT_COLOR,
+    apply_material,
+    mix,
+    set_edges,
+    shaded,
+    style,
 )
-BACKGROUND = "white"
-GRID_COLOR = "#8a8a8a"
-ERROR_COLOR = "#b00020"
-TEXT_COLOR = "#333333"
 
-# the four kinds of drawn geometry, in drawing order, and the two control overlays
+__all__ = [
+    "PALETTE",
+    "TEXT_COLOR",
+    "Layer",
+    "Scene",
+    "expand",
+    "fit_scenes",
+    "geometry_items",
+    "nice_range",
+    "view_axis",
+]
+
+# the four kinds of drawn geometry, in drawing order, the control overlays, and the lines
+# drawn along feature edges and open boundaries of surfaces and meshes
 KINDS = ("meshes", "surfaces", "curves", "points")
 OVERLAYS = ("polygon", "net")
+LINES = ("features",)
 LEGEND_FACE = {"meshes": "rectangle", "surfaces": "rectangle", "curves": "line", "points": "circle"}
+STATUS_HEIGHT = 26  # pixels a line of text takes at the top or bottom of a view
 
 
 def expand(label: str, value: Any) -> list[tuple[str, Any]]:
@@ -126,62 +139,35 @@ def _surface_resolution(s: Surface) -> tuple[int, int]:
 
 
 def datasets_of(items: Sequence[Geometry]) -> dict[str, Any]:
-    """The PolyData of each kind (and overlay) present in ``items``."""
+    """The PolyData of each kind, overlay and line set present in ``items``.
+
+    Surfaces and meshes come with split point normals for smooth shading; ``features``
+    holds their feature edges and open boundaries (see :func:`~.style.shaded`).
+    """
     import pyvista as pv
 
     points = [np.asarray(g.xyz) for g in items if isinstance(g, Points) and len(g)]
     curves = [g for g in items if isinstance(g, Curve)]
     surfaces = [g for g in items if isinstance(g, Surface)]
     meshes = [g for g in items if isinstance(g, Mesh) and g.n_faces]
-    out = {
+    surface_data = _merge([s.tessellate(*_surface_resolution(s)).to_pyvista() for s in surfaces])
+    mesh_data = _merge([m.to_pyvista() for m in meshes])
+    out: dict[str, Any] = {
         "points": pv.PolyData(np.concatenate(points)) if points else None,
         "curves": _polylines([c.display_points() for c in curves]),
-        "surfaces": _merge([s.tessellate(*_surface_resolution(s)).to_pyvista() for s in surfaces]),
-        "meshes": _merge([m.to_pyvista() for m in meshes]),
         "polygon": _polylines([c.control_points for c in curves if isinstance(c, NurbsCurve)]),
         "net": _merge(
             [_control_net(s.control_points) for s in surfaces if isinstance(s, NurbsSurface)]
         ),
     }
+    lines = []
+    for kind, data in (("surfaces", surface_data), ("meshes", mesh_data)):
+        if data is None:
+            continue
+        out[kind], edges = shaded(data)
+        lines.append(edges)
+    out["features"] = _merge(lines)
     return {k: v for k, v in out.items() if v is not None and v.n_points > 0}
-
-
-# ----------------------------------------------------------------------------- colours
-
-
-def _mix(color: str, other: str, t: float) -> tuple[float, float, float]:
-    import pyvista as pv
-
-    a = np.array(pv.Color(color).float_rgb)
-    b = np.array(pv.Color(other).float_rgb)
-    return tuple(float(x) for x in (1 - t) * a + t * b)  # type: ignore[return-value]
-
-
-def _style(kind: str, color: str) -> dict[str, Any]:
-    """add_mesh keywords for one kind of geometry drawn in ``color``."""
-    if kind == "points":
-        return dict(color=color, render_points_as_spheres=True, point_size=12, style="points")
-    if kind == "curves":
-        return dict(color=color, line_width=3.5, render_lines_as_tubes=True)
-    if kind == "surfaces":
-        return dict(
-            color=color,
-            smooth_shading=True,
-            ambient=0.2,
-            diffuse=0.8,
-            specular=0.25,
-            specular_power=20,
-        )
-    if kind == "meshes":
-        return dict(
-            color=color,
-            show_edges=True,
-            edge_color=_mix(color, "black", 0.45),
-            ambient=0.2,
-            diffuse=0.8,
-        )
-    # control polygon / net: thin lines in a paler shade, with their control points
-    return dict(color=_mix(color, "black", 0.35), line_width=1.2, style="wireframe")
 
 
 # ------------------------------------------------------------------------------- scene
@@ -205,50 +191,92 @@ class Layer:
     color: str
     summary: str = ""
     parts: dict[str, Part] = field(default_factory=dict)
+    mesh_faces: int = 0  # faces of the meshes drawn (what makes a mesh coarse)
 
     @property
     def kinds(self) -> list[str]:
         return [k for k in KINDS if k in self.parts]
 
 
-def view_axis(bounds: Sequence[float], rel: float = 1e-9) -> int | None:
-    """The axis (0, 1, 2) along which ``bounds`` are flat, or None for a 3-D extent.
-
-    A flat z is preferred (a top view), then y, then x.
-    """
-    b = np.asarray(bounds, dtype=np.float64).reshape(3, 2)
-    extent = b[:, 1] - b[:, 0]
-    size = float(extent.max())
-    if size <= 0.0:
-        return None
-    for axis in (2, 1, 0):
-        if extent[axis] <= rel * size:
-            return axis
-    return None
-
-
 class Scene:
-    """The drawn state of a plotter: layers by label, legend, bounds grid and texts.
+    """The drawn state of one view: layers by label, legend or title, texts, scale.
 
     Parameters
     ----------
     plotter : pyvista.Plotter
         Where to draw (on screen or off screen).
+    subplot : (int, int), optional
+        The subplot of ``plotter`` this scene draws in (the plotter's only one by default).
+    titled : bool
+        Name what is shown in a title at the top left (one node per view, as in the side
+        by side layout) instead of in a legend at the top right.
+    edges : bool, optional
+        Draw the edges of every mesh face (True), of none (False), or of coarse meshes only
+        (None, at most :data:`~.style.COARSE_FACES` faces).
+    colors : dict, optional
+        Label -> colour, shared between scenes so that a node keeps its colour.
     """
 
-    def __init__(self, plotter: Any):
+    def __init__(
+        self,
+        plotter: Any,
+        subplot: tuple[int, int] | None = None,
+        *,
+        titled: bool = False,
+        edges: bool | None = None,
+        colors: dict[str, str] | None = None,
+    ):
         self.plotter = plotter
+        self.subplot = subplot
+        self.titled = titled
+        self.edges = edges
         self.layers: dict[str, Layer] = {}
-        self.colors: dict[str, str] = {}
+        self.colors: dict[str, str] = colors if colors is not None else {}
+        self.captions: dict[str, str] = {}  # label -> node type, for titles
         self.show_polygons = False
         self.show_nets = False
-        self.show_grid = True
+        self.show_grid = False
         self.error: str | None = None
         self.view_shift = 0.0  # move the picture left, to leave room for the sliders
         self._drawn_grid: Any = None  # what the bounds grid and legend show now
         self._drawn_legend: list[Any] = []
+        self._legend_width = 0.0  # fraction of the view's width the legend takes
+        self.free = (0.0, 0.0, 1.0, 1.0)  # where the last fit put the picture (fractions)
+        self.activate()
+        self.renderer = plotter.renderer
         plotter.set_background(BACKGROUND)
         plotter.enable_anti_aliasing("ssaa")
+        self.scale_bar = ScaleBar(self.renderer)
+
+    def set_frame(self, bounds: Sequence[float] | None) -> None:
+        """An invisible box (8 points, opacity 0) that this view's clipping planes must
+        keep: views sharing a camera then never clip what another view draws."""
+        import pyvista as pv
+
+        self.activate()
+        if bounds is None:
+            self.plotter.remove_actor("frame", render=False)
+            return
+        b = np.asarray(bounds, dtype=np.float64).reshape(3, 2)
+        corners = np.array(np.meshgrid(*b, indexing="ij")).reshape(3, -1).T
+        actor = self.plotter.add_mesh(
+            pv.PolyData(corners), opacity=0.0, name="frame", reset_camera=False, pickable=False
+        )
+        actor.SetPickable(False)
+
+    def activate(self) -> None:
+        """Make this scene's subplot the one the plotter draws in."""
+        if self.subplot is not None:
+            self.plotter.subplot(*self.subplot)
+
+    def size(self) -> tuple[int, int]:
+        """This view's size in pixels."""
+        w, h = self.renderer.GetSize()
+        if w <= 0 or h <= 0:  # not rendered yet: the window's share
+            rows, cols = self.plotter.shape
+            ww, wh = self.plotter.window_size
+            return max(1, ww // cols), max(1, wh // rows)
+        return int(w), int(h)
 
     # ---------------------------------------------------------------------- drawing
 
@@ -259,6 +287,7 @@ class Scene:
 
     def update(self, shown: Iterable[tuple[str, Any]]) -> None:
         """Draw ``(label, value)`` pairs, reusing the actors already there."""
+        self.activate()
         pairs = [p for label, value in shown for p in expand(label, value)]
         seen = set()
         for label, value in pairs:
@@ -268,6 +297,7 @@ class Scene:
             if layer is None:
                 layer = self.layers[label] = Layer(label, self.color_of(label))
             layer.summary = describe(value, items)
+            layer.mesh_faces = sum(g.n_faces for g in items if isinstance(g, Mesh))
             self._update_layer(layer, datasets_of(items))
         for label in [lb for lb in self.layers if lb not in seen]:
             for kind in list(self.layers[label].parts):
@@ -277,9 +307,10 @@ class Scene:
         self.layers = {label: self.layers[label] for label, _ in pairs}
         self._legend()
         self._bounds_grid()
+        self._size_line()
 
     def _update_layer(self, layer: Layer, data: dict[str, Any]) -> None:
-        for kind in KINDS + OVERLAYS:
+        for kind in KINDS + OVERLAYS + LINES:
             new = data.get(kind)
             part = layer.parts.get(kind)
             if new is None:
@@ -292,14 +323,16 @@ class Scene:
             part.data.copy_from(new)
             if part.vertices is not None:
                 part.vertices.copy_from(_vertices(new))
+        self._layer_edges(layer)
 
     def _add_part(self, layer: Layer, kind: str, data: Any) -> Part:
-        actor = self.plotter.add_mesh(data, reset_camera=False, **_style(kind, layer.color))
+        actor = self.plotter.add_mesh(data, reset_camera=False, **style(kind, layer.color))
+        apply_material(actor, kind)
         part = Part(data, actor)
         if kind in OVERLAYS:
             part.vertices = _vertices(data)
-            style = dict(_style("points", _mix(layer.color, "black", 0.35)), point_size=7)
-            part.vertex_actor = self.plotter.add_mesh(part.vertices, reset_camera=False, **style)
+            points = dict(style("points", mix(layer.color, "black", 0.35)), point_size=7)
+            part.vertex_actor = self.plotter.add_mesh(part.vertices, reset_camera=False, **points)
             self._set_overlay_visible(
                 part, self.show_polygons if kind == "polygon" else self.show_nets
             )
@@ -316,6 +349,17 @@ class Scene:
         part.actor.SetVisibility(visible)
         part.vertex_actor.SetVisibility(visible)
 
+    def edges_shown(self, layer: Layer, kind: str = "meshes") -> bool:
+        """Whether the face edges of a layer's meshes (or surfaces) are drawn."""
+        if self.edges is not None:
+            return self.edges
+        return kind == "meshes" and 0 < layer.mesh_faces <= COARSE_FACES
+
+    def _layer_edges(self, layer: Layer) -> None:
+        for kind in ("meshes", "surfaces"):
+            if kind in layer.parts:
+                set_edges(layer.parts[kind].actor, self.edges_shown(layer, kind))
+
     def toggle(self, overlay: str) -> bool:
         """Show or hide the control polygons (``'polygon'``) or control nets (``'net'``)."""
         if overlay == "polygon":
@@ -328,6 +372,16 @@ class Scene:
             if overlay in layer.parts:
                 self._set_overlay_visible(layer.parts[overlay], visible)
         return visible
+
+    def toggle_edges(self) -> bool:
+        """Draw the edges of every face, or of none (the first press turns them all on
+        unless every mesh shows them already)."""
+        meshes = [lay for lay in self.layers.values() if "meshes" in lay.parts]
+        shown = bool(meshes) and all(self.edges_shown(lay) for lay in meshes)
+        self.edges = not shown
+        for layer in self.layers.values():
+            self._layer_edges(layer)
+        return self.edges
 
     def toggle_grid(self) -> bool:
         self.show_grid = not self.show_grid
@@ -350,46 +404,41 @@ class Scene:
         hi = np.max([b[:, 1] for b in boxes], axis=0)
         return tuple(float(x) for x in np.column_stack([lo, hi]).ravel())
 
-    def fit_camera(self) -> None:
-        """Frame everything: a top (or side) view of flat geometry, else isometric."""
-        grid = self.grid_bounds()
-        if grid is None:
-            return
-        bounds = grid[0] if self.show_grid else self.bounds()
-        axis = view_axis(bounds)
-        p = self.plotter
-        # sliders take the right of the window: centre the picture in what is left; the
-        # legend takes the top right: on a drawing, move the picture down below it
-        legend = self._legend_height() if axis is not None else 0.0
-        p.camera.SetWindowCenter(self.view_shift, legend)
-        # flat geometry is a drawing: look straight at it, without perspective
-        p.camera.parallel_projection = axis is not None
-        {None: p.view_isometric, 2: p.view_xy, 1: p.view_xz, 0: p.view_yz}[axis](render=False)
-        p.reset_camera(render=False, bounds=bounds)
-        # leave room for the axis labels (and, on a drawing, the legend above it)
-        self._zoom_to_fit(bounds, fill=0.8 if axis is None else 0.8 - legend)
+    def points(self) -> np.ndarray:
+        """A sample of the drawn points (what the camera frames), (m, 3)."""
+        chunks = [
+            sample(np.asarray(part.data.points))
+            for layer in self.layers.values()
+            for kind, part in layer.parts.items()
+            if part.data.n_points and (kind in KINDS or part.actor.GetVisibility())
+        ]
+        return np.concatenate(chunks) if chunks else np.zeros((0, 3))
 
-    def _zoom_to_fit(self, bounds: Sequence[float], fill: float) -> None:
-        """Zoom until the box's projection fills ``fill`` of the free part of the window.
+    def margins(self, axis: int | None) -> tuple[float, float, float, float]:
+        """Pixels kept free at the left, bottom, right and top (texts, legend, scale)."""
+        top = self._legend_height() * self.size()[1] + 8 if not self.titled else 2 * 20 + 8
+        top = max(top, STATUS_HEIGHT)
+        bottom = STATUS_HEIGHT + (ScaleBar.HEIGHT if axis is not None else 0)
+        side = 10.0
+        if self.show_grid:  # the grid's labels go around the box
+            w, h = self.size()
+            side, bottom, top = side + 0.08 * w, bottom + 0.06 * h, top + 0.04 * h
+        return side, bottom, side, top
 
-        reset_camera frames the bounding sphere, which leaves a flat or long box small.
-        """
-        ren = self.plotter.renderer
-        width, height = self.plotter.window_size
-        free_w = width * (1.0 - self.view_shift)
-        corners = np.array(np.meshgrid(*np.asarray(bounds).reshape(3, 2), indexing="ij"))
-        corners = corners.reshape(3, -1).T
-        for _ in range(2):  # perspective: the second pass corrects the first
-            xy = np.empty((len(corners), 2))
-            for k, c in enumerate(corners):  # eight corners
-                ren.SetWorldPoint(*c, 1.0)
-                ren.WorldToDisplay()
-                xy[k] = ren.GetDisplayPoint()[:2]
-            w, h = np.ptp(xy, axis=0)
-            if w <= 0 and h <= 0:
-                return
-            factor = fill * min(free_w / max(w, 1e-9), height / max(h, 1e-9))
-            self.plotter.camera.zoom(float(factor))
+    def margin_options(self, axis: int | None) -> list[tuple[float, float, float, float]]:
+        """:meth:`margins`, and with a legend the other way to keep clear of it: the
+        picture beside the legend rather than below it (a tall drawing fits better so)."""
+        options = [self.margins(axis)]
+        if not self.titled and self.layers and not self.show_grid:
+            left, bottom, right, _ = options[0]
+            right += self._legend_width * self.size()[0] + 8
+            options.append((left, bottom, right, float(STATUS_HEIGHT)))
+        return options
+
+    def fit_camera(self, others: Sequence[Scene] = ()) -> None:
+        """Frame everything (and what ``others``, sharing this camera, draw): a straight
+        view without perspective of flat geometry (a drawing), else an isometric one."""
+        fit_scenes([self, *others])
 
     def grid_bounds(self) -> tuple[tuple[float, ...], tuple[int, int, int]] | None:
         """The bounds grid's box, widened to round tick values, and its label counts."""
@@ -406,6 +455,7 @@ class Scene:
         return tuple(box), (counts[0], counts[1], counts[2])
 
     def _bounds_grid(self) -> None:
+        self.activate()
         p = self.plotter
         grid = self.grid_bounds() if self.show_grid else None
         if grid == self._drawn_grid and (grid is None) == (p.renderer.cube_axes_actor is None):
@@ -443,11 +493,14 @@ class Scene:
     # -------------------------------------------------------------------- legend, text
 
     def _legend_height(self) -> float:
-        """The fraction of the window's height the legend takes (0 with no legend)."""
-        n = len(self.layers)
-        return 0.0 if n == 0 else min((20 * n + 8) / self.plotter.window_size[1], 0.5)
+        """The fraction of the view's height the legend takes (0 with no legend)."""
+        n = 0 if self.titled else len(self.layers)
+        return 0.0 if n == 0 else min((20 * n + 8) / self.size()[1], 0.5)
 
     def _legend(self) -> None:
+        if self.titled:
+            self._title()
+            return
         p = self.plotter
         entries = []
         for layer in self.layers.values():
@@ -460,13 +513,14 @@ class Scene:
         self._drawn_legend = entries
         if p.legend is not None:
             p.remove_legend(render=False)
+        self._legend_width = 0.0
         if not entries:
             return
         # placed by hand: pyvista's loc="upper right" offsets x by the height, not the width
         # about 13-pixel text, whatever the window size
-        win_w, win_h = p.window_size
+        win_w, win_h = self.size()
         height = self._legend_height()
-        width = min((7.5 * max(len(e[0]) for e in entries) + 34) / win_w, 0.45)
+        width = min((7.5 * max(len(e[0]) for e in entries) + 34) / win_w, 0.6)
         legend = p.add_legend(
             entries,
             bcolor="white",
@@ -475,91 +529,88 @@ class Scene:
             loc=None,
             background_opacity=0.85,
         )
+        self._legend_width = width
         legend.SetPosition(0.985 - width, 0.985 - height)
         legend.SetPosition2(width, height)
 
-    def set_status(self, text: str | None) -> None:
-        """The line at the top left (evaluation time), or nothing."""
+    def _title(self) -> None:
+        """Name, node type and size of what this view shows, in its colour."""
+        lines = []
+        for layer in self.layers.values():
+            caption = self.captions.get(layer.label.split(".", 1)[0], "")
+            lines.append((layer.label, ", ".join(x for x in (caption, layer.summary) if x)))
+        color = next(iter(self.layers.values())).color if self.layers else TEXT_COLOR
+        head = "  ".join(label for label, _ in lines)
+        tail = "; ".join(text for _, text in lines)
+        self.plotter.add_text(
+            head, position=(10, self.size()[1] - 28), font_size=12, color=color, name="title"
+        )
+        self.plotter.add_text(
+            tail, position=(10, self.size()[1] - 46), font_size=8, color=TEXT_COLOR, name="caption"
+        )
+
+    def _size_line(self) -> None:
+        """The size of what is drawn, in model units, at the bottom left."""
+        bounds = self.bounds()
+        if bounds is None:
+            self.plotter.remove_actor("size", render=False)
+            return
+        self.plotter.add_text(
+            size_text(bounds, view_axis(bounds)),
+            position=(12, 6),
+            font_size=8,
+            color=TEXT_COLOR,
+            name="size",
+        )
+
+    def set_status(self, text: str | None, position: str = "upper_left") -> None:
+        """The line with the evaluation time (at the top left), or nothing."""
+        self.activate()
         if text is None:
             self.plotter.remove_actor("status", render=False)
             return
-        self.plotter.add_text(
-            text, position="upper_left", font_size=9, color=TEXT_COLOR, name="status"
-        )
+        self.plotter.add_text(text, position=position, font_size=9, color=TEXT_COLOR, name="status")
 
     def set_help(self, text: str) -> None:
+        self.activate()
         self.plotter.add_text(
             text, position="lower_right", font_size=8, color="#777777", name="help"
         )
 
     def set_error(self, message: str | None) -> None:
         """Show an error at the bottom left (red, wrapped), or clear it."""
+        self.activate()
         self.error = message
         if message is None:
             self.plotter.remove_actor("error", render=False)
             return
+        width = max(30, int(self.size()[0] / 7.5))
         lines = []
         for line in message.splitlines()[:12]:
-            lines.extend(textwrap.wrap(line, 90) or [""])
+            lines.extend(textwrap.wrap(line, width) or [""])
         self.plotter.add_text(
             "\n".join(lines[:16]),
-            position="lower_left",
+            position=(10, STATUS_HEIGHT),
             font_size=9,
             color=ERROR_COLOR,
             name="error",
         )
 
     def texts(self) -> dict[str, str]:
-        """The texts on screen by name (status, error, help), for tests and notebooks."""
+        """The texts on screen by name (status, error, help, ...), for tests and notebooks."""
+        self.activate()
         out = {}
-        for name in ("status", "error", "help"):
+        for name in ("status", "error", "help", "title", "caption", "size"):
             actor = self.plotter.actors.get(name)
             if actor is not None:
                 out[name] = _text_of(actor)
         return out
 
 
-def nice_range(lo: float, hi: float, size: float, max_ticks: int = 9) -> tuple[float, float, int]:
-    """``[lo, hi]`` widened to the nearest multiples of a round step, and the tick count.
-
-    The step is 1, 2, 2.5 or 5 times a power of ten, at least ``size / 12`` (so labels on a
-    short axis do not crowd), with at most ``max_ticks`` ticks; of those, the one that widens
-    the range least (then the one with nearer five ticks). A thin axis (under ``size / 12``)
-    keeps its ends and gets no labels (0: they would overlap); a flat one (``hi - lo`` tiny
-    next to ``size``) gets one tick.
-    """
-    if size <= 0 or hi - lo <= 1e-9 * size:
-        return lo, hi, 1
-    if hi - lo < size / 12:  # a thin axis: widening it to a round step would swamp it
-        return lo, hi, 0
-    best: tuple[tuple[float, int], float, float, int] | None = None
-    for power in range(int(np.floor(np.log10(hi - lo))) - 1, int(np.floor(np.log10(size))) + 2):
-        for m in (1.0, 2.0, 2.5, 5.0):
-            step = m * 10.0**power
-            if step < size / 12:
-                continue
-            lo2 = step * np.floor(lo / step + 1e-9)
-            hi2 = step * np.ceil(hi / step - 1e-9)
-            n = int(round((hi2 - lo2) / step)) + 1
-            key = (round(float(hi2 - lo2) / size, 9), abs(n - 5))
-            if n <= max_ticks and (best is None or key < best[0]):
-                best = (key, float(lo2), float(hi2), n)
-    assert best is not None  # the largest step always fits in two or three ticks
-    return best[1], best[2], best[3]
-
-
 def _vertices(data: Any) -> Any:
     import pyvista as pv
 
     return pv.PolyData(np.array(data.points))
-
-
-def _padded(bounds: Sequence[float], rel: float) -> tuple[float, ...]:
-    b = np.asarray(bounds, dtype=np.float64).reshape(3, 2).copy()
-    pad = rel * float((b[:, 1] - b[:, 0]).max())
-    b[:, 0] -= pad
-    b[:, 1] += pad
-    return tuple(float(x) for x in b.ravel())
 
 
 def _text_of(actor: Any) -> str:

@@ -4,13 +4,19 @@ A :class:`Watcher` polls the files' modification stamps from the plotter's timer
 :meth:`Watcher.reload` reads, checks and evaluates the file again; a broken edit puts the
 error in the window (and on stderr) and leaves the last good geometry on screen. Successive
 versions share one memory cache, so an edit recomputes only the nodes it reaches.
+
+Without a display, :class:`ScreenshotWatcher` does the same off screen: each good version
+is rendered to a PNG (written atomically, so a viewer of the file never sees half of one)
+and one status line is printed; a broken version prints its error and leaves the last good
+PNG in place.
 """
 
 from __future__ import annotations
 
 import os
 import sys
-from collections.abc import Sequence
+import time
+from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -18,10 +24,11 @@ from formgraph.errors import FormgraphError
 from formgraph.graph import load
 from formgraph.registry import DEFAULT_BUDGET
 
-from .app import Session, _window_title
+from .app import Session
+from .entry import _window_title
 from .scene import Scene
 
-__all__ = ["Watcher", "watch"]
+__all__ = ["ScreenshotWatcher", "Watcher", "display_problem", "watch"]
 
 
 class Watcher:
@@ -31,8 +38,8 @@ class Watcher:
     ----------
     path : str or path
         The YAML graph file.
-    node : str, optional
-        The node to show; default: the graph's results.
+    node : str or list of str, optional
+        The nodes to show; default: the graph's results.
     plotter : pyvista.Plotter
         Where to draw.
     sets : sequence of str
@@ -45,14 +52,18 @@ class Watcher:
     def __init__(
         self,
         path: str | os.PathLike[str],
-        node: str | None = None,
+        node: str | Iterable[str] | None = None,
         *,
         plotter: Any,
         sets: Sequence[str] = (),
         out_dir: str | os.PathLike[str] = "out",
         budget: int = DEFAULT_BUDGET,
+        layout: str = "overlay",
+        edges: bool | None = None,
     ):
         self.path = Path(path)
+        self.layout = layout
+        self.edges = edges
         self.node = node
         self.plotter = plotter
         self.sets = list(sets)
@@ -69,17 +80,7 @@ class Watcher:
         return self.session.scene if self.session is not None else None
 
     def _stamp(self) -> tuple[Any, ...] | None:
-        stamps: list[Any] = []
-        for f in self.files:
-            try:
-                st = f.stat()
-            except OSError:
-                if f == self.path:
-                    return None  # mid-save (an editor's rename): look again on the next tick
-                stamps.append(None)
-                continue
-            stamps.append((st.st_mtime_ns, st.st_size))
-        return tuple(stamps)
+        return _stamps(self.path, self.files)
 
     def poll(self) -> bool | None:
         """Reload if the file changed since the last look; None when it did not."""
@@ -106,7 +107,14 @@ class Watcher:
                 graph.memory = self.session.graph.memory  # an edit recomputes what it reaches
             params = parse_sets(graph, self.sets)
             if self.session is None:
-                self.session = Session(graph, self.node, plotter=self.plotter, params=params)
+                self.session = Session(
+                    graph,
+                    self.node,
+                    plotter=self.plotter,
+                    params=params,
+                    layout=self.layout,
+                    edges=self.edges,
+                )
                 self.session.add_keys()
                 self.session.scene.set_error(None)  # an error left by a broken start
             else:
@@ -142,13 +150,15 @@ class Watcher:
 
 def watch(
     graph_path: str | os.PathLike[str],
-    node: str | None = None,
+    node: str | Iterable[str] | None = None,
     *,
     sets: Sequence[str] = (),
     out_dir: str | os.PathLike[str] = "out",
     budget: int = DEFAULT_BUDGET,
     size: tuple[int, int] = (1024, 768),
     interval: float = 0.3,
+    layout: str = "overlay",
+    edges: bool | None = None,
 ) -> Watcher:
     """Open a window on ``graph_path`` that redraws whenever the file is saved.
 
@@ -156,15 +166,31 @@ def watch(
     window and on stderr and keeps the last good geometry; the window stays open until
     closed (``q``).
     """
-    import pyvista as pv
-
     for item in sets:
         if "=" not in item:
             from formgraph.cli import UsageError
 
             raise UsageError(f"--set takes NAME=VALUE, got {item!r}")
-    plotter = pv.Plotter(window_size=list(size), title=_window_title(graph_path) + " (watching)")
-    watcher = Watcher(graph_path, node, plotter=plotter, sets=sets, out_dir=out_dir, budget=budget)
+    from .entry import make_plotter, view_count
+
+    views = 1
+    if layout == "side":  # the window's views are fixed: as many as the first version shows
+        try:
+            views = view_count(load(graph_path, out_dir=out_dir, budget=budget), node)
+        except FormgraphError:
+            views = 1 if node is None else len([node] if isinstance(node, str) else list(node))
+    title = _window_title(graph_path) + " (watching)"
+    plotter = make_plotter(views, layout, size, title=title)
+    watcher = Watcher(
+        graph_path,
+        node,
+        plotter=plotter,
+        sets=sets,
+        out_dir=out_dir,
+        budget=budget,
+        layout=layout,
+        edges=edges,
+    )
     watcher.reload()
     plotter.add_timer_event(
         max_steps=2**31 - 1,
@@ -174,3 +200,179 @@ def watch(
     print(f"watching {graph_path} (close the window or press q to stop)", file=sys.stderr)
     plotter.show()
     return watcher
+
+
+# --------------------------------------------------------------------------- headless
+
+
+def display_problem() -> str | None:
+    """Why a window cannot open here (no display), or None when one can.
+
+    Only Linux and the BSDs are checked (elsewhere a window system is always there). VTK
+    draws its windows through X, so ``DISPLAY`` must be set (a Wayland desktop sets it for
+    XWayland), and a local display's socket must exist: VTK aborts the whole process on a
+    display that does not answer.
+    """
+    if not sys.platform.startswith(("linux", "freebsd", "openbsd", "netbsd")):
+        return None
+    display = os.environ.get("DISPLAY", "")
+    if not display:
+        if os.environ.get("WAYLAND_DISPLAY"):
+            return "there is a Wayland display but no X display for VTK (DISPLAY is not set)"
+        return "there is no display (DISPLAY is not set)"
+    host, _, number = display.partition(":")
+    number = number.split(".", 1)[0]
+    if host in ("", "unix") and number.isdigit():
+        if not Path(f"/tmp/.X11-unix/X{number}").exists():
+            return f"DISPLAY={display}, but no X server listens there"
+    return None
+
+
+class ScreenshotWatcher:
+    """Watch a graph file without a window: a PNG and a status line per good version.
+
+    Each change is loaded, checked and evaluated (sharing the memory cache with the
+    previous version, so an edit recomputes only what it reaches) and rendered off screen
+    to ``screenshot``, written atomically. A broken version prints its error and keeps the
+    last good PNG.
+
+    Parameters
+    ----------
+    path, node, sets, out_dir, budget, layout, edges
+        As for :class:`Watcher`.
+    screenshot : str or path
+        The PNG to (re)write.
+    size : (int, int)
+        Image size in pixels.
+    out, err : text streams
+        Where the status lines and the errors go.
+    """
+
+    def __init__(
+        self,
+        path: str | os.PathLike[str],
+        screenshot: str | os.PathLike[str],
+        node: str | Iterable[str] | None = None,
+        *,
+        sets: Sequence[str] = (),
+        out_dir: str | os.PathLike[str] = "out",
+        budget: int = DEFAULT_BUDGET,
+        size: tuple[int, int] = (1024, 768),
+        layout: str = "overlay",
+        edges: bool | None = None,
+        out: Any = None,
+        err: Any = None,
+    ):
+        self.path = Path(path)
+        self.screenshot = Path(screenshot)
+        self.node = node
+        self.sets = list(sets)
+        self.out_dir = out_dir
+        self.budget = budget
+        self.size = size
+        self.layout = layout
+        self.edges = edges
+        self.out = out if out is not None else sys.stdout
+        self.err = err if err is not None else sys.stderr
+        self.stamp: tuple[Any, ...] | None = None
+        self.files: list[Path] = [self.path]  # the graph's file and its subgraph files
+        self.memory: Any = None  # the cache shared by successive versions
+        self.written = 0  # PNGs written
+        self.last_error: str | None = None
+
+    def _stamp(self) -> tuple[Any, ...] | None:
+        return _stamps(self.path, self.files)
+
+    def poll(self) -> bool | None:
+        """Render if the file changed since the last look; None when it did not."""
+        stamp = self._stamp()
+        if stamp is None or stamp == self.stamp:
+            return None
+        return self.reload()
+
+    def reload(self) -> bool:
+        """Load, evaluate and render the file once; True when a new PNG was written."""
+        from formgraph.cli import UsageError, parse_sets
+
+        from .entry import make_plotter
+
+        self.stamp = self._stamp()
+        try:
+            graph = load(self.path, out_dir=self.out_dir, budget=self.budget)
+            self.files = [self.path, *graph.files[1:]]
+            self.stamp = self._stamp()
+            if self.memory is not None:
+                graph.memory = self.memory
+            params = parse_sets(graph, self.sets)
+            views = 1
+            if self.layout == "side":
+                from .entry import view_count
+
+                views = view_count(graph, self.node)
+            plotter = make_plotter(views, self.layout, self.size, off_screen=True)
+            try:
+                session = Session(
+                    graph,
+                    self.node,
+                    plotter=plotter,
+                    params=params,
+                    timing=False,
+                    layout=self.layout,
+                    edges=self.edges,
+                )
+                self.screenshot.parent.mkdir(parents=True, exist_ok=True)
+                tmp = self.screenshot.with_name(f".{self.screenshot.name}.{os.getpid()}.tmp.png")
+                plotter.screenshot(str(tmp))
+                os.replace(tmp, self.screenshot)
+            finally:
+                plotter.close()
+        except (FormgraphError, UsageError) as exc:
+            if getattr(exc, "files", None):  # a broken subgraph file is watched too
+                self.files = [self.path, *exc.files[1:]]
+                self.stamp = self._stamp()
+            return self._failed(str(exc))
+        except Exception as exc:  # a bug of ours must not end the watch
+            return self._failed(f"internal error: {type(exc).__name__}: {exc}")
+        self.memory = graph.memory
+        self.written += 1
+        self.last_error = None
+        print(f"{self.path.name}: {session.status_line()}, wrote {self.screenshot}", file=self.out)
+        self.out.flush()
+        return True
+
+    def _failed(self, message: str) -> bool:
+        self.last_error = message
+        kept = (
+            f" (kept {self.screenshot}, the last version that worked)"
+            if self.written
+            else f" ({self.screenshot} not written)"
+        )
+        print(message + kept, file=self.err)
+        self.err.flush()
+        return False
+
+    def run(self, interval: float = 0.3, stop: Callable[[], bool] | None = None) -> None:
+        """Render now, then poll every ``interval`` seconds until ``stop()`` (or Ctrl-C)."""
+        print(
+            f"watching {self.path} (a new {self.screenshot} on every good save; Ctrl-C stops)",
+            file=self.err,
+        )
+        self.reload()
+        while stop is None or not stop():
+            time.sleep(interval)
+            self.poll()
+
+
+def _stamps(path: Path, files: Sequence[Path]) -> tuple[Any, ...] | None:
+    """(mtime, size) of each file; None while the graph's own file is missing (mid-save)."""
+    stamps: list[Any] = []
+    for f in files:
+        try:
+            st = f.stat()
+        except OSError:
+            if f == path:
+                return None
+            stamps.append(None)
+            continue
+        stamps.append((st.st_mtime_ns, st.st_size))
+    return tuple(stamps)
