@@ -4,24 +4,29 @@ from Python and from ``formgraph cache``; the sweep command's refusals."""
 from __future__ import annotations
 
 import os
-import subprocess
-import sys
 import textwrap
 from pathlib import Path
 
 import pytest
 
 from formgraph.cache import DiskCache, key_of, parse_size
+from formgraph.cli import main
 
 
-def cli(*args: str, env: dict[str, str] | None = None) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(
-        [sys.executable, "-m", "formgraph.cli", *args],
-        capture_output=True,
-        text=True,
-        timeout=120,
-        env={**os.environ, **(env or {})},
-    )
+@pytest.fixture
+def cli(capsys, monkeypatch):
+    """``formgraph ARGS`` in this process: (exit code, stdout, stderr)."""
+
+    def run(*args: str, env: dict[str, str] | None = None) -> tuple[int, str, str]:
+        for k, v in (env or {}).items():
+            monkeypatch.setenv(k, v)
+        code = main(list(args))
+        out, err = capsys.readouterr()
+        for k in env or {}:
+            monkeypatch.delenv(k)
+        return code, out, err
+
+    return run
 
 
 def filled(root: Path, count: int = 5) -> tuple[DiskCache, list[str], int]:
@@ -80,24 +85,27 @@ def test_clear_leaves_other_files_alone(tmp_path):
     assert (tmp_path / "ab" / "not-an-entry.npz").exists()
 
 
-def test_cache_command(tmp_path):
+def test_cache_command(tmp_path, cli):
     _, _, size = filled(tmp_path)
-    r = cli("cache", "info", "--cache-dir", str(tmp_path))
-    assert r.returncode == 0, r.stderr
-    assert f"cache: {tmp_path}" in r.stdout and "entries: 5" in r.stdout
-    assert "of 2.0 GiB" in r.stdout
-    r = cli("cache", "info", "--cache-dir", str(tmp_path), env={"FORMGRAPH_CACHE_MAX_SIZE": "1G"})
-    assert "of 1.0 GiB" in r.stdout
-    r = cli("cache", "prune", "--max-size", str(2 * size), "--cache-dir", str(tmp_path))
-    assert r.returncode == 0, r.stderr
-    assert "removed 3 entries" in r.stdout and "2 left" in r.stdout
-    r = cli("cache", "clear", "--cache-dir", str(tmp_path))
-    assert "removed 2 entries" in r.stdout
-    r = cli("cache", "prune", "--max-size", "lots", "--cache-dir", str(tmp_path))
-    assert r.returncode == 2 and "--max-size: 'lots' is not a size" in r.stderr
+    code, out, err = cli("cache", "info", "--cache-dir", str(tmp_path))
+    assert code == 0, err
+    assert f"cache: {tmp_path}" in out and "entries: 5" in out and "of 2.0 GiB" in out
+    _, out, _ = cli(
+        "cache", "info", "--cache-dir", str(tmp_path), env={"FORMGRAPH_CACHE_MAX_SIZE": "1G"}
+    )
+    assert "of 1.0 GiB" in out
+    code, out, err = cli(
+        "cache", "prune", "--max-size", str(2 * size), "--cache-dir", str(tmp_path)
+    )
+    assert code == 0, err
+    assert "removed 3 entries" in out and "2 left" in out
+    _, out, _ = cli("cache", "clear", "--cache-dir", str(tmp_path))
+    assert "removed 2 entries" in out
+    code, _, err = cli("cache", "prune", "--max-size", "lots", "--cache-dir", str(tmp_path))
+    assert code == 2 and "--max-size: 'lots' is not a size" in err
 
 
-def test_sweep_command_refusals(tmp_path):
+def test_sweep_command_refusals(tmp_path, cli):
     graph = tmp_path / "g.yaml"
     graph.write_text(
         textwrap.dedent(
@@ -110,13 +118,13 @@ def test_sweep_command_refusals(tmp_path):
             """
         ).lstrip()
     )
-    r = cli("sweep", str(graph), "--vary", "n")
-    assert r.returncode == 2 and "--vary takes NAME=SPEC" in r.stderr
-    r = cli("sweep", str(graph), "--vary", "n=1:20", "--out", str(tmp_path / "o"))
-    assert r.returncode == 1
-    assert "g.yaml:3: param 'n': vary n=1:20: goes down to 1, below the param's min 3" in r.stderr
-    assert "Traceback" not in r.stderr and not (tmp_path / "o").exists()
-    r = cli("sweep", str(graph), "--vary", "n=3:5", "--method", "lhs")
-    assert r.returncode == 2 and "method lhs needs a sample count" in r.stderr
-    r = cli("sweep", str(graph), "--vary", "n=3:5", "--measure", "pts")
-    assert r.returncode == 1 and "measure: 'pts' gives Points, not a number" in r.stderr
+    code, _, err = cli("sweep", str(graph), "--vary", "n")
+    assert code == 2 and "--vary takes NAME=SPEC" in err
+    code, _, err = cli("sweep", str(graph), "--vary", "n=1:20", "--out", str(tmp_path / "o"))
+    assert code == 1
+    assert "g.yaml:3: param 'n': vary n=1:20: goes down to 1, below the param's min 3" in err
+    assert "Traceback" not in err and not (tmp_path / "o").exists()
+    code, _, err = cli("sweep", str(graph), "--vary", "n=3:5", "--method", "lhs")
+    assert code == 2 and "method lhs needs a sample count" in err
+    code, _, err = cli("sweep", str(graph), "--vary", "n=3:5", "--measure", "pts")
+    assert code == 1 and "measure: 'pts' gives Points, not a number" in err

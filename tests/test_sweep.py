@@ -405,3 +405,45 @@ def test_the_embedded_cluster_is_started_and_closed_by_the_sweep(tmp_path, capsy
         assert [r["n"] for r in csv.DictReader(fh)] == ["3", "4", "5", "6"]
     assert cli_main(args) == 0  # everything done: kept, no cluster started
     assert "(4 kept from an earlier run)" in capsys.readouterr().out
+
+
+def test_ctrl_c_leaves_a_valid_table_and_the_rerun_completes_it(tmp_path):
+    graph = tmp_path / "slow.yaml"
+    log = tmp_path / "calls.log"
+    graph.write_text(
+        "formgraph: 1\nparams:\n  a: {default: 1.0, min: 0, max: 100}\nnodes:\n"
+        f'  per: {{type: stub.logged, x: "=a", log: "{log}", label: per, seconds: 0.15}}\n'
+    )
+    out = tmp_path / "out"
+    code = (
+        "import sys; sys.path.insert(0, sys.argv[1]); import sweep_stubs; "
+        "from formgraph.cli import main; sys.exit(main(sys.argv[2:]))"
+    )
+    args = [sys.executable, "-c", code, str(ROOT / "tests"), "sweep", str(graph)]
+    args += ["--vary", "a=1:12:12", "--measure", "per", "--workers", "1", "--out", str(out)]
+    args += ["--cache-dir", str(tmp_path / "cache")]
+    proc = subprocess.Popen(args, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline:  # until a few rows are in
+            if (out / "sweep.csv").exists() and (out / "sweep.csv").read_text().count("\n") > 3:
+                break
+            time.sleep(0.05)
+        proc.send_signal(signal.SIGINT)
+        _, err = proc.communicate(timeout=60)
+    finally:
+        proc.kill()
+    assert proc.returncode == 130 and "interrupted" in err and "Traceback" not in err
+    with open(out / "sweep.csv", newline="") as fh:
+        partial = list(csv.DictReader(fh))
+    assert 3 <= len(partial) < 12 and all(r["status"] == "ok" for r in partial)
+    done = subprocess.run(args, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert f"({len(partial)} kept from an earlier run)" in done.stdout
+    with open(out / "sweep.csv", newline="") as fh:
+        table = list(csv.DictReader(fh))
+    assert [int(r["variant"]) for r in table] == list(range(12))
+    assert [float(r["per"]) for r in table] == [float(a) for a in range(1, 13)]
+    calls = sweep_stubs.calls(log)
+    for r in partial:  # the rows kept were not run again
+        assert calls.count(f"per:{float(r['a']):g}") == 1
