@@ -78,7 +78,7 @@ def _targets(
                 Problem(here, f"measure: '{node}' is an export; export its files with --export")
             )
             continue
-        outs = spec.outputs if spec.multi_output else {None: spec.outputs["out"]}
+        outs = spec.outputs if spec.multi_output else {None: spec.output_type(None)}
         if output and output not in outs:
             listed = ", ".join(f"{node}.{o}" for o in outs if o) or node
             problems.append(Problem(here, f"measure: '{item}': no such output; use {listed}"))
