@@ -130,3 +130,21 @@ def test_random_sampling_is_seeded_and_stays_in_the_domain():
 def test_progress_text():
     assert progress_text(3, 10, 1, 0.0) == "sweep 3/10 done, 1 failed"
     assert progress_text(37, 200, 2, 4.0) == "sweep 37/200 done, 2 failed, 4.0/s, ETA 0:40"
+
+
+def test_the_progress_line_shows_on_a_terminal_only():
+    import io
+
+    from formgraph.sweep import TerminalProgress
+
+    class Terminal(io.StringIO):
+        def isatty(self) -> bool:
+            return True
+
+    term, pipe = Terminal(), io.StringIO()
+    for stream in (term, pipe):
+        line = TerminalProgress(stream)
+        line(4, 4, 1, 2.0)
+        line.clear()
+    assert term.getvalue() == "\r\x1b[Ksweep 4/4 done, 1 failed, 2.0/s, ETA 0:00\r\x1b[K"
+    assert pipe.getvalue() == ""
