@@ -447,3 +447,18 @@ def test_ctrl_c_leaves_a_valid_table_and_the_rerun_completes_it(tmp_path):
     calls = sweep_stubs.calls(log)
     for r in partial:  # the rows kept were not run again
         assert calls.count(f"per:{float(r['a']):g}") == 1
+
+
+def test_an_export_that_variants_share_runs_once_and_lands_in_each_folder(client, tmp_path):
+    g = fg.Graph()
+    g.add_param("a", 1.0)
+    g.add("pts", "points.circle", count=5, radius=2)
+    g.add("ring", "curves.polyline", points="@pts", closed=True)
+    g.add("drawing", "export.svg", curves="@ring", path="ring.svg")
+    g.add("v", "stub.value", x="=a")
+    s = fg.sweep(g, {"a": "1,2,3"}, ["v"], export=True, client=client, out=tmp_path)
+    assert [r["drawing"] for r in s.rows] == [f"variants/{i:04d}/ring.svg" for i in range(3)]
+    assert [r["v"] for r in s.rows] == [1.0, 2.0, 3.0]
+    assert (s.totals.naive, s.totals.needed) == (3 * 4, 3 + 3)  # pts, ring, drawing once
+    files = [(tmp_path / r["drawing"]).read_bytes() for r in s.rows]
+    assert files[0].startswith(b"<?xml") and files[0] == files[1] == files[2]
