@@ -372,7 +372,8 @@ def test_repeated_and_subgraph_nodes_sweep_like_a_plain_loop(client):
 
 
 def test_subgraph_files_travel_with_the_graph(tmp_path):
-    from formgraph.sweep_dask import _graph_file, blueprint
+    from formgraph.sweep_dask import blueprint
+    from formgraph.sweep_tasks import _graph_file
 
     for rel in ("lamp.yaml", "parts/ring.yaml"):
         (tmp_path / rel).parent.mkdir(exist_ok=True)
