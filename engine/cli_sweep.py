@@ -86,6 +86,8 @@ def cmd_sweep(
         name, sep, spec = item.partition("=")
         if not sep or not name.strip() or not spec.strip():
             raise UsageError(f"--vary takes NAME=SPEC, e.g. turns=1:12, got {item!r}")
+        if name.strip() in vary:
+            raise UsageError(f"--vary {name.strip()} is given twice")
         vary[name.strip()] = spec.strip()
     cache_dir: Any = None
     if not args.no_cache:

@@ -120,6 +120,8 @@ def test_sweep_command_refusals(tmp_path, cli):
     )
     code, _, err = cli("sweep", str(graph), "--vary", "n")
     assert code == 2 and "--vary takes NAME=SPEC" in err
+    code, _, err = cli("sweep", str(graph), "--vary", "n=3:4", "n=5")
+    assert code == 2 and "--vary n is given twice" in err
     code, _, err = cli("sweep", str(graph), "--vary", "n=1:20", "--out", str(tmp_path / "o"))
     assert code == 1
     assert "g.yaml:3: param 'n': vary n=1:20: goes down to 1, below the param's min 3" in err
