@@ -105,8 +105,12 @@ def _graph_file(bp: Blueprint) -> str:
             return bp.path
     except (OSError, UnicodeDecodeError):
         pass
+    from .safety import path_problem
+
     scratch = Path(tempfile.mkdtemp(prefix="formgraph-graph-"))
     for rel, text in bp.files.items():
+        if path_problem(rel):  # a subgraph never leaves the graph's folder
+            raise FormgraphError(f"{bp.file}: cannot place the subgraph file {rel!r}")
         target = scratch / rel
         target.parent.mkdir(parents=True, exist_ok=True)
         target.write_text(text, encoding="utf-8")
