@@ -1,4 +1,6 @@
-"""Subdivision benchmark: Catmull-Clark and Doo-Sabin of a 10,000-quad torus.
+"""Mesh benchmark: Catmull-Clark and Doo-Sabin of a 10,000-quad torus; ear clipping of a
+concave star of 1,200 and 10,000 corners (against mapbox_earcut, compiled C++ ear clipping
+with z-order hashing, and shapely's constrained Delaunay triangulation).
 
 References, timed in the same run: pyopensubdiv (OpenSubdiv 3.4.4 through ctypes; its
 Python wrapper converts the mesh to and from lists, which is part of what a caller pays)
@@ -12,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
+from formgraph.kernels.mesh.polygon import triangulate_polygon
 from formgraph.kernels.mesh.subdivision import catmull_clark, doo_sabin
 
 # the benchmarks measure the tests' canonical shapes
@@ -53,8 +56,32 @@ def run(table) -> None:
             "pymeshlab",
             lambda lv=levels: _pymeshlab(v, fi, "meshing_surface_subdivision_catmull_clark", lv),
         )
+    for k in (1_200, 10_000):
+        xy = _star(k)
+        case = f"triangulate a concave {k:,}-corner star"
+        table.time(case, "formgraph", lambda xy=xy: triangulate_polygon(xy), repeat=3)
+        table.time(case, "mapbox_earcut", lambda xy=xy: _earcut(xy), repeat=3)
+        table.time(case, "shapely (constrained Delaunay)", lambda xy=xy: _shapely_cdt(xy), repeat=3)
     case = "doo_sabin 10k-quad torus, 1 lvl -> 30k faces"
     table.time(case, "formgraph", lambda: doo_sabin(v, fi, fo, 1))
     table.time(
         case, "pymeshlab", lambda: _pymeshlab(v, fi, "meshing_surface_subdivision_doo_sabin", 1)
     )
+
+
+def _star(k: int) -> np.ndarray:
+    t = np.linspace(0, 2 * np.pi, k, endpoint=False)
+    r = np.where(np.arange(k) % 2 == 0, 1.0, 0.4)
+    return np.column_stack([r * np.cos(t), r * np.sin(t)])
+
+
+def _earcut(xy: np.ndarray):
+    import mapbox_earcut
+
+    return mapbox_earcut.triangulate_float64(xy, np.array([len(xy)], dtype=np.uint32))
+
+
+def _shapely_cdt(xy: np.ndarray):
+    import shapely
+
+    return shapely.constrained_delaunay_triangles(shapely.Polygon(xy))

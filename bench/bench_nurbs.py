@@ -4,7 +4,9 @@ splipy and geomdl (pure Python).
 Cases: a degree-3 curve with 100 control points at 100,000 parameters (non-rational and
 rational); a 20 x 20 degree-3 surface on a 300 x 300 grid (both); knot insertion and
 refinement; a loft of 10 curves with 200 control points each (different knot vectors,
-so the compatibility step has real work: 10 x ~2,000 control points).
+so the compatibility step has real work: 10 x ~2,000 control points); interpolation of
+100,000 points (banded solve; scipy's make_interp_spline on the same knots, also banded);
+elevation of a 1,000-point cubic by 29 degrees in one step.
 
 Gotchas of the references: geomdl wants lists and parameters in [0, 1] and mutates the
 curve in insert_knot (we time it on a fresh copy); splipy's BSplineBasis takes the order
@@ -218,6 +220,41 @@ def run(table) -> None:  # noqa: ANN001 - the harness's Table
         return lambda: fitting.interpolate_curve(pl, 3)
 
     table.time(case_i, "geomdl", _lazy(geomdl_interp), repeat=1)
+
+    # ---- interpolation of many points: the banded solve (a dense one would need 80 GB)
+    big = 100_000
+    tb = np.linspace(0, 60 * np.pi, big)
+    pts_big = np.stack([np.cos(tb), np.sin(tb), np.sin(0.37 * tb)], -1)
+    case_b = f"interpolate {big:,} points, p=3 (open)"
+    table.time(case_b, "formgraph", lambda: K.interpolate(pts_big, 3), repeat=3)
+
+    def scipy_interp():
+        from scipy.interpolate import make_interp_spline
+
+        u = K.interpolation_parameters(pts_big)
+        knots_b = K.interpolate(pts_big, 3)[2]  # the same knots (A9.1's averaging)
+        return lambda: make_interp_spline(u, pts_big, k=3, t=knots_b)
+
+    table.time(case_b, "scipy make_interp_spline", _lazy(scipy_interp), repeat=3)
+    table.time(
+        f"interpolate {big:,} points, p=3 (closed)",
+        "formgraph",
+        lambda: K.interpolate(pts_big[: big - 1], 3, closed=True),
+        repeat=3,
+    )
+
+    # ---- degree elevation by many degrees at once
+    cp_e, _, knots_e, _ = _curve(rng, 1000, 3)
+    case_e29 = "elevate degree 3->32, 1,000 cp"
+    table.time(case_e29, "formgraph", lambda: K.elevate_degree(cp_e, 3, knots_e, None, 29))
+
+    def splipy_elevate29():
+        from splipy import BSplineBasis, Curve
+
+        c = Curve(BSplineBasis(4, knots_e), cp_e)
+        return lambda: c.clone().raise_order(29)
+
+    table.time(case_e29, "splipy (incl. clone)", _lazy(splipy_elevate29), repeat=1)
 
     hx = np.linspace(0, 6 * np.pi, 512)
     path = np.stack([2 * np.cos(hx), 2 * np.sin(hx), hx / np.pi], -1)

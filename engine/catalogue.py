@@ -8,6 +8,7 @@ checks it is current; regenerate with ``formgraph nodes --markdown > docs/nodes.
 from __future__ import annotations
 
 import enum
+import typing
 from typing import Any
 
 from .registry import REQUIRED, NodeSpec, Port, node_types
@@ -44,8 +45,10 @@ ESCAPED = {
 
 def _kind_schema(k: Kind) -> dict[str, Any]:
     base = k.base
-    if base is bool:
-        item: dict[str, Any] = {"type": "boolean"}
+    if typing.get_origin(base) is list:  # a nested list, e.g. list[list[float]]
+        item: dict[str, Any] = _kind_schema(Kind(typing.get_args(base)[0], True))
+    elif base is bool:
+        item = {"type": "boolean"}
     elif base is int:
         item = {"type": "integer"}
     elif base is float:

@@ -58,6 +58,9 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--no-cache", action="store_true", help="do not use the on-disk cache")
     run.add_argument("--cache-dir", default=None, help=argparse.SUPPRESS)
     run.add_argument("--profile", action="store_true", help="print a table of node timings")
+    run.add_argument(
+        "--strict", action="store_true", help="treat warnings as errors (exit 1 if any)"
+    )
 
     chk = sub.add_parser("check", help="validate a graph; exit 1 with every problem")
     chk.add_argument("graph")
@@ -249,16 +252,24 @@ def cmd_run(args: argparse.Namespace) -> int:
         outs = g.evaluate(args.nodes, **params) if args.nodes else g.evaluate_all(**params)
     finally:
         progress.clear()
+    label = "error" if args.strict else "warning"
     for name, value in outs.items():
         print(f"{name}: {_describe(value)}")
         for w in g.stats.get(name).warnings if name in g.stats else []:
-            print(f"  warning: {w}", file=sys.stderr)
+            print(f"  {label}: {w}", file=sys.stderr)
     for name, st in g.stats.items():
         if name not in outs:
             for w in st.warnings:
-                print(f"{name}: warning: {w}", file=sys.stderr)
+                print(f"{name}: {label}: {w}", file=sys.stderr)
     if args.profile:
         print(_profile_table(g.stats, g.nodes))
+    count = sum(len(st.warnings) for st in g.stats.values())
+    if args.strict and count:
+        print(
+            f"formgraph: --strict: {count} warning{'s' if count != 1 else ''} (see above)",
+            file=sys.stderr,
+        )
+        return 1
     return 0
 
 

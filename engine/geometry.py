@@ -360,7 +360,7 @@ class Surface(Geometry):
         if closed_v:
             pts = pts[:, :-1]
         fi, fo = _grid.grid_faces(pts.shape[0], pts.shape[1], closed_u, closed_v)
-        return Mesh(pts.reshape(-1, 3), fi, fo)
+        return Mesh(*_grid.collapse_poles(pts, fi, fo))
 
     def to_pyvista(self) -> Any:
         return self.tessellate(64, 64).to_pyvista()
@@ -583,6 +583,46 @@ class Mesh(Geometry):
         from .kernels.mesh import build_halfedges
 
         return build_halfedges(self.face_indices, self.face_offsets, self.n_vertices)
+
+    # measures (kernels in :mod:`formgraph.kernels.mesh.measure`), computed once per mesh
+
+    @functools.cached_property
+    def edge_table(self) -> Any:
+        """Undirected edges with their face counts (:class:`~.kernels.mesh.measure.EdgeTable`)."""
+        from .kernels.mesh import measure
+
+        return measure.edge_table(self.face_indices, self.face_offsets, self.n_vertices)
+
+    @functools.cached_property
+    def area(self) -> float:
+        """Total face area (Newell's vector per face: exact for planar polygons)."""
+        from .kernels.mesh import measure
+
+        return float(measure.face_areas(*self.state().values()).sum())
+
+    @functools.cached_property
+    def volume(self) -> float:
+        """Signed enclosed volume by the divergence theorem: positive for a closed, outward
+        mesh; only meaningful when :attr:`is_watertight`."""
+        from .kernels.mesh import measure
+
+        return float(measure.signed_volume(*self.state().values()).sum())
+
+    @functools.cached_property
+    def bounds(self) -> np.ndarray:
+        """(2, 3) read-only: the lowest and highest corner of the vertices' bounding box."""
+        v = self.vertices if self.n_vertices else np.zeros((1, 3))
+        return frozen_array([v.min(axis=0), v.max(axis=0)])
+
+    @property
+    def is_watertight(self) -> bool:
+        """Every edge lies on exactly two faces (no open or non-manifold edge)."""
+        return self.n_faces > 0 and bool(np.all(self.edge_table.counts == 2))
+
+    @property
+    def euler_characteristic(self) -> int:
+        """V - E + F, counting every vertex: 2 for a closed sphere-like mesh."""
+        return self.n_vertices - self.edge_table.n_edges + self.n_faces
 
     @property
     def nbytes(self) -> int:

@@ -106,7 +106,12 @@ class Kind:
 
     @property
     def name(self) -> str:
-        n = getattr(self.base, "port_name", None) or getattr(self.base, "__name__", str(self.base))
+        if typing.get_origin(self.base) is list:  # a nested list, e.g. list[list[float]]
+            n = Kind(typing.get_args(self.base)[0], True).name
+        else:
+            n = getattr(self.base, "port_name", None) or getattr(
+                self.base, "__name__", str(self.base)
+            )
         return f"list[{n}]" if self.is_list else n
 
 
@@ -239,6 +244,10 @@ def _coerce_kind(k: Kind, value: Any) -> Any:
     base = k.base
     if base is Any:
         return value
+    if typing.get_origin(base) is list:  # an item that is itself a list (list[list[float]])
+        if not isinstance(value, (list, tuple)):
+            raise TypeMismatch(f"expected {Kind(base).name}, got {describe(value)}")
+        return _coerce_kind(Kind(typing.get_args(base)[0], True), value)
     if base is bool:
         if isinstance(value, (bool, np.bool_)):
             return bool(value)

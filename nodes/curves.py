@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 from enum import Enum
-from typing import Annotated, Any
+from typing import Annotated, Any, NamedTuple
 
 import numpy as np
 
 from formgraph.errors import InputError
 from formgraph.geometry import Curve, NurbsCurve, ParametricCurve, Points
 from formgraph.kernels import curves as kc
+from formgraph.kernels.curves import measure as kmeasure
 from formgraph.registry import Context, Range, node
 from formgraph.types import Expression, Variables
 
@@ -280,7 +281,11 @@ def resample(
 
 @node("curves.offset", version=1)
 def offset(
-    curve: Curve, distance: float, miter_limit: Annotated[float, Range(min=1)] = 4.0
+    curve: Curve,
+    distance: float,
+    miter_limit: Annotated[float, Range(min=1)] = 4.0,
+    *,
+    ctx: Context,
 ) -> NurbsCurve:
     """The bisector offset of a polyline in the XY plane (mitred corners), as a polyline.
 
@@ -293,8 +298,11 @@ def offset(
     (use curves.resample first to choose the resolution).
 
     This is a local construction: where the distance exceeds the local size of the shape
-    the result loops over itself; ``offset.marching_squares`` is the node that resolves
-    self-intersections (and islands and holes).
+    the result loops over itself (a warning says how many edges folded);
+    ``offset.marching_squares`` is the node that resolves self-intersections (and islands
+    and holes). An inward offset of a closed curve past its inradius, where nothing is
+    left, is an error pointing there (the construction would turn the polygon inside out:
+    an 8-gon of radius 1 offset by -2 would come out with radius 1.16).
 
     Parameters
     ----------
@@ -311,7 +319,60 @@ def offset(
         p, closed = np.asarray(curve.display_points()), curve.closed
         if closed:
             p = p[:-1]
-    out = _kernel(
-        "curve", kc.bisector_offset, p, closed=closed, distance=distance, miter_limit=miter_limit
+    out, source = _kernel(
+        "curve",
+        kc.bisector_offset,
+        p,
+        closed=closed,
+        distance=distance,
+        miter_limit=miter_limit,
+        return_source=True,
     )
+    inside_out, folded = kc.offset_folds(p, out, source, closed, inward=closed and distance < 0)
+    if inside_out:
+        raise InputError(
+            "distance",
+            f"an inward offset by {abs(distance):g} turns the curve inside out: the distance "
+            "is past the curve's inradius (nothing is left inside) or past half its width "
+            "somewhere, where the bisector offset cannot be right; offset.marching_squares "
+            "gives the true offset (no loops when nothing is left)",
+        )
+    if folded:
+        ctx.warn(
+            f"the offset folds over itself at {folded} edge(s): the distance exceeds the "
+            "local size of the curve there; offset.marching_squares resolves the loops"
+        )
     return _polyline(out, closed=closed)
+
+
+class CurveMeasures(NamedTuple):
+    length: float
+    area: float
+    closed: bool
+
+
+@node("curves.measure", version=1)
+def measure(curve: Curve) -> CurveMeasures:
+    """Length of a curve, the area it encloses if closed and planar, and whether it is closed.
+
+    Gauss-Legendre quadrature (8 points) of the speed ``|C'(t)|`` and of the vector area
+    ``1/2 C x C'`` on every knot span of a NURBS curve, each split in 8 (a parametric curve:
+    its ``samples`` intervals); the area is 0 for an open or non-planar curve.
+
+    Parameters
+    ----------
+    curve : Curve
+        Any curve.
+    """
+    t0, t1 = curve.domain
+    if isinstance(curve, NurbsCurve):
+        knots = np.unique(curve.knots[(curve.knots >= t0) & (curve.knots <= t1)])
+        split = 1 if curve.degree == 1 else 8
+        steps = np.arange(split) / split
+        inner = knots[:-1, None] + np.diff(knots)[:, None] * steps
+        breaks = np.append(inner.reshape(-1), knots[-1])
+    else:
+        breaks = np.linspace(t0, t1, max(2, getattr(curve, "samples", 256)) + 1)
+    closed = curve.closed
+    length, area = kmeasure.length_and_area(curve.evaluate, curve.derivative, breaks, closed)
+    return CurveMeasures(length=length, area=area, closed=closed)

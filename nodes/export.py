@@ -13,6 +13,7 @@ from typing import Annotated
 
 import numpy as np
 
+from formgraph.errors import InputError
 from formgraph.geometry import Curve, Mesh, NurbsCurve
 from formgraph.kernels import nurbs
 from formgraph.kernels.io import (
@@ -125,6 +126,7 @@ def svg(
     samples : int
         Points per curve for curves that can only be drawn as polylines.
     """
+    _guard_samples(curves, samples, ctx)
     paths = [curve_path(c, samples) for c in curves]
     return str(ctx.write(path, svg_bytes(paths, margin=margin, stroke_width=stroke_width)))
 
@@ -157,24 +159,39 @@ def pdf(
     samples : int
         Points per curve for curves that can only be drawn as polylines.
     """
+    _guard_samples(curves, samples, ctx)
     paths = [curve_path(c, samples) for c in curves]
     return str(ctx.write(path, pdf_bytes(paths, margin=margin, stroke_width=stroke_width)))
 
 
-@node("export.dxf", version=1)
+_PALETTE = (1, 5, 3, 6, 4, 2)  # ACI red, blue, green, magenta, cyan, yellow: default layers
+
+
+@node("export.dxf", version=2)
 def dxf(
     path: OutputPath,
     curves: list[Curve] | None = None,
     mesh: Mesh | None = None,
     samples: Annotated[int, Range(min=2)] = 1024,
+    layers: list[str] | None = None,
+    colors: list[int] | None = None,
+    mesh_layer: str = "mesh",
     *,
     ctx: Context,
 ) -> str:
     """Write curves and a mesh as DXF for CAD: NURBS as exact SPLINEs, meshes as MESH.
 
     A NURBS curve keeps its degree, knots, weights and control points (a circle stays a
-    circle); degree-1 curves become polylines (LWPOLYLINE when flat at z = 0, else a 3-D
-    POLYLINE); other curves a polyline of ``samples`` points. Units are millimetres.
+    circle), and a closed one gets the SPLINE's closed flag; degree-1 curves become
+    polylines (LWPOLYLINE when flat at z = 0, else a 3-D POLYLINE); other curves a
+    polyline of ``samples`` points. Units are millimetres.
+
+    Each curve goes on a layer, so that cut, engrave and each tool path can be told apart:
+    by default all curves on ``curves`` and the mesh on ``mesh_layer``; with ``layers``,
+    curve i on ``layers[i]``, the last name also taking any curves after it (``[outline,
+    toolpath]`` puts the first curve on outline, every other on toolpath). Each layer gets
+    a colour (AutoCAD Color Index): ``colors[i]`` for ``layers[i]``, else red, blue, green,
+    magenta, cyan, yellow in turn.
 
     Parameters
     ----------
@@ -186,27 +203,95 @@ def dxf(
         A mesh to write.
     samples : int
         Points per curve for curves that are not NURBS.
+    layers : list[str] | None
+        Layer name of each curve, in order (the last repeats for the rest).
+    colors : list[int] | None
+        Colour (ACI, 1 to 255) of each entry of ``layers``.
+    mesh_layer : str
+        Layer of the mesh.
     """
+    curves = curves or []
+    _guard_samples(curves, samples, ctx, drawing=False)
+    names = _curve_layers(layers, len(curves))
+    layer_colors = _layer_colors(layers, colors, names, mesh_layer if mesh is not None else None)
     splines, polylines = [], []
-    for c in curves or []:  # one iteration per curve
+    for c, layer in zip(curves, names, strict=True):  # one iteration per curve
         if isinstance(c, NurbsCurve) and c.degree == 1:
             pts = np.asarray(c.control_points)
             closed = len(pts) > 2 and np.array_equal(pts[0], pts[-1])
-            polylines.append((pts[:-1] if closed else pts, closed))
+            polylines.append((pts[:-1] if closed else pts, closed, layer))
         elif isinstance(c, NurbsCurve):
             w = np.asarray(c.weights) if c.rational else None
-            splines.append((c.control_points, c.degree, c.knots, w))
+            splines.append((c.control_points, c.degree, c.knots, w, bool(c.closed), layer))
         else:
             pts, closed = c.sample(samples), bool(c.closed)
-            polylines.append((pts[:-1] if closed else pts, closed))
-    meshes = [] if mesh is None else [(mesh.vertices, mesh.face_indices, mesh.face_offsets)]
+            polylines.append((pts[:-1] if closed else pts, closed, layer))
+    meshes = []
+    if mesh is not None:
+        meshes = [(mesh.vertices, mesh.face_indices, mesh.face_offsets, mesh_layer)]
     if not splines and not polylines and not meshes:
         raise ValueError("export.dxf needs curves or a mesh to write, got neither")
-    return str(ctx.write(path, dxf_bytes(splines, polylines, meshes)))
+    try:
+        data = dxf_bytes(splines, polylines, meshes, layer_colors=layer_colors)
+    except ValueError as exc:
+        if "layer" in str(exc):
+            port = "mesh_layer" if str(exc).startswith("mesh") else "layers"
+            raise InputError(port, str(exc)) from None
+        raise
+    return str(ctx.write(path, data))
+
+
+def _curve_layers(layers: list[str] | None, count: int) -> list[str]:
+    if layers is None:
+        return ["curves"] * count
+    if not layers:
+        raise InputError("layers", "give at least one layer name, or leave layers out")
+    return [layers[min(i, len(layers) - 1)] for i in range(count)]
+
+
+def _layer_colors(
+    layers: list[str] | None, colors: list[int] | None, names: list[str], mesh_layer: str | None
+) -> dict[str, int]:
+    order = list(dict.fromkeys([*(layers or names), *([mesh_layer] if mesh_layer else [])]))
+    given: dict[str, int] = {}
+    if colors is not None:
+        if layers is None or len(colors) != len(layers):
+            raise InputError(
+                "colors",
+                f"one colour per entry of layers is needed: {len(layers or [])} layers, "
+                f"{len(colors)} colours",
+            )
+        for name, aci in zip(layers, colors, strict=True):
+            if not 1 <= aci <= 255:
+                raise InputError(
+                    "colors", f"a colour is an AutoCAD Color Index 1 to 255, got {aci}"
+                )
+            if given.setdefault(name, aci) != aci:
+                raise InputError(
+                    "colors", f"layer {name!r} is given two colours, {given[name]} and {aci}"
+                )
+    return {name: given.get(name, _PALETTE[i % len(_PALETTE)]) for i, name in enumerate(order)}
 
 
 # --------------------------------------------------------------------------------------------
 # adapters
+
+
+def _guard_samples(curves: list[Curve], samples: int, ctx: Context, drawing: bool = True) -> None:
+    """Refuse, before sampling, more polyline points than the budget (all curves together).
+
+    Only curves written as polylines of ``samples`` points count: in a drawing, those that
+    are neither polylines nor Beziers of degree <= 3 nor rational quadratics (the circle
+    test may still send one of those to the polyline path); in DXF, curves that are not
+    NURBS.
+    """
+
+    def sampled(c: Curve) -> bool:
+        if not isinstance(c, NurbsCurve):
+            return True
+        return drawing and not (c.degree <= 3 and (not c.rational or c.degree <= 2))
+
+    ctx.guard(samples * sum(sampled(c) for c in curves), "sample points")
 
 
 def curve_path(curve: Curve, samples: int = 1024) -> Path2D:

@@ -14,7 +14,13 @@ import numpy as np
 
 from formgraph.errors import InputError
 from formgraph.geometry import Mesh, Points
-from formgraph.kernels.mesh import HalfEdges, MeshTopologyError, meshops, subdivision
+from formgraph.kernels.mesh import (
+    HalfEdges,
+    MeshTopologyError,
+    WorkLimitError,
+    meshops,
+    subdivision,
+)
 from formgraph.registry import Context, Range, node
 from formgraph.types import Faces, Vec3
 
@@ -160,18 +166,24 @@ def doo_sabin(mesh: Mesh, levels: Annotated[int, Range(min=0)] = 1, *, ctx: Cont
 
 
 @node("mesh.triangulate", version=1)
-def triangulate(mesh: Mesh) -> Mesh:
+def triangulate(mesh: Mesh, *, ctx: Context) -> Mesh:
     """Split every face into triangles, keeping orientation and face order.
 
     Convex faces become fans from their first corner; concave ones are ear-clipped in
-    their own plane (Newell normal).
+    their own plane (Newell normal), in O(k^2) at worst for a face of k corners (a
+    10,000-corner star takes well under a second). The clipping's triangle-corner tests
+    count against the element budget.
 
     Parameters
     ----------
     mesh : Mesh
         Any polygon mesh.
     """
-    return Mesh(*meshops.triangulate(*_arrays(mesh)))
+    try:
+        return Mesh(*meshops.triangulate(*_arrays(mesh), max_tests=ctx.budget))
+    except WorkLimitError as exc:
+        ctx.guard(exc.work, "triangle-corner tests of ear clipping")
+        raise
 
 
 @node("mesh.merge", version=1)

@@ -24,7 +24,7 @@ from formgraph.geometry import (
 )
 from formgraph.kernels import nurbs as K
 from formgraph.registry import Context, Range, node
-from formgraph.types import Vec3
+from formgraph.types import SameAs, Vec3
 
 CurveTuple = tuple[np.ndarray, int, np.ndarray, "np.ndarray | None"]
 
@@ -60,12 +60,14 @@ def _surface(s: tuple) -> NurbsSurface:
     return NurbsSurface(*s)
 
 
-def _as_nurbs(curve: Curve, port: str) -> CurveTuple:
+def _as_nurbs(curve: Curve, port: str, ctx: Context) -> CurveTuple:
     """A NURBS curve exactly; any other curve (e.g. a parametric one) as the cubic through
-    its sample points (as many as it is drawn with), closed if it closes."""
+    its sample points (as many as it is drawn with), closed if it closes. The banded
+    interpolation (:mod:`~formgraph.kernels.nurbs.banded`) costs O(samples)."""
     if isinstance(curve, NurbsCurve):
         return _tuple(curve)
     samples = curve.samples if isinstance(curve, ParametricCurve) else 256
+    ctx.guard(4 * max(samples, 4), f"entries of the interpolation system of input '{port}'")
     pts = np.asarray(curve.sample(max(samples, 4)))
     closed = bool(curve.closed)
     return _call(port, K.interpolate, pts[:-1] if closed else pts, 3, closed)
@@ -250,36 +252,65 @@ def interpolate(
     count = len(pts) - (1 if closed and len(pts) > 1 and np.array_equal(pts[0], pts[-1]) else 0)
     if degree > count - 1 >= 1:
         ctx.warn(f"degree {degree} needs {degree + 1} points, got {count}: using {count - 1}")
-    # the interpolation system is solved dense: its size, not the output's, is what to guard
-    ctx.guard(count * count, "entries of the dense interpolation system (points squared)")
+    # the banded system holds (degree + 1) entries per point, and as many blocks in its solve
+    ctx.guard(count * (min(degree, max(count - 1, 1)) + 1), "entries of the interpolation system")
     return _curve(_call("points", K.interpolate, pts, degree, closed, parametrization.value))
 
 
-@node("nurbs.insert_knot", version=1)
+class Direction(str, Enum):
+    """A parameter direction of a surface."""
+
+    u = "u"  # across the rows of control points
+    v = "v"  # along each row
+
+
+@node("nurbs.insert_knot", version=2)
 def insert_knot(
-    curve: NurbsCurve,
+    curve: NurbsCurve | NurbsSurface,
     t: float,
     times: Annotated[int, Range(min=0)] = 1,
-) -> NurbsCurve:
-    """The same curve with the knot t inserted (Boehm's algorithm, A5.1): one more control
-    point per insertion, shape unchanged.
+    direction: Direction = Direction.u,
+    *,
+    ctx: Context,
+) -> Annotated[NurbsCurve | NurbsSurface, SameAs("curve")]:
+    """The same curve (or surface) with the knot t inserted: one more control point per
+    insertion, shape unchanged (Boehm's algorithm, A5.1; on a surface A5.3, in u or v).
 
     A knot's multiplicity may not exceed the degree. Useful before editing control points
-    locally, or to split a curve.
+    locally, or to split a curve. Given a surface, the knot goes into its u or v knot
+    vector (``direction``), adding a row (u) or a column (v) of control points per
+    insertion; the output is a surface then.
 
     Parameters
     ----------
-    curve : NurbsCurve
-        The curve.
+    curve : NurbsCurve | NurbsSurface
+        The curve, or a surface.
     t : float
-        Parameter of the new knot, inside the curve's domain.
+        Parameter of the new knot, inside the domain (of the chosen direction).
     times : int
         How many times to insert it.
+    direction : Direction
+        For a surface: u (across the rows of control points) or v (along each row).
     """
+    if isinstance(curve, NurbsSurface):
+        cp = np.asarray(curve.control_points)
+        nu, nv = cp.shape[:2]
+        grown = (nu + times) * nv if direction is Direction.u else nu * (nv + times)
+        ctx.guard(grown, "control points")
+        w = np.asarray(curve.weights) if curve.rational else None
+        args = (cp, curve.degree_u, curve.degree_v, curve.knots_u, curve.knots_v, w)
+        try:
+            return _surface(K.insert_knot_surface(*args, t, times, direction.value))
+        except ValueError as exc:
+            raise InputError(_knot_port(exc), str(exc)) from None
     try:
         return _curve(K.insert_knot(*_tuple(curve), t, times))
     except ValueError as exc:
-        raise InputError("times" if "multiplicity" in str(exc) else "t", str(exc)) from None
+        raise InputError(_knot_port(exc), str(exc)) from None
+
+
+def _knot_port(exc: ValueError) -> str:
+    return "times" if "multiplicity" in str(exc) else "t"
 
 
 @node("nurbs.elevate_degree", version=1)
@@ -293,7 +324,9 @@ def elevate_degree(
 
     Each distinct knot gains ``times`` in multiplicity, so the control points grow in
     number; a closed (periodic) curve becomes clamped. Used to match degrees before
-    lofting, or for exporters that want one degree.
+    lofting, or for exporters that want one degree. The degree is raised in one step
+    (A5.9 generalized to any ``times``): a 1,000-point cubic raised by 29 takes a fraction
+    of a second; the work (new control points x degree^2) counts against the budget.
 
     Parameters
     ----------
@@ -306,10 +339,11 @@ def elevate_degree(
         raise InputError(
             "times", f"degree {curve.degree} + {times} is above 32, the most supported"
         )
-    ctx.guard(
-        len(curve.control_points) * (times + 1) + len(np.unique(curve.knots)) * times,
-        "control points",
-    )
+    n_new = len(curve.control_points) * (times + 1) + len(np.unique(curve.knots)) * times
+    ctx.guard(n_new, "control points")
+    q = curve.degree + times
+    # each new control point is a blossom of degree q: q^2 / 2 affine steps (one pass)
+    ctx.guard(n_new * (q + 1) ** 2 // 2, "blossom steps (new control points x degree^2 / 2)")
     return _curve(_call("times", K.elevate_degree, *_tuple(curve), times))
 
 
@@ -323,7 +357,7 @@ def surface(
     degree_v: Annotated[int, Range(min=1)] = 3,
     knots_u: list[float] | None = None,
     knots_v: list[float] | None = None,
-    weights: list[float] | None = None,
+    weights: list[float] | list[list[float]] | None = None,
     *,
     ctx: Context,
 ) -> NurbsSurface:
@@ -346,8 +380,9 @@ def surface(
         Knot vector across the rows (rows + degree_u + 1 values).
     knots_v : list[float] | None
         Knot vector along the rows (row length + degree_v + 1 values).
-    weights : list[float] | None
-        One positive weight per control point, row after row (rows x row length values).
+    weights : list[float] | list[list[float]] | None
+        One positive weight per control point: a grid shaped like ``points`` (a list of
+        rows), or flat, row after row (rows x row length values).
     """
     sizes = [len(r) for r in points]
     if len(sizes) < 2:
@@ -361,18 +396,31 @@ def surface(
     net = np.stack([r.xyz for r in points])
     nu, nv = net.shape[:2]
     ctx.guard(nu * nv, "control points")
-    w = None
-    if weights is not None:
-        if len(weights) != nu * nv:
-            raise InputError(
-                "weights",
-                f"one weight per control point is needed: {nu} x {nv} = {nu * nv}, "
-                f"got {len(weights)}",
-            )
-        w = np.asarray(weights, dtype=np.float64).reshape(nu, nv)
+    w = None if weights is None else _surface_weights(weights, nu, nv)
     ku = _surface_knots(knots_u, degree_u, nu, "u", ctx)
     kv = _surface_knots(knots_v, degree_v, nv, "v", ctx)
     return _call("weights", NurbsSurface, net, ku[1], kv[1], ku[0], kv[0], w)
+
+
+def _surface_weights(weights: list, nu: int, nv: int) -> np.ndarray:
+    """Weights given as rows (shaped like the points) or flat, as an (nu, nv) array."""
+    if weights and all(isinstance(r, list) for r in weights):
+        sizes = [len(r) for r in weights]
+        if len(sizes) != nu or any(n != nv for n in sizes):
+            got = f"{len(sizes)} rows of " + (
+                f"{sizes[0]}" if len(set(sizes)) == 1 else "/".join(map(str, sizes))
+            )
+            raise InputError(
+                "weights",
+                f"a grid of weights must be shaped like the points, {nu} rows of {nv}; got {got}",
+            )
+        return np.asarray(weights, dtype=np.float64)
+    if len(weights) != nu * nv:
+        raise InputError(
+            "weights",
+            f"one weight per control point is needed: {nu} x {nv} = {nu * nv}, got {len(weights)}",
+        )
+    return np.asarray(weights, dtype=np.float64).reshape(nu, nv)
 
 
 def _surface_knots(
@@ -415,13 +463,13 @@ def loft(
     closed : bool
         Join the last curve smoothly back to the first.
     """
-    tuples = [_as_nurbs(c, "curves") for c in curves]
+    tuples = [_as_nurbs(c, "curves", ctx) for c in curves]
     ctx.guard(sum(len(t[0]) for t in tuples) * len(tuples), "control points")
     return _surface(_call("curves", K.loft, tuples, degree_v, closed))
 
 
 @node("nurbs.extrude", version=1)
-def extrude(curve: Curve, direction: Vec3 = (0.0, 0.0, 1.0)) -> NurbsSurface:
+def extrude(curve: Curve, direction: Vec3 = (0.0, 0.0, 1.0), *, ctx: Context) -> NurbsSurface:
     """The curve moved along a straight direction, as a ruled surface (u along the curve,
     v from 0 at the curve to 1 at the moved copy).
 
@@ -432,7 +480,7 @@ def extrude(curve: Curve, direction: Vec3 = (0.0, 0.0, 1.0)) -> NurbsSurface:
     direction : Vec3
         Direction and length of the extrusion.
     """
-    return _surface(_call("direction", K.extrude, _as_nurbs(curve, "curve"), direction))
+    return _surface(_call("direction", K.extrude, _as_nurbs(curve, "curve", ctx), direction))
 
 
 @node("nurbs.revolve", version=1)
@@ -441,6 +489,8 @@ def revolve(
     axis_point: Vec3 = (0.0, 0.0, 0.0),
     axis: Vec3 = (0.0, 0.0, 1.0),
     angle: float = 360.0,
+    *,
+    ctx: Context,
 ) -> NurbsSurface:
     """The exact surface of revolution of a profile curve about an axis (A8.1).
 
@@ -464,7 +514,7 @@ def revolve(
         raise InputError(
             "angle", f"angle must be more than 0 and at most 360 degrees, got {angle:g}"
         )
-    prof = _as_nurbs(curve, "curve")
+    prof = _as_nurbs(curve, "curve", ctx)
     return _surface(_call("axis", K.revolve, prof, axis_point, axis, angle))
 
 
@@ -497,9 +547,8 @@ def sweep(
     if stations == 1:
         raise InputError("stations", "a sweep needs at least 2 stations (or 0 for automatic)")
     m = stations or _auto_stations(path)
-    prof = _as_nurbs(profile, "profile")
+    prof = _as_nurbs(profile, "profile", ctx)
     ctx.guard(m * len(prof[0]), "control points")
-    ctx.guard(m * m, "entries of the dense skinning system (stations squared)")
     t0, t1 = path.domain
     t = np.linspace(t0, t1, m)
     pts = np.asarray(path.evaluate(t))
@@ -522,7 +571,7 @@ def _auto_stations(path: Curve) -> int:
     return 256
 
 
-@node("nurbs.tessellate", version=1)
+@node("nurbs.tessellate", version=2)
 def tessellate(
     surface: Surface,
     u: Annotated[int, Range(min=1)] = 32,
@@ -532,6 +581,10 @@ def tessellate(
 ) -> Mesh:
     """A quad mesh of the surface: u x v faces over its whole domain, evenly spaced in the
     parameters; seams of closed surfaces are joined (no duplicate vertices there).
+
+    A row of the grid that sits at one point (a pole: a revolve whose profile ends on the
+    axis, a sphere's tip) becomes one vertex, its quads triangles: no zero-area faces, and
+    a revolve to the axis comes out closed there.
 
     Parameters
     ----------

@@ -13,6 +13,8 @@ from formgraph.registry import Context, Range, node
 
 _TOLERANCE = 1e-3  # the kernel's accuracy, as a fraction of the input's extent
 _SAMPLE_SHARE = 0.1  # sampling error allowed, as a share of that (and of the cell)
+MAX_SMOOTH = 100  # smoothing passes: each costs a pass over every vertex; more change nothing
+_SMALLEST = 1e-9  # the smallest |distance| and cell, relative to the input's extent
 
 
 @node("offset.marching_squares", version=1)
@@ -20,7 +22,7 @@ def marching_squares(
     curves: list[Curve],
     distance: float,
     cell: Annotated[float | None, Range(min=0)] = None,
-    smooth: Annotated[int, Range(min=0)] = 0,
+    smooth: Annotated[int, Range(min=0, max=MAX_SMOOTH)] = 0,
     simplify: Annotated[float, Range(min=0)] = 0.0,
     *,
     ctx: Context,
@@ -54,7 +56,8 @@ def marching_squares(
         2 sqrt(|distance| * 0.001 * extent), at most |distance| / 2).
     smooth : int
         Smoothing passes that even out the vertices along the offset (each vertex stays
-        exactly on it; corners stay sharp).
+        exactly on it; corners stay sharp); at most 100 (the vertices are even long
+        before), and the passes over the vertices count against the element budget.
     simplify : float
         Douglas-Peucker tolerance for the result (0: keep every vertex).
 
@@ -74,10 +77,22 @@ def marching_squares(
     pts = np.concatenate([r[1][:, :2] for r in rough])
     lo, hi = pts.min(axis=0), pts.max(axis=0)
     extent = float((hi - lo).max())
+    if extent > 0 and abs(distance) < _SMALLEST * extent:
+        raise InputError(
+            "distance",
+            f"the offset distance {distance:g} is below 1e-9 of the input's size ({extent:g}): "
+            "too small to resolve in double precision (the offset is the input itself)",
+        )
     if cell is None:
         cell = default_cell(extent, distance)
     elif not cell > 0:
         raise InputError("cell", f"cell must be positive, got {cell}")
+    elif cell < _SMALLEST * max(extent, abs(distance)):
+        raise InputError(
+            "cell",
+            f"cell {cell:g} is below 1e-9 of the input's size ({max(extent, abs(distance)):g}): "
+            "a grid that fine would have more cells than any budget",
+        )
     scale = extent if extent > 0 else 2 * abs(distance)
     tol = _SAMPLE_SHARE * min(cell, _TOLERANCE * scale)
     ctx.guard(grid_cells(lo, hi, distance, cell), "offset grid cells")
@@ -92,7 +107,9 @@ def marching_squares(
             polylines, closed, distance, cell, smooth, simplify, max_cells=ctx.budget
         )
     except ValueError as exc:
-        raise InputError("cell", str(exc)) from None
+        raise InputError(
+            "smooth" if str(exc).startswith("smoothing") else "cell", str(exc)
+        ) from None
     if not loops:
         ctx.warn(f"the offset at {distance} is empty (the inward offset removes everything)")
     return [NurbsCurve.polyline(np.c_[lp, np.zeros(len(lp))], closed=True) for lp in loops]

@@ -17,6 +17,11 @@ from formgraph.types import Expression, Variables
 def _rows(points: list[Points], closed_u: bool, closed_v: bool) -> np.ndarray:
     """Rows of points as an (nu, nv, 3) grid, checked rectangular and large enough."""
     sizes = [len(r) for r in points]
+    if not sizes:
+        raise InputError(
+            "points",
+            "a grid needs rows of points (a list of rows, each a list of points), got none",
+        )
     for i, n in enumerate(sizes):
         if n != sizes[0]:
             raise InputError(

@@ -248,11 +248,11 @@ def test_cli_graph_svg_png_and_run(tmp_path, capsys, monkeypatch):
     f = ROOT / "graphs" / "vase.yaml"
     svg, png = tmp_path / "v.svg", tmp_path / "v.png"
     assert main(["graph", str(f), "-o", str(svg)]) == 0
-    assert f"wrote {svg} (4 nodes, 3 params)" in capsys.readouterr().out
-    assert len(by_class(parse(svg.read_text()), "rect", "node")) == 4
+    assert f"wrote {svg} (6 nodes, 4 params)" in capsys.readouterr().out
+    assert len(by_class(parse(svg.read_text()), "rect", "node")) == 6
     args = ["graph", str(f), "-o", str(png), "--run", "--no-cache", "--out", str(tmp_path / "o")]
     assert main(args) == 0
-    assert "after a run of 4 nodes" in capsys.readouterr().out
+    assert "after a run of 6 nodes" in capsys.readouterr().out
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert main(["graph", str(f), "-o", "-"]) == 0
     assert parse(capsys.readouterr().out).tag == f"{SVG}svg"

@@ -248,7 +248,7 @@ def test_nurbs_circles_and_arcs_become_svg_arcs_and_dxf_splines(tmp_path):
     args = _numbers(circle)[2:].reshape(-1, 7)
     assert np.allclose(args[:, :2], 5) and np.allclose(args[-1, 5:], [6, -2])
     args = _numbers(arc)[2:].reshape(-1, 7)
-    assert np.allclose(args[:, :2], 3) and np.all(args[:, 4] == 1)  # counter-clockwise
+    assert np.allclose(args[:, :2], 3) and np.all(args[:, 4] == 0)  # CCW: y flipped on the page
     end = np.radians(200)
     assert np.allclose(args[-1, 5:], [3 * np.cos(end), -3 * np.sin(end)], atol=1e-6)
     assert " L " in tilted and " A " not in tilted  # not a circle in the drawing: a polyline

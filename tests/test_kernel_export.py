@@ -382,12 +382,12 @@ def test_svg_arcs_are_exact_circle_commands():
     assert t[:3] == ["M", 15.0, -5.0] and t[3] == "A" and t[-1] == "Z"
     args = np.array(t[4:-1], dtype=float).reshape(4, 7)
     assert np.allclose(args[:, :2], 10.0) and np.all(args[:, 2:4] == 0)
-    assert np.all(args[:, 4] == 1)  # counter-clockwise in the model: positive sweep on the page
+    assert np.all(args[:, 4] == 0)  # counter-clockwise in the model: y flipped, negative angle
     assert np.allclose(args[:, 5:], [[5, -15], [-5, -5], [5, 5], [15, -5]])
     assert [float(x) for x in root.get("viewBox").split()] == [-5, -15, 20, 20]
     cw = Path2D("arc", CIRCLE.points[::-1])
     _, (d2,) = _svg_paths(svg_bytes([cw]))
-    assert np.all(np.array(_tokens(d2)[4:], dtype=float).reshape(4, 7)[:, 4] == 0)
+    assert np.all(np.array(_tokens(d2)[4:], dtype=float).reshape(4, 7)[:, 4] == 1)
 
 
 def test_cubic_bounds_are_tight():

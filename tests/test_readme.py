@@ -35,5 +35,5 @@ def test_yaml_example_is_the_spiral_tube_graph():
     (example,) = [b for b in blocks("yaml") if "Spiral tube" in b]
     g = fg.Graph.from_text(example)
     assert g.params == {"turns": 3, "radius": 2.0}
-    assert set(g.nodes) == {"spiral", "section", "tube", "mesh", "print"}
+    assert set(g.nodes) == {"spiral", "section", "tube", "mesh", "closed", "solid", "print"}
     assert yaml.safe_load(example)["nodes"]["print"]["type"] == "export.stl"

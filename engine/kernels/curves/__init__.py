@@ -14,6 +14,7 @@ from .polylines import (
     arc_length_table,
     bisector_offset,
     drop_repeats,
+    offset_folds,
     parameters_at_lengths,
     polyline_length,
     resample_count,
@@ -32,6 +33,7 @@ from .splines import (
 )
 
 __all__ = [
+    "offset_folds",
     "CurveTuple",
     "SurfaceTuple",
     "SPACINGS",

@@ -446,6 +446,60 @@ def bisector_offset(
     return (out, source) if return_source else out
 
 
+def offset_folds(
+    points: np.ndarray, offset: np.ndarray, source: np.ndarray, closed: bool, inward: bool = False
+) -> tuple[bool, int]:
+    """How an offset polyline went wrong, if it did: (inside out, folded edges).
+
+    An edge of a bisector offset runs parallel to its source edge, the same way while the
+    distance is below the local size of the shape; past it the edge has shrunk through
+    zero length and runs backwards ("folded"), and the result loops. An inward offset of
+    a closed polygon past its inradius (the largest circle inside it) turns the whole
+    polygon inside out: every edge folds, its signed area no longer lies between 0 and the
+    original's (an 8-gon of radius 1 offset by -2 comes out as an 8-gon of radius 1.16).
+
+    Parameters
+    ----------
+    points : (n, 3) float
+        The polyline that was offset, repeats dropped as in :func:`bisector_offset`.
+    offset, source : as returned by ``bisector_offset(..., return_source=True)``
+    closed : bool
+    inward : bool
+        The offset was towards the inside of a closed polyline (it should shrink).
+
+    Returns
+    -------
+    inside_out : bool
+        Closed only: every edge folded, or (inward) the offset's signed area is not
+        strictly between 0 and the original's, same sign.
+    folded : int
+        Number of offset edges that run against their source edge.
+    """
+    p = as_points(points)[:, :2]
+    p = p[_keep_mask(p, closed)]
+    q = np.asarray(offset, dtype=np.float64)[:, :2]
+    src = np.asarray(source, dtype=np.int64)
+    n, m = len(p), len(q)
+    k = np.arange(m if closed else m - 1)
+    a, b = src[k], src[(k + 1) % m]
+    step = (b - a) % n if closed else b - a
+    edge = step == 1  # offset edges that follow a source edge (not the bevel of a clip)
+    d_src = p[(a + 1) % n] - p[a]
+    d_off = q[(k + 1) % m] - q[k]
+    folded = int(np.count_nonzero(edge & (np.einsum("ij,ij->i", d_src, d_off) < 0)))
+    if not closed:
+        return False, folded
+
+    def area2(xy: np.ndarray) -> float:
+        c = xy - xy.mean(axis=0)
+        return float(np.dot(c[:, 0], np.roll(c[:, 1], -1)) - np.dot(np.roll(c[:, 0], -1), c[:, 1]))
+
+    a0, a1 = area2(p), area2(q)
+    ratio = a1 / a0 if a0 else 0.0
+    inside_out = folded == int(np.count_nonzero(edge)) or (inward and not 0.0 < ratio < 1.0)
+    return inside_out, folded
+
+
 def _orientation(xy: np.ndarray) -> float:
     """+1 for a counter-clockwise closed polygon, -1 clockwise (shoelace signed area)."""
     centred = xy - xy.mean(axis=0)

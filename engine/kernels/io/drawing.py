@@ -241,10 +241,11 @@ def svg_bytes(
             items = [(b" M", _numbers(q[:1], decimals)), (b" C", _numbers(q[1:], decimals))]
         else:
             _, radius, _, sweep, _ = _arc_geometry(path.points)
-            # y flipped: a counter-clockwise arc of the model runs clockwise on the page, which
-            # is SVG's positive-angle direction (sweep-flag 1); every piece is under 180 degrees
+            # Flipping y mirrors every arc, so a counter-clockwise arc of the model runs the
+            # negative-angle way in the page's coordinates: sweep-flag 0 (SVG 1.1, F.6.5, where
+            # flag 1 means increasing angle in user space). Every piece is under 180 degrees.
             k = len(radius)
-            cols = [radius, radius, np.zeros(k), np.zeros(k), (sweep > 0) * 1.0]
+            cols = [radius, radius, np.zeros(k), np.zeros(k), (sweep < 0) * 1.0]
             args = np.column_stack(cols + [q[2::2, 0], q[2::2, 1]])
             items = [(b" M", _numbers(q[:1], decimals)), (b" A", _numbers(args, decimals))]
         if path.closed:

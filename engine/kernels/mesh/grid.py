@@ -40,3 +40,45 @@ def grid_faces(
     face_indices = quads.reshape(-1).astype(np.int64)
     face_offsets = np.arange(0, face_indices.size + 1, 4, dtype=np.int64)
     return face_indices, face_offsets
+
+
+def collapse_poles(
+    points: np.ndarray, face_indices: np.ndarray, face_offsets: np.ndarray, rtol: float = 1e-10
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Merge each degenerate grid row or column (a pole) into one vertex.
+
+    A surface that reaches an axis (a revolve whose profile ends on it, a sphere's pole)
+    has a whole row of the grid at one point; its quads would have zero-area corners. Each
+    such row (or column) becomes a single vertex, the quads touching it become triangles,
+    and faces left with fewer than 3 corners are dropped.
+
+    Parameters
+    ----------
+    points : (nu, nv, 3) float
+        The grid, row-major as in :func:`grid_faces`.
+    face_indices, face_offsets
+        Its faces from :func:`grid_faces`.
+    rtol : float
+        A row is a pole when all its points lie within ``rtol`` times the grid's largest
+        coordinate (at least 1) of its first point.
+
+    Returns
+    -------
+    vertices, face_indices, face_offsets
+        Unchanged (vertices flattened) when there is no pole.
+    """
+    from .repair import compact, drop_collapsed
+
+    pts = np.asarray(points, dtype=np.float64)
+    nu, nv, _ = pts.shape
+    flat = pts.reshape(-1, 3)
+    tol = rtol * max(1.0, float(np.abs(pts).max(initial=0.0)))
+    rows = np.abs(pts - pts[:, :1]).max(axis=(1, 2)) <= tol
+    cols = np.abs(pts - pts[:1, :]).max(axis=(0, 2)) <= tol
+    if not (rows.any() or cols.any()):
+        return flat, face_indices, face_offsets
+    ids = np.arange(nu * nv).reshape(nu, nv)
+    ids[rows] = ids[rows][:, :1]
+    ids[:, cols] = ids[:, cols][:1, :]
+    fi, fo = drop_collapsed(ids.reshape(-1)[face_indices], face_offsets, nu * nv)
+    return compact(flat, fi, fo)

@@ -11,6 +11,9 @@ from collections.abc import Sequence
 import numpy as np
 
 from .halfedge import HalfEdges, build_halfedges
+from .polygon import WorkLimitError, triangulate_polygon  # noqa: F401 (re-exported)
+
+_BATCH_UP_TO = 32  # concave faces up to this size are clipped together (O(k^3) each)
 
 __all__ = [
     "box",
@@ -22,6 +25,7 @@ __all__ = [
     "rotation_matrix",
     "transform",
     "triangulate",
+    "triangulate_polygon",
     "validate_faces",
 ]
 
@@ -313,12 +317,17 @@ def _ear_clip(xy: np.ndarray) -> np.ndarray:
 
 
 def triangulate(
-    vertices: np.ndarray, face_indices: np.ndarray, face_offsets: np.ndarray
+    vertices: np.ndarray,
+    face_indices: np.ndarray,
+    face_offsets: np.ndarray,
+    max_tests: int | None = None,
 ) -> MeshArrays:
     """Split every face into triangles, keeping its orientation and the face order.
 
     A convex face becomes a fan from its first corner; a concave one is ear-clipped in the
-    plane of its Newell normal. Faces are processed in groups of equal size.
+    plane of its Newell normal. Faces are processed in groups of equal size: small concave
+    faces all at once, larger ones (over 32 corners) one by one with the O(k^2)-at-worst
+    clipper of :func:`~.polygon.triangulate_polygon`.
 
     Parameters
     ----------
@@ -333,6 +342,12 @@ def triangulate(
     face_indices : (3 * (m - 2 n_faces),) int64
         The triangles of face 0, then of face 1, ...
     face_offsets : (m - 2 n_faces + 1,) int64
+
+    Raises
+    ------
+    WorkLimitError
+        When a large concave face needs more than ``max_tests`` triangle-corner tests, or
+        the small concave faces of one size together (k^3 each) would.
     """
     v = np.asarray(vertices, dtype=np.float64)
     fi = np.asarray(face_indices, dtype=np.int64)
@@ -360,7 +375,13 @@ def triangulate(
         turn = np.einsum("fkd,fd->fk", np.cross(edge_in, edge_out), normal)
         tol = 1e-12 * (np.einsum("fd,fd->f", normal, normal) + 1e-300)
         concave = np.flatnonzero((turn < -tol[:, None]).any(axis=1))
-        if concave.size:
+        if concave.size and k > _BATCH_UP_TO:
+            for f in concave:  # one large polygon at a time, each vectorized inside
+                local[f] = triangulate_polygon(p[f], max_tests)
+        elif concave.size:
+            work = concave.size * k**3  # the batched clipper tests every corner, every round
+            if max_tests is not None and work > max_tests:
+                raise WorkLimitError(work, max_tests)
             nrm = normal[concave] / np.linalg.norm(normal[concave], axis=1, keepdims=True)
             helper = np.where(np.abs(nrm[:, :1]) < 0.9, [[1.0, 0, 0]], [[0, 1.0, 0]])
             u = np.cross(nrm, helper)

@@ -6,17 +6,20 @@ coordinates. Closed interpolation is its periodic counterpart: a periodic knot v
 (knots at the parameters for odd degree, at their midpoints for even degree, so that the
 Schoenberg-Whitney conditions hold) and a cyclic collocation system.
 
-The systems are dense and solved with LAPACK through ``numpy.linalg.solve``: collocation
-matrices of B-splines are totally positive, so elimination is stable. The cost grows as
-the cube of the point count; a few thousand points take well under a second.
+The systems are banded (at most p + 1 entries per row, next to the diagonal; for a closed
+curve the band wraps around the corners) and solved by :mod:`.banded` in O(n) work and
+memory: block cyclic reduction, with a bordered elimination of the wrapping corners.
+Collocation matrices of B-splines are totally positive, so elimination is stable; 100,000
+points interpolate in a fraction of a second.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from .banded import solve_banded_rows
+from .basis import _basis_rows, find_spans
 from .knots import respace
-from .surface import basis_matrix
 
 __all__ = ["fit_columns", "interpolate", "interpolation_parameters"]
 
@@ -121,19 +124,25 @@ def fit_columns(
     p = degree
     if not closed:
         knots = _averaged_knots(params, p)
-        A = basis_matrix(p, knots, params, k)
-        ctrl = np.linalg.solve(A, flat)
+        cols, rows = _collocation_rows(p, knots, params)
+        ctrl = solve_banded_rows(cols, rows, flat)
         return ctrl.reshape(vals.shape), knots
     knots = _periodic_knots(params, p)
     t = params if p % 2 == 1 else np.where(params < knots[p], params + 1.0, params)
-    A = basis_matrix(p, knots, t, k + p)
-    A[:, :p] += A[:, k:]
-    ctrl = np.linalg.solve(A[:, :k], flat)
+    cols, rows = _collocation_rows(p, knots, t)
+    ctrl = solve_banded_rows(cols % k, rows, flat, cyclic=True)  # basis k + j is basis j
     if p % 2 == 0:
         ctrl, knots = _start_at_zero(ctrl, knots[p : p + k], p)
         k += 1
     ctrl = np.concatenate([ctrl, ctrl[:p]])
     return ctrl.reshape((k + p,) + vals.shape[1:]), knots
+
+
+def _collocation_rows(p: int, knots: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The non-zeros of the collocation matrix ``N_j(t_i)``: columns and values (k, p + 1)."""
+    spans = find_spans(p, knots, t)
+    vals = np.stack(_basis_rows(p, knots, spans, t), axis=1)
+    return spans[:, None] - p + np.arange(p + 1), vals
 
 
 def _start_at_zero(ctrl: np.ndarray, period: np.ndarray, p: int) -> tuple[np.ndarray, np.ndarray]:

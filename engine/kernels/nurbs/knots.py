@@ -17,11 +17,12 @@ CAGD 6 (1989).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 import numpy as np
 
-from .basis import blossom_basis, domain_spans, find_spans, validate_curve
+from .basis import blossom_basis, domain_spans, find_spans, validate_curve, validate_surface
 from .curve import homogeneous, project
 
 __all__ = [
@@ -29,6 +30,7 @@ __all__ = [
     "decompose_bezier",
     "elevate_degree",
     "insert_knot",
+    "insert_knot_surface",
     "is_clamped",
     "make_compatible",
     "refine_knots",
@@ -175,8 +177,17 @@ def insert_knot(
         If t is outside the domain or the multiplicity would exceed the degree.
     """
     validate_curve(control_points, degree, knots, weights)
-    p = degree
     U = np.asarray(knots, dtype=np.float64)
+    Qw, UQ = _insert_rows(degree, U, homogeneous(control_points, weights), t, times)
+    cp, w = project(Qw, weights is not None)
+    return cp, degree, UQ, w
+
+
+def _insert_rows(
+    p: int, U: np.ndarray, Pw: np.ndarray, t: float, times: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """Boehm's insertion (A5.1) on rows of control points ``Pw`` (n, ...): each row a
+    control point, trailing axes carried along (A5.3 for a surface's net)."""
     n = len(U) - p - 1
     if isinstance(times, bool) or int(times) != times or times < 0:
         raise ValueError(f"times must be a whole number >= 0, got {times!r}")
@@ -191,27 +202,78 @@ def insert_knot(
             f"knot {t:g} has multiplicity {s}; inserting it {times} more time(s) would exceed "
             f"the degree {p}"
         )
-    Pw = homogeneous(control_points, weights)
+    Pw = np.asarray(Pw, dtype=np.float64)
     if times == 0:
-        return np.array(control_points, dtype=np.float64), p, U.copy(), _copy(weights)
+        return Pw.copy(), U.copy()
     r = times
     k = int(np.searchsorted(U, t, side="right")) - 1
-    Qw = np.empty((n + r, Pw.shape[1]))
+    Qw = np.empty((n + r,) + Pw.shape[1:])
     Qw[: k - p + 1] = Pw[: k - p + 1]
     Qw[k - s + r :] = Pw[k - s :]
     Rw = Pw[k - p : k - s + 1].copy()
+    tail = (1,) * (Pw.ndim - 1)
     L = k - p
     for j in range(1, r + 1):  # loops over the inserted copies and the degree only
         L = k - p + j
         i = np.arange(p - j - s + 1)
-        alpha = ((t - U[L + i]) / (U[i + k + 1] - U[L + i]))[:, None]
+        alpha = ((t - U[L + i]) / (U[i + k + 1] - U[L + i])).reshape((-1,) + tail)
         Rw[: len(i)] = alpha * Rw[1 : len(i) + 1] + (1.0 - alpha) * Rw[: len(i)]
         Qw[L] = Rw[0]
         Qw[k + r - j - s] = Rw[p - j - s]
     Qw[L + 1 : k - s] = Rw[1 : k - s - L]
     UQ = np.concatenate([U[: k + 1], np.full(r, t), U[k + 1 :]])
-    cp, w = project(Qw, weights is not None)
-    return cp, p, UQ, w
+    return Qw, UQ
+
+
+def insert_knot_surface(
+    control_points: np.ndarray,
+    degree_u: int,
+    degree_v: int,
+    knots_u: np.ndarray,
+    knots_v: np.ndarray,
+    weights: np.ndarray | None,
+    t: float,
+    times: int = 1,
+    direction: str = "u",
+) -> tuple[np.ndarray, int, int, np.ndarray, np.ndarray, np.ndarray | None]:
+    """Insert a knot in u or in v without changing the surface (A5.3).
+
+    Inserting ``t`` in u is Boehm's curve insertion applied to every column of the net
+    (the control points with the same v index) at once: the same coefficients for all,
+    one more row of control points per insertion. In v, to every row.
+
+    Parameters
+    ----------
+    control_points : (nu, nv, 3) float
+    degree_u, degree_v : int
+    knots_u : (nu + degree_u + 1,) float
+    knots_v : (nv + degree_v + 1,) float
+    weights : (nu, nv) float or None
+    t : float
+        In the domain of the chosen direction.
+    times : int
+        How many times (the multiplicity may not exceed that direction's degree).
+    direction : {"u", "v"}
+
+    Returns
+    -------
+    surface tuple with (nu + times, nv) or (nu, nv + times) control points; new arrays.
+    """
+    validate_surface(control_points, degree_u, degree_v, knots_u, knots_v, weights)
+    if direction not in ("u", "v"):
+        raise ValueError(f"direction must be 'u' or 'v', got {direction!r}")
+    pw = homogeneous(control_points, weights)
+    if direction == "u":
+        U = np.asarray(knots_u, dtype=np.float64)
+        qw, knots = _insert_rows(degree_u, U, pw, t, times)
+        ku, kv = knots, np.array(knots_v, dtype=np.float64)
+    else:
+        U = np.asarray(knots_v, dtype=np.float64)
+        qw, knots = _insert_rows(degree_v, U, np.swapaxes(pw, 0, 1), t, times)
+        qw = np.swapaxes(qw, 0, 1)
+        ku, kv = np.array(knots_u, dtype=np.float64), knots
+    cp, w = project(np.ascontiguousarray(qw), weights is not None)
+    return cp, degree_u, degree_v, ku, kv, w
 
 
 def refine_knots(
@@ -272,14 +334,17 @@ def elevate_degree(
     weights: np.ndarray | None,
     times: int = 1,
 ) -> Curve:
-    """Raise the degree by ``times`` without changing the curve.
+    """Raise the degree by ``times`` in one step, without changing the curve.
 
-    Each step raises the degree by one and every distinct knot's multiplicity by one, so
-    the continuity is kept (the result of A5.9). The new control points are the
-    symmetric blossoms (Ramshaw): for degree q = p + 1, row i is the average over the
-    q arguments ``new_knots[i+1 .. i+q]`` left out one at a time of the degree-p
-    blossom, vectorized over all rows. An unclamped (periodic) curve is clamped first
-    (same shape and domain).
+    Every distinct knot's multiplicity grows by ``times``, so the continuity is kept (the
+    result of A5.9, generalized there to any ``t``). As in A5.9 the curve is split into its
+    Bezier pieces (:func:`decompose_bezier`), each piece is raised from degree p to
+    q = p + t at once with the coefficients ``C(p, j) C(t, i - j) / C(q, i)`` (Eq. 5.36),
+    and the surplus knots are then removed all together: the new control points are the
+    dual functionals (blossoms, :func:`respace`) of the degree-q piecewise Bezier curve on
+    the target knot vector, which holds the curve exactly. The cost is one pass over the
+    new control points (O(n q^2)), whatever ``t``. An unclamped (periodic) curve is
+    clamped first (same shape and domain).
 
     Returns
     -------
@@ -288,25 +353,82 @@ def elevate_degree(
     validate_curve(control_points, degree, knots, weights)
     if isinstance(times, bool) or int(times) != times or times < 0:
         raise ValueError(f"times must be a whole number >= 0, got {times!r}")
+    t = int(times)
     cp, p, U, w = clamp(control_points, degree, knots, weights)
-    pw = homogeneous(cp, w)
-    for _ in range(int(times)):
-        values, counts = np.unique(U, return_counts=True)
-        tau = np.repeat(values, counts + 1)
-        q = p + 1
-        n_new = len(tau) - q - 1
-        lo = tau[:n_new]
-        mu = find_spans(p, U, lo)
-        args = np.lib.stride_tricks.sliding_window_view(tau[1:], q)[:n_new]
-        alpha = np.zeros((n_new, p + 1))
-        for leave in range(q):
-            alpha += blossom_basis(p, U, mu, np.delete(args, leave, axis=1))
-        alpha /= q
-        idx = mu[:, None] - p + np.arange(p + 1)
-        pw = np.einsum("ir,ird->id", alpha, pw[idx])
-        p, U = q, tau
+    if t == 0:
+        return cp, p, U, w
+    q = p + t
+    seg, spans = _bezier_pieces(p, U, homogeneous(cp, w))  # (S, p + 1, d)
+    j = np.arange(p + 1)
+    i = np.arange(q + 1)[:, None]
+    coef = np.where(
+        (i - j >= 0) & (i - j <= t),
+        _binom(p, j) * _binom(t, np.clip(i - j, 0, t)) / _binom(q, i),
+        0.0,
+    )
+    raised = np.einsum("ij,sjd->sid", coef, seg)  # (S, q + 1, d)
+    chain = np.concatenate([raised[:1, 0], raised[:, 1:].reshape(-1, raised.shape[2])])
+    breaks = np.concatenate([U[spans], U[spans[-1] + 1 : spans[-1] + 2]])
+    reps = np.full(len(breaks), q)
+    reps[[0, -1]] = q + 1
+    bezier_knots = np.repeat(breaks, reps)
+    values, counts = np.unique(U, return_counts=True)
+    tau = np.repeat(values, counts + t)
+    pw = _blossoms_on_widest_span(q, bezier_knots, breaks, chain, tau)
     cp, w = project(pw, weights is not None)
-    return cp, p, U, w
+    return cp, q, tau, w
+
+
+def _blossoms_on_widest_span(
+    q: int, bezier_knots: np.ndarray, breaks: np.ndarray, chain: np.ndarray, tau: np.ndarray
+) -> np.ndarray:
+    """Control points on ``tau`` of a piecewise Bezier curve of degree q (knots at
+    ``breaks``, each interior one q times): row i is the blossom at ``tau[i+1 .. i+q]`` of
+    the piece on the widest span under new basis function i. Any span under it gives the
+    same value in exact arithmetic; the widest extrapolates least, so rounding grows least
+    (a knot removal, unlike an insertion, is not a convex combination)."""
+    n_new = len(tau) - q - 1
+    width = np.diff(breaks)
+    first = np.searchsorted(breaks, tau[:n_new], side="right") - 1
+    last = np.searchsorted(breaks, tau[q + 1 : q + 1 + n_new], side="left") - 1
+    first = np.clip(first, 0, len(width) - 1)
+    last = np.clip(np.maximum(last, first), 0, len(width) - 1)
+    best = first.copy()
+    for step in range(1, int((last - first).max(initial=0)) + 1):  # at most q + 1 spans
+        cand = np.minimum(first + step, last)
+        best = np.where(width[cand] > width[best], cand, best)
+    # span index of piece `best` in the Bezier knot vector: q + 1 + q * best - 1
+    mu = q * best + q
+    args = np.lib.stride_tricks.sliding_window_view(tau[1:], q)[:n_new]
+    alpha = blossom_basis(q, bezier_knots, mu, args)
+    idx = mu[:, None] - q + np.arange(q + 1)
+    flat = chain.reshape(len(chain), -1)
+    return np.einsum("ir,ird->id", alpha, flat[idx]).reshape((n_new,) + chain.shape[1:])
+
+
+def _binom(n: int, k: np.ndarray) -> np.ndarray:
+    """Binomial coefficients C(n, k) as floats (exact for the degrees used here)."""
+    k = np.asarray(k)
+    return np.array([math.comb(n, int(x)) for x in k.ravel()], dtype=np.float64).reshape(k.shape)
+
+
+def _bezier_pieces(p: int, U: np.ndarray, pw: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Bezier control points (S, p + 1, d) of every non-empty span of the domain, and the
+    spans; Bezier point k of the piece on [a, b] is its blossom at (a^(p-k), b^k)."""
+    first, last = domain_spans(p, U)
+    spans = np.arange(first, last + 1)
+    spans = spans[U[spans + 1] > U[spans]]
+    a, b = U[spans], U[spans + 1]
+    kk = np.arange(p + 1)
+    # argument j of Bezier point k is b when j < k, else a
+    args = np.where(
+        np.arange(p)[None, None, :] < kk[None, :, None], b[:, None, None], a[:, None, None]
+    )  # (segments, p+1, p)
+    mu = np.repeat(spans, p + 1)
+    alpha = blossom_basis(p, U, mu, args.reshape(-1, p))
+    idx = mu[:, None] - p + kk
+    seg = np.einsum("ir,ird->id", alpha, pw[idx]).reshape(len(spans), p + 1, -1)
+    return seg, spans
 
 
 def decompose_bezier(
@@ -325,22 +447,8 @@ def decompose_bezier(
     segment_weights : (k, p + 1) float, or None for a non-rational curve
     """
     validate_curve(control_points, degree, knots, weights)
-    p = degree
     U = np.asarray(knots, dtype=np.float64)
-    first, last = domain_spans(p, U)
-    spans = np.arange(first, last + 1)
-    spans = spans[U[spans + 1] > U[spans]]
-    a, b = U[spans], U[spans + 1]
-    kk = np.arange(p + 1)
-    # argument j of Bezier point k is b when j < k, else a
-    args = np.where(
-        np.arange(p)[None, None, :] < kk[None, :, None], b[:, None, None], a[:, None, None]
-    )  # (segments, p+1, p)
-    mu = np.repeat(spans, p + 1)
-    alpha = blossom_basis(p, U, mu, args.reshape(-1, p))
-    pw = homogeneous(control_points, weights)
-    idx = mu[:, None] - p + kk
-    seg = np.einsum("ir,ird->id", alpha, pw[idx]).reshape(len(spans), p + 1, -1)
+    seg, _ = _bezier_pieces(degree, U, homogeneous(control_points, weights))
     cp, w = project(seg, weights is not None)
     return cp, w
 

@@ -219,6 +219,8 @@ def grid_cells(lo: np.ndarray, hi: np.ndarray, distance: float, cell: float) -> 
     """
     margin = abs(distance) + 2 * cell
     size = (np.asarray(hi, float) - np.asarray(lo, float) + 2 * margin) / cell
+    if not np.all(np.isfinite(size)) or size.max() > 2.0**31:
+        return 2**62  # more than any budget (a cell tiny next to the input)
     levels = max(0, int(np.ceil(np.log2(max(size.max() / _COARSE_CELLS, 1.0)))))
     step = 2**levels
     ncx, ncy = (np.ceil(size / step) * step).tolist()
@@ -475,6 +477,11 @@ def offset_polylines(
             break
         cell /= 2
     xy = origin + np.stack([cr.col, cr.row], axis=-1)[cr.order] * cell
+    if smooth * xy.shape[0] > max_cells:  # each pass moves every vertex: budget the passes
+        raise ValueError(
+            f"smoothing: {smooth} passes over {xy.shape[0]:,} vertices would make "
+            f"{smooth * xy.shape[0]:,} vertex moves, over the limit of {max_cells:,}"
+        )
     if cell < 0.9 * radius and xy.shape[0]:
         # Every point within 0.9 |d| of the level lies on the level's side of the input, so
         # the unsigned distance alone can make the loops exact.

@@ -1,0 +1,109 @@
+"""Solids benchmark: a boolean of two 100k-triangle spheres, and the repair chain on 1M.
+
+- union of two overlapping 100,488-triangle UV spheres: ours (``mesh.boolean``'s path:
+  refuse-or-convert, manifold3d, back to a frozen ``Mesh``) against manifold3d called
+  directly on ready-made arrays, and against trimesh's ``boolean.union`` with the manifold
+  engine;
+- weld + orient + cap of a 1,000,000-triangle open tube given as a triangle soup (every
+  triangle with its own 3 vertices, half of them flipped, as an unrepaired STL holds it)
+  against trimesh's ``merge_vertices`` + ``fix_normals`` + ``fill_holes``. trimesh's
+  ``fill_holes`` fills only holes of 3 or 4 edges, so its chain leaves the tube's two
+  1000-edge ends open, where ours caps them.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from formgraph.geometry import Mesh
+from formgraph.kernels.mesh import boolean as kb
+from formgraph.kernels.mesh import primitives as kp
+from formgraph.kernels.mesh import repair as kr
+from formgraph.kernels.mesh.grid import grid_faces
+from formgraph.kernels.mesh.meshops import triangulate
+
+
+def _sphere(centre: tuple[float, float, float]) -> Mesh:
+    return Mesh(*triangulate(*kp.sphere(1.0, 318, centre)))  # 2 * 318 * 158 triangles
+
+
+def _manifold_direct(a: tuple, b: tuple):
+    import manifold3d
+
+    ma = manifold3d.Manifold(manifold3d.Mesh64(vert_properties=a[0], tri_verts=a[1]))
+    mb = manifold3d.Manifold(manifold3d.Mesh64(vert_properties=b[0], tri_verts=b[1]))
+    out = (ma + mb).to_mesh64()
+    return np.asarray(out.vert_properties), np.asarray(out.tri_verts)
+
+
+def _trimesh_union(a, b):
+    import trimesh
+
+    return trimesh.boolean.union([a, b], engine="manifold")
+
+
+def _ours_union(a: Mesh, b: Mesh) -> Mesh:
+    ma = kb.to_manifold(a.vertices, a.face_indices, a.face_offsets, "input a")
+    mb = kb.to_manifold(b.vertices, b.face_indices, b.face_offsets, "input b")
+    return Mesh(*kb.from_manifold(kb.combine(ma, mb, "union")))
+
+
+def tube_soup(rows: int = 500, around: int = 1000, seed: int = 1):
+    """An open tube of ``2 rows around`` triangles as a soup, half its faces flipped."""
+    phi = 2 * np.pi * np.arange(around) / around
+    z = np.linspace(0.0, 5.0, rows + 1)
+    pts = np.stack(
+        np.broadcast_arrays(np.cos(phi)[None, :], np.sin(phi)[None, :], z[:, None]), -1
+    ).reshape(-1, 3)
+    fi, fo = grid_faces(rows + 1, around, False, True)
+    v, t, _ = triangulate(pts, fi, fo)
+    tri = t.reshape(-1, 3).copy()
+    flip = np.random.default_rng(seed).random(len(tri)) < 0.5
+    tri[flip] = tri[flip][:, ::-1]
+    soup = v[tri.reshape(-1)]
+    return soup, np.arange(soup.shape[0]), np.arange(0, soup.shape[0] + 1, 3)
+
+
+def _ours_repair(v, fi, fo):
+    w = kr.weld(v, fi, fo)
+    o, _ = kr.orient(*w)
+    return kr.cap(w[0], o, w[2])
+
+
+def _trimesh_repair(v, fi):
+    import trimesh
+
+    m = trimesh.Trimesh(v, fi.reshape(-1, 3), process=False)
+    m.merge_vertices()
+    m.fix_normals()
+    m.fill_holes()
+    return m
+
+
+def run(table) -> None:
+    a, b = _sphere((0.0, 0.0, 0.0)), _sphere((0.6, 0.2, 0.1))
+    case = f"union of two {a.n_faces // 1000}k-triangle spheres"
+    table.time(case, "formgraph", lambda: _ours_union(a, b), repeat=3)
+    raw = [
+        (np.array(m.vertices), np.array(m.face_indices, np.uint64).reshape(-1, 3)) for m in (a, b)
+    ]
+    table.time(case, "manifold3d direct", lambda: _manifold_direct(*raw), repeat=3)
+    try:
+        import trimesh
+
+        ta = trimesh.Trimesh(raw[0][0], raw[0][1].astype(np.int64), process=False)
+        tb = trimesh.Trimesh(raw[1][0], raw[1][1].astype(np.int64), process=False)
+        table.time(case, "trimesh (manifold)", lambda: _trimesh_union(ta, tb), repeat=3)
+    except ImportError as exc:
+        table.add(case, "trimesh (manifold)", None, f"not installed ({exc.name})")
+
+    v, fi, fo = tube_soup()
+    case = "weld + orient + cap, 1M-triangle soup (open tube)"
+    table.time(case, "formgraph", lambda: _ours_repair(v, fi, fo), repeat=2)
+    table.time(
+        case,
+        "trimesh",
+        lambda: _trimesh_repair(v, fi),
+        repeat=1,
+        note="merge_vertices + fix_normals + fill_holes; leaves the two ends open",
+    )

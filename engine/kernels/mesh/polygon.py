@@ -1,0 +1,234 @@
+"""Triangulation of one simple polygon by ear clipping, in rounds over independent ears.
+
+Ear clipping (G. H. Meisters, "Polygons have ears", Amer. Math. Monthly 82, 1975) cuts off
+one convex corner at a time whose triangle holds no other corner. Done naively (test every
+corner against every corner, one ear per step) it costs O(n^3); this version is the
+standard O(n^2)-at-worst one (D. Eberly, "Triangulation by ear clipping", Geometric
+Tools, 2002) made vectorized:
+
+- only reflex corners can lie inside an ear's triangle (if any corner does, a reflex one
+  does), and a reflex corner never becomes reflex again once convex, so the candidates are
+  the reflex corners, kept sorted by x: each triangle is tested only against those inside
+  its x range (a ragged gather, ``searchsorted`` plus ``repeat``);
+- clipping an ear changes the ear status of its two neighbours only, so each round clips
+  every other ear of each run of ears at once (no two adjacent) and re-tests just the
+  neighbours. A star loses all its tips in the first round, and a convex remainder half
+  its corners per round.
+
+The work (triangle-corner tests) is counted and refused past ``max_tests`` before it is
+done, so a hostile polygon cannot take minutes.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["WorkLimitError", "polygon_plane", "triangulate_polygon"]
+
+_CHUNK = 1 << 21  # triangle-corner pairs tested at once (bounds the memory of a round)
+
+
+class WorkLimitError(ValueError):
+    """More triangle-corner tests than allowed; ``work`` is how many were needed so far."""
+
+    def __init__(self, work: int, limit: int):
+        super().__init__(
+            f"ear clipping needs more than {limit:,} triangle-corner tests ({work:,} so far)"
+        )
+        self.work = work
+        self.limit = limit
+
+
+def polygon_plane(points: np.ndarray) -> np.ndarray:
+    """Coordinates (k, 2) of a polygon loop in its own plane, counter-clockwise.
+
+    ``(k, 2)`` input that runs clockwise is mirrored; ``(k, 3)`` input is projected on the
+    plane of its Newell normal, seen from the side the normal points to (so the loop runs
+    counter-clockwise there). Centred on the mean corner.
+    """
+    p = np.asarray(points, dtype=np.float64)
+    if p.ndim != 2 or p.shape[1] not in (2, 3):
+        raise ValueError(f"a polygon must be a (k, 2) or (k, 3) array of corners, got {p.shape}")
+    if not np.all(np.isfinite(p)):
+        raise ValueError("polygon corners must be finite")
+    q = p - p.mean(axis=0)
+    if p.shape[1] == 2:
+        area2 = float(np.sum(q[:, 0] * np.roll(q[:, 1], -1) - np.roll(q[:, 0], -1) * q[:, 1]))
+        return q * np.array([-1.0, 1.0]) if area2 < 0 else q
+    normal = np.cross(q, np.roll(q, -1, axis=0)).sum(axis=0)
+    length = np.linalg.norm(normal)
+    if length == 0:
+        return q[:, :2]  # no area at all: any projection (the fan fallback handles it)
+    nrm = normal / length
+    helper = np.array([1.0, 0, 0]) if abs(nrm[0]) < 0.9 else np.array([0, 1.0, 0])
+    u = np.cross(nrm, helper)
+    u /= np.linalg.norm(u)
+    w = np.cross(nrm, u)
+    return np.column_stack([q @ u, q @ w])
+
+
+def triangulate_polygon(points: np.ndarray, max_tests: int | None = None) -> np.ndarray:
+    """Triangles (k - 2, 3) of corner indices for a simple polygon given as a loop.
+
+    Parameters
+    ----------
+    points : (k, 2) or (k, 3) float
+        The corners in order (k >= 3), without repeating the first at the end. A 3-D loop
+        is triangulated in the plane of its Newell normal.
+    max_tests : int, optional
+        Refuse (:class:`WorkLimitError`) once more triangle-corner tests than this would
+        be needed; the worst case is about k^2 / 2.
+
+    Returns
+    -------
+    (k - 2, 3) int64
+        Each triangle runs the same way round as the loop. A polygon that is not simple
+        (self-touching, or with no area) still gets k - 2 triangles: where no ear is left,
+        the most convex corner is cut off.
+
+    Example
+    -------
+    >>> triangulate_polygon([[0, 0], [2, 0], [2, 2], [1, 1], [0, 2]]).shape
+    (3, 3)
+    """
+    xy = polygon_plane(points)
+    k = len(xy)
+    if k < 3:
+        raise ValueError(f"a polygon needs at least 3 corners, got {k}")
+    return _ear_clip_rounds(xy, max_tests)
+
+
+def _turns(xy: np.ndarray, a: np.ndarray, v: np.ndarray, c: np.ndarray) -> np.ndarray:
+    pa, pv, pc = xy[a], xy[v], xy[c]
+    return (pv[:, 0] - pa[:, 0]) * (pc[:, 1] - pv[:, 1]) - (pv[:, 1] - pa[:, 1]) * (
+        pc[:, 0] - pv[:, 0]
+    )
+
+
+class _Clipper:
+    """State of one ear clipping: the corners left (in loop order) and the reflex ones."""
+
+    def __init__(self, xy: np.ndarray, max_tests: int | None):
+        self.xy = xy
+        k = len(xy)
+        scale = float(np.abs(xy).max(initial=1.0)) or 1.0
+        self.eps = 1e-12 * scale * scale
+        self.ring = np.arange(k)
+        self.turn = _turns(xy, np.roll(self.ring, 1), self.ring, np.roll(self.ring, -1))
+        self.alive = np.ones(k, dtype=bool)
+        reflex = np.flatnonzero(self.turn <= self.eps)
+        order = np.argsort(xy[reflex, 0], kind="stable")
+        self.rid = reflex[order]  # ever-reflex corners, by x
+        self.rx = xy[self.rid, 0]
+        self.work = 0
+        self.max_tests = max_tests
+
+    def ears(self, pos: np.ndarray) -> np.ndarray:
+        """Whether the corners at ring positions ``pos`` are ears now."""
+        r = len(self.ring)
+        a, v, c = self.ring[(pos - 1) % r], self.ring[pos], self.ring[(pos + 1) % r]
+        ok = self.turn[v] > self.eps
+        idx = np.flatnonzero(ok)
+        if idx.size == 0 or self.rid.size == 0:
+            return ok
+        ta, tv, tc = a[idx], v[idx], c[idx]
+        xs = self.xy[np.stack([ta, tv, tc]), 0]
+        lo = np.searchsorted(self.rx, xs.min(axis=0), side="left")
+        hi = np.searchsorted(self.rx, xs.max(axis=0), side="right")
+        counts = hi - lo
+        total = int(counts.sum())
+        self.work += total
+        if self.max_tests is not None and self.work > self.max_tests:
+            raise WorkLimitError(self.work, self.max_tests)
+        blocked = np.zeros(idx.size, dtype=bool)
+        ends = np.cumsum(counts)
+        start = 0
+        while start < idx.size:  # chunks of at most _CHUNK pairs (one round's tests)
+            stop = max(start + 1, int(np.searchsorted(ends, ends[start] - counts[start] + _CHUNK)))
+            sl = slice(start, stop)
+            blocked[sl] = self._blocked(ta[sl], tv[sl], tc[sl], lo[sl], counts[sl])
+            start = stop
+        ok[idx[blocked]] = False
+        return ok
+
+    def _blocked(self, a, v, c, lo, counts) -> np.ndarray:
+        n = counts.sum()
+        tri = np.repeat(np.arange(len(a)), counts)
+        first = np.repeat(np.cumsum(counts) - counts, counts)
+        q = self.rid[np.repeat(lo, counts) + np.arange(n) - first]
+        live = self.alive[q] & (self.turn[q] <= self.eps)
+        live &= (q != a[tri]) & (q != v[tri]) & (q != c[tri])
+        tri, q = tri[live], q[live]
+        pa, pv, pc, pq = self.xy[a[tri]], self.xy[v[tri]], self.xy[c[tri]], self.xy[q]
+
+        def side(u: np.ndarray, w: np.ndarray) -> np.ndarray:
+            return (w[:, 0] - u[:, 0]) * (pq[:, 1] - u[:, 1]) - (w[:, 1] - u[:, 1]) * (
+                pq[:, 0] - u[:, 0]
+            )
+
+        inside = (side(pa, pv) >= -self.eps) & (side(pv, pc) >= -self.eps)
+        inside &= side(pc, pa) >= -self.eps
+        return np.bincount(tri[inside], minlength=len(a)) > 0
+
+    def clip(self, chosen: np.ndarray) -> np.ndarray:
+        """Cut off the corners at the chosen ring positions; their triangles (c, 3)."""
+        r = len(self.ring)
+        pos = np.flatnonzero(chosen)
+        tris = np.stack(
+            [self.ring[(pos - 1) % r], self.ring[pos], self.ring[(pos + 1) % r]], axis=1
+        )
+        self.alive[self.ring[pos]] = False
+        touched = np.zeros(r, dtype=bool)
+        touched[(pos - 1) % r] = True
+        touched[(pos + 1) % r] = True
+        touched &= ~chosen
+        self.ring = self.ring[~chosen]
+        return tris, np.flatnonzero(touched[~chosen])
+
+    def retune(self, pos: np.ndarray) -> None:
+        """New turns at the given ring positions; drop candidates that are no longer reflex."""
+        r = len(self.ring)
+        v = self.ring[pos]
+        self.turn[v] = _turns(self.xy, self.ring[(pos - 1) % r], v, self.ring[(pos + 1) % r])
+        keep = self.alive[self.rid] & (self.turn[self.rid] <= self.eps)
+        if 2 * np.count_nonzero(keep) < keep.size:  # compact now and then: O(n) overall
+            self.rid, self.rx = self.rid[keep], self.rx[keep]
+
+
+def _ear_clip_rounds(xy: np.ndarray, max_tests: int | None) -> np.ndarray:
+    st = _Clipper(xy, max_tests)
+    ear = st.ears(np.arange(len(xy)))
+    out = []
+    while len(st.ring) > 3:  # rounds: ~log n for stars and convex parts, n at worst
+        r = len(st.ring)
+        if ear.any():
+            chosen = _every_other(ear)
+            if chosen.sum() > r - 3:
+                chosen[np.flatnonzero(chosen)[r - 3 :]] = False
+        else:  # no ear (not a simple polygon): the most convex corner goes
+            chosen = np.zeros(r, dtype=bool)
+            chosen[int(np.argmax(st.turn[st.ring]))] = True
+        tris, touched = st.clip(chosen)
+        out.append(tris)
+        ear = ear[~chosen]
+        st.retune(touched)
+        ear[touched] = st.ears(touched)
+    out.append(st.ring[None, :])
+    return np.concatenate(out).astype(np.int64)
+
+
+def _every_other(flags: np.ndarray) -> np.ndarray:
+    """Every other True of each run of consecutive Trues (cyclic): no two chosen adjacent."""
+    r = len(flags)
+    if flags.all():
+        chosen = np.zeros(r, dtype=bool)
+        chosen[0 : r - (r % 2) : 2] = True
+        return chosen
+    # rotate so that position 0 is False: no run wraps around
+    shift = int(np.argmin(flags))
+    f = np.roll(flags, -shift)
+    idx = np.arange(r)
+    starts = np.where(f & ~np.roll(f, 1), idx, 0)
+    run_start = np.maximum.accumulate(starts)
+    chosen = f & ((idx - run_start) % 2 == 0)
+    return np.roll(chosen, shift)

@@ -1,0 +1,413 @@
+"""Mesh repair on flat arrays: weld close vertices, orient faces, cap boundary loops.
+
+- :func:`weld`: vertices closer than a tolerance merged (transitively), faces that collapse
+  dropped; neighbours found in a uniform grid of cells one tolerance wide, so only the 27
+  cells around a point are searched;
+- :func:`orient`: one orientation per connected part, found by a parity union-find over the
+  faces (two faces sharing an edge the same way must differ), then each closed part turned
+  outward by its signed volume;
+- :func:`cap`: every boundary loop filled, planar ones as triangulated polygons (ear
+  clipping, concave outlines too), others as a fan to the loop's centroid.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..io.exporters import fan_triangles
+from .halfedge import build_halfedges
+from .measure import edge_table, face_areas, next_corner, signed_volume, union_find
+from .meshops import reverse_faces, triangulate
+
+__all__ = ["cap", "compact", "drop_collapsed", "orient", "weld", "weld_tolerance"]
+
+MeshArrays = tuple[np.ndarray, np.ndarray, np.ndarray]
+
+#: default weld tolerance, relative to the bounding-box diagonal
+RELATIVE_TOLERANCE = 1e-6
+#: most candidate vertex pairs a weld compares (a tolerance near the mesh's size would
+#: compare every vertex with every other)
+MAX_PAIRS = 20_000_000
+
+
+def weld_tolerance(vertices: np.ndarray) -> float:
+    """The default tolerance: 1e-6 of the bounding-box diagonal (0 for a single point)."""
+    v = np.asarray(vertices, dtype=np.float64)
+    if len(v) == 0:
+        return 0.0
+    return RELATIVE_TOLERANCE * float(np.linalg.norm(v.max(axis=0) - v.min(axis=0)))
+
+
+def _close_pairs(v: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
+    """All pairs ``i < j`` with ``|v[i] - v[j]| <= tol`` (cells of side ``tol``)."""
+    lo = v.min(axis=0)
+    q = np.floor((v - lo) / tol).astype(np.int64)
+    dims = q.max(axis=0) + 3  # room for the -1 / +1 neighbours
+    if float(np.prod(dims.astype(np.float64))) >= 2.0**62:
+        raise ValueError(
+            f"weld tolerance {tol:g} is too small for a mesh this large (cell grid overflow)"
+        )
+    q += 1
+    key = (q[:, 0] * dims[1] + q[:, 1]) * dims[2] + q[:, 2]
+    cells, cell_of, counts = np.unique(key, return_inverse=True, return_counts=True)
+    order = np.argsort(cell_of)
+    start = np.zeros(cells.size + 1, dtype=np.int64)
+    np.cumsum(counts, out=start[1:])
+    # the cell itself and the 13 neighbours "after" it: each unordered cell pair once
+    offsets = [(dx, dy, dz) for dx in (-1, 0, 1) for dy in (-1, 0, 1) for dz in (-1, 0, 1)]
+    found = []
+    for dx, dy, dz in offsets[13:]:
+        target = cells + (dx * dims[1] + dy) * dims[2] + dz
+        pos = np.minimum(np.searchsorted(cells, target), cells.size - 1)
+        hit = np.flatnonzero(cells[pos] == target)
+        found.append((dx, dy, dz, hit, pos[hit]))
+    # pairs to compare: na * nb between two cells, na (na - 1) / 2 within one
+    total = 0
+    for dx, dy, dz, ca, cb in found:
+        na, nb = counts[ca], counts[cb]
+        same = (dx, dy, dz) == (0, 0, 0)
+        total += int(np.sum(na * (nb - 1) // 2 if same else na * nb))
+    if total > MAX_PAIRS:
+        raise ValueError(
+            f"weld tolerance {tol:g} is too coarse for this mesh: {total:,} vertex pairs fall "
+            f"within a cell of each other (limit {MAX_PAIRS:,}); use a smaller tolerance"
+        )
+    ii, jj = [], []
+    for dx, dy, dz, ca, cb in found:
+        if ca.size == 0:
+            continue
+        na, nb = counts[ca], counts[cb]
+        pairs = na * nb
+        owner = np.repeat(np.arange(ca.size), pairs)
+        k = np.arange(owner.size) - np.repeat(np.cumsum(pairs) - pairs, pairs)
+        i = order[start[ca][owner] + k // nb[owner]]
+        j = order[start[cb][owner] + k % nb[owner]]
+        keep = i < j if (dx, dy, dz) == (0, 0, 0) else i != j
+        ii.append(i[keep])
+        jj.append(j[keep])
+    i = np.concatenate(ii) if ii else np.zeros(0, np.int64)
+    j = np.concatenate(jj) if jj else np.zeros(0, np.int64)
+    d2 = np.einsum("ij,ij->i", v[i] - v[j], v[i] - v[j])
+    close = d2 <= tol * tol
+    return i[close], j[close]
+
+
+def weld(
+    vertices: np.ndarray,
+    face_indices: np.ndarray,
+    face_offsets: np.ndarray,
+    tolerance: float | None = None,
+) -> MeshArrays:
+    """Merge vertices closer than ``tolerance``, transitively; drop faces that collapse.
+
+    Exact duplicates are merged first (one sort of the coordinates), then the remaining
+    points are bucketed in cells ``tolerance`` wide: two points that close are in the same
+    or neighbouring cells, so the pairs come from 14 vectorized cell look-ups, and
+    :func:`~formgraph.kernels.mesh.measure.union_find` groups them. Each group keeps the
+    position of its first vertex. Unused vertices are removed.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+    face_indices : (m,) int
+    face_offsets : (n_faces + 1,) int
+    tolerance : float, optional
+        Distance under which vertices merge; default :func:`weld_tolerance` (1e-6 of the
+        bounding-box diagonal). 0 merges exact duplicates only.
+
+    Returns
+    -------
+    vertices, face_indices, face_offsets
+        Faces keep their order; a face left with fewer than 3 distinct corners, or that
+        visits a vertex twice, is dropped.
+    """
+    v = np.asarray(vertices, dtype=np.float64)
+    fi = np.asarray(face_indices, dtype=np.int64)
+    fo = np.asarray(face_offsets, dtype=np.int64)
+    tol = weld_tolerance(v) if tolerance is None else float(tolerance)
+    if not np.isfinite(tol) or tol < 0:
+        raise ValueError(f"tolerance must be a finite number >= 0, got {tolerance!r}")
+    if len(v) == 0:
+        return v.copy(), fi.copy(), fo.copy()
+    first, inverse = exact_duplicates(v)
+    uniq = v[first]
+    if tol > 0 and len(uniq) > 1:
+        i, j = _close_pairs(uniq, tol)
+        root, _ = union_find(len(uniq), i, j)
+    else:
+        root = np.arange(len(uniq))
+    # groups keep their smallest member: the first vertex met
+    vmap = root[inverse]
+    out_fi, out_fo = drop_collapsed(vmap[fi], fo, len(uniq))
+    return compact(uniq, out_fi, out_fo)
+
+
+def _mix(x: np.ndarray) -> np.ndarray:
+    """The splitmix64 finalizer (Steele et al. 2014): a bijection of 64-bit words."""
+    with np.errstate(over="ignore"):
+        x = (x ^ (x >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
+        x = (x ^ (x >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
+        return x ^ (x >> np.uint64(31))
+
+
+def exact_duplicates(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Group identical rows: one sort of a 64-bit hash of the coordinates' bits.
+
+    The hash groups are checked against the coordinates themselves; in the (astronomically
+    unlikely) case of a collision the rows are grouped by a sort of the rows instead.
+
+    Returns
+    -------
+    first : (k,) int64
+        The first row of each group, in the order the groups first appear.
+    inverse : (n,) int64
+        The group of each row.
+    """
+    p = np.ascontiguousarray(np.asarray(points, dtype=np.float64) + 0.0)  # -0.0 -> 0.0
+    if len(p) == 0:
+        return np.zeros(0, np.int64), np.zeros(0, np.int64)
+    bits = p.view(np.uint64).reshape(-1, 3)
+    h = _mix(_mix(_mix(bits[:, 0]) ^ bits[:, 1]) ^ bits[:, 2])
+    order = np.argsort(h)
+    hs = h[order]
+    starts = np.flatnonzero(np.r_[True, hs[1:] != hs[:-1]])
+    group_sorted = np.cumsum(np.r_[True, hs[1:] != hs[:-1]]) - 1
+    first = np.minimum.reduceat(order, starts)
+    inverse = np.empty(len(p), dtype=np.int64)
+    inverse[order] = group_sorted
+    if not np.array_equal(p[first[inverse]], p):  # a hash collision: do it the slow way
+        _, first, inverse = np.unique(p, axis=0, return_index=True, return_inverse=True)
+        inverse = inverse.reshape(-1)
+    rank = np.argsort(first)
+    where = np.empty(rank.size, dtype=np.int64)
+    where[rank] = np.arange(rank.size)
+    return first[rank], where[inverse]
+
+
+def drop_collapsed(
+    face_indices: np.ndarray, face_offsets: np.ndarray, n_vertices: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """Remove repeated consecutive corners; drop faces under 3 corners or repeating one.
+
+    Returns
+    -------
+    face_indices, face_offsets
+        The surviving faces, in order.
+    """
+    fi = np.asarray(face_indices, dtype=np.int64)
+    fo = np.asarray(face_offsets, dtype=np.int64)
+    n_faces = fo.size - 1
+    if n_faces == 0:
+        return fi.copy(), fo.copy()
+    face = np.repeat(np.arange(n_faces), np.diff(fo))
+    keep = fi != fi[next_corner(fo)]
+    sizes = np.bincount(face[keep], minlength=n_faces)
+    bad = sizes < 3
+    kf, kv = face[keep], fi[keep]
+    key = np.sort(kf * max(n_vertices, 1) + kv)
+    dup = key[1:] == key[:-1]
+    bad[key[1:][dup] // max(n_vertices, 1)] = True
+    keep &= ~bad[face]
+    sizes[bad] = 0
+    out_fo = np.zeros(n_faces - int(bad.sum()) + 1, dtype=np.int64)
+    np.cumsum(sizes[~bad], out=out_fo[1:])
+    return fi[keep], out_fo
+
+
+def compact(vertices: np.ndarray, face_indices: np.ndarray, face_offsets: np.ndarray) -> MeshArrays:
+    """Drop the vertices that no face uses, renumbering the faces (order kept)."""
+    v = np.asarray(vertices, dtype=np.float64)
+    fi = np.asarray(face_indices, dtype=np.int64)
+    used = np.zeros(len(v), dtype=bool)
+    used[fi] = True
+    new = np.cumsum(used) - 1
+    return v[used], new[fi], np.asarray(face_offsets, dtype=np.int64).copy()
+
+
+def orient(
+    vertices: np.ndarray, face_indices: np.ndarray, face_offsets: np.ndarray
+) -> tuple[np.ndarray, int]:
+    """Consistent face orientation, each closed part outward (positive signed volume).
+
+    Faces sharing a manifold edge (one on exactly two faces) are linked; a link whose two
+    faces run the edge the same way says "orientations differ". A parity union-find over
+    these links (:func:`~formgraph.kernels.mesh.measure.union_find`) gives every face its
+    orientation relative to its part's root face. A closed part is then turned so its signed
+    volume is positive, unless it lies inside an odd number of the other closed parts (a
+    cavity, such as the inner wall of a hollow shell): that one faces inward. An open part
+    is turned so its signed volume about its own centroid is positive (its faces look away
+    from its middle, like a cup's outside), or, when that volume is about 0 (a flat sheet),
+    so that most of its area keeps the orientation it came with.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+    face_indices : (m,) int
+    face_offsets : (n_faces + 1,) int
+
+    Returns
+    -------
+    face_indices : (m,) int64
+        Faces reversed where needed (first corner kept).
+    conflicts : int
+        Links that no orientation satisfies (non-orientable parts, e.g. a Moebius strip);
+        0 for an orientable mesh.
+    """
+    v = np.asarray(vertices, dtype=np.float64)
+    fi = np.asarray(face_indices, dtype=np.int64)
+    fo = np.asarray(face_offsets, dtype=np.int64)
+    n_faces = fo.size - 1
+    if n_faces == 0:
+        return fi.copy(), 0
+    sizes = np.diff(fo)
+    face = np.repeat(np.arange(n_faces), sizes)
+    t = edge_table(fi, fo, len(v))
+    two = t.starts[t.counts == 2]
+    h0, h1 = t.order[two], t.order[two + 1]
+    same = fi[h0] == fi[h1]  # both start at the same vertex: same direction
+    f0, f1 = face[h0], face[h1]
+    root, flip = union_find(n_faces, f0, f1, same)
+    conflicts = int(np.count_nonzero((flip[f0] ^ flip[f1]) != same))
+    # decide each part's overall direction with the faces as they would be after the flips
+    sign = np.where(flip, -1.0, 1.0)
+    areas = face_areas(v, fi, fo)
+    part_area = np.bincount(root, weights=areas, minlength=n_faces)
+    centroid = np.stack(
+        [np.bincount(face, weights=v[fi, k], minlength=n_faces) for k in range(3)], 1
+    )
+    corners = np.bincount(root, weights=sizes, minlength=n_faces)
+    part_centroid = (
+        np.stack(
+            [np.bincount(root, weights=centroid[:, k], minlength=n_faces) for k in range(3)], 1
+        )
+        / np.maximum(corners, 1)[:, None]
+    )
+    vol = np.bincount(
+        root, weights=sign * signed_volume(v, fi, fo, part_centroid[root]), minlength=n_faces
+    )
+    open_face = np.zeros(n_faces, dtype=bool)
+    open_face[face[t.order[t.starts[t.counts != 2]]]] = True
+    part_open = np.bincount(root, weights=open_face, minlength=n_faces) > 0
+    kept = np.bincount(root, weights=sign * areas, minlength=n_faces)
+    flat = np.abs(vol) <= 1e-9 * np.maximum(part_area, 1e-300) ** 1.5
+    turn = np.where(part_open & flat, kept < 0, vol < 0)
+    flip = flip ^ turn[root]
+    reversed_ = reverse_faces(fi, fo)
+    out = np.where(np.repeat(flip, sizes), reversed_, fi)
+    closed_parts = np.flatnonzero((np.bincount(root, minlength=n_faces) > 0) & ~part_open)
+    if 1 < closed_parts.size <= MAX_NESTED_PARTS:
+        inner = _nested_inside(v, out, fo, root, closed_parts)
+        if inner.any():
+            flip_part = np.zeros(n_faces, dtype=bool)
+            flip_part[closed_parts[inner]] = True
+            out = np.where(np.repeat(flip_part[root], sizes), reverse_faces(out, fo), out)
+    return out, conflicts
+
+
+#: parts of one mesh above which orient skips the nesting test (each part is tested
+#: against the triangles of all the others)
+MAX_NESTED_PARTS = 64
+
+
+def _nested_inside(
+    v: np.ndarray, fi: np.ndarray, fo: np.ndarray, root: np.ndarray, parts: np.ndarray
+) -> np.ndarray:
+    """(len(parts),) bool: the part lies inside an odd number of the other closed parts.
+
+    With every closed part outward, the winding number of the others at a vertex of a part
+    counts the parts around it (the generalized winding number: the solid angle of each
+    triangle, Van Oosterom & Strackee 1983, summed over 4 pi). A cavity (inside one other
+    part, like the inner wall of a hollow shell) must face inward, so it is turned back.
+    """
+    tris = fan_triangles(fi, fo)
+    face_of_tri = np.repeat(np.arange(fo.size - 1), np.diff(fo) - 2)
+    part_of_tri = root[face_of_tri]
+    closed = np.isin(part_of_tri, parts)
+    out = np.zeros(parts.size, dtype=bool)
+    for k, part in enumerate(parts):  # one vectorized pass over the triangles per part
+        p = v[fi[fo[np.flatnonzero(root == part)[0]]]]
+        others = tris[closed & (part_of_tri != part)]
+        a, b, c = v[others[:, 0]] - p, v[others[:, 1]] - p, v[others[:, 2]] - p
+        la, lb, lc = (np.linalg.norm(x, axis=1) for x in (a, b, c))
+        num = np.einsum("ij,ij->i", a, np.cross(b, c))
+        den = (
+            la * lb * lc
+            + np.einsum("ij,ij->i", a, b) * lc
+            + np.einsum("ij,ij->i", a, c) * lb
+            + np.einsum("ij,ij->i", b, c) * la
+        )
+        winding = np.sum(2.0 * np.arctan2(num, den)) / (4.0 * np.pi)
+        out[k] = int(round(winding)) % 2 == 1
+    return out
+
+
+def cap(
+    vertices: np.ndarray,
+    face_indices: np.ndarray,
+    face_offsets: np.ndarray,
+    planar_tolerance: float = 1e-6,
+) -> MeshArrays:
+    """Fill every boundary loop; the new faces are oriented with their neighbours.
+
+    A loop runs with the mesh on its left, so its cap runs it backwards. A loop whose
+    points lie within ``planar_tolerance`` (relative to the loop's size) of the plane of
+    its Newell normal is triangulated as a polygon (ear clipping in that plane,
+    :func:`~formgraph.kernels.mesh.meshops.triangulate`: concave outlines stay inside);
+    any other loop becomes a fan of triangles to its centroid (one new vertex).
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+    face_indices : (m,) int
+    face_offsets : (n_faces + 1,) int
+        An oriented manifold mesh (see :func:`orient`).
+    planar_tolerance : float
+        Largest distance from the plane, as a fraction of the loop's bounding-box diagonal.
+
+    Returns
+    -------
+    vertices : (n + k, 3) float64
+        One vertex appended per non-planar loop.
+    face_indices, face_offsets
+        The original faces, then the caps' triangles.
+
+    Raises
+    ------
+    MeshTopologyError
+        Non-manifold or inconsistently oriented input.
+    """
+    v = np.asarray(vertices, dtype=np.float64)
+    fi = np.asarray(face_indices, dtype=np.int64)
+    fo = np.asarray(face_offsets, dtype=np.int64)
+    loops = build_halfedges(fi, fo, len(v)).boundary_loops()
+    if not loops:
+        return v.copy(), fi.copy(), fo.copy()
+    lo_sizes = np.array([len(lp) for lp in loops], dtype=np.int64)
+    lo_off = np.zeros(lo_sizes.size + 1, dtype=np.int64)
+    np.cumsum(lo_sizes, out=lo_off[1:])
+    ring = reverse_faces(np.concatenate(loops), lo_off)  # each loop backwards
+    p = v[ring]
+    starts = lo_off[:-1]
+    centre = np.add.reduceat(p, starts, axis=0) / lo_sizes[:, None]
+    nxt = next_corner(lo_off)
+    normal = np.add.reduceat(np.cross(p - centre.repeat(lo_sizes, 0), p[nxt] - p), starts, 0)
+    length = np.linalg.norm(normal, axis=1)
+    unit = normal / np.where(length > 0, length, 1.0)[:, None]
+    dist = np.abs(np.einsum("ij,ij->i", p - centre.repeat(lo_sizes, 0), unit.repeat(lo_sizes, 0)))
+    size = np.linalg.norm(
+        np.maximum.reduceat(p, starts, 0) - np.minimum.reduceat(p, starts, 0), axis=1
+    )
+    planar = (np.maximum.reduceat(dist, starts) <= planar_tolerance * size) & (length > 0)
+    planar |= lo_sizes == 3
+    corner_planar = planar.repeat(lo_sizes)
+    pf, pfo = ring[corner_planar], np.concatenate([[0], np.cumsum(lo_sizes[planar])])
+    _, tri, _ = triangulate(v, pf, pfo)
+    # the fans: (centroid, a, b) for each edge a -> b of a non-planar loop
+    fan = np.flatnonzero(~planar)
+    new_v = centre[fan]
+    centre_id = len(v) + np.repeat(np.arange(fan.size), lo_sizes[fan])
+    h = np.flatnonzero(~corner_planar)
+    fans = np.stack([centre_id, ring[h], ring[nxt[h]]], axis=1).reshape(-1)
+    caps = np.concatenate([tri, fans])
+    out_fo = np.concatenate([fo, fo[-1] + np.arange(3, caps.size + 1, 3)])
+    return np.concatenate([v, new_v]), np.concatenate([fi, caps]), out_fo

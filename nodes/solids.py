@@ -1,0 +1,409 @@
+"""Solids for fabrication (mesh family): primitives, repair, thickening, booleans, measures.
+
+Thin adapters over :mod:`formgraph.kernels.mesh.primitives`, ``.repair``, ``.solidify``,
+``.boolean`` (manifold3d) and ``.measure``. Closed primitives come out watertight and
+outward; ``mesh.weld`` -> ``mesh.orient`` -> ``mesh.cap`` turns a triangle soup or an open
+tube into a printable solid.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Annotated, Any, NamedTuple
+
+import numpy as np
+
+from formgraph.errors import InputError
+from formgraph.geometry import Mesh
+from formgraph.kernels.mesh import MeshTopologyError, meshops
+from formgraph.kernels.mesh import boolean as kb
+from formgraph.kernels.mesh import primitives as kp
+from formgraph.kernels.mesh import repair as kr
+from formgraph.kernels.mesh import solidify as ks
+from formgraph.registry import Context, Range, node
+from formgraph.types import Expression, Variables, Vec3
+
+
+def _arrays(mesh: Mesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    return mesh.vertices, mesh.face_indices, mesh.face_offsets
+
+
+def _topology(port: str, fn: Callable[..., Any], *args: Any) -> Any:
+    """Call a kernel that needs an oriented manifold; say which node fixes what it lacks."""
+    try:
+        return fn(*args)
+    except MeshTopologyError as exc:
+        hint = (
+            "mesh.orient makes the faces agree"
+            if "orientation" in str(exc)
+            else "mesh.weld or a cleaner source may help"
+        )
+        raise InputError(port, f"{exc}; {hint}") from None
+
+
+# ------------------------------------------------------------------------------ primitives
+
+
+@node("mesh.cylinder", version=1)
+def cylinder(
+    radius: Annotated[float, Range(min=0)],
+    height: Annotated[float, Range(min=0)],
+    segments: Annotated[int, Range(min=3)] = 64,
+    caps: bool = True,
+    center: Vec3 = (0.0, 0.0, 0.0),
+    *,
+    ctx: Context,
+) -> Mesh:
+    """A cylinder along z: quads around, an n-gon at each end; watertight and outward.
+
+    Its vertices lie on the true cylinder, so its volume is the inscribed prism's,
+    (n / 2) r^2 sin(2 pi / n) h, within (2 pi / n)^2 / 6 of pi r^2 h (relative).
+
+    Parameters
+    ----------
+    radius : float
+        Radius, > 0.
+    height : float
+        Length along z, > 0; the cylinder spans center.z - height/2 .. center.z + height/2.
+    segments : int
+        Quads around.
+    caps : bool
+        Close both ends (false: an open tube).
+    center : Vec3
+        Centre of the cylinder.
+    """
+    ctx.guard(6 * segments, "face corners")
+    try:
+        return Mesh(*kp.cylinder(radius, height, segments, caps, center))
+    except ValueError as exc:
+        raise InputError("radius" if "radius" in str(exc) else "height", str(exc)) from None
+
+
+@node("mesh.sphere", version=1)
+def sphere(
+    radius: Annotated[float, Range(min=0)],
+    segments: Annotated[int, Range(min=3)] = 32,
+    center: Vec3 = (0.0, 0.0, 0.0),
+    *,
+    ctx: Context,
+) -> Mesh:
+    """A UV sphere: segments around, segments / 2 bands, triangle fans at the poles.
+
+    Watertight and outward; inscribed in the true sphere (volume and area converge from
+    below as segments grow).
+
+    Parameters
+    ----------
+    radius : float
+        Radius, > 0.
+    segments : int
+        Faces around the equator; the bands pole to pole are half as many (at least 2).
+    center : Vec3
+        Centre of the sphere.
+    """
+    ctx.guard(segments * max(2, segments // 2), "faces")
+    try:
+        return Mesh(*kp.sphere(radius, segments, center))
+    except ValueError as exc:
+        raise InputError("radius", str(exc)) from None
+
+
+@node("mesh.torus", version=1)
+def torus(
+    major: Annotated[float, Range(min=0)],
+    minor: Annotated[float, Range(min=0)],
+    segments_u: Annotated[int, Range(min=3)] = 64,
+    segments_v: Annotated[int, Range(min=3)] = 32,
+    center: Vec3 = (0.0, 0.0, 0.0),
+    *,
+    ctx: Context,
+) -> Mesh:
+    """A ring torus about the z axis, all quads, watertight and outward.
+
+    Parameters
+    ----------
+    major : float
+        Distance from the axis to the centre of the tube.
+    minor : float
+        Radius of the tube, smaller than major.
+    segments_u : int
+        Quads around the z axis.
+    segments_v : int
+        Quads around the tube.
+    center : Vec3
+        Centre of the torus.
+    """
+    ctx.guard(segments_u * segments_v, "faces")
+    try:
+        return Mesh(*kp.torus(major, minor, segments_u, segments_v, center))
+    except ValueError as exc:
+        raise InputError("minor", str(exc)) from None
+
+
+@node("mesh.plane", version=1)
+def plane(
+    size: list[float] = (1.0, 1.0),  # type: ignore[assignment]
+    divisions: list[int] = (1, 1),  # type: ignore[assignment]
+    center: Vec3 = (0.0, 0.0, 0.0),
+    *,
+    ctx: Context,
+) -> Mesh:
+    """A flat grid of quads in the xy plane, facing +z (an open sheet).
+
+    Parameters
+    ----------
+    size : list[float]
+        [width along x, depth along y], each > 0.
+    divisions : list[int]
+        [quads along x, quads along y], each >= 1.
+    center : Vec3
+        Centre of the sheet.
+    """
+    if len(size) != 2:
+        raise InputError("size", f"size takes [width, depth], got {list(size)}")
+    if len(divisions) != 2:
+        raise InputError("divisions", f"divisions takes [nx, ny], got {list(divisions)}")
+    ctx.guard(float(divisions[0] + 1) * float(divisions[1] + 1), "vertices")
+    try:
+        return Mesh(*kp.plane(size, divisions, center))
+    except ValueError as exc:
+        raise InputError("size" if "size" in str(exc) else "divisions", str(exc)) from None
+
+
+# ---------------------------------------------------------------------------------- repair
+
+
+@node("mesh.weld", version=1)
+def weld(
+    mesh: Mesh, tolerance: Annotated[float | None, Range(min=0)] = None, *, ctx: Context
+) -> Mesh:
+    """Merge vertices closer than the tolerance; drop the faces that collapse.
+
+    Closeness is transitive (a chain of close vertices becomes one); each group keeps the
+    position of its first vertex; unused vertices are removed. Cells one tolerance wide
+    make it O(n log n).
+
+    Parameters
+    ----------
+    mesh : Mesh
+        Any polygon mesh, e.g. an STL-like triangle soup.
+    tolerance : float | None
+        Merge distance. None: 1e-6 of the bounding-box diagonal (joins seams and
+        duplicated vertices, never features); 0: exact duplicates only.
+    """
+    try:
+        out = Mesh(*kr.weld(*_arrays(mesh), tolerance))
+    except ValueError as exc:
+        raise InputError("tolerance", str(exc)) from None
+    dropped = mesh.n_faces - out.n_faces
+    if dropped:
+        ctx.warn(f"{dropped} faces collapsed and were dropped")
+    return out
+
+
+@node("mesh.orient", version=1)
+def orient(mesh: Mesh, *, ctx: Context) -> Mesh:
+    """Consistent face orientation; every closed part outward (positive volume).
+
+    Faces that share an edge are made to run it in opposite directions (a parity
+    union-find over the edges, all at once); then each closed part is turned so its signed
+    volume is positive, except a cavity (a part inside an odd number of the others, by the
+    generalized winding number), which faces inward so a hollow stays hollow. An open part
+    is turned so its faces look away from its centroid, or, if it is flat, so most of its
+    area keeps the side it had.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        Any polygon mesh; edges on more than two faces do not link their faces.
+    """
+    fi, conflicts = kr.orient(*_arrays(mesh))
+    if conflicts:
+        ctx.warn(
+            f"part of the mesh cannot be oriented (it is one-sided, like a Moebius strip): "
+            f"faces still disagree across {conflicts} of its edges"
+        )
+    return Mesh(mesh.vertices, fi, mesh.face_offsets)
+
+
+@node("mesh.flip", version=1)
+def flip(mesh: Mesh) -> Mesh:
+    """Reverse every face (inside out), keeping each face's first vertex.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        The mesh to turn.
+    """
+    return Mesh(
+        mesh.vertices,
+        meshops.reverse_faces(mesh.face_indices, mesh.face_offsets),
+        mesh.face_offsets,
+    )
+
+
+@node("mesh.cap", version=1)
+def cap(mesh: Mesh) -> Mesh:
+    """Fill every boundary loop, so an open tube comes out watertight.
+
+    A planar loop becomes its polygon, triangulated by ear clipping in its plane (concave
+    outlines stay inside); any other loop a fan of triangles to its centroid. The new
+    faces run each loop opposite to its neighbours, so orientation stays consistent.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        An oriented manifold mesh (mesh.weld and mesh.orient make one).
+    """
+    return Mesh(*_topology("mesh", kr.cap, *_arrays(mesh)))
+
+
+@node("mesh.solidify", version=1)
+def solidify(
+    mesh: Mesh,
+    thickness: Annotated[float, Range(min=0)],
+    offset: Annotated[float, Range(min=-1, max=1)] = 0.0,
+    thickness_map: Annotated[Expression | None, Variables("x", "y", "z", "thickness")] = None,
+    *,
+    ctx: Context,
+) -> Mesh:
+    """Thicken a surface into a closed shell: two offset copies joined along the rims.
+
+    Vertices move along angle-weighted normals (Thuermer & Wuethrich 1998); every boundary
+    edge gets a quad joining the two sides. An oriented manifold surface, open or closed,
+    gives a watertight, outward shell; a closed one gives a hollow solid. The wall stays
+    clean while the thickness is below the surface's smallest radius of curvature.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        An oriented manifold surface.
+    thickness : float
+        Wall thickness, > 0 (an expression like "=wall" reads the graph's params).
+    offset : float
+        Where the wall sits: -1 behind the surface (inside), 0 centred, 1 in front.
+    thickness_map : Expression | None
+        A wall that varies: the thickness at each vertex as an expression in its position
+        x, y, z and ``thickness``, e.g. "thickness * (1 + z / 5)". Each value must be > 0.
+    """
+    if thickness <= 0:
+        raise InputError("thickness", f"thickness must be > 0, got {thickness:g}")
+    ctx.guard(3 * mesh.face_indices.size, "face corners")
+    t: float | np.ndarray = thickness
+    if thickness_map is not None:
+        v = mesh.vertices
+        t = np.broadcast_to(
+            np.asarray(thickness_map(x=v[:, 0], y=v[:, 1], z=v[:, 2], thickness=thickness), float),
+            (mesh.n_vertices,),
+        )
+        bad = np.flatnonzero(~(np.isfinite(t) & (t > 0)))
+        if bad.size:
+            i = int(bad[0])
+            raise InputError(
+                "thickness_map",
+                f"{getattr(thickness_map, 'text', 'the expression')!r} gives {t[i]:g} at vertex "
+                f"{i} ({', '.join(f'{c:.6g}' for c in v[i])}); a thickness must be > 0",
+            )
+    try:
+        return Mesh(*_topology("mesh", ks.solidify, *_arrays(mesh), t, offset))
+    except ValueError as exc:
+        raise InputError("mesh", str(exc)) from None
+
+
+# -------------------------------------------------------------------------------- booleans
+
+
+def _solid(port: str, fn: Callable[..., Any], *args: Any) -> Any:
+    try:
+        return fn(*args)
+    except kb.NotSolidError as exc:
+        raise InputError(port, str(exc)) from None
+
+
+@node("mesh.boolean", version=1)
+def boolean(
+    a: Mesh, b: Mesh, operation: kb.Operation = kb.Operation.union, *, ctx: Context
+) -> Mesh:
+    """Union, difference (a minus b) or intersection of two solids, through manifold3d.
+
+    Both meshes must be closed, manifold and outward; anything else is refused with the
+    count of open or non-manifold edges and where one is. The result is a manifold
+    triangle mesh.
+
+    Parameters
+    ----------
+    a : Mesh
+        The first solid.
+    b : Mesh
+        The second solid (the one removed by difference).
+    operation : Operation
+        union, difference or intersection.
+    """
+    try:
+        ma = kb.to_manifold(*_arrays(a), "the mesh")
+    except kb.NotSolidError as exc:
+        raise InputError("a", str(exc)) from None
+    try:
+        mb = kb.to_manifold(*_arrays(b), "the mesh")
+    except kb.NotSolidError as exc:
+        raise InputError("b", str(exc)) from None
+    out = Mesh(*kb.from_manifold(kb.combine(ma, mb, operation)))
+    if out.n_faces == 0:
+        ctx.warn(f"the {kb.Operation(operation).value} is empty")
+    return out
+
+
+@node("mesh.union", version=1)
+def union(meshes: list[Mesh], *, ctx: Context) -> Mesh:
+    """The union of several solids at once, through manifold3d.
+
+    Parameters
+    ----------
+    meshes : list[Mesh]
+        Closed, manifold, outward meshes; they may overlap.
+    """
+    ctx.guard(sum(m.n_faces for m in meshes), "faces")
+    return Mesh(*_solid("meshes", kb.union, [_arrays(m) for m in meshes]))
+
+
+# -------------------------------------------------------------------------------- measures
+
+
+class MeshMeasures(NamedTuple):
+    area: float
+    volume: float
+    watertight: bool
+    size: Vec3
+    center: Vec3
+    faces: int
+
+
+@node("mesh.measure", version=1)
+def measure(mesh: Mesh, *, ctx: Context) -> MeshMeasures:
+    """Area, volume, watertightness, bounding box and face count of a mesh.
+
+    Outputs: ``area`` (sum of face areas), ``volume`` (enclosed volume by the divergence
+    theorem; 0, with a warning, for a mesh that is not watertight), ``watertight`` (every
+    edge on exactly two faces), ``size`` and ``center`` of the bounding box, ``faces``.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        Any polygon mesh.
+    """
+    watertight = mesh.is_watertight
+    volume = mesh.volume if watertight else 0.0
+    if mesh.n_faces == 0:
+        ctx.warn("mesh has no faces: area and volume 0")
+    elif not watertight:
+        open_edges = int(np.count_nonzero(mesh.edge_table.counts != 2))
+        ctx.warn(f"mesh is not watertight ({open_edges} open or non-manifold edges): volume 0")
+    lo, hi = mesh.bounds
+    return MeshMeasures(
+        area=mesh.area,
+        volume=float(volume),
+        watertight=watertight,
+        size=[float(x) for x in hi - lo],  # type: ignore[arg-type]
+        center=[float(x) for x in (lo + hi) / 2],  # type: ignore[arg-type]
+        faces=mesh.n_faces,
+    )

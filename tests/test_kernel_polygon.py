@@ -1,0 +1,144 @@
+"""Ear clipping of one polygon (kernels/mesh/polygon.py) against shapely: the triangles
+tile the polygon exactly (areas add up, each lies inside, none is flipped)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from formgraph.kernels.mesh import WorkLimitError, meshops, triangulate_polygon
+
+
+def star(k: int, inner: float = 0.4) -> np.ndarray:
+    t = np.linspace(0, 2 * np.pi, k, endpoint=False)
+    r = np.where(np.arange(k) % 2 == 0, 1.0, inner)
+    return np.column_stack([r * np.cos(t), r * np.sin(t)])
+
+
+def signed_areas(xy: np.ndarray, tris: np.ndarray) -> np.ndarray:
+    a, b, c = xy[tris[:, 0]], xy[tris[:, 1]], xy[tris[:, 2]]
+    return 0.5 * (
+        (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
+    )
+
+
+def assert_tiles(xy: np.ndarray, tris: np.ndarray) -> None:
+    shapely = pytest.importorskip("shapely")
+    poly = shapely.Polygon(xy)
+    assert poly.is_valid
+    k = len(xy)
+    assert tris.shape == (k - 2, 3)
+    assert np.array_equal(np.sort(np.unique(tris)), np.arange(k))  # every corner used
+    area = signed_areas(xy, tris)
+    sign = 1.0 if poly.exterior.is_ccw else -1.0
+    assert np.all(sign * area > 0)  # same winding as the loop, no flipped triangle
+    assert abs(np.abs(area).sum() - poly.area) <= 1e-9 * poly.area
+    centroids = xy[tris].mean(axis=1)
+    assert np.all(shapely.contains_xy(poly.buffer(1e-9 * np.sqrt(poly.area)), *centroids.T))
+
+
+@pytest.mark.parametrize("k", [4, 6, 40, 1200])
+def test_stars_are_tiled(k):
+    xy = star(k)
+    assert_tiles(xy, triangulate_polygon(xy))
+
+
+def test_a_clockwise_loop_gets_clockwise_triangles():
+    xy = star(30)[::-1]
+    tris = triangulate_polygon(xy)
+    assert_tiles(xy, tris)
+    assert np.all(signed_areas(xy, tris) < 0)
+
+
+def test_a_comb_with_deep_teeth_is_tiled():
+    n = 200
+    x = np.linspace(0, 1, n)
+    top = np.column_stack([x[::-1], 1 + 3 * (np.arange(n) % 2)])
+    xy = np.concatenate([np.column_stack([x, np.zeros(n)]), top])
+    assert_tiles(xy, triangulate_polygon(xy))
+
+
+@settings(max_examples=40, deadline=None)
+@given(k=st.integers(3, 300), seed=st.integers(0, 10_000))
+def test_random_star_shaped_polygons_are_tiled(k, seed):
+    rng = np.random.default_rng(seed)
+    t = np.sort(rng.uniform(0, 2 * np.pi, k))
+    t += np.arange(k) * 1e-6  # distinct angles
+    r = rng.uniform(0.1, 1.0, k)
+    xy = np.column_stack([r * np.cos(t), r * np.sin(t)])
+    shapely = pytest.importorskip("shapely")
+    if not shapely.Polygon(xy).is_valid:
+        return  # (nearly coincident angles can touch)
+    assert_tiles(xy, triangulate_polygon(xy))
+
+
+def test_a_loop_in_space_is_triangulated_in_its_plane_and_keeps_its_normal():
+    xy = star(50)
+    rot = np.linalg.qr(np.random.default_rng(1).normal(size=(3, 3)))[0]
+    pts = np.column_stack([xy, np.zeros(len(xy))]) @ rot.T + [3, -2, 5]
+    tris = triangulate_polygon(pts)
+    assert_tiles(xy, tris)
+    normal = np.cross(pts[tris[:, 1]] - pts[tris[:, 0]], pts[tris[:, 2]] - pts[tris[:, 0]])
+    newell = np.cross(pts, np.roll(pts, -1, axis=0)).sum(axis=0)
+    assert np.all(normal @ newell > 0)
+
+
+def test_the_work_is_refused_past_the_limit():
+    with pytest.raises(WorkLimitError, match="triangle-corner tests"):
+        triangulate_polygon(star(2000), max_tests=1000)
+
+
+def test_agrees_with_mapbox_earcut_on_the_count_and_area():
+    earcut = pytest.importorskip("mapbox_earcut")
+    xy = star(600, inner=0.2)
+    ref = earcut.triangulate_float64(xy, np.array([len(xy)], dtype=np.uint32)).reshape(-1, 3)
+    ours = triangulate_polygon(xy)
+    assert len(ours) == len(ref)
+    assert np.abs(signed_areas(xy, ours)).sum() == pytest.approx(
+        np.abs(signed_areas(xy, ref)).sum(), rel=1e-12
+    )
+
+
+def test_mesh_triangulate_clips_a_large_concave_face():
+    xy = star(1200)
+    v = np.column_stack([xy, np.zeros(len(xy))])
+    _, fi, fo = meshops.triangulate(v, np.arange(len(xy)), np.array([0, len(xy)]))
+    tris = fi.reshape(-1, 3)
+    assert_tiles(xy, tris)
+
+
+def test_bad_polygons_are_refused():
+    with pytest.raises(ValueError, match="at least 3 corners"):
+        triangulate_polygon(np.zeros((2, 2)))
+    with pytest.raises(ValueError, match=r"\(k, 2\) or \(k, 3\)"):
+        triangulate_polygon(np.zeros((5, 4)))
+    with pytest.raises(ValueError, match="finite"):
+        triangulate_polygon([[0, 0], [1, 0], [np.nan, 1]])
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    k=st.integers(3, 80),
+    seed=st.integers(0, 10_000),
+    dup=st.booleans(),
+)
+def test_any_loop_gets_k_minus_2_triangles_of_its_corners(k, seed, dup):
+    """Self-intersecting, repeated and collinear corners: no crash, no endless loop."""
+    rng = np.random.default_rng(seed)
+    xy = rng.integers(-3, 4, size=(k, 2)).astype(float)  # many collinear and equal points
+    if dup:
+        xy[k // 2] = xy[0]
+    tris = triangulate_polygon(xy)
+    assert tris.shape == (k - 2, 3)
+    assert tris.min() >= 0 and tris.max() < k
+    assert np.all(
+        (tris[:, 0] != tris[:, 1]) & (tris[:, 1] != tris[:, 2]) & (tris[:, 0] != tris[:, 2])
+    )
+
+
+def test_a_loop_of_no_area_is_fanned_without_error():
+    xy = np.column_stack([np.arange(6.0), np.zeros(6)])
+    assert triangulate_polygon(xy).shape == (4, 3)
+    assert triangulate_polygon(np.zeros((5, 3))).shape == (3, 3)
