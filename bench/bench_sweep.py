@@ -1,7 +1,7 @@
 """Sweeps on Dask vs a plain loop of ``g.evaluate`` in one process.
 
-- 200 variants of the spiral tube (turns 1..10 x 20 radii), the tessellated mesh built
-  for each: a sweep on a running 2-worker LocalCluster vs the loop (which shares the
+- 200 variants of the spiral tube (turns 1..10 x 20 radii), the capped solid built for
+  each: a sweep on a running 2-worker LocalCluster vs the loop (which shares the
   unvaried section through its memory cache, as any loop over one Graph does). The note
   gives the node evaluations the sweep's graph needed against variants x nodes.
 - 2,000 variants of a light graph (a 16-point circle and its polyline, microseconds of
@@ -53,7 +53,8 @@ def run(table) -> None:
         vary = {"turns": "1:10", "radius": "0.5:5:20"}
         g = fg.load(tube)
         variants = sample([domain(g, n, s) for n, s in vary.items()])
-        loop = _loop(fg.load(tube), "mesh", variants)
+        built = g.plan("print")[-1].upstream[0]  # what a sweep builds: the exported solid
+        loop = _loop(fg.load(tube), built, variants)
         ours, s = _sweep(fg.load(tube), vary, client)
         t = s.totals
         case = f"sweep: spiral tube, {len(variants)} variants, 2 workers"

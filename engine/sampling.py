@@ -136,7 +136,8 @@ def parse_spec(text: str, kind: type) -> Domain:
     count = _number(parts[2], int)
     if not 1 <= count <= MAX_VARIANTS:
         raise ValueError(f"{text!r}: the count must be 1 to {MAX_VARIANTS:,}, got {count}")
-    values = np.linspace(low, high, count).tolist()
+    # 12 significant digits: 0.3, not 0.30000000000000004, in the table and the labels
+    values = [float(f"{v:.12g}") for v in np.linspace(low, high, count)]
     if kind is int:
         if any(abs(v - round(v)) > 1e-9 for v in values):
             raise ValueError(
