@@ -466,3 +466,19 @@ def test_an_export_that_variants_share_runs_once_and_lands_in_each_folder(client
     assert (s.totals.naive, s.totals.needed) == (3 * 4, 3 + 3)  # pts, ring, drawing once
     files = [(tmp_path / r["drawing"]).read_bytes() for r in s.rows]
     assert files[0].startswith(b"<?xml") and files[0] == files[1] == files[2]
+
+
+def test_measured_boxes_match_their_closed_forms(client):
+    g = fg.Graph()
+    g.add_param("w", 1.0, min=0.1, max=10)
+    g.add_param("d", 2.0, min=0.1, max=10)
+    g.add("box", "mesh.box", size=["=w", "=d", 3.0])
+    g.add("m", "mesh.measure", mesh="@box")
+    s = fg.sweep(g, {"w": "0.5:2:4", "d": "1,3"}, ["m"], client=client, cache_dir=None)
+    assert len(s.rows) == 8
+    for r in s.rows:
+        w, d = r["w"], r["d"]
+        assert r["m.volume"] == pytest.approx(w * d * 3.0, rel=1e-12)
+        assert r["m.area"] == pytest.approx(2 * (w * d + 3 * w + 3 * d), rel=1e-12)
+        assert r["m.watertight"] is True and r["m.faces"] == 6
+    assert "m.size" not in s.columns  # a vector: not a column
