@@ -3,9 +3,13 @@
 Keys are computed from what went into a node (its type, implementation version, canonical
 literal inputs and the keys of its wired inputs), never from the data. Values on disk are
 plain ``.npz`` archives (``allow_pickle=False``) with a JSON description and a checksum, so
-a truncated, corrupt or foreign entry is detected and recomputed, never trusted. The disk
-cache is bounded (2 GiB unless ``$FORMGRAPH_CACHE_MAX_SIZE`` says otherwise): reading an
-entry marks it used, and the least recently used entries go first when it is pruned.
+a truncated, corrupt or foreign entry is detected and recomputed, never trusted. Reading an
+entry never inflates it past :data:`MAX_INFLATE` times its size on disk (the arrays' headers
+are checked against the bytes that hold them before anything is allocated) and never parses
+a description nested deeper than :data:`MAX_META_DEPTH`: a hostile entry is a miss, not a
+``MemoryError`` or ``RecursionError``. The disk cache is bounded (2 GiB unless
+``$FORMGRAPH_CACHE_MAX_SIZE`` says otherwise): reading an entry marks it used, and the least
+recently used entries go first when it is pruned.
 """
 
 from __future__ import annotations
@@ -14,6 +18,7 @@ import enum
 import hashlib
 import io
 import json
+import math
 import os
 import re
 import tempfile
@@ -31,6 +36,8 @@ import numpy as np
 from .geometry import STORABLE, Geometry, from_state
 
 FORMAT = 1
+MAX_INFLATE = 16  # ours are stored uncompressed (1x); anything far beyond is hostile
+MAX_META_DEPTH = 64  # ours nest a few levels per list of geometry
 
 
 def canonical(value: Any) -> Any:
@@ -213,28 +220,32 @@ class DiskCache:
         except OSError:
             return False, None, None
         try:
-            with np.load(io.BytesIO(data), allow_pickle=False) as z:
-                meta = json.loads(bytes(z["meta"]).decode())
-                if meta.get("format") != FORMAT or meta.get("key") != key:
-                    raise ValueError("foreign entry")
-                arrays = {name: z[name] for name in z.files if name != "meta"}
+            arrays = _read_npz(data)
+            # json's parser refuses absurd nesting itself (RecursionError, a miss); what it
+            # accepts is checked before the recursive decoding below
+            meta = json.loads(bytes(arrays.pop("meta")).decode())
+            if _depth(meta) > MAX_META_DEPTH:
+                raise ValueError("description nested too deeply")
+            if meta.get("format") != FORMAT or meta.get("key") != key:
+                raise ValueError("foreign entry")
             check = hashlib.blake2b(digest_size=16)
             for name in sorted(arrays):
                 check.update(name.encode())
                 check.update(_hash_bytes(arrays[name]).encode())
             if check.hexdigest() != meta.get("check"):
                 raise ValueError("checksum mismatch")
-            for a in arrays.values():
-                a.flags.writeable = False
             return True, _decode(meta["value"], arrays), meta.get("identity")
         except (
             ValueError,
             KeyError,
+            IndexError,
             OSError,
             EOFError,
             zipfile.BadZipFile,
             TypeError,
             AttributeError,
+            RecursionError,
+            MemoryError,
         ):
             try:
                 path.unlink()
@@ -455,6 +466,57 @@ def _unlink(path: Path) -> bool:
     except OSError:
         return False
     return True
+
+
+def _read_npz(data: bytes) -> dict[str, np.ndarray]:
+    """The arrays of an ``.npz`` archive, read-only over immutable bytes, inflating at most
+    :data:`MAX_INFLATE` times ``len(data)``.
+
+    Raises
+    ------
+    ValueError, zipfile.BadZipFile
+        For anything but plain arrays whose headers agree with their bytes.
+    """
+    allowed = max(len(data) * MAX_INFLATE, 1 << 16)
+    out: dict[str, np.ndarray] = {}
+    with zipfile.ZipFile(io.BytesIO(data)) as zf:
+        infos = zf.infolist()
+        if sum(i.file_size for i in infos) > allowed:  # declared sizes bound what is read
+            raise ValueError("entry inflates too far")
+        for info in infos:
+            if not info.filename.endswith(".npy"):
+                raise ValueError("not an array")
+            out[info.filename[:-4]] = _read_npy(zf.read(info))
+    return out
+
+
+def _read_npy(raw: bytes) -> np.ndarray:
+    fh = io.BytesIO(raw)
+    version = np.lib.format.read_magic(fh)
+    if version == (1, 0):
+        shape, fortran, dtype = np.lib.format.read_array_header_1_0(fh)
+    elif version == (2, 0):
+        shape, fortran, dtype = np.lib.format.read_array_header_2_0(fh)
+    else:
+        raise ValueError(f"npy format {version}")
+    if dtype.hasobject or any(not isinstance(n, int) or n < 0 for n in shape):
+        raise ValueError("not a plain array")
+    count = math.prod(shape)
+    if count * dtype.itemsize != len(raw) - fh.tell():  # the header must agree with the data
+        raise ValueError("array size does not match its header")
+    a = np.frombuffer(raw, dtype=dtype, count=count, offset=fh.tell())
+    return a.reshape(shape[::-1]).T if fortran else a.reshape(shape)
+
+
+def _depth(value: Any) -> int:
+    """How deeply parsed JSON nests, measured without recursion."""
+    deepest, stack = 0, [(value, 1)]
+    while stack:
+        v, d = stack.pop()
+        if isinstance(v, (list, dict)):
+            deepest = max(deepest, d)
+            stack.extend((c, d + 1) for c in (v.values() if isinstance(v, dict) else v))
+    return deepest
 
 
 def default_cache_dir() -> Path:

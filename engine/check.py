@@ -18,7 +18,7 @@ from .errors import ExpressionError, Problem, Where
 from .expr import compile_expression
 from .model import Expr, Input, Items, Literal, NodeDef, ParamDef, Wire
 from .registry import NodeSpec, node_types
-from .types import Kind, PortType, TypeMismatch, Vec3, as_list, describe
+from .types import Kind, PortType, TypeMismatch, Vec3, as_list, describe, number_text
 
 
 def suggest(name: str, options: Any) -> str:
@@ -26,27 +26,60 @@ def suggest(name: str, options: Any) -> str:
     return f" (did you mean '{close[0]}'?)" if close else ""
 
 
+def _whole(x: Any) -> bool:
+    return isinstance(x, int) and not isinstance(x, bool)
+
+
+def param_kind(p: ParamDef) -> type | None:
+    """The scalar type of a param without a declared ``type:``, read from how it is written.
+
+    A number is an ``int`` only when its default, min and max are all written as whole
+    numbers (``{default: 3, min: 0.5, max: 10}`` is a float); None for anything else.
+    """
+    if p.type is not None:
+        return None
+    d = p.default
+    if isinstance(d, (bool, str)):
+        return type(d)
+    if _whole(d):
+        return int if all(_whole(b) for b in (p.min, p.max) if b is not None) else float
+    if isinstance(d, float):
+        return float
+    return None
+
+
 def check_param_value(p: ParamDef, value: Any) -> Any:
     """The value of param ``p`` as the graph uses it, or TypeMismatch."""
+    kind = param_kind(p)
     if p.type is not None:
         if value is None:
             return None
         out = p.type.coerce(value)
-    elif isinstance(p.default, bool):
-        out = PortType((Kind(bool),)).coerce(value)
-    elif isinstance(p.default, int):
-        out = PortType((Kind(int),)).coerce(value)
-    elif isinstance(p.default, float):
-        out = PortType((Kind(float),)).coerce(value)
-    elif isinstance(p.default, str):
-        out = PortType((Kind(str),)).coerce(value)
+    elif kind is not None:
+        out = PortType((Kind(kind),)).coerce(value)
     else:
         out = value
     if isinstance(out, (int, float)) and not isinstance(out, bool):
         if p.min is not None and out < p.min:
-            raise TypeMismatch(f"must be >= {p.min:g}, got {out:g}")
+            raise TypeMismatch(f"must be >= {number_text(p.min)}, got {number_text(out)}")
         if p.max is not None and out > p.max:
-            raise TypeMismatch(f"must be <= {p.max:g}, got {out:g}")
+            raise TypeMismatch(f"must be <= {number_text(p.max)}, got {number_text(out)}")
+    return out
+
+
+def param_warnings(params: Mapping[str, ParamDef], file: str) -> list[Problem]:
+    """Params whose type was guessed where a guess could be wrong: a slider-ready number
+    (with a min or max) read as int because everything about it is written whole."""
+    out = []
+    for p in params.values():
+        if param_kind(p) is int and (p.min is not None or p.max is not None):
+            out.append(
+                Problem(
+                    Where(file, p.line),
+                    f"param '{p.name}' is read as int (its default, min and max are whole "
+                    f"numbers); write 'type: int' to confirm, or 'type: float' to allow fractions",
+                )
+            )
     return out
 
 
@@ -116,7 +149,7 @@ def check_graph(g: Outline, extra: list[Problem] | None = None) -> list[Problem]
                 # the SPEC's form: file:line, then the type (the node is named after it)
                 problems.append(
                     Problem(
-                        Where(file, nd.line),
+                        Where(file, nd.input_lines.get("type", nd.line)),
                         f"unknown node type '{nd.type}'{suggest(nd.type, registry)}"
                         f" in node '{nd.name}'",
                     )
@@ -337,6 +370,8 @@ def _check_input(
             resolved = [_static_value(g, i, loop) for i in value.items]
         except _Unknown as exc:
             return [str(exc)] if str(exc) else []
+        except (ExpressionError, ValueError, TypeError, ZeroDivisionError) as exc:
+            return [f"an expression fails with the param defaults: {exc}"]
         return _coerce_problems(pt, resolved)
     list_kinds = [k for k in pt.kinds if k.is_list]
     if not list_kinds:

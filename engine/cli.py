@@ -12,17 +12,28 @@ import os
 import sys
 import time
 import traceback
+import warnings
 from collections.abc import Sequence
 from typing import Any
 
 import yaml
 
-from .errors import FormgraphError, GraphError
+from .errors import FormgraphError, FormgraphWarning, GraphError
 from .registry import DEFAULT_BUDGET
 
 
 class UsageError(Exception):
     """A command line that does not make sense (exit code 2)."""
+
+
+def _budget(text: str) -> int:
+    try:
+        value = int(text.replace("_", ""))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be at least 1, got {value}")
+    return value
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -35,14 +46,16 @@ def _parser() -> argparse.ArgumentParser:
     def graph_options(p: argparse.ArgumentParser) -> None:
         p.add_argument(
             "--set",
-            action="append",
+            action="extend",
+            nargs="+",
             default=[],
             metavar="NAME=VALUE",
-            help="override a graph param (parsed by the param's type)",
+            help="override graph params (parsed by each param's type); several may follow "
+            "one --set",
         )
         p.add_argument(
             "--budget",
-            type=int,
+            type=_budget,
             default=DEFAULT_BUDGET,
             help=f"element budget per node (default {DEFAULT_BUDGET:,})",
         )
@@ -142,7 +155,7 @@ def parse_sets(graph: Any, items: Sequence[str]) -> dict[str, Any]:
         name, sep, text = item.partition("=")
         name = name.strip()
         if not sep or not name:
-            raise UsageError(f"--set takes NAME=VALUE, got {item!r}")
+            raise UsageError(f"--set takes NAME=VALUE, got {item!r} (node names go before --set)")
         if name not in defs:
             from .check import suggest
 
@@ -150,22 +163,23 @@ def parse_sets(graph: Any, items: Sequence[str]) -> dict[str, Any]:
                 f"--set {name}: unknown param{suggest(name, defs)}; params are "
                 f"{', '.join(defs) or 'none'}"
             )
-        default = defs[name].default
-        if isinstance(default, str):
+        from .check import param_kind
+        from .yamlread import load_value
+
+        kind = param_kind(defs[name])
+        if kind is str:
             value: Any = text
-        elif isinstance(default, (int, float)) and not isinstance(default, bool):
+        elif kind in (int, float):
             value = _number(text)
+            if kind is float and isinstance(value, int):
+                value = float(value)
         else:
             try:
-                value = yaml.safe_load(text)
-            except yaml.YAMLError:
-                raise UsageError(f"--set {name}: cannot read {text!r}") from None
-            if (
-                isinstance(default, float)
-                and isinstance(value, int)
-                and not isinstance(value, bool)
-            ):
-                value = float(value)
+                value = load_value(text)  # YAML 1.2 numbers, as in the graph file
+            except (yaml.YAMLError, ValueError, TypeError, RecursionError) as exc:
+                shown = text if len(text) <= 40 else text[:37] + "..."
+                why = getattr(exc, "problem", None) or exc
+                raise UsageError(f"--set {name}: cannot read {shown!r}: {why}") from None
         out[name] = value
     return out
 
@@ -235,7 +249,9 @@ def _size(n: int) -> str:
 
 def _describe(value: Any) -> str:
     if isinstance(value, str) and os.path.isabs(value):
-        return f"wrote {os.path.relpath(value)}"
+        if os.path.isfile(value):
+            return f"wrote {os.path.relpath(value)}"
+        return f"{os.path.relpath(value)} is missing (it was not written)"
     return repr(value)
 
 
@@ -274,9 +290,12 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 
 def cmd_check(args: argparse.Namespace) -> int:
+    from .check import param_warnings
     from .graph import load
 
     g = load(args.graph)
+    for p in param_warnings(g.param_defs, g.file_label):
+        print(f"{p.where.prefix()}: warning: {p.message}", file=sys.stderr)
     print(f"{args.graph}: ok ({len(g.nodes)} nodes, {len(g.params)} params)")
     return 0
 
@@ -462,7 +481,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     ap = _parser()
     args = ap.parse_args(argv)  # exits 2 on a usage error
     try:
-        return COMMANDS[args.command](args)
+        with warnings.catch_warnings():
+            # the commands print node warnings themselves, once, next to the node's output
+            warnings.simplefilter("ignore", FormgraphWarning)
+            return COMMANDS[args.command](args)
     except UsageError as exc:
         print(f"formgraph: {exc}", file=sys.stderr)
         return 2

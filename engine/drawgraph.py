@@ -204,7 +204,7 @@ def _model(graph: Any, marks: Iterable[Mark] | None) -> tuple[dict[str, Box], li
     values = graph.params
     boxes: dict[str, Box] = {}
     for name, p in params.items():
-        if p.type_name:
+        if p.type_name and p.default is None:  # a slot filled from Python (`type: int` is not)
             sub = f"{p.type_name} input"
         else:
             sub = f"= {_short(values.get(name))}"

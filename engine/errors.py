@@ -91,6 +91,14 @@ class NodeError(FormgraphError):
         super().__init__(f"{where.prefix()} ({node_type}): {message}")
 
 
+class FormgraphWarning(UserWarning):
+    """A node's warning (a hole in a mesh, a value clamped), also kept in ``g.stats``.
+
+    Emitted through :mod:`warnings`, so ``warnings.simplefilter("error", FormgraphWarning)``
+    turns them into errors and ``pytest.warns`` catches them.
+    """
+
+
 class InputError(ValueError):
     """Raised by a node function to say which of its inputs holds a bad value."""
 

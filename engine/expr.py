@@ -125,7 +125,13 @@ class Compiled:
                 f"expression {self.text!r} needs a value for {', '.join(sorted(missing))}"
             )
         with np.errstate(all="ignore"):
-            return self._fn(scope)
+            try:
+                return self._fn(scope)
+            except OverflowError:  # a Python int too large for a float64, e.g. a param
+                raise ValueError(
+                    f"{_glimpse(self.text)}: a number is too large (numbers in expressions "
+                    f"are floats, up to about 1.8e308)"
+                ) from None
 
     @property
     def is_bare_name(self) -> bool:
@@ -198,6 +204,10 @@ def compile_expression(text: str, allowed: set[str] | frozenset[str] | None = No
     return Compiled(text, frozenset(names), fn)
 
 
+def _glimpse(text: str) -> str:
+    return repr(text) if len(text) <= 40 else repr(text[:37]) + "..."
+
+
 class _Compiler:
     def __init__(self, text: str, allowed: set[str] | frozenset[str] | None, names: set[str]):
         self.text = text
@@ -218,7 +228,13 @@ class _Compiler:
         value = node.value
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise self.refuse(node, "a literal of this kind")
-        v = np.float64(value)
+        try:
+            v = np.float64(value)
+        except OverflowError:
+            raise ExpressionError(
+                f"a number in {_glimpse(self.text)} is too large "
+                f"(numbers in expressions are floats, up to about 1.8e308)"
+            ) from None
         return lambda env: v
 
     def visit_Name(self, node: ast.Name) -> Callable[[Env], Any]:

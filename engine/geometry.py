@@ -20,25 +20,48 @@ import numpy as np
 from .kernels.mesh import grid as _grid
 
 
+def is_frozen(a: Any) -> bool:
+    """Whether nobody can ever write to array ``a``: read-only all the way to an immutable
+    ``bytes`` buffer (an array that owns its data could be made writable again)."""
+    if not isinstance(a, np.ndarray) or a.flags.writeable:
+        return False
+    base: Any = a
+    while isinstance(base, np.ndarray):
+        base = base.base
+    return isinstance(base, bytes)
+
+
 def frozen_array(values: Any, dtype: Any = np.float64) -> np.ndarray:
-    """A read-only, C-contiguous copy of ``values`` (never a view others can write through)."""
-    a = np.array(values, dtype=dtype, copy=True, order="C")
-    a.flags.writeable = False
-    return a
+    """A C-contiguous array of ``values`` that nobody can write to, or make writable.
+
+    The data are copied once into an immutable ``bytes`` buffer and viewed from there, so
+    ``a.flags.writeable = True`` raises (for ``a`` and for ``a.base``). An array that is
+    already frozen is shared as it is, never copied.
+    """
+    if is_frozen(values) and values.dtype == dtype and values.flags.c_contiguous:
+        return values
+    a = np.asarray(values, dtype=dtype)
+    return np.frombuffer(a.tobytes(order="C"), dtype=a.dtype).reshape(a.shape)
 
 
 def as_xyz(values: Any, what: str = "points") -> np.ndarray:
     """``(n, 2)`` or ``(n, 3)`` coordinates as a read-only ``(n, 3)`` float64 array (z = 0)."""
+    frozen = is_frozen(values) and values.dtype == np.float64 and values.flags.c_contiguous
+    if frozen and values.ndim == 2 and values.shape[1] == 3 and np.isfinite(values).all():
+        return values  # immutable and valid already (another value's coordinates): shared
     try:
         raw = np.asarray(values)
         if raw.dtype.kind not in "biuf":
             raise TypeError  # strings, objects: not coordinates
-        a = raw.astype(np.float64)
+        a = raw.astype(np.float64, copy=False)
     except (TypeError, ValueError, OverflowError):
+        raw = None
         a = _pad_rows(values, what)
+    if raw is not None and raw.dtype.kind == "b":
+        raise ValueError(f"{what} must be numbers, not true/false")
     if a.ndim == 1 and a.size in (2, 3):
         a = a[None, :]
-    if a.size == 0:
+    if a.size == 0 and a.shape in ((0,), (0, 2), (0, 3)):
         a = a.reshape(0, 3)
     if a.ndim != 2 or a.shape[1] not in (2, 3):
         raise ValueError(
@@ -91,6 +114,14 @@ class Geometry:
         """What determines this value, for content hashes (its state, by default)."""
         return self.state()
 
+    def __reduce_ex__(self, protocol: Any) -> Any:
+        # pickled (e.g. to a worker process) as its state and rebuilt through the
+        # constructor, so the copy is validated and as frozen as the original
+        name = type(self).__name__
+        if STORABLE.get(name) is type(self):
+            return from_state, (name, self.state())
+        return super().__reduce_ex__(protocol)
+
 
 # ---------------------------------------------------------------------------------- points
 
@@ -108,7 +139,7 @@ class Points(Geometry):
     xyz: np.ndarray
 
     def __init__(self, xyz: Any):
-        object.__setattr__(self, "xyz", xyz if _is_frozen_xyz(xyz) else as_xyz(xyz))
+        object.__setattr__(self, "xyz", as_xyz(xyz))
 
     def __array__(self, dtype: Any = None, copy: Any = None) -> np.ndarray:
         return self.xyz if dtype is None else self.xyz.astype(dtype)
@@ -126,17 +157,6 @@ class Points(Geometry):
 
     def state(self) -> dict[str, Any]:
         return {"xyz": self.xyz}
-
-
-def _is_frozen_xyz(a: Any) -> bool:
-    return (
-        isinstance(a, np.ndarray)
-        and a.dtype == np.float64
-        and a.ndim == 2
-        and a.shape[1] == 3
-        and not a.flags.writeable
-        and a.flags.owndata  # a read-only view of someone's writable array is not enough
-    )
 
 
 # ---------------------------------------------------------------------------------- curves

@@ -33,8 +33,8 @@ from .model import NodeDef, ParamDef, parse_input
 from .registry import DEFAULT_BUDGET, NodeSpec, node_types
 from .run import NodeStat, Step, _Run
 from .subgraph import Includes, SubgraphSpec, is_graph_type
-from .types import TypeMismatch, type_by_name
-from .yamlio import MAX_BYTES, dump, parse
+from .types import TypeMismatch, describe, type_by_name
+from .yamlio import MAX_BYTES, MAX_DEPTH, dump, parse
 
 __all__ = ["Graph", "NodeStat", "Step", "load"]
 
@@ -57,6 +57,9 @@ def load(
     GraphError
         With every problem found, each naming file, line, node and input.
     """
+    if not isinstance(path, (str, os.PathLike)):
+        raise GraphError(f"load() takes the path of a graph file, got {describe(path)}")
+    _check_budgets(budget, memory_bytes)
     path = Path(path)
     try:
         with open(path, "rb") as fh:  # never read more than the format allows
@@ -101,6 +104,7 @@ class Graph:
         description: str = "",
         file: str | None = None,
     ):
+        _check_budgets(budget, memory_bytes)
         self.file = file
         self.description = description
         self.out_dir = Path(out_dir)
@@ -198,18 +202,34 @@ class Graph:
         type: str | None = None,
     ) -> None:
         """Declare a graph param (``type`` names a geometry type for a Python input slot)."""
+        if not isinstance(name, str):
+            raise ParamError(f"add_param() takes a param name (a string), got {describe(name)}")
+        for bound, b in (("min", min), ("max", max)):
+            if b is not None and (isinstance(b, bool) or not isinstance(b, (int, float))):
+                raise ParamError(f"param '{name}': {bound} must be a number, got {describe(b)}")
         long_form = any(x is not None for x in (min, max, type)) or bool(doc)
-        default = _plain(default)
+        default = _plain(default, f"param '{name}'")
         p = ParamDef(name, default, None, type, min, max, doc, None, long_form)
         if type is not None:
-            p.type = type_by_name(type)
+            if not isinstance(type, str):
+                raise ParamError(f"param '{name}': type must be a name such as 'Mesh'")
+            try:
+                p.type = type_by_name(type)
+            except TypeMismatch as exc:
+                raise ParamError(f"param '{name}': {exc}") from None
         self._params[name] = p
         self._values[name] = default
         self._checked = False
 
     def add(self, name: str, type: str, **inputs: Any) -> None:
         """Add (or replace) node ``name`` of node type ``type`` with its inputs."""
-        self._nodes[name] = NodeDef.make(name, type, {k: _plain(v) for k, v in inputs.items()})
+        if not isinstance(name, str) or not isinstance(type, str):
+            what = "node name" if not isinstance(name, str) else "node type"
+            bad = name if not isinstance(name, str) else type
+            raise GraphError(f"add() takes a {what} (a string), got {describe(bad)}")
+        self._nodes[name] = NodeDef.make(
+            name, type, {k: _plain(v, f"input '{k}' of '{name}'") for k, v in inputs.items()}
+        )
         self._checked = False
 
     def remove(self, name: str) -> None:
@@ -234,7 +254,7 @@ class Graph:
     def set_input(self, node: str, port: str, value: Any) -> None:
         """Change one input of a node as authored (a literal, wire or expression)."""
         nd = self._nodes[node]
-        value = _plain(value)
+        value = _plain(value, f"input '{port}' of '{node}'")
         if port == "repeat":  # not an input: the node's loop
             nd.set_repeat(value)
             self._checked = False
@@ -279,6 +299,14 @@ class Graph:
                     )
                 )
                 continue
+            if _nesting(value) > MAX_DEPTH:
+                problems.append(
+                    Problem(
+                        Where(self.file_label, p.line),
+                        f"param '{name}': the value is nested more than {MAX_DEPTH} levels deep",
+                    )
+                )
+                continue
             try:
                 out[name] = check_param_value(p, value)
             except TypeMismatch as exc:
@@ -313,7 +341,7 @@ class Graph:
             self.check()
         values = dict(self._values)
         values.update(self._checked_params(params))
-        names = [nodes] if isinstance(nodes, str) else list(nodes)
+        names = _node_names(nodes)
         for n in names:
             if n not in self._nodes:
                 from .check import suggest
@@ -468,15 +496,63 @@ class Graph:
         return f"Graph({self.file_label!r}, {len(self._nodes)} nodes, params={self._values})"
 
 
-def _plain(value: Any) -> Any:
+def _node_names(nodes: Any) -> list[str]:
+    """The names asked for by ``evaluate(nodes)``: one name or an iterable of names."""
+    if isinstance(nodes, str):
+        return [nodes]
+    names = None
+    if isinstance(nodes, Iterable) and not isinstance(nodes, (bytes, dict)):
+        names = list(nodes)
+    if names is None or not all(isinstance(n, str) for n in names):
+        raise GraphError(
+            f"evaluate() takes a node name or a list of node names, got {describe(nodes)}"
+        )
+    return names
+
+
+def _check_budgets(budget: Any, memory_bytes: Any) -> None:
+    for what, value, least in (("budget", budget, 1), ("memory_bytes", memory_bytes, 0)):
+        if isinstance(value, bool) or not isinstance(value, int) or value < least:
+            raise GraphError(
+                f"{what} must be a whole number of {'elements' if what == 'budget' else 'bytes'}"
+                f" (at least {least}), got {describe(value)}"
+            )
+
+
+def _nesting(value: Any) -> int:
+    """How deeply lists, tuples and dicts nest in ``value``, without recursion."""
+    deepest, stack = 0, [(value, 0)]
+    while stack:
+        v, d = stack.pop()
+        if isinstance(v, (list, tuple, dict)):
+            if d + 1 > MAX_DEPTH:
+                return d + 1  # deep enough to refuse: no need to walk the rest
+            deepest = max(deepest, d + 1)
+            stack.extend((c, d + 1) for c in (v.values() if isinstance(v, dict) else v))
+        elif isinstance(v, np.ndarray):
+            deepest = max(deepest, d + v.ndim)
+    return deepest
+
+
+def _plain(value: Any, what: str = "a value", depth: int = 0) -> Any:
     """Inputs given from Python as the YAML they save to: tuples and arrays become lists,
-    numpy numbers Python numbers (geometry objects stay as they are)."""
+    numpy numbers Python numbers (geometry objects stay as they are).
+
+    Raises
+    ------
+    GraphError
+        For a value nested deeper than a graph file may be.
+    """
+    if depth > MAX_DEPTH:
+        raise GraphError(f"{what} is nested more than {MAX_DEPTH} levels deep")
     if isinstance(value, np.ndarray):
+        if value.ndim > MAX_DEPTH:
+            raise GraphError(f"{what} is nested more than {MAX_DEPTH} levels deep")
         return value.tolist()
     if isinstance(value, np.generic):
         return value.item()
     if isinstance(value, (list, tuple)):
-        return [_plain(v) for v in value]
+        return [_plain(v, what, depth + 1) for v in value]
     if isinstance(value, dict):
-        return {k: _plain(v) for k, v in value.items()}
+        return {k: _plain(v, what, depth + 1) for k, v in value.items()}
     return value

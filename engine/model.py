@@ -75,6 +75,9 @@ class Items:
 Input = Union[Literal, Wire, Expr, Items]  # noqa: UP007 (a runtime alias)
 
 
+_NUMBERS = (int, float, bool)
+
+
 def parse_input(raw: Any) -> Input:
     """Parse an authored input value.
 
@@ -103,6 +106,8 @@ def parse_input(raw: Any) -> Input:
     if isinstance(raw, dict) and set(raw) == {"value"}:
         return Literal(raw["value"])
     if isinstance(raw, list):
+        if all(type(v) in _NUMBERS for v in raw):
+            return Literal(raw)  # the common case of coordinates, without a call per number
         items = tuple(parse_input(v) for v in raw)
         if any(not isinstance(i, Literal) for i in items):
             return Items(items)

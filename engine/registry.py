@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import functools
 import inspect
+import math
 import re
 import typing
 from collections.abc import Callable
@@ -172,6 +173,15 @@ def parse_param_docs(doc: str) -> dict[str, str]:
     return {k: v for k, v in out.items() if k not in ("Returns", "Raises", "Example", "Examples")}
 
 
+def _count(elements: int | float) -> str:
+    """A count for a message: exact while readable, then its order of magnitude."""
+    if elements < 1e15:
+        return f"{int(elements):,}"
+    if isinstance(elements, float):
+        return f"{elements:.3g}" if elements != float("inf") else "infinitely many"
+    return f"about 10^{int(math.log10(elements))}"  # exact for ints of any size
+
+
 @dataclass
 class Context:
     """What a running node may use besides its inputs: budget, output directory, warnings.
@@ -188,8 +198,9 @@ class Context:
     def guard(self, elements: int | float, what: str = "elements") -> None:
         """Refuse, before allocating, an output of more than the element budget."""
         if elements > self.budget:
+            count = _count(elements)
             raise BudgetError(
-                f"would make {int(elements):,} {what}, over the budget of "
+                f"would make {count} {what}, over the budget of "
                 f"{self.budget:,} (raise it with budget= or --budget if you mean it)"
             )
 

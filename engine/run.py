@@ -10,17 +10,26 @@ are evaluated by the :class:`formgraph.language.LanguageRun` mixin.
 
 from __future__ import annotations
 
+import os
+import sys
 import time
+import warnings as _warnings
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
 from . import cache as _cache
+from . import safety
 from .errors import (
     BudgetError,
     ExpressionError,
+    FormgraphWarning,
     GraphError,
     InputError,
     NodeError,
+    PathError,
     Problem,
     Where,
 )
@@ -83,10 +92,13 @@ class _Run(LanguageRun):
         self.inner: dict[str, dict[str, NodeStat]] = {}  # subgraph node -> its run's stats
         self.results: dict[str, Any] = {}
         self.stats: dict[str, NodeStat] = {}
-        self.out_path = g.out_dir.resolve()
+        try:
+            self.out_path = safety.output_root(g.out_dir)
+        except PathError:  # only an export needs it: each says why, at its own line
+            self.out_path = Path(os.path.abspath(g.out_dir))
         self.out_dir = str(self.out_path)
         self.total = 0
-        self.done = 0
+        self.started: set[str] = set()  # nodes that began computing, for the progress line
 
     def where(self, name: str, port: str | None = None) -> Where:
         nd = self.g._nodes[name]
@@ -266,8 +278,12 @@ class _Run(LanguageRun):
             source = "disk"
             if hit:
                 self.g.memory.put(key, value)
-        if hit and spec.is_export and self.g._written.get(key) != file_stamp(value):
-            hit = False  # the file is gone or holds something else now: write it again
+        if hit and spec.is_export:
+            # trusted only when this graph wrote the file and it is still what was written; a
+            # fresh process has no record, so it writes again (an identical file stays untouched)
+            stamp = file_stamp(value)
+            if stamp is None or self.g._written.get(key) != stamp:
+                hit = False
         if hit and spec.multi_output and not isinstance(value, spec.output_class):
             value = spec.output_class(*value)  # the disk cache stores the outputs as a list
         if hit and key not in self.g._identity:
@@ -317,15 +333,19 @@ class _Run(LanguageRun):
         warnings: list[str] = []
         if spec.wants_context:
             kwargs["ctx"] = Context(name, self.out_path, self.g.budget, warnings)
-        if self.g.progress is not None:
-            computed = sum(1 for s in self.stats.values() if s.status == "computed")
-            self.g.progress(name, computed, self.total)
+        if self.g.progress is not None:  # counted as it goes: linear in the graph's size
+            self.g.progress(name, len(self.started) - (name in self.started), self.total)
+        self.started.add(name)
         t0 = time.perf_counter()
         try:
-            if isinstance(spec, SubgraphSpec):
-                value = self.run_subgraph(name, nd, spec, kwargs, env)
-            else:
-                value = spec.func(**kwargs)
+            with np.errstate(all="ignore"), _warnings.catch_warnings():
+                # numpy's overflow/invalid-value chatter never reaches a user: a result that
+                # is not finite is refused (check_output, the geometry types), located
+                _warnings.simplefilter("ignore", RuntimeWarning)
+                if isinstance(spec, SubgraphSpec):
+                    value = self.run_subgraph(name, nd, spec, kwargs, env)
+                else:
+                    value = spec.func(**kwargs)
         except BudgetError as exc:
             raise BudgetError(
                 [Problem(self.where(name), p.message) for p in exc.problems]
@@ -347,6 +367,8 @@ class _Run(LanguageRun):
             raise NodeError(self.where(name), nd.type, str(exc)) from exc
         except Exception as exc:
             raise NodeError(self.where(name), nd.type, f"{type(exc).__name__}: {exc}") from exc
+        for w in warnings:
+            _warn(f"{self.where(name).prefix()}: {w}")
         return value, time.perf_counter() - t0, warnings
 
     def compute(self, name: str, nd: NodeDef, spec: NodeSpec) -> Any:
@@ -403,6 +425,13 @@ class _Run(LanguageRun):
 
     def check_output(self, name: str, nd: NodeDef, spec: NodeSpec, value: Any) -> Any:
         if spec.multi_output:
+            for field_name, v in zip(spec.outputs, value, strict=False):
+                if isinstance(v, float) and not np.isfinite(v):
+                    raise NodeError(
+                        self.where(name),
+                        nd.type,
+                        f"output '{field_name}' is not finite ({v}): an input is too extreme",
+                    )
             return value
         out_type = spec.output_type(None)
         try:
@@ -413,3 +442,14 @@ class _Run(LanguageRun):
                 nd.type,
                 f"returned a value that does not fit its output {out_type.name}: {exc}",
             ) from None
+
+
+_PACKAGE = os.path.dirname(os.path.abspath(__file__))
+
+
+def _warn(message: str) -> None:
+    """Emit a :class:`FormgraphWarning` attributed to the first caller outside formgraph."""
+    frame, level = sys._getframe(0), 1
+    while frame is not None and frame.f_code.co_filename.startswith(_PACKAGE):
+        frame, level = frame.f_back, level + 1
+    _warnings.warn(message, FormgraphWarning, stacklevel=level)

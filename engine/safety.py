@@ -3,16 +3,27 @@
 A graph downloaded from someone else must not write anywhere but the output directory, so
 every export path is relative, free of ``..``, and still inside the directory after symlinks
 are followed. Files appear whole or not at all (temp file in the same folder, fsync,
-``os.replace``), and a file that already holds exactly the bytes is left untouched.
+``os.replace``), and a file that already holds exactly the bytes is left untouched. A temp
+file names the process that writes it, so one left behind by a killed run is removed by the
+next write into its folder.
 """
 
 from __future__ import annotations
 
 import os
+import re
 import tempfile
+import time
 from pathlib import Path, PurePosixPath, PureWindowsPath
 
 from .errors import PathError
+
+MAX_PATH_CHARS = 1024
+MAX_PATH_PARTS = 32  # folders deep
+MAX_NAME_CHARS = 200  # per folder or file name, leaving room for the temp file's affixes
+TMP_TAG = ".fgtmp-"  # temp files are '.{name}.fgtmp-{pid}-{random}.tmp'
+_TMP = re.compile(r"^\..+\.fgtmp-(\d+)-[^.]+\.tmp$")
+STALE_SECONDS = 24 * 3600  # a temp file this old is stale whoever wrote it
 
 
 def path_problem(relpath: str) -> str | None:
@@ -31,7 +42,36 @@ def path_problem(relpath: str) -> str | None:
         return f"output path {relpath!r} is absolute; give a path relative to the output directory"
     if ".." in posix.parts or ".." in win.parts:
         return f"output path {relpath!r} leaves the output directory ('..')"
+    shown = relpath if len(relpath) <= 60 else relpath[:57] + "..."
+    if len(relpath) > MAX_PATH_CHARS:
+        return (
+            f"output path {shown!r} is {len(relpath):,} characters long (at most {MAX_PATH_CHARS})"
+        )
+    parts = [p for p in relpath.replace("\\", "/").split("/") if p not in ("", ".")]
+    if len(parts) > MAX_PATH_PARTS:
+        return f"output path {shown!r} is {len(parts):,} folders deep (at most {MAX_PATH_PARTS})"
+    if any(len(p) > MAX_NAME_CHARS for p in parts):
+        return f"output path {shown!r} has a name longer than {MAX_NAME_CHARS} characters"
     return None
+
+
+def output_root(out_dir: str | os.PathLike[str]) -> Path:
+    """The output directory, absolute, symlinks followed (it need not exist yet).
+
+    Raises
+    ------
+    PathError
+        When it cannot be followed (a symlink loop) or is something other than a folder.
+    """
+    try:
+        root = Path(out_dir).resolve()
+    except (OSError, RuntimeError) as exc:  # RuntimeError: a symlink loop (Python < 3.13)
+        raise PathError(
+            f"the output directory {str(out_dir)!r} cannot be followed: {exc}"
+        ) from None
+    if root.exists() and not root.is_dir():
+        raise PathError(f"the output directory {str(out_dir)!r} is not a folder")
+    return root
 
 
 def resolve_output(out_dir: str | os.PathLike[str], relpath: str) -> Path:
@@ -45,9 +85,12 @@ def resolve_output(out_dir: str | os.PathLike[str], relpath: str) -> Path:
     problem = path_problem(relpath)
     if problem:
         raise PathError(problem)
-    root = Path(out_dir).resolve()
-    target = root / PurePosixPath(relpath.replace("\\", "/"))
-    real = target.resolve()  # follows any symlinks that exist along the way
+    root = output_root(out_dir)
+    try:
+        target = root / PurePosixPath(relpath.replace("\\", "/"))
+        real = target.resolve()  # follows any symlinks that exist along the way
+    except (OSError, RuntimeError) as exc:  # RuntimeError: a symlink loop (Python < 3.13)
+        raise PathError(f"output path {relpath!r} cannot be followed: {exc}") from None
     if real != root and root not in real.parents:
         raise PathError(
             f"output path {relpath!r} leads outside the output directory {str(root)!r} "
@@ -65,14 +108,20 @@ def write_atomic(out_dir: str | os.PathLike[str], relpath: str, data: bytes) -> 
     On any failure the previous file (if any) is intact and no temp file is left behind.
     """
     target = resolve_output(out_dir, relpath)
-    target.parent.mkdir(parents=True, exist_ok=True)
+    try:
+        target.parent.mkdir(parents=True, exist_ok=True)
+    except FileExistsError:
+        raise PathError(f"output path {relpath!r} runs through a file, not a folder") from None
     target = resolve_output(out_dir, relpath)  # a folder made meanwhile could be a symlink
     try:
         if target.is_file() and target.stat().st_size == len(data) and target.read_bytes() == data:
             return target
     except OSError:
         pass
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    remove_stale_temps(target.parent)
+    fd, tmp = tempfile.mkstemp(
+        prefix=f".{target.name}{TMP_TAG}{os.getpid()}-", suffix=".tmp", dir=target.parent
+    )
     try:
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
@@ -87,3 +136,41 @@ def write_atomic(out_dir: str | os.PathLike[str], relpath: str, data: bytes) -> 
             pass
         raise
     return target
+
+
+def remove_stale_temps(folder: Path) -> list[Path]:
+    """Delete the temp files of ours in ``folder`` that no running writer owns; returns them.
+
+    A temp file is stale when the process named in it is gone (a run killed mid-write), or
+    when it is older than a day (a writer on another machine sharing the folder).
+    """
+    removed = []
+    try:
+        entries = list(os.scandir(folder))
+    except OSError:
+        return removed
+    now = time.time()
+    for entry in entries:
+        m = _TMP.match(entry.name)
+        if m is None:
+            continue
+        try:
+            stale = not _running(int(m.group(1))) or now - entry.stat().st_mtime > STALE_SECONDS
+            if stale and entry.is_file(follow_symlinks=False):
+                os.unlink(entry.path)
+                removed.append(Path(entry.path))
+        except OSError:
+            continue  # another writer removed or replaced it meanwhile
+    return removed
+
+
+def _running(pid: int) -> bool:
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError, OSError):
+        return True  # someone else's process, or a number we cannot ask about: keep it
+    return True

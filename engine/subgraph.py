@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from .check import Outline, check_graph, output_type
+from .check import Outline, check_graph, output_type, param_kind
 from .errors import Problem, Where
 from .model import NodeDef, ParamDef, Wire, parse_input
 from .registry import REQUIRED, NodeSpec, Port, node_types
@@ -54,13 +54,8 @@ def _param_port(p: ParamDef) -> Port:
     if p.type is not None:
         t = PortType(p.type.kinds, optional=p.default is not None)
         return Port(p.name, t, REQUIRED if p.default is None else p.default, p.doc)
-    d = p.default
-    base: Any = Any
-    for cls in (bool, int, float, str):
-        if type(d) is cls:
-            base = cls
-            break
-    return Port(p.name, PortType((Kind(base),), range=rng), d, p.doc)
+    base: Any = param_kind(p) or Any  # an int only when written whole throughout
+    return Port(p.name, PortType((Kind(base),), range=rng), p.default, p.doc)
 
 
 def _chain_text(chain: list[tuple[str, str]]) -> str:

@@ -48,6 +48,15 @@ class OutputPath(str):
     """A relative output path, checked not to leave the output directory."""
 
 
+def number_text(x: float) -> str:
+    """A number for a message: ``%g`` style, and an int too large for a float by its size."""
+    if isinstance(x, int) and not -(10**15) < x < 10**15:
+        import math
+
+        return f"{'a negative' if x < 0 else 'an'} integer of {int(math.log10(abs(x))) + 1} digits"
+    return f"{x:g}"
+
+
 @dataclass(frozen=True)
 class Range:
     """Inclusive bounds of a numeric port, checked at load."""
@@ -57,9 +66,9 @@ class Range:
 
     def check(self, value: float) -> str | None:
         if self.min is not None and value < self.min:
-            return f"must be >= {self.min:g}, got {value:g}"
+            return f"must be >= {number_text(self.min)}, got {number_text(value)}"
         if self.max is not None and value > self.max:
-            return f"must be <= {self.max:g}, got {value:g}"
+            return f"must be <= {number_text(self.max)}, got {number_text(value)}"
         return None
 
 
@@ -218,6 +227,8 @@ def describe(value: Any) -> str:
     """A short description of a value for error messages: its type and a glimpse."""
     if isinstance(value, Geometry):
         return type(value).__name__
+    if value is None:
+        return "None (null)"
     if isinstance(value, bool):
         return f"bool {value}"
     if isinstance(value, (int, float)):
@@ -251,7 +262,9 @@ def _coerce_kind(k: Kind, value: Any) -> Any:
     if base is bool:
         if isinstance(value, (bool, np.bool_)):
             return bool(value)
-        raise TypeMismatch(f"expected bool, got {describe(value)}")
+        yaml11 = isinstance(value, str) and value.lower() in ("yes", "no", "on", "off", "y", "n")
+        hint = " (YAML 1.2 reads it as text: write true or false)" if yaml11 else ""
+        raise TypeMismatch(f"expected bool, got {describe(value)}{hint}")
     if base is int:
         if isinstance(value, (bool, np.bool_)):
             raise TypeMismatch(f"expected int, got {describe(value)}")
@@ -284,11 +297,18 @@ def _coerce_kind(k: Kind, value: Any) -> Any:
         try:
             return base(value)
         except ValueError:
-            options = ", ".join(repr(m.value) for m in base)
+            import difflib
+
+            values = [str(m.value) for m in base]
+            options = ", ".join(repr(v) for v in values)
+            close = difflib.get_close_matches(str(value), values, n=1, cutoff=0.6)
+            hint = f" (did you mean {close[0]!r}?)" if close else ""
             raise TypeMismatch(
-                f"{value!r} is not a valid option, must be one of {options}"
+                f"{value!r} is not a valid option{hint}, must be one of {options}"
             ) from None
     if base is Points and not isinstance(value, Geometry):
+        if _holds_bool(value):
+            raise TypeMismatch(f"expected Points (numbers), got true/false in {describe(value)}")
         try:
             return Points(value)
         except ValueError as exc:
@@ -327,7 +347,18 @@ def _faces(value: Any) -> Faces:
     return out
 
 
+def _holds_bool(rows: Any) -> bool:
+    """Whether a list of coordinate rows holds a bool (numpy would read True as 1)."""
+    if not isinstance(rows, (list, tuple)):
+        return False
+    return any(
+        type(x) is bool for row in rows for x in (row if isinstance(row, (list, tuple)) else (row,))
+    )
+
+
 def _vec_list(value: Any) -> np.ndarray:
+    if _holds_bool(value):
+        raise TypeMismatch(f"expected [x, y, z] numbers, got true/false in {describe(value)}")
     try:
         return as_xyz(value, "coordinates")
     except ValueError as exc:

@@ -1,25 +1,28 @@
 """Reading and writing graph files.
 
-Reading uses PyYAML's safe loader only: the text is composed into a node tree (to keep the
-line of every node and input), then each value is built by the safe constructor, so a
-``!!python/...`` tag is refused with its line. Duplicate keys, which YAML would silently
-resolve to the last one, are reported.
+Reading uses PyYAML's safe loading only, through :mod:`formgraph.yamlread` (libyaml, YAML 1.2
+numbers, a cost bounded by what is accepted): the text is composed into a node tree (to keep
+the line of every node and input), then each value is built, so a ``!!python/...`` tag is
+refused with its line. Duplicate keys, which YAML would silently resolve to the last one, are
+reported; merge keys (``<<: *base``) are resolved.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import Any
 
 import yaml
 
+from . import yamlread
 from .errors import Problem, Where
 from .model import NodeDef, ParamDef
-from .types import TypeMismatch, type_by_name
+from .types import TypeMismatch, describe, type_by_name
 
 FORMAT_VERSION = 1
 MAX_BYTES = 16 * 1024 * 1024
-MAX_VALUES = 2_000_000  # scalars and collections, with aliases expanded
+MAX_VALUES = 400_000  # scalars and collections, with aliases expanded: a few seconds to read
 MAX_DEPTH = 64
 TOP_KEYS = ("formgraph", "description", "params", "nodes", "outputs")
 
@@ -34,44 +37,8 @@ class Document:
     output_lines: dict[str, int] = field(default_factory=dict)
 
 
-def _expansion_problem(root: yaml.Node | None) -> str | None:
-    """Why the composed tree is too big to read (an alias bomb, absurd nesting), or None.
-
-    Walks the tree without recursion, counting every node as often as aliases repeat it.
-    """
-    if root is None:
-        return None
-    count = 0
-    distinct: set[int] = set()
-    stack: list[tuple[yaml.Node, int]] = [(root, 0)]
-    while stack:
-        node, depth = stack.pop()
-        count += 1
-        distinct.add(id(node))
-        # text cannot hold more values than it has characters; only aliases multiply them
-        if count > MAX_VALUES or (count > 100_000 and count > 4 * len(distinct)):
-            return (
-                f"the YAML's aliases expand to more than {min(count, MAX_VALUES):,} values "
-                f"(aliases of aliases?); refusing to read it"
-            )
-        if depth > MAX_DEPTH:
-            return f"the YAML is nested too deeply (more than {MAX_DEPTH} levels)"
-        if isinstance(node, yaml.SequenceNode):
-            stack.extend((v, depth + 1) for v in node.value)
-        elif isinstance(node, yaml.MappingNode):
-            for k, v in node.value:
-                stack.append((k, depth + 1))
-                stack.append((v, depth + 1))
-    return None
-
-
 def _line(node: yaml.Node) -> int:
     return node.start_mark.line + 1
-
-
-def _construct(node: yaml.Node) -> Any:
-    constructor = yaml.constructor.SafeConstructor()
-    return constructor.construct_document(node)
 
 
 def parse(text: str, file: str = "<graph>") -> Document:
@@ -86,8 +53,21 @@ def parse(text: str, file: str = "<graph>") -> Document:
     if len(text.encode()) > MAX_BYTES:
         problem(f"the file is larger than {MAX_BYTES // (1024 * 1024)} MiB")
         return doc
+    estimate = yamlread.estimate_values(text)
+    if estimate > 2 * MAX_VALUES:  # well over the exact limit, which is checked after composing
+        problem(
+            f"the file holds about {estimate:,} values (numbers, strings, lists and mappings), "
+            f"more than the {MAX_VALUES:,} a graph file may hold; a graph this large is better "
+            f"built in Python"
+        )
+        return doc
     try:
-        root = yaml.compose(text, Loader=yaml.SafeLoader)
+        try:
+            root, bulk = yamlread.compose(text)
+            too_big = yamlread.expansion_problem(root, bulk, MAX_VALUES, MAX_DEPTH)
+        except (yaml.YAMLError, ValueError):  # a lifted array was not a plain value: as written
+            root, bulk = yaml.compose(text, Loader=yamlread.Loader), yamlread.Bulk()
+            too_big = yamlread.expansion_problem(root, bulk, MAX_VALUES, MAX_DEPTH)
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         problem(
@@ -98,7 +78,6 @@ def parse(text: str, file: str = "<graph>") -> Document:
     except RecursionError:
         problem(f"the YAML is nested too deeply (more than {MAX_DEPTH} levels)")
         return doc
-    too_big = _expansion_problem(root)
     if too_big:
         problem(too_big)
         return doc
@@ -107,6 +86,8 @@ def parse(text: str, file: str = "<graph>") -> Document:
         return doc
 
     top: dict[str, tuple[yaml.Node, yaml.Node]] = {}
+    if not _merged(root, problem):
+        return doc
     for k, v in root.value:
         key = _scalar_key(k)
         if key in top:
@@ -134,12 +115,12 @@ def parse(text: str, file: str = "<graph>") -> Document:
     if "params" in top:
         k, v = top["params"]
         if isinstance(v, yaml.MappingNode):
-            for pk, pv in v.value:
+            for pk, pv in v.value if _merged(v, problem) else ():
                 name = _scalar_key(pk)
                 if name in doc.params:
                     problem(f"param '{name}' is declared twice", _line(pk))
                     continue
-                param = _param(name, pv, problem)
+                param = _param(name, pv, problem, bulk)
                 if param is not None:
                     doc.params[name] = param
         elif not (isinstance(v, yaml.ScalarNode) and v.value in ("", "null", "~")):
@@ -164,7 +145,7 @@ def parse(text: str, file: str = "<graph>") -> Document:
     if not isinstance(v, yaml.MappingNode):
         problem("'nodes' must be a mapping of node name to {type: ..., inputs...}", _line(k))
         return doc
-    for nk, nv in v.value:
+    for nk, nv in v.value if _merged(v, problem) else ():
         name = _scalar_key(nk)
         line = _line(nk)
         if name in doc.nodes:
@@ -183,22 +164,30 @@ def parse(text: str, file: str = "<graph>") -> Document:
         lines: dict[str, int] = {}
         unreadable: dict[str, str] = {}
         node_type = None
-        for ik, iv in nv.value:
+        for ik, iv in nv.value if _merged(nv, problem) else ():
             port = _scalar_key(ik)
             if port in raw or (port == "type" and node_type is not None):
                 problem("input appears twice", _line(ik), name, port)
                 continue
             bad: list[str] = []
-            value = _value(iv, lambda msg, *a, bad=bad: bad.append(msg), name, port)
+            value = _value(iv, lambda msg, *a, bad=bad: bad.append(msg), name, port, bulk)
             if port == "type":
                 node_type = value
+                lines["type"] = _line(ik)  # an unknown type is reported at its own line
                 bad and problem(bad[0], _line(ik), name)
                 continue
             raw[port] = value
             lines[port] = _line(ik)
             if bad:
                 unreadable[port] = bad[0]
-        if not isinstance(node_type, str):
+        if node_type is not None and not isinstance(node_type, str):
+            problem(
+                f"'type' must be a node type name such as points.circle, got {describe(node_type)}",
+                lines["type"],
+                name,
+            )
+            node_type = ""
+        elif not isinstance(node_type, str):
             problem("missing 'type:' (e.g. type: points.circle)", line, name)
             node_type = ""
         nd = NodeDef.make(name, node_type, raw, line, lines)
@@ -207,27 +196,56 @@ def parse(text: str, file: str = "<graph>") -> Document:
     return doc
 
 
+def _merged(node: yaml.MappingNode, problem: Any) -> bool:
+    """Resolve the merge keys (``<<: *base``) of a mapping in place; False when it cannot."""
+    try:
+        yamlread.Constructor().flatten_mapping(node)
+    except yaml.YAMLError as exc:
+        problem(f"cannot merge: {getattr(exc, 'problem', None) or exc}", _line(node))
+        return False
+    return True
+
+
 def _scalar_key(node: yaml.Node) -> str:
     return str(node.value) if isinstance(node, yaml.ScalarNode) else "<complex key>"
 
 
-def _value(node: yaml.Node, problem: Any, where_node: str | None, port: str | None) -> Any:
+def _value(
+    node: yaml.Node,
+    problem: Any,
+    where_node: str | None,
+    port: str | None,
+    bulk: yamlread.Bulk | None = None,
+) -> Any:
     try:
-        return _construct(node)
+        return yamlread.construct(node, bulk)
     except yaml.YAMLError as exc:
-        problem(
-            f"cannot read this value: {getattr(exc, 'problem', None) or exc} (only plain "
-            f"YAML data is allowed; no !!python tags)",
-            _line(node),
-            where_node,
-            port,
+        why = getattr(exc, "problem", None) or exc
+        hint = (
+            ""
+            if str(why).startswith("'") or "too long" in str(why)
+            else (" (only plain YAML data is allowed; no !!python tags)")
         )
+        problem(f"cannot read this value: {why}{hint}", _line(node), where_node, port)
+        return None
+    except (
+        ValueError,
+        TypeError,
+        OverflowError,
+        RecursionError,
+        AttributeError,
+        IndexError,
+    ) as exc:
+        # the safe constructor's own readers (e.g. a malformed !!binary or !!timestamp)
+        problem(f"cannot read this value: {exc}", _line(node), where_node, port)
         return None
 
 
-def _param(name: str, node: yaml.Node, problem: Any) -> ParamDef | None:
+def _param(
+    name: str, node: yaml.Node, problem: Any, bulk: yamlread.Bulk | None = None
+) -> ParamDef | None:
     line = _line(node)
-    value = _value(node, problem, None, None)
+    value = _value(node, problem, None, None, bulk)
     if not isinstance(value, dict):
         return ParamDef(name, value, line=line)
     unknown = set(value) - {"default", "min", "max", "doc", "type"}
@@ -244,6 +262,8 @@ def _param(name: str, node: yaml.Node, problem: Any) -> ParamDef | None:
         b = value.get(bound)
         if b is not None and (isinstance(b, bool) or not isinstance(b, (int, float))):
             problem(f"param '{name}': {bound} must be a number, got {b!r}", line)
+        elif isinstance(b, float) and not math.isfinite(b):
+            problem(f"param '{name}': {bound} must be a finite number, got {b!r}", line)
         else:
             setattr(p, bound, b)
     if "type" in value:

@@ -78,7 +78,7 @@ def test_check_exit_codes(graph_file, tmp_path):
     r = cli("check", str(bad))
     assert r.returncode == 1
     assert (
-        "bad.yaml:3: unknown node type 'points.circel' (did you mean 'points.circle'?)" in r.stderr
+        "bad.yaml:4: unknown node type 'points.circel' (did you mean 'points.circle'?)" in r.stderr
     )
     assert "Traceback" not in r.stderr
 

@@ -101,7 +101,7 @@ def test_unknown_type_suggests(tmp_path):
     )
     with pytest.raises(
         fg.GraphError,
-        match=r"g.yaml:3: unknown node type 'curves.polylin' "
+        match=r"g.yaml:4: unknown node type 'curves.polylin' "
         r"\(did you mean 'curves.polyline'\?\)",
     ):
         fg.load(p)

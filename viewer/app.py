@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from formgraph.check import param_kind
 from formgraph.errors import FormgraphError, GraphError, Problem, Where
 from formgraph.graph import Graph, load
 from formgraph.model import Items, Wire, parse_input
@@ -341,7 +342,7 @@ class Session:
                 continue
             if not isinstance(value, (int, float)):
                 continue
-            integer = isinstance(p.default, int) and not isinstance(p.default, bool)
+            integer = param_kind(p) is int or (p.type is not None and p.type.name == "int")
             out.append(Slider(name, float(p.min), float(p.max), float(value), integer, p.doc))
         return out
 
