@@ -140,6 +140,10 @@ def _parser() -> argparse.ArgumentParser:
     schema.add_argument(
         "--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS
     )
+
+    from .cli_sweep import add_parsers
+
+    add_parsers(sub, graph_options)
     return ap
 
 
@@ -465,7 +469,17 @@ COMMANDS = {
     "graph": cmd_graph,
     "nodes": cmd_nodes,
     "schema": cmd_schema,
+    "sweep": lambda args: _sweep_command("cmd_sweep", args),
+    "cache": lambda args: _sweep_command("cmd_cache", args),
 }
+
+
+def _sweep_command(name: str, args: argparse.Namespace) -> int:
+    from . import cli_sweep
+
+    # this module's own UsageError and parse_sets: under `python -m formgraph.cli` it runs
+    # as __main__, and an imported copy's UsageError would not be the one main() catches
+    return getattr(cli_sweep, name)(args, UsageError, parse_sets)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
