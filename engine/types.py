@@ -256,7 +256,9 @@ def _coerce_kind(k: Kind, value: Any) -> Any:
     base = k.base
     if base is Any:
         return value
-    if typing.get_origin(base) is list:  # an item that is itself a list (list[list[float]])
+    # An item that is itself a list (list[list[float]]); a plain class never is (and asking
+    # typing costs every float and wire a call).
+    if type(base) is not type and typing.get_origin(base) is list:
         if not isinstance(value, (list, tuple)):
             raise TypeMismatch(f"expected {Kind(base).name}, got {describe(value)}")
         return _coerce_kind(Kind(typing.get_args(base)[0], True), value)
