@@ -7,9 +7,18 @@ in which every reference library's time is shown next to ours, measured in the s
 
 from __future__ import annotations
 
+import os
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+
+# ``BENCH_CLOCK=cpu`` times CPU seconds of this process instead of wall seconds: on a
+# machine shared with other jobs, far steadier (every row here is single-threaded: one
+# BLAS thread; a threaded reference would have its threads' time added up).
+CLOCK = os.environ.get("BENCH_CLOCK", "wall")
+if CLOCK not in ("wall", "cpu"):
+    raise SystemExit(f"BENCH_CLOCK must be wall or cpu, got {CLOCK!r}")
+_now = time.process_time if CLOCK == "cpu" else time.perf_counter
 
 
 def best_time(
@@ -25,19 +34,19 @@ def best_time(
     loops enough calls to last ``min_seconds`` (at least one), so short calls are not
     dominated by timer resolution.
     """
-    t0 = time.perf_counter()
+    t0 = _now()
     fn()
-    first = time.perf_counter() - t0
+    first = _now() - t0
     if number is None:
         number = max(1, int(min_seconds / max(first, 1e-9)))
     if first > 2.0:  # slow reference: one more call is enough
         repeat, number = 1, 1
     best = float("inf")
     for _ in range(repeat):
-        t0 = time.perf_counter()
+        t0 = _now()
         for _ in range(number):
             fn()
-        best = min(best, (time.perf_counter() - t0) / number)
+        best = min(best, (_now() - t0) / number)
     return best
 
 
@@ -76,7 +85,8 @@ class Table:
         self.rows.append(Row(case, impl, seconds, note))
 
     def render(self) -> str:
-        lines = [f"{'case':<52} {'impl':<22} {'time':>11} {'vs ours':>9}  note", "-" * 110]
+        head = "time" if CLOCK == "wall" else "cpu time"
+        lines = [f"{'case':<52} {'impl':<22} {head:>11} {'vs ours':>9}  note", "-" * 110]
         cases: dict[str, list[Row]] = {}
         for row in self.rows:
             cases.setdefault(row.case, []).append(row)

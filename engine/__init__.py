@@ -38,6 +38,7 @@ from .geometry import (
 )
 from .graph import Graph, NodeStat, load
 from .registry import node_types
+from .sweep import Sweep, sweep
 
 
 def show(source: Any, node: str | Iterable[str] | None = None, **kwargs: Any) -> Any:
@@ -74,9 +75,11 @@ __all__ = [
     "PathError",
     "Points",
     "Surface",
+    "Sweep",
     "draw_graph",
     "geometry",
     "load",
     "node_types",
     "show",
+    "sweep",
 ]

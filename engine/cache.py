@@ -7,7 +7,9 @@ a truncated, corrupt or foreign entry is detected and recomputed, never trusted.
 entry never inflates it past :data:`MAX_INFLATE` times its size on disk (the arrays' headers
 are checked against the bytes that hold them before anything is allocated) and never parses
 a description nested deeper than :data:`MAX_META_DEPTH`: a hostile entry is a miss, not a
-``MemoryError`` or ``RecursionError``.
+``MemoryError`` or ``RecursionError``. The disk cache is bounded (2 GiB unless
+``$FORMGRAPH_CACHE_MAX_SIZE`` says otherwise): reading an entry marks it used, and the least
+recently used entries go first when it is pruned.
 """
 
 from __future__ import annotations
@@ -18,11 +20,14 @@ import io
 import json
 import math
 import os
+import re
 import tempfile
+import time
 import uuid
 import weakref
 import zipfile
 from collections import OrderedDict
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -77,8 +82,54 @@ def _token(value: Any) -> str:
 
 
 def key_of(parts: Any) -> str:
-    text = json.dumps(canonical(parts), sort_keys=True, separators=(",", ":"))
-    return hashlib.blake2b(text.encode(), digest_size=20).hexdigest()
+    """The cache key of ``parts``: a hash of the JSON text of ``canonical(parts)``."""
+    return hashlib.blake2b(key_text(parts).encode(), digest_size=20).hexdigest()
+
+
+def key_text(value: Any) -> str:
+    """``json.dumps(canonical(value), sort_keys=True, separators=(",", ":"))``, in one pass.
+
+    Every node's key is built from this text on every run, so the plain values that inputs
+    are made of (str, int, bool, None, float, lists and str-keyed dicts of them) are written
+    directly, the leaves of a container without a call of their own; anything else goes
+    through `canonical` and `json`. The text is the same either way, so keys do not change.
+    """
+    t = type(value)
+    if t is dict:
+        try:
+            keys = sorted(value)
+        except TypeError:  # mixed key types: canonical says so
+            return _JSON.encode(canonical(value))
+        out = []
+        for k in keys:
+            if type(k) is not str:
+                return _JSON.encode(canonical(value))
+            v = value[k]
+            tv = type(v)
+            if tv is str:
+                out.append(_quote(k) + ":" + _quote(v))
+            elif tv is float:
+                out.append(_quote(k) + ':{"f":"' + v.hex() + '"}')
+            else:
+                out.append(_quote(k) + ":" + key_text(v))
+        return "{" + ",".join(out) + "}"
+    if t is str:
+        return _quote(value)
+    if t is float:
+        return '{"f":"' + value.hex() + '"}'
+    if t is bool:
+        return "true" if value else "false"
+    if t is int:
+        return str(value)
+    if value is None:
+        return "null"
+    if t is list or t is tuple:
+        return "[" + ",".join([key_text(v) for v in value]) + "]"
+    return _JSON.encode(canonical(value))
+
+
+_quote = json.encoder.encode_basestring_ascii  # what json.dumps writes a str as
+_JSON = json.JSONEncoder(sort_keys=True, separators=(",", ":"))
 
 
 def _hash_bytes(a: np.ndarray) -> str:
@@ -190,11 +241,17 @@ class DiskCache:
     wrong checksum, unknown format) deletes it and reports a miss.
     """
 
-    def __init__(self, root: str | os.PathLike[str]):
+    def __init__(self, root: str | os.PathLike[str], max_bytes: int | None = None):
         self.root = Path(root)
+        self.max_bytes = default_max_bytes() if max_bytes is None else max_bytes
+        self._written = 0  # bytes written since this object last pruned
 
     def _path(self, key: str) -> Path:
         return self.root / key[:2] / f"{key}.npz"
+
+    def has(self, key: str) -> bool:
+        """Whether an entry for ``key`` exists (not read, so not checked: a hint only)."""
+        return self._path(key).is_file()
 
     def get(self, key: str) -> tuple[bool, Any]:
         hit, value, _ = self.get_entry(key)
@@ -203,6 +260,7 @@ class DiskCache:
     def get_entry(self, key: str) -> tuple[bool, Any, str | None]:
         """(hit, value, identity recorded with it)."""
         path = self._path(key)
+        _mark_used(path)
         try:
             data = path.read_bytes()
         except OSError:
@@ -269,6 +327,7 @@ class DiskCache:
                 with os.fdopen(fd, "wb") as fh:
                     fh.write(buf.getvalue())
                 os.replace(tmp, path)
+                self._account(len(buf.getbuffer()))
             except BaseException:
                 try:
                     os.unlink(tmp)
@@ -278,6 +337,181 @@ class DiskCache:
         except OSError:
             return False  # a cache that cannot be written is only slower, never wrong
         return True
+
+    # ------------------------------------------------------------------- bounds
+
+    def _account(self, nbytes: int) -> None:
+        """Prune back to the limit after every tenth of it written (by this process)."""
+        self._written += nbytes
+        if self._written > self.max_bytes // 10:
+            self._written = 0
+            self.prune(self.max_bytes)
+
+    def entries(self) -> list[tuple[Path, int, float]]:
+        """(path, size in bytes, last use) of every entry; a file that vanishes is skipped."""
+        out = []
+        for path in _entry_paths(self.root):
+            try:
+                st = path.stat()
+            except OSError:
+                continue
+            out.append((path, st.st_size, st.st_mtime))
+        return out
+
+    def info(self) -> CacheInfo:
+        """How many entries the cache holds, their total size and the limit."""
+        entries = self.entries()
+        times = [t for _, _, t in entries]
+        return CacheInfo(
+            self.root,
+            len(entries),
+            sum(s for _, s, _ in entries),
+            self.max_bytes,
+            min(times) if times else None,
+            max(times) if times else None,
+        )
+
+    def prune(self, max_bytes: int | None = None) -> tuple[int, int]:
+        """Delete least recently used entries until the rest fit in ``max_bytes``.
+
+        Entries are touched when read (their modification time is their last use), so the
+        order is least recently used first. Temp files a crashed writer left (older than an
+        hour) go too. Safe while other processes use the cache: a reader of an entry just
+        deleted simply misses and recomputes. Returns (entries deleted, bytes freed).
+        """
+        limit = self.max_bytes if max_bytes is None else max_bytes
+        entries = sorted(self.entries(), key=lambda e: e[2])
+        total = sum(s for _, s, _ in entries)
+        removed = freed = 0
+        for path, size, _ in entries:
+            if total <= limit:
+                break
+            if _unlink(path):
+                removed += 1
+                freed += size
+            total -= size
+        _remove_stale_temps(self.root)
+        return removed, freed
+
+    def clear(self) -> tuple[int, int]:
+        """Delete every entry (and only the cache's own files). Returns (entries, bytes)."""
+        return self.prune(0)
+
+
+@dataclass(frozen=True)
+class CacheInfo:
+    """What ``formgraph cache info`` reports."""
+
+    root: Path
+    entries: int
+    bytes: int
+    max_bytes: int
+    oldest: float | None  # last-use times (seconds since the epoch)
+    newest: float | None
+
+
+DEFAULT_MAX_BYTES = 2 << 30
+_ENTRY = re.compile(r"[0-9a-f]{40}\.npz")
+
+
+def default_max_bytes() -> int:
+    """The disk cache limit: ``$FORMGRAPH_CACHE_MAX_SIZE`` (e.g. ``10GiB``), else 2 GiB."""
+    text = os.environ.get("FORMGRAPH_CACHE_MAX_SIZE")
+    if not text:
+        return DEFAULT_MAX_BYTES
+    try:
+        return parse_size(text)
+    except ValueError:
+        return DEFAULT_MAX_BYTES  # a bad setting must not break every run; the CLI says why
+
+
+_UNITS = {
+    "": 1,
+    "b": 1,
+    "k": 1 << 10,
+    "kib": 1 << 10,
+    "kb": 10**3,
+    "m": 1 << 20,
+    "mib": 1 << 20,
+    "mb": 10**6,
+    "g": 1 << 30,
+    "gib": 1 << 30,
+    "gb": 10**9,
+    "t": 1 << 40,
+    "tib": 1 << 40,
+    "tb": 10**12,
+}
+
+
+def parse_size(text: str) -> int:
+    """Bytes from a size as people write it: ``500M``, ``2GiB``, ``1.5 GB``, ``1048576``.
+
+    K, M, G, T alone and KiB, MiB, ... are powers of 1024; KB, MB, ... powers of 1000.
+
+    Raises
+    ------
+    ValueError
+        With a sentence naming the text.
+    """
+    m = re.fullmatch(r"\s*([0-9]*\.?[0-9]+)\s*([a-zA-Z]*)\s*", text)
+    unit = m.group(2).lower() if m else None
+    if m is None or unit not in _UNITS:
+        raise ValueError(
+            f"{text!r} is not a size; write bytes or a number with K, M, G, T "
+            f"(1024s) or KB, MB, GB, TB (1000s), e.g. 2GiB or 500M"
+        )
+    return int(float(m.group(1)) * _UNITS[unit])
+
+
+def _entry_paths(root: Path) -> list[Path]:
+    """The cache's own entry files (``xx/<key>.npz``), nothing else in the folder."""
+    out: list[Path] = []
+    try:
+        subdirs = [d for d in os.scandir(root) if len(d.name) == 2 and d.is_dir()]
+    except OSError:
+        return out
+    for d in subdirs:
+        try:
+            names = os.listdir(d.path)
+        except OSError:
+            continue
+        out.extend(Path(d.path, n) for n in names if _ENTRY.fullmatch(n) and n[:2] == d.name)
+    return out
+
+
+def _remove_stale_temps(root: Path, age: float = 3600.0) -> None:
+    now = time.time()
+    try:
+        subdirs = [d for d in os.scandir(root) if len(d.name) == 2 and d.is_dir()]
+    except OSError:
+        return
+    for d in subdirs:
+        try:
+            temps = [e for e in os.scandir(d.path) if e.name.startswith(".")]
+        except OSError:
+            continue
+        for e in temps:
+            try:
+                if e.name.endswith(".tmp") and now - e.stat().st_mtime > age:
+                    os.unlink(e.path)
+            except OSError:
+                pass
+
+
+def _mark_used(path: Path) -> None:
+    """Record a read as the entry's last use (its modification time), for LRU pruning."""
+    try:
+        os.utime(path)
+    except OSError:
+        pass
+
+
+def _unlink(path: Path) -> bool:
+    try:
+        os.unlink(path)
+    except OSError:
+        return False
+    return True
 
 
 def _read_npz(data: bytes) -> dict[str, np.ndarray]:

@@ -140,6 +140,10 @@ def _parser() -> argparse.ArgumentParser:
     schema.add_argument(
         "--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS
     )
+
+    from .cli_sweep import add_parsers
+
+    add_parsers(sub, graph_options)
     return ap
 
 
@@ -200,11 +204,16 @@ class _ProgressLine:
         self.stream = stream
         self.enabled = hasattr(stream, "isatty") and stream.isatty()
         self.start = time.perf_counter()
+        self.last = -float("inf")
         self.shown = False
 
     def __call__(self, node: str, done: int, total: int) -> None:
-        if not self.enabled or time.perf_counter() - self.start < 0.5:
+        # Quiet for the first half second, then at most 20 updates a second (a write per
+        # node would cost a chain of small nodes more than the nodes themselves).
+        now = time.perf_counter()
+        if not self.enabled or now - self.start < 0.5 or now - self.last < 0.05:
             return
+        self.last = now
         self.stream.write(f"\r\x1b[Kcooking '{node}' ({done + 1}/{total} nodes)")
         self.stream.flush()
         self.shown = True
@@ -450,7 +459,17 @@ COMMANDS = {
     "graph": cmd_graph,
     "nodes": cmd_nodes,
     "schema": cmd_schema,
+    "sweep": lambda args: _sweep_command("cmd_sweep", args),
+    "cache": lambda args: _sweep_command("cmd_cache", args),
 }
+
+
+def _sweep_command(name: str, args: argparse.Namespace) -> int:
+    from . import cli_sweep
+
+    # this module's own UsageError and parse_sets: under `python -m formgraph.cli` it runs
+    # as __main__, and an imported copy's UsageError would not be the one main() catches
+    return getattr(cli_sweep, name)(args, UsageError, parse_sets)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

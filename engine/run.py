@@ -42,7 +42,7 @@ from .types import TypeMismatch
 if TYPE_CHECKING:
     from .graph import Graph
 
-__all__ = ["NodeStat"]
+__all__ = ["NodeStat", "Step"]
 
 
 @dataclass
@@ -59,12 +59,30 @@ class NodeStat:
     inner: dict[str, NodeStat] | None = None  # a subgraph node: its own nodes' stats
 
 
+@dataclass(frozen=True)
+class Step:
+    """One node of an evaluation plan (see :meth:`formgraph.Graph.plan`)."""
+
+    name: str
+    key: str  # the node's cache key for the planned params
+    upstream: tuple[str, ...]  # the nodes whose outputs it reads, each once
+    export: bool  # an export node (writes a file into the output directory)
+    upstream_keys: tuple[str, ...] = ()  # their keys, in the same order
+
+
 class _Run(LanguageRun):
     """One evaluation call: memoized keys, identities and values, and the run record."""
 
-    def __init__(self, g: Graph, values: dict[str, Any], tokens: dict[str, Any] | None = None):
+    def __init__(
+        self,
+        g: Graph,
+        values: dict[str, Any],
+        tokens: dict[str, Any] | None = None,
+        pure: bool = False,
+    ):
         self.g = g
         self.values = values
+        self.pure = pure  # identities are keys: no early cutoff (for plans)
         self.tokens = tokens or {}  # key stand-ins of params that hold wired values
         self.registry = {**node_types(), **g._subgraphs}
         self.keys: dict[str, str] = {}
@@ -113,6 +131,8 @@ class _Run(LanguageRun):
     def identity(self, name: str) -> str:
         # identity of the value that flows out of a node: its key, or an earlier identical
         # output's (early cutoff); known for every upstream node by the time it is asked
+        if self.pure:
+            return self.key(name)
         return self.g._identity[self.keys[name]]
 
     def key(self, name: str) -> str:
@@ -356,7 +376,7 @@ class _Run(LanguageRun):
         value, seconds, warnings = self.call(name, nd, spec, kwargs)
         value = self.check_output(name, nd, spec, value)
         key = self.key(name)
-        identity = self.cutoff_identity(name, key, value)
+        identity = key if self.pure else self.cutoff_identity(name, key, value)
         size = _cache.sizeof(value)
         self.g.memory.put(key, value, size)
         if self.g.disk is not None:
@@ -365,7 +385,8 @@ class _Run(LanguageRun):
             self.g._identity.clear()
             self.g._digests.clear()
         self.g._identity[key] = identity
-        self.g._last[name] = (key, identity)
+        if not self.pure:
+            self.g._last[name] = (key, identity)
         if spec.is_export:
             self.g._written[key] = file_stamp(value)
         self.stats[name] = NodeStat("computed", seconds, size, warnings)

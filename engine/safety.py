@@ -101,12 +101,14 @@ def resolve_output(out_dir: str | os.PathLike[str], relpath: str) -> Path:
     return real
 
 
-def write_atomic(out_dir: str | os.PathLike[str], relpath: str, data: bytes) -> Path:
+def write_atomic(out_dir: str | os.PathLike[str], relpath: str, data: bytes | memoryview) -> Path:
     """Write ``data`` to ``relpath`` inside ``out_dir``, atomically; returns the path.
 
     Creates sub-folders; leaves an existing file untouched when it already holds ``data``.
     On any failure the previous file (if any) is intact and no temp file is left behind.
+    ``data`` is any bytes-like object; it is written as it is, never copied.
     """
+    data = memoryview(data).cast("B")
     target = resolve_output(out_dir, relpath)
     try:
         target.parent.mkdir(parents=True, exist_ok=True)
@@ -114,7 +116,7 @@ def write_atomic(out_dir: str | os.PathLike[str], relpath: str, data: bytes) -> 
         raise PathError(f"output path {relpath!r} runs through a file, not a folder") from None
     target = resolve_output(out_dir, relpath)  # a folder made meanwhile could be a symlink
     try:
-        if target.is_file() and target.stat().st_size == len(data) and target.read_bytes() == data:
+        if target.is_file() and target.stat().st_size == data.nbytes and _holds(target, data):
             return target
     except OSError:
         pass
@@ -136,6 +138,19 @@ def write_atomic(out_dir: str | os.PathLike[str], relpath: str, data: bytes) -> 
             pass
         raise
     return target
+
+
+def _holds(path: Path, data: memoryview, chunk: int = 1 << 20) -> bool:
+    """Whether the file holds exactly ``data`` (of its size), read a chunk at a time (a big
+    export is not read into a second buffer of its size)."""
+    buffer = bytearray(min(chunk, max(len(data), 1)))
+    view = memoryview(buffer)
+    with open(path, "rb") as fh:
+        for start in range(0, len(data), len(buffer)):
+            got = fh.readinto(buffer)
+            if got == 0 or view[:got] != data[start : start + got]:
+                return False
+    return True
 
 
 def remove_stale_temps(folder: Path) -> list[Path]:

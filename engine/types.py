@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import enum
 import functools
+import math
 import types as _pytypes
 import typing
 from dataclasses import dataclass
@@ -280,7 +281,9 @@ def _coerce_kind(k: Kind, value: Any) -> Any:
     base = k.base
     if base is Any:
         return value
-    if typing.get_origin(base) is list:  # an item that is itself a list (list[list[float]])
+    # An item that is itself a list (list[list[float]]); a plain class never is (and asking
+    # typing costs every float and wire a call).
+    if type(base) is not type and typing.get_origin(base) is list:
         if not isinstance(value, (list, tuple)):
             raise TypeMismatch(f"expected {Kind(base).name}, got {describe(value)}")
         return _coerce_kind(Kind(typing.get_args(base)[0], True), value)
@@ -307,7 +310,7 @@ def _coerce_kind(k: Kind, value: Any) -> Any:
             raise TypeMismatch(
                 f"expected a float, got a number too large ({describe(value)[:40]})"
             ) from None
-        if not np.isfinite(f):
+        if not math.isfinite(f):
             raise TypeMismatch(f"expected a finite float, got {f}")
         return f
     if base in (str, Expression, OutputPath):

@@ -2,16 +2,20 @@
 
 from __future__ import annotations
 
+import enum
+import json
 import multiprocessing as mp
 import os
 from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 from stubs import CALLS
 
 import formgraph as fg
-from formgraph.cache import DiskCache, MemoryCache, key_of
+from formgraph.cache import DiskCache, MemoryCache, canonical, key_of, key_text
 
 
 def graph(cache_dir: Path) -> fg.Graph:
@@ -131,3 +135,46 @@ def test_memory_cache_lru_order():
     c.get("a")  # a is now the most recent
     c.put("d", 2.0)
     assert "a" in c and "b" not in c
+
+
+_PLAIN = st.recursive(
+    st.none()
+    | st.booleans()
+    | st.integers()
+    | st.floats(allow_nan=True, allow_infinity=True)
+    | st.text(max_size=8),
+    lambda inner: (
+        st.lists(inner, max_size=4)
+        | st.tuples(inner, inner)
+        | st.dictionaries(st.text(max_size=4), inner, max_size=4)
+        | st.dictionaries(st.integers(-3, 3), inner, max_size=3)
+    ),
+    max_leaves=20,
+)
+
+
+@given(_PLAIN)
+def test_key_text_is_the_json_of_the_canonical_form(value):
+    # Keys are built in one pass over plain values; they must stay what they were (disk
+    # caches written before keep their keys).
+    expected = json.dumps(canonical(value), sort_keys=True, separators=(",", ":"))
+    assert key_text(value) == expected
+
+
+def test_key_text_of_other_values_goes_through_canonical():
+    class Shape(enum.Enum):
+        ROUND = "round"
+
+    value = {"e": Shape.ROUND, "a": np.arange(3), "g": np.float32(0.5), "p": fg.Points([[1, 2]])}
+    expected = json.dumps(canonical(value), sort_keys=True, separators=(",", ":"))
+    assert key_text(value) == expected
+    with pytest.raises(TypeError):
+        key_text({1: 2, "1": 3})  # keys that cannot be ordered, as canonical() refuses
+
+
+def test_a_node_key_is_pinned():
+    # The key of a typical node, as computed before the one-pass text: unchanged.
+    parts = {"type": "bench.work", "version": 1, "inputs": {"points": {"wire": "ab" * 20}}}
+    parts["inputs"]["points"]["output"] = None
+    parts["inputs"]["k"] = 0.5
+    assert key_of(parts) == "d2f95f5a5424d0b22be338ac64470fb0af31448e"

@@ -181,6 +181,11 @@ def test_progress_line_on_a_terminal_only():
     line.start -= 1.0
     line("mesh", 1, 3)
     assert "cooking 'mesh' (2/3 nodes)" in term.getvalue()
+    line("next", 2, 3)  # at once after: not written (at most 20 updates a second)
+    assert "next" not in term.getvalue()
+    line.last -= 1.0
+    line("last", 2, 3)
+    assert "cooking 'last' (3/3 nodes)" in term.getvalue()
     line.clear()
     assert term.getvalue().endswith("\r\x1b[K")
     pipe = io.StringIO()  # not a terminal: never a progress line

@@ -266,3 +266,23 @@ def test_a_list_from_a_wire_joins_a_list_port():
     g.add("p", "stub.points", n=2)
     with pytest.raises(fg.GraphError, match="expected float, got Points from '@p'"):
         g.check()
+
+
+def test_progress_counts_the_nodes_computed_so_far():
+    g = fg.Graph()
+    g.add_param("x", 1.0)
+    g.add("a", "stub.value", x="=x")
+    g.add("b", "stub.add", a="@a", b=1.0)
+    g.add("c", "stub.add", a="@b", b=2.0)
+    seen = []
+    g.progress = lambda node, done, total: seen.append((node, done, total))
+    g.evaluate("c")
+    assert seen == [("a", 0, 3), ("b", 1, 3), ("c", 2, 3)]
+    seen.clear()
+    g.set(x=2.0)  # the cached ones do not count
+    g.evaluate("c")
+    assert [done for _, done, _ in seen] == [0, 1, 2]
+    g.add("d", "stub.add", a="@c", b=0.0)
+    seen.clear()
+    g.evaluate("d")
+    assert seen == [("d", 0, 4)]

@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from skimage import measure
 
-from formgraph.kernels.offset.contour import _cycles, marching_squares
+from formgraph.kernels.offset.contour import _cycles, marching_squares, unique_ids
 
 
 def area(loop: np.ndarray) -> float:
@@ -146,3 +146,19 @@ def test_cycles_of_a_permutation(perm):
         # Each cycle starts at its smallest element and follows the successors round.
         assert cycle[0] == cycle.min()
         assert (succ[cycle] == np.roll(cycle, -1)).all()
+
+
+@given(
+    st.lists(st.integers(-50, 10**12), max_size=200),
+    st.booleans(),
+    st.booleans(),
+)
+def test_unique_ids_is_np_unique(values, inverse, counts):
+    ids = np.array(values, dtype=np.int64)
+    expected = np.unique(ids, return_inverse=inverse, return_counts=counts)
+    got = unique_ids(ids, return_inverse=inverse, return_counts=counts)
+    if not (inverse or counts):
+        expected, got = (expected,), (got,)
+    assert len(got) == len(expected)
+    for g, e in zip(got, expected, strict=True):
+        np.testing.assert_array_equal(g, e.reshape(-1))

@@ -89,6 +89,24 @@ def test_clockwise_input_gives_the_same_result():
     assert abs(area(ccw) - area(cw)) < 1e-9
 
 
+@pytest.mark.parametrize("d", [0.05, -0.05])
+def test_sparse_sample_store_gives_the_same_loops(monkeypatch, d):
+    # Big grids keep their band of samples sorted and searched instead of in a dense table;
+    # both stores must give the very same offset.
+    import formgraph.kernels.offset.marching as marching
+
+    t = np.linspace(0, 2 * np.pi, 400, endpoint=False)
+    r = 1 + 0.1 * np.sin(9 * t)
+    pts = np.c_[r * np.cos(t), r * np.sin(t)]
+    dense = offset_polylines([pts], [True], d)
+    monkeypatch.setattr(marching, "_DENSE", 0)
+    monkeypatch.setattr(marching, "_DENSE_MIN", 0)
+    sparse = offset_polylines([pts], [True], d)
+    assert len(dense) == len(sparse)
+    for a, b in zip(dense, sparse, strict=True):
+        np.testing.assert_array_equal(a, b)
+
+
 def test_inward_offset_splits_a_dumbbell_into_two_islands():
     # Two 1 x 1 squares joined by a bar 0.2 wide.
     shape = np.array(
@@ -266,6 +284,61 @@ def test_random_polygons_match_shapely(polygon, d):
     # tolerance (so a sliver at most that thin along the whole boundary).
     size = extent(polygon)
     assert ours.symmetric_difference(reference).area <= 1e-3 * size * reference.length + 1e-9
+
+
+# A random star (found by fuzzing) whose inward offset keeps a narrow spike: a corner
+# solve whose segments could walk round the polygon's sharp vertices met the far flank of
+# the spike and cut it off.
+SPIKY_STAR = np.array(
+    [
+        [0.3950631104613595, 0.17798558189271604],
+        [0.23597679658863652, 0.27332259819061394],
+        [0.09564953853487583, 0.29255136867851256],
+        [-0.11691101407881564, 0.9545169250357848],
+        [-0.2779190282513372, 0.7877899752682074],
+        [-0.34751718368123397, 0.5738162387947644],
+        [-0.3387914858625161, 0.41358057403190557],
+        [-0.29291016526811825, 0.22000080714470535],
+        [-0.37358027137669636, 0.09280620620101013],
+        [-0.39345000385223095, -0.081206536364076],
+        [-0.3821480813026686, -0.27003934290271125],
+        [-0.5307432625424624, -0.5011466033953933],
+        [-0.2316353573012384, -0.5935927823832722],
+        [-0.22552084082926055, -0.9712233856102825],
+        [0.1126549613362168, -0.9638272519723242],
+        [0.09006644750001548, -0.3517111393741989],
+        [0.3241223554725673, -0.6902259264556769],
+        [0.5417953958873498, -0.7584131218391902],
+        [0.6384207082182218, -0.602956613381105],
+        [0.32523629417872857, -0.2426012245112854],
+        [0.3436935364093114, -0.06930510026206509],
+        [0.30788240785615795, -3.4886395152211657e-16],
+    ]
+)
+
+
+def test_corners_do_not_walk_round_sharp_vertices():
+    d = -0.2262821260648043
+    (loop,) = offset_polylines([SPIKY_STAR], [True], d)
+    reference = shapely.Polygon(SPIKY_STAR).buffer(d, quad_segs=64)
+    ours = shapely.Polygon(loop)
+    size = extent(SPIKY_STAR)
+    assert ours.symmetric_difference(reference).area <= 1e-3 * size * reference.length
+
+
+def test_smooth_runs_stop_at_sharp_vertices_and_between_polylines():
+    from formgraph.kernels.offset.refine import _smooth_runs
+
+    t = np.linspace(0, np.pi / 2, 50)
+    arc = np.c_[np.cos(t), np.sin(t)]  # 49 segments turning 1.8 degrees each
+    corner = np.array([[0.0, 1.0], [0.0, 2.0], [1.0, 2.0]])  # a right angle
+    a = np.concatenate([arc[:-1], corner[:-1], arc[:-1] + 5])
+    b = np.concatenate([arc[1:], corner[1:], arc[1:] + 5])
+    run = _smooth_runs(SegmentTree(a, b))
+    assert len(np.unique(run[:49])) == 1  # the arc is one run
+    assert run[49] != run[48]  # the next polyline starts by the arc's end, turning 90 degrees
+    assert run[50] != run[49]  # its right angle
+    assert run[51] != run[50] and len(np.unique(run[51:])) == 1  # a new polyline, smooth
 
 
 # --- errors ---------------------------------------------------------------------------------

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 
+import numpy as np
 import pytest
 
 import formgraph as fg
@@ -54,6 +55,23 @@ def test_identical_bytes_leave_the_file_untouched(tmp_path):
     assert target.stat().st_mtime == 1_000_000
     write_atomic(tmp_path, "a.txt", b"different")
     assert target.read_bytes() == b"different"
+    assert target.stat().st_mtime != 1_000_000
+
+
+def test_big_buffers_are_compared_and_written_without_copies(tmp_path):
+    # Several read chunks (1 MiB), a read-only view as the STL writer hands out, and a
+    # difference in the very last byte only.
+    data = np.arange(3 * 2**20 + 5, dtype=np.uint32).view(np.uint8)
+    data.flags.writeable = False
+    target = write_atomic(tmp_path, "big.bin", memoryview(data))
+    assert target.read_bytes() == data.tobytes()
+    os.utime(target, (1_000_000, 1_000_000))
+    write_atomic(tmp_path, "big.bin", memoryview(data))
+    assert target.stat().st_mtime == 1_000_000
+    changed = data.copy()
+    changed[-1] ^= 1
+    write_atomic(tmp_path, "big.bin", changed.tobytes())
+    assert target.read_bytes() == changed.tobytes()
     assert target.stat().st_mtime != 1_000_000
 
 

@@ -159,12 +159,17 @@ def _blocks(n: int, size: int = _BLOCK) -> list[slice]:
     return [slice(i, min(i + size, n)) for i in range(0, n, size)]
 
 
-def stl_binary(vertices: np.ndarray, face_indices: np.ndarray, face_offsets: np.ndarray) -> bytes:
+def stl_binary(
+    vertices: np.ndarray, face_indices: np.ndarray, face_offsets: np.ndarray
+) -> memoryview:
     """Binary STL: an 80-byte header, the triangle count, then 50 bytes per triangle.
 
     Polygons are fan-triangulated; each facet's normal comes from its winding (counter-
     clockwise seen from outside), as the format asks. Coordinates are stored as float32
-    (the format's only precision). The records are one packed structured array.
+    (the format's only precision). The whole file is built in one buffer -- header, count
+    and the packed records (`_STL_RECORD`) filled a block at a time -- and handed out as a
+    read-only view of it, so the 50 bytes a triangle are never copied again before the
+    write (a 1M-triangle file is 48 MiB).
 
     Parameters
     ----------
@@ -174,20 +179,31 @@ def stl_binary(vertices: np.ndarray, face_indices: np.ndarray, face_offsets: np.
 
     Returns
     -------
-    bytes
-        ``84 + 50 * n_triangles`` bytes.
+    memoryview
+        ``84 + 50 * n_triangles`` bytes (read-only, bytes-like: it compares equal to the
+        same ``bytes``, and files and sockets write it as it is).
     """
     v, tris = _stl_input(vertices, face_indices, face_offsets)
     v32 = v.astype(np.float32)
-    records = np.empty((len(tris), 50), dtype=np.uint8)
-    normal, corners = records[:, :12].view("V12")[:, 0], records[:, 12:48].view("V36")[:, 0]
-    records[:, 48:] = 0  # the attribute byte count
+    n = len(tris)
+    buffer = np.empty(84 + _STL_RECORD.itemsize * n, dtype=np.uint8)
+    buffer[:80] = np.frombuffer(_STL_HEADER, dtype=np.uint8)
+    buffer[80:84] = np.frombuffer(struct.pack("<I", n), dtype=np.uint8)
+    records = buffer[84:].reshape(n, _STL_RECORD.itemsize)
+    # Fields as opaque byte blobs: copying those into the packed (unaligned) records is far
+    # faster than assigning float32 fields of the structured dtype.
+    fields = _STL_RECORD.fields
+    start = [fields[name][1] for name in ("normal", "vertices", "attribute")]
+    normal = records[:, start[0] : start[1]].view(f"V{start[1] - start[0]}")[:, 0]
+    corners = records[:, start[1] : start[2]].view(f"V{start[2] - start[1]}")[:, 0]
+    records[:, start[2] :] = 0  # the attribute byte count
     columns = [np.ascontiguousarray(v32[:, k]) for k in range(3)]
-    for s in _blocks(len(tris)):
+    for s in _blocks(n):
         c = np.take(v32, tris[s], axis=0)  # (b, 3, 3) float32, the stored corners
-        corners[s] = c.reshape(-1, 9).view("V36")[:, 0]
-        normal[s] = _facet_normals(columns, tris[s]).view("V12")[:, 0]
-    return b"".join([_STL_HEADER, struct.pack("<I", len(tris)), records.data])
+        corners[s] = c.reshape(-1, 9).view(corners.dtype)[:, 0]
+        normal[s] = _facet_normals(columns, tris[s]).view(normal.dtype)[:, 0]
+    buffer.flags.writeable = False
+    return memoryview(buffer)
 
 
 def _facet_normals(columns: list[np.ndarray], tris: np.ndarray) -> np.ndarray:

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Crossings", "marching_squares", "split_loops", "trace_crossings"]
+__all__ = ["Crossings", "marching_squares", "split_loops", "trace_crossings", "unique_ids"]
 
 # Cell corners counter-clockwise: 0 = (i, j) bottom-left, 1 = (i, j+1) bottom-right,
 # 2 = (i+1, j+1) top-right, 3 = (i+1, j) top-left. Side s joins corner s to corner s+1:
@@ -161,7 +161,7 @@ def trace_crossings(
         saddle = np.flatnonzero((case == 5) | (case == 10))
         if saddle.size:
             # Each saddle cell is entered twice; ask once per cell.
-            cells, inverse = np.unique(corner[saddle], return_inverse=True)
+            cells, inverse = unique_ids(corner[saddle], return_inverse=True)
             mid[saddle] = centre(cells)[inverse]
     centre_in = (mid < level) if below else (mid > level)
     exit_side = _EXIT[case, entry, centre_in.astype(np.int8)].astype(np.int64)
@@ -175,6 +175,47 @@ def trace_crossings(
     succ[exit_vertical] = h_edges.size + _lookup(v_edges, exit_edge[exit_vertical])
     order, offsets = _cycles(succ)
     return Crossings(col, row, edge, vertical, order, offsets)
+
+
+def unique_ids(
+    ids: np.ndarray, return_inverse: bool = False, return_counts: bool = False
+) -> np.ndarray | tuple[np.ndarray, ...]:
+    """Sorted distinct values of an integer array, by one sort: ``np.unique`` for ids.
+
+    Gives what ``np.unique`` gives (the sorted values, and with the flags the inverse and
+    the counts), but numpy 2 hashes integers in ``np.unique``, which on these arrays of
+    grid ids is ten to twenty times slower than sorting them.
+
+    Parameters
+    ----------
+    ids : (n,) int
+    return_inverse, return_counts : bool
+
+    Returns
+    -------
+    values : (k,) int
+    inverse : (n,) int64, optional
+        ``values[inverse] == ids``.
+    counts : (k,) int64, optional
+    """
+    ids = np.asarray(ids).reshape(-1)
+    if not (return_inverse or return_counts):
+        s = np.sort(ids)
+        first = np.ones(s.size, dtype=bool)
+        np.not_equal(s[1:], s[:-1], out=first[1:])
+        return s[first]
+    order = np.argsort(ids, kind="stable")
+    s = ids[order]
+    first = np.ones(s.size, dtype=bool)
+    np.not_equal(s[1:], s[:-1], out=first[1:])
+    out = [s[first]]
+    if return_inverse:
+        inverse = np.empty(ids.size, dtype=np.int64)
+        inverse[order] = np.cumsum(first) - 1
+        out.append(inverse)
+    if return_counts:
+        out.append(np.diff(np.append(np.flatnonzero(first), ids.size)))
+    return tuple(out)
 
 
 def _lookup(sorted_ids: np.ndarray, ids: np.ndarray) -> np.ndarray:

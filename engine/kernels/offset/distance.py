@@ -3,12 +3,14 @@
 `SegmentTree` is a bounding-volume hierarchy of capsules (a segment's axis grown by a
 radius) over runs of consecutive segments: for curve samples these capsules are thin, so
 a nearest-segment query prunes almost everything at every level. Queries run breadth
-first for all points at once (one numpy pass per level over the surviving
-(point, node) pairs), with branch-and-bound: a node is dropped when its capsule's lower
-bound exceeds the best upper bound found so far, as in the nearest-neighbour search of
-Roussopoulos, Kelley & Vincent (SIGMOD 1995). A query may also carry a band
-``[lo, hi]``: the distance is exact inside it, and outside it only certified to be below
-``lo`` or above ``hi`` -- which is all a contour at one level needs, and far cheaper.
+first for all points at once (one numpy pass per visited level over the surviving
+(point, node) pairs; levels are visited in jumps that keep about a thousand pairs a pass,
+so a query of a few points makes few numpy calls), with branch-and-bound: a node is
+dropped when its capsule's lower bound exceeds the best upper bound found so far, as in
+the nearest-neighbour search of Roussopoulos, Kelley & Vincent (SIGMOD 1995). A query
+may also carry a band ``[lo, hi]``: the distance is exact inside it, and outside it only
+certified to be below ``lo`` or above ``hi`` -- which is all a contour at one level needs,
+and far cheaper.
 
 `RowParity` answers the even-odd (crossing number) test for the points of a grid:
 the crossings of every closed segment with every grid row are computed once, and a point
@@ -24,6 +26,8 @@ from dataclasses import dataclass
 import numpy as np
 
 __all__ = ["Nearest", "RowParity", "SegmentTree", "point_segment"]
+
+_PAIRS = 1024  # (point, node) pairs a query tests per visited level, about
 
 
 def point_segment(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -101,37 +105,50 @@ class SegmentTree:
 
         # Leaf capsules: axis from the first segment's start to the last one's end, radius
         # the farthest segment end from that axis (a capsule is convex, so it then holds
-        # every segment whole).
+        # every segment whole). Coordinates one by one: contiguous, and squared distances
+        # until the one square root of the maximum.
         ca = self.a.reshape(n_leaves, leaf, 2)
         cb = self.b.reshape(n_leaves, leaf, 2)
         axa = ca[:, 0]
         axb = cb[:, -1]
-        ends = np.concatenate([ca, cb], axis=1)
-        da, _ = point_segment(ends, axa[:, None], axb[:, None])
-        rad = da.max(axis=1)
+        ends = np.ascontiguousarray(np.concatenate([ca, cb], axis=1).transpose(1, 2, 0))
+        ax, ay, bx, by = (np.ascontiguousarray(c) for c in (*axa.T, *axb.T))
+        d2 = _dist2(ends[:, 0], ends[:, 1], ax, ay, bx, by)  # ends: (2 leaf, 2, n_leaves)
+        rad = np.sqrt(d2.max(axis=0))
         # Missing leaves copy the last real axis (a true curve point keeps the upper bound
         # valid) with radius -inf, so their lower bound is +inf and they are never entered.
         extra = width - n_leaves
         axa = np.concatenate([axa, np.repeat(axa[-1:], extra, axis=0)])
         axb = np.concatenate([axb, np.repeat(axb[-1:], extra, axis=0)])
         rad = np.concatenate([rad, np.full(extra, -np.inf)])
-        levels = [(axa, axb, rad)]
+        levels = [(axa[:, 0], axa[:, 1], axb[:, 0], axb[:, 1], rad)]
         # Parents: axis from the left child's start to the right child's end (the left
         # child's end if the right one is missing); a radius that holds both child capsules
-        # (distance to a segment is convex, so a child's axis ends bound its whole axis).
+        # (distance to a segment is convex, so a child's axis ends bound its whole axis; the
+        # left child's start lies on the parent's axis).
         while levels[-1][0].shape[0] > 1:
-            ca, cb, cr = levels[-1]
-            la, lb, lr = ca[0::2], cb[0::2], cr[0::2]
-            ra, rb, rr = ca[1::2], cb[1::2], cr[1::2]
+            ax, ay, bx, by, r = levels[-1]
+            lax, lay, lbx, lby, lr = ax[0::2], ay[0::2], bx[0::2], by[0::2], r[0::2]
+            rax, ray, rbx, rby, rr = ax[1::2], ay[1::2], bx[1::2], by[1::2], r[1::2]
             missing = np.isneginf(rr)
-            pb = np.where(missing[:, None], lb, rb)
-            d, _ = point_segment(np.stack([la, lb, ra, rb]), la, pb)
-            left = lr + np.maximum(d[0], d[1])
-            right = rr + np.maximum(d[2], d[3])
-            levels.append((la, pb, np.maximum(left, right)))
+            pbx, pby = np.where(missing, lbx, rbx), np.where(missing, lby, rby)
+            d = np.sqrt(
+                _dist2(np.stack([lbx, rax, rbx]), np.stack([lby, ray, rby]), lax, lay, pbx, pby)
+            )
+            right = rr + np.maximum(d[1], d[2])
+            levels.append((lax, lay, pbx, pby, np.maximum(lr + d[0], right)))
         # Per level, contiguous node fields (gathered one by one, which numpy does far
-        # faster than rows): start x, y, axis vector x, y, 1 / |axis|^2 (0 if none), radius.
-        self._levels = [_fields(axa, axb) + (rad,) for axa, axb, rad in levels[::-1]]
+        # faster than rows): start x, y, axis vector x, y, 1 / |axis|^2 (0 if none), radius;
+        # computed for all levels at once. The radius carries a hair of slack, as does the
+        # bound in `query` (the node holding the bound's own point must never be lost to
+        # rounding); a missing node's is NaN, which no test passes.
+        levels = levels[::-1]
+        cut = np.cumsum([lv[0].shape[0] for lv in levels])[:-1]
+        ax, ay, bx, by, rad = (np.concatenate([lv[k] for lv in levels]) for k in range(5))
+        rad = np.where(np.isneginf(rad), np.nan, rad * (1 + 1e-12))
+        fields = _fields(np.stack([ax, ay], axis=1), np.stack([bx, by], axis=1)) + (rad,)
+        split = [np.split(f, cut) for f in fields]
+        self._levels = [tuple(f[k] for f in split) for k in range(len(levels))]
         self._segs = _fields(self.a, self.b)
 
     def query(
@@ -164,70 +181,118 @@ class SegmentTree:
         hi2 = np.square(np.maximum(hi, 0.0))
         lo2 = np.where(lo > 0, np.square(lo), -1.0)
         best2 = np.full(q, np.inf)  # squared distance to the nearest curve point seen
-        # Few points: start a few levels down (all their nodes), saving numpy calls.
-        start = min(self.depth, max(0, int(np.log2(max(4096 // max(q, 1), 1)))))
-        qi = np.repeat(np.arange(q), 2**start)
-        node = np.tile(np.arange(2**start), q)
-        # For few points, every other level only: four children a step halves the numpy
-        # calls (which then cost more than the arithmetic) for a few more capsules tested.
-        visit = list(range(start, self.depth + 1, 2 if q < 512 else 1))
-        if visit[-1] != self.depth:
-            visit.append(self.depth)
-        for k, level in enumerate(visit):
+        # Levels are visited in jumps that keep about _PAIRS (point, node) pairs per visit:
+        # few points start deep and skip levels (numpy calls cost more than the few more
+        # capsules tested), many go two levels a step.
+        level = min(self.depth, max(0, int(np.log2(max(_PAIRS // q, 1)))))
+        qi = np.arange(q).repeat(2**level)
+        node = np.tile(np.arange(2**level), q)
+        while True:
             ax, ay, ux, uy, inv, rad = self._levels[level]
-            if k:
-                fan = 2 ** (level - visit[k - 1])
-                qi = np.repeat(qi, fan)
-                node = (node[:, None] * fan + np.arange(fan)).reshape(-1)
-            if qi.size == 0:
-                break
-            ux_, uy_ = ux.take(node), uy.take(node)
-            dx = px.take(qi) - ax.take(node)
-            dy = py.take(qi) - ay.take(node)
-            t = np.clip((dx * ux_ + dy * uy_) * inv.take(node), 0.0, 1.0)
-            ex = dx - t * ux_
-            ey = dy - t * uy_
+            nux, nuy = ux.take(node), uy.take(node)
+            dx = px.take(qi)
+            dx -= ax.take(node)
+            dy = py.take(qi)
+            dy -= ay.take(node)
+            t = dx * nux
+            t += dy * nuy
+            t *= inv.take(node)
+            np.minimum(np.maximum(t, 0.0, out=t), 1.0, out=t)
             # The axis start is a curve point: an upper bound. (Its end is the next node's
             # start, so it adds little.)
-            np.minimum.at(best2, qi, dx * dx + dy * dy)
+            d2 = dx * dx
+            d2 += dy * dy
+            np.minimum.at(best2, qi, d2)
+            nux *= t
+            dx -= nux
+            nuy *= t
+            dy -= nuy
+            dx *= dx
+            dy *= dy
+            dx += dy  # squared distance to the capsule's axis
             # Drop a node whose capsule is farther than the best upper bound (or the band's
-            # top), and every node of a point already certified below the band.
+            # top), and every node of a point already certified below the band (NaN).
             cut = np.sqrt(np.minimum(best2, hi2))
-            cut[best2 < lo2] = -np.inf
-            # (A hair of slack: the node holding the bound's own point must never be lost
-            # to rounding.)
-            thr = (cut.take(qi) + rad.take(node)) * (1 + 1e-12)
-            keep = np.flatnonzero((thr >= 0) & (ex * ex + ey * ey <= thr * thr))
+            cut *= 1 + 1e-12
+            cut[best2 < lo2] = np.nan
+            thr = cut.take(qi)
+            thr += rad.take(node)
+            thr *= thr
+            keep = (dx <= thr).nonzero()[0]
             qi, node = qi.take(keep), node.take(keep)
+            if level == self.depth or qi.size == 0:
+                break
+            jump = int(np.log2(max(_PAIRS // max(qi.size, 1), 1)))
+            jump = min(self.depth - level, max(jump, 2))
+            fan = 2**jump
+            level += jump
+            qi = qi.repeat(fan)
+            node = np.add.outer(node * fan, np.arange(fan)).ravel()
 
         # Leaves: brute force over their segments.
-        seg = (node[:, None] * self.leaf + np.arange(self.leaf)).reshape(-1)
-        qs = np.repeat(qi, self.leaf)
-        ax, ay, ux, uy, inv = (f.take(seg) for f in self._segs)
-        dx = px.take(qs) - ax
-        dy = py.take(qs) - ay
-        t = np.clip((dx * ux + dy * uy) * inv, 0.0, 1.0)
-        ex = dx - t * ux
-        ey = dy - t * uy
-        d2 = ex * ex + ey * ey
+        seg = np.add.outer(node * self.leaf, np.arange(self.leaf)).ravel()
+        qs = qi.repeat(self.leaf)
+        ax, ay, ux, uy, inv = self._segs
+        dx = px.take(qs)
+        dx -= ax.take(seg)
+        dy = py.take(qs)
+        dy -= ay.take(seg)
+        nux, nuy = ux.take(seg), uy.take(seg)
+        t = dx * nux
+        t += dy * nuy
+        t *= inv.take(seg)
+        np.minimum(np.maximum(t, 0.0, out=t), 1.0, out=t)
+        nux *= t
+        dx -= nux
+        nuy *= t
+        dy -= nuy
+        dx *= dx
+        dy *= dy
+        dx += dy
+        d2 = dx
         dist2 = np.full(q, np.inf)
         np.minimum.at(dist2, qs, d2)
-        hit = np.flatnonzero(d2 == dist2.take(qs))
+        hit = (d2 == dist2.take(qs)).nonzero()[0]
         segment = np.full(q, -1, dtype=np.int64)
         param = np.zeros(q)
         # Ties give several hits per point; any one of them is a nearest segment.
-        segment[qs[hit]] = np.minimum(seg[hit], self.n - 1)
-        param[qs[hit]] = t[hit]
+        at = qs.take(hit)
+        segment[at] = np.minimum(seg.take(hit), self.n - 1)
+        param[at] = t.take(hit)
         dist = np.sqrt(dist2)
-        best = np.sqrt(best2)
-        found = np.isfinite(dist)
+        found = dist2 < np.inf
         exact = found & (dist <= hi)
-        out = np.where(found, dist, best)
-        near = ~found & (best2 < lo2)
-        far = ~found & ~near
-        out[far] = np.maximum(best[far], np.nextafter(hi[far], np.inf))
+        if found.all():
+            out = dist
+        else:
+            best = np.sqrt(best2)
+            out = np.where(found, dist, best)
+            far = ~found & ~(best2 < lo2)
+            out[far] = np.maximum(best[far], np.nextafter(hi[far], np.inf))
         segment[~exact] = -1
         return Nearest(out, exact, segment, param)
+
+
+def _dist2(
+    ex: np.ndarray, ey: np.ndarray, ax: np.ndarray, ay: np.ndarray, bx: np.ndarray, by: np.ndarray
+) -> np.ndarray:
+    """Squared distances (k, m) from points ``(ex[i, j], ey[i, j])`` to the segments
+    ``(ax[j], ay[j]) -> (bx[j], by[j])``: segments along the last axis, so numpy's inner
+    loops run over all of them (a short last axis would make them crawl)."""
+    ux, uy = bx - ax, by - ay
+    len2 = ux * ux + uy * uy
+    inv = np.divide(1.0, len2, out=np.zeros_like(len2), where=len2 > 0)
+    dx, dy = ex - ax, ey - ay
+    t = dx * ux
+    t += dy * uy
+    t *= inv
+    np.minimum(np.maximum(t, 0.0, out=t), 1.0, out=t)
+    dx -= t * ux
+    dy -= t * uy
+    dx *= dx
+    dy *= dy
+    dx += dy
+    return dx
 
 
 def _fields(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, ...]:

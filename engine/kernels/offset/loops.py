@@ -177,14 +177,23 @@ def tidy(loops: Loops, gap: float) -> Loops:
         )
         cut[nxt[back]] = True
         cut |= _detours(loops, gap)
-        # A chord crossing one a few chords ahead: the vertices between are twisted.
-        steps = [nxt]  # steps[o - 1] = the vertex o ahead
-        for _ in range(_UNTANGLE):
-            steps.append(nxt[steps[-1]])
-        for o in range(2, _UNTANGLE + 1):
-            crossing = crosses(xy, nxt, steps[o - 1], steps[o])
-            for between in steps[:o]:
-                cut[between[crossing]] = True
+        # A chord crossing one a few chords ahead: the vertices between are twisted. All
+        # offsets o = 2 .. _UNTANGLE at once: steps[o - 1] is the vertex o ahead, and the
+        # vertex k + 1 ahead is between for every crossing at an offset o > k.
+        steps = np.empty((_UNTANGLE + 1, nxt.size), dtype=nxt.dtype)
+        steps[0] = nxt
+        for o in range(1, _UNTANGLE + 1):
+            steps[o] = nxt[steps[o - 1]]
+        n = nxt.size
+        crossing = segments_cross(
+            np.tile(xy, (_UNTANGLE - 1, 1)),
+            np.tile(xy[nxt], (_UNTANGLE - 1, 1)),
+            xy[steps[1:_UNTANGLE].reshape(-1)],
+            xy[steps[2:].reshape(-1)],
+        ).reshape(_UNTANGLE - 1, n)  # row o - 2
+        beyond = np.logical_or.accumulate(crossing[::-1], axis=0)[::-1]  # any offset >= o
+        between = beyond[np.maximum(np.arange(_UNTANGLE) - 1, 0)]  # (k, n): any o > k
+        cut[steps[:_UNTANGLE][between]] = True
         if not cut.any():
             break
         loops = loops.select(~cut)

@@ -32,7 +32,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from .contour import split_loops, trace_crossings
+from .contour import split_loops, trace_crossings, unique_ids
 from .distance import RowParity, SegmentTree
 from .loops import simplify as simplify_loops
 from .refine import exact_loops
@@ -142,7 +142,26 @@ class _Field:
         return sign * f, feet
 
 
+# Sample values are found through a dense table of positions while the grid has at most
+# _DENSE samples per stored one, or at most _DENSE_MIN samples.
+_DENSE = 32
+_DENSE_MIN = 1 << 16
+
+
 def _store_lookup(ids: np.ndarray, values: np.ndarray):
+    """``value(q)``: the ``values`` of sample ids ``q``, each one of the sorted ``ids``. A dense
+    table of positions while the ids span a small grid or one the stored band fills well
+    (two gathers a call), else a binary search (only a band of a big grid is stored)."""
+    size = int(ids[-1]) + 1 if ids.size else 1
+    if size <= max(_DENSE_MIN, _DENSE * ids.size):
+        table = np.empty(size, dtype=np.int32)  # (only stored ids are ever asked)
+        table[ids] = np.arange(ids.size, dtype=np.int32)
+
+        def dense(q: np.ndarray) -> np.ndarray:
+            return values[table[q]]
+
+        return dense
+
     def value(q: np.ndarray) -> np.ndarray:
         perm = np.argsort(q)
         pos = np.empty(q.size, dtype=np.int64)
@@ -170,7 +189,7 @@ def _band_cells(field: _Field, ncx: int, ncy: int, levels: int):
     # Level `levels`: the whole coarse grid.
     ci, cj = np.mgrid[0 : ncy // step, 0 : ncx // step]
     ci, cj = ci.ravel(), cj.ravel()
-    value = foot = None
+    value = foot = gaps = None
     for lev in range(levels, -1, -1):
         step = 2**lev
         w = ncx // step + 1
@@ -178,10 +197,10 @@ def _band_cells(field: _Field, ncx: int, ncy: int, levels: int):
             pi, pj = np.mgrid[0 : ncy // step + 1, 0 : ncx // step + 1]
             pid = (pi * w + pj).ravel()
         else:
-            # Children of the surviving parents, and their 3 x 3 samples.
-            ci = (2 * ci[:, None] + np.array([0, 0, 1, 1])).ravel()
-            cj = (2 * cj[:, None] + np.array([0, 1, 0, 1])).ravel()
-            pid = np.unique(
+            # Children of the surviving parents, and their samples; a child goes unsampled
+            # where the parent's corners already rule it out (`_children`).
+            ci, cj = _children(ci, cj, gaps, step * field.cell)
+            pid = unique_ids(
                 (ci[:, None] + np.array([0, 0, 1, 1])) * w + cj[:, None] + np.array([0, 1, 0, 1])
             )
         pi, pj = np.divmod(pid, w)
@@ -200,14 +219,45 @@ def _band_cells(field: _Field, ncx: int, ncy: int, levels: int):
         value = _store_lookup(pid, values)
         foot = _store_lookup(pid, feet)
         corner = ci * w + cj
-        gap = np.abs(
+        corners = np.abs(
             np.stack([value(corner), value(corner + 1), value(corner + w), value(corner + w + 1)])
             - d
-        ).min(axis=0)
+        )
+        gap = corners.min(axis=0)
         # A cell can hold a point at the level only if a corner is within half a diagonal.
-        keep = gap <= step * field.cell * (np.sqrt(0.5) * (1 + 1e-9))
-        ci, cj = ci[keep], cj[keep]
+        keep = gap <= step * field.cell * _HALF_DIAGONAL
+        # (Values outside the band are only certified beyond it: clamped there, the gaps
+        # stay lower bounds for `_children`.)
+        ci, cj, gaps = ci[keep], cj[keep], np.minimum(corners[:, keep], band)
     return pid, values, feet, ci * (ncx + 1) + cj
+
+
+_HALF_DIAGONAL = np.sqrt(0.5) * (1 + 1e-9)  # a hair of slack against rounding
+# For the 3 x 3 samples of a split cell (row-major, parent corners at 0, 2, 6, 8): which
+# parent corner each child's corners are (in order 00, 01, 10, 11), and how far each of the
+# 9 samples is from each parent corner, in child cells.
+_CHILD_SAMPLES = np.array([[0, 1, 3, 4], [1, 2, 4, 5], [3, 4, 6, 7], [4, 5, 7, 8]])
+_SAMPLE_TO_CORNER = np.linalg.norm(
+    np.array(np.divmod(np.arange(9), 3)).T[:, None] - np.array([[0, 0], [0, 2], [2, 0], [2, 2]]),
+    axis=2,
+)  # (9 samples, 4 parent corners)
+
+
+def _children(ci: np.ndarray, cj: np.ndarray, gaps: np.ndarray, h: float):
+    """The four children of each cell ``(ci, cj)``, less those its corners rule out.
+
+    ``gaps`` (4, m) holds lower bounds of ``|f - level|`` at each parent's corners 00, 01,
+    10, 11. ``f`` being 1-Lipschitz, ``|f(y) - level| >= gap(c) - |y - c|`` at every sample
+    ``y`` of the parent; a child whose four corners are all bounded above half its diagonal
+    ``h`` would be dropped once sampled, so it is dropped now (the cells kept are the same,
+    with fewer samples to evaluate).
+    """
+    bound = (gaps.T[:, None, :] - h * _SAMPLE_TO_CORNER[None]).max(axis=2)  # (m, 9)
+    child_bound = bound[:, _CHILD_SAMPLES].min(axis=2)  # (m, 4)
+    keep = child_bound <= h * _HALF_DIAGONAL
+    ci = (2 * ci[:, None] + np.array([0, 0, 1, 1]))[keep]
+    cj = (2 * cj[:, None] + np.array([0, 1, 0, 1]))[keep]
+    return ci, cj
 
 
 def grid_cells(lo: np.ndarray, hi: np.ndarray, distance: float, cell: float) -> int:
@@ -314,14 +364,17 @@ def _thin_parts(field: _Field, ids, values, feet, cells, ncx: int) -> bool:
     if not both:
         return False
     owners = np.concatenate(both, axis=1)
-    _, count = np.unique(owners, return_counts=True)
+    _, count = unique_ids(owners, return_counts=True)
     if (count >= 2).any():
         return True
     # An island thinner than a cell that no sample sees: its edge borders no crossed cell.
     corners = np.stack([value(cells), value(cells + 1), value(cells + nx), value(cells + nx + 1)])
     side = near(corners)
-    crossed = cells[side.any(axis=0) & ~side.all(axis=0)]
-    seen = np.isin(owners, crossed)
+    crossed = np.sort(cells[side.any(axis=0) & ~side.all(axis=0)])
+    if crossed.size == 0:
+        seen = np.zeros(owners.shape, dtype=bool)
+    else:  # (np.isin, by a search: far cheaper for these few ids)
+        seen = crossed[np.minimum(np.searchsorted(crossed, owners), crossed.size - 1)] == owners
     # A far-side piece joining two crossed cells through an edge that marching squares
     # sees as uncrossed: a connection cut.
     return bool((~seen.any(axis=0)).any() or seen.all(axis=0).any())

@@ -140,13 +140,18 @@ def _crossing(tree, p0, p1, d0, radius, tol, iterations=16):
     return found, point, normal, seg
 
 
-def _corner(tree, s1, s2, start, radius, tol, chases=2, iterations=4):
-    """Where the offsets of two segments meet near ``start``: a corner of the level set.
+def _corner(tree, s1, s2, start, radius, tol, chases=2, iterations=6):
+    """Where the offsets of two pieces of the input meet near ``start``: a corner of the level
+    set.
 
     Solves ``dist(x, s1) = dist(x, s2) = radius`` by Newton's method (exact in one step for
-    two lines, quadratic for lines and circles), then checks with a query that no other
-    segment comes closer. If one does, it replaces the pair member whose gradient at ``x``
-    is closest to its own (the one on the same side of the corner) and the solve repeats.
+    two lines, quadratic for lines and circles). Each step the pair follows the input: each
+    member becomes the segment nearest ``x`` among its neighbours in index order (a window of
+    `_TRACK` on either side, never reaching past the other member), so two smooth stretches
+    of a finely sampled input meet where their offsets do, not where two of their segments'
+    offsets would. A query then checks that no other segment comes closer. If one does, it
+    replaces the pair member whose gradient at ``x`` is closest to its own (the one on the
+    same side of the corner) and the solve repeats.
 
     Returns
     -------
@@ -171,36 +176,89 @@ def _corner(tree, s1, s2, start, radius, tol, chases=2, iterations=4):
         if act.size == 0:
             break
         x = point[act]
-        a1, b1, a2, b2 = tree.a[s1[act]], tree.b[s1[act]], tree.a[s2[act]], tree.b[s2[act]]
-        for _ in range(iterations):
-            d1, t1 = point_segment(x, a1, b1)
-            d2, t2 = point_segment(x, a2, b2)
-            n1 = unit(x - (a1 + t1[:, None] * (b1 - a1)))
-            n2 = unit(x - (a2 + t2[:, None] * (b2 - a2)))
+        p1, p2 = s1[act], s2[act]
+        for k in range(iterations):
+            p1, d1, t1 = _track(tree, x, p1, p2)
+            p2, d2, t2 = _track(tree, x, p2, p1)
+            f1, f2 = d1 - radius, d2 - radius
+            if k and np.all((np.abs(f1) <= 0.1 * eps) & (np.abs(f2) <= 0.1 * eps)):
+                break  # converged (the usual case after one or two steps)
+            n1 = unit(x - _foot(tree, p1, t1))
+            n2 = unit(x - _foot(tree, p2, t2))
             det = n1[:, 0] * n2[:, 1] - n1[:, 1] * n2[:, 0]
             safe = np.abs(det) > 1e-6
             det = np.where(safe, det, 1.0)
-            f1, f2 = d1 - radius, d2 - radius
             # Solve [n1; n2] step = -(f1, f2).
             step = np.stack([-(n2[:, 1] * f1 - n1[:, 1] * f2), n2[:, 0] * f1 - n1[:, 0] * f2], -1)
             x = np.where(safe[:, None], x + step / det[:, None], x)
-        d1, t1 = point_segment(x, a1, b1)
-        d2, t2 = point_segment(x, a2, b2)
-        n1 = unit(x - (a1 + t1[:, None] * (b1 - a1)))
-        n2 = unit(x - (a2 + t2[:, None] * (b2 - a2)))
+        else:
+            p1, d1, t1 = _track(tree, x, p1, p2)
+            p2, d2, t2 = _track(tree, x, p2, p1)
+        s1[act], s2[act] = p1, p2
+        n1 = unit(x - _foot(tree, p1, t1))
+        n2 = unit(x - _foot(tree, p2, t2))
         near = tree.query(x, radius - 0.5 * radius, radius + 0.5 * radius)
         nx = _feet(tree, near, x)[1]
         ok = near.exact & (np.abs(near.dist - radius) <= eps) & safe
         ok &= (np.abs(d1 - radius) <= eps) & (np.abs(d2 - radius) <= eps)
         point[act], n1_all[act], n2_all[act] = x, n1, n2
         found[act[ok]] = True
-        # Swallowed by a third segment: it takes the place of the member on its side.
+        # Swallowed by a third segment: it takes the place of the member on its side (a
+        # member found again changes nothing).
         again = ~ok & near.exact & (near.dist < radius) & safe
+        again &= (near.segment != p1) & (near.segment != p2)
         swap1 = np.einsum("ij,ij->i", nx, n1) > np.einsum("ij,ij->i", nx, n2)
         s1[act[again & swap1]] = near.segment[again & swap1]
         s2[act[again & ~swap1]] = near.segment[again & ~swap1]
         act = act[again]
     return found, point, n1_all, s1, n2_all, s2
+
+
+_TRACK = 16  # neighbours on either side a corner's pair member may move to each step
+_OFFSETS = np.concatenate([[0], np.arange(-_TRACK, 0), np.arange(1, _TRACK + 1)])
+
+
+def _foot(tree: SegmentTree, seg: np.ndarray, t: np.ndarray) -> np.ndarray:
+    a = tree.a[seg]
+    return a + t[:, None] * (tree.b[seg] - a)
+
+
+def _track(tree: SegmentTree, x: np.ndarray, seg: np.ndarray, other: np.ndarray):
+    """The segment nearest ``x`` among ``seg``'s index neighbours, with its distance and
+    nearest-point parameter.
+
+    The neighbours are those up to `_TRACK` either side on the same smooth run of the input
+    as ``seg`` (`_smooth_runs`: a member follows its own stretch of curve, never around a
+    sharp vertex of the input, where another feature begins), none at or past ``other``.
+    """
+    run = _smooth_runs(tree)
+    window = seg[:, None] + _OFFSETS  # seg itself first: it stays unless another is nearer
+    window = np.minimum(np.maximum(window, 0), tree.n - 1)
+    gap = other[:, None] - seg[:, None]
+    # Keep strictly on seg's side of other (other itself, and beyond, belong to it).
+    allowed = np.where(gap > 0, window < other[:, None], window > other[:, None])
+    allowed &= run[window] == run[seg][:, None]
+    window = np.where(allowed, window, seg[:, None])
+    d, t = point_segment(x[:, None], tree.a[window], tree.b[window])
+    best = np.argmin(d, axis=1)
+    rows = np.arange(x.shape[0])
+    return window[rows, best], d[rows, best], t[rows, best]
+
+
+def _smooth_runs(tree: SegmentTree) -> np.ndarray:
+    """Run id of each segment: consecutive segments share one while each starts where the
+    previous one ends and turns from it by less than 30 degrees (computed once per tree)."""
+    run = getattr(tree, "_smooth_run", None)
+    if run is None:
+        a, b = tree.a[: tree.n], tree.b[: tree.n]
+        u = b - a
+        joined = (b[:-1] == a[1:]).all(axis=1)
+        length = np.hypot(u[:, 0], u[:, 1])
+        cos = np.einsum("ij,ij->i", u[:-1], u[1:])
+        smooth = joined & (cos > COS30 * length[:-1] * length[1:]) & (length[:-1] > 0)
+        run = np.concatenate([[0], np.cumsum(~smooth)])
+        tree._smooth_run = run
+    return run
 
 
 def _between(u: np.ndarray, c: np.ndarray, p: np.ndarray) -> np.ndarray:

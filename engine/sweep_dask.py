@@ -1,0 +1,350 @@
+"""Running a sweep's variants as one Dask graph keyed by the nodes' cache keys.
+
+Every variant is planned on the client (:meth:`formgraph.Graph.plan`): each node it needs,
+keyed as a cold evaluation keys it. A node that two or more variants need (a profile the
+varied param never reaches) is a task under its cache key, so shared work runs once in the
+whole sweep. A variant's own nodes run in its row (``row-<hash of its target keys>``, which
+identical variants share), a few rows to a task when there are many: Dask's linear fusion,
+done by what variants share, so the per-task overhead is paid once per few variants. A node
+the client sees in the disk cache is loaded instead (evaluated on a worker that lacks it),
+and its ancestors are not scheduled. The tasks themselves are :mod:`formgraph.sweep_tasks`.
+
+Workers receive the graph once, as its YAML text (a task of its own, ``graph-<token>``),
+never a file path: nothing here assumes a shared filesystem. Shared nodes' outputs travel
+between workers as Dask data; measured values, exported files (their bytes) and rendered
+cells come back to the client in one small result per variant, which the client writes.
+
+A node that fails is an outcome holding its one-line error, never an exception, so its
+dependents finish at once with the same error and the sweep goes on. A worker that dies
+is Dask's business: the scheduler reruns its tasks elsewhere (``distributed``'s
+``allowed-failures``), and a variant is reported once, when its row task finishes.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import os
+import time
+import uuid
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from .cache import DiskCache, default_cache_dir, key_of
+from .errors import FormgraphError
+from .graph import Graph, Step
+from .sweep_tasks import (
+    Blueprint,
+    Job,
+    RowChunk,
+    RowJob,
+    RowPlan,
+    RowResult,
+    cached_step,
+    one_line,
+    run_export,
+    run_rows,
+    run_step,
+)
+
+__all__ = ["RowResult", "SweepError", "Targets", "Totals", "connect", "run"]
+
+BLAS_ENV = {
+    "OMP_NUM_THREADS": "1",
+    "OPENBLAS_NUM_THREADS": "1",
+    "MKL_NUM_THREADS": "1",
+    "VECLIB_MAXIMUM_THREADS": "1",
+    "NUMEXPR_NUM_THREADS": "1",
+}
+
+
+class SweepError(FormgraphError):
+    """A sweep that cannot run: no cluster to reach, a graph workers cannot rebuild."""
+
+
+@dataclass(frozen=True)
+class Targets:
+    """What each variant brings back: measured outputs, exports, a rendered node."""
+
+    measures: tuple[tuple[str, str | None, str], ...] = ()  # (node, output, column)
+    exports: tuple[str, ...] = ()  # export node names
+    render: str | None = None
+    size: tuple[int, int] = (256, 192)
+    build: tuple[str, ...] = ()  # nodes only built (nothing measured, exported or drawn)
+
+    @property
+    def nodes(self) -> list[str]:
+        names = [m[0] for m in self.measures] + list(self.exports) + list(self.build)
+        if self.render:
+            names.append(self.render)
+        return list(dict.fromkeys(names))
+
+
+@dataclass
+class Totals:
+    """How much work the sweep's graph held and did."""
+
+    variants: int = 0
+    naive: int = 0  # node evaluations of a plain loop without any cache: variants x nodes
+    needed: int = 0  # distinct node tasks in the sweep's graph
+    computed: int = 0
+    cached: int = 0
+
+
+def blueprint(g: Graph, cache_dir: str | None, worker_cache: bool) -> Blueprint:
+    """The graph as workers will rebuild it.
+
+    Raises
+    ------
+    SweepError
+        When a node type is defined where workers cannot import it (``__main__``), or the
+        graph holds Python objects that do not write to YAML.
+    """
+    registry = g.node_types()  # the registry and the graph files it names
+    modules = set()
+    for name, type_name in g.nodes.items():
+        module = registry[type_name].func.__module__
+        if module == "__main__":
+            raise SweepError(
+                f"{g.file_label}: node '{name}': its type '{type_name}' is defined in the "
+                f"script being run (__main__), which Dask workers cannot import; define it "
+                f"in a module"
+            )
+        if not module.startswith("formgraph."):
+            modules.add(module)
+    try:
+        text = g.to_yaml()
+    except Exception as exc:  # yaml's RepresenterError for a geometry typed in as an input
+        raise SweepError(
+            f"{g.file_label}: the graph cannot be sent to Dask workers as YAML ({exc}); pass "
+            f"geometry through a typed param instead of a node input"
+        ) from None
+    files: dict[str, str] = {}
+    if g.file and len(g.files) > 1:  # subgraphs: their text travels with the graph
+        root = Path(g.file).resolve().parent
+        for path in g.files[1:]:
+            try:
+                rel = Path(path).resolve().relative_to(root).as_posix()
+                files[rel] = Path(path).read_text(encoding="utf-8")
+            except (OSError, ValueError, UnicodeDecodeError) as exc:
+                raise SweepError(
+                    f"{g.file_label}: cannot send {path} to Dask workers: {exc}"
+                ) from None
+    return Blueprint(
+        uuid.uuid4().hex,
+        text,
+        g.file_label,
+        g.params,
+        tuple(sorted(modules)),
+        g.budget,
+        None if cache_dir is None else str(cache_dir),
+        worker_cache,
+        files,
+        str(Path(g.file).resolve()) if g.file else "",
+    )
+
+
+def build(
+    g: Graph,
+    bp_key: str,
+    variants: Sequence[tuple[int, dict[str, Any]]],
+    targets: Targets,
+    visible: DiskCache | None,
+    chunk: int = 1,
+) -> tuple[dict[str, Any], dict[str, list[int]], dict[str, list[str]], Totals]:
+    """The Dask graph of every variant, the variants of each row key, the row keys of each
+    row task, and the totals.
+
+    A node two or more variants need is a task under its cache key, computed once; a
+    variant's own nodes run inside its row task (``row-<hash of its target keys>``, so
+    identical variants share a row), ``chunk`` rows to a task. A node the client sees in the
+    disk cache is loaded instead of computed, and its ancestors are not needed at all.
+    """
+    names = targets.nodes
+    plans: list[tuple[str, list[Step], dict[str, Any]]] = []
+    rows: dict[str, list[int]] = {}
+    users: dict[str, int] = {}  # node key -> how many distinct rows need it
+    cached: set[str] = set()
+    totals = Totals(variants=len(variants))
+    for index, params in variants:
+        steps = g.plan(names, **params)
+        totals.naive += len(steps)
+        by_name = {s.name: s for s in steps}
+        row_key = "row-" + key_of([by_name[n].key for n in names] + [list(targets.size)])
+        if row_key in rows:
+            rows[row_key].append(index)
+            continue
+        rows[row_key] = [index]
+        needed = set(names)
+        kept = []
+        for s in reversed(steps):  # from the targets up: a cached node needs no ancestors
+            if s.name not in needed:
+                continue
+            kept.append(s)
+            if not s.export and visible is not None and visible.has(s.key):
+                cached.add(s.key)
+                continue
+            needed.update(s.upstream)
+        kept.reverse()
+        for s in kept:
+            users[s.key] = users.get(s.key, 0) + 1
+        plans.append((row_key, kept, params))
+    dsk: dict[str, Any] = {}
+    job = RowJob(targets.measures, targets.exports, targets.render, targets.size)
+    row_plans = []
+    for row_key, steps, params in plans:
+        by_name = {s.name: s for s in steps}
+        own = tuple(s for s in steps if users[s.key] == 1)
+        for s in steps:
+            if users[s.key] == 1 or s.key in dsk:
+                continue
+            if s.key in cached:
+                dsk[s.key] = (cached_step, bp_key, Job(s, params))
+            else:
+                ups = [by_name[u].key for u in s.upstream]
+                dsk[s.key] = (run_export if s.export else run_step, bp_key, Job(s, params), *ups)
+        wanted = [u for s in own if s.key not in cached for u in s.upstream] + names
+        shared = tuple(
+            (n, by_name[n].key) for n in dict.fromkeys(wanted) if users[by_name[n].key] > 1
+        )
+        row_plans.append(RowPlan(own, shared, params, row_key))
+    chunks: dict[str, list[str]] = {}
+    for i in range(0, len(row_plans), chunk):
+        group = tuple(row_plans[i : i + chunk])
+        keys = tuple(dict.fromkeys(k for p in group for _, k in p.shared))
+        task_key = group[0].key if len(group) == 1 else "rows-" + key_of([p.key for p in group])
+        dsk[task_key] = (run_rows, bp_key, job, RowChunk(group, keys), *keys)
+        chunks[task_key] = [p.key for p in group]
+    totals.needed = len(users)
+    return dsk, rows, chunks, totals
+
+
+@contextlib.contextmanager
+def connect(client: Any, workers: int | None) -> Iterator[Any]:
+    """A Dask client: the one given, one for a scheduler address, or an embedded cluster.
+
+    The embedded :class:`distributed.LocalCluster` has one single-threaded worker process per
+    core (BLAS threads pinned to 1), listens on the loopback only, and is closed on the way
+    out, whatever happened.
+    """
+    from distributed import Client, LocalCluster
+
+    if client is not None and not isinstance(client, str):
+        yield client
+        return
+    if isinstance(client, str):
+        try:
+            c = Client(client, timeout="10s")
+        except (OSError, TimeoutError) as exc:
+            raise SweepError(f"cannot reach the Dask scheduler at {client}: {exc}") from None
+        try:
+            yield c
+        finally:
+            c.close()
+        return
+    import dask
+
+    n = workers or os.cpu_count() or 1
+    # distributed sets MALLOC_TRIM_THRESHOLD_ in workers to hand memory back early; for
+    # numpy kernels whose temporaries are megabytes that costs a page-fault storm (the spiral
+    # tube builds 1.4x slower), and a sweep's workers end with the sweep anyway
+    with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}):
+        cluster = LocalCluster(
+            n_workers=n,
+            threads_per_worker=1,
+            processes=True,
+            host="127.0.0.1",
+            dashboard_address=None,
+            scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},  # its HTTP routes, off 8787
+            silence_logs=logging.ERROR,
+            env=BLAS_ENV,
+        )
+    try:
+        c = Client(cluster)
+        try:
+            yield c
+        finally:
+            c.close()
+    finally:
+        cluster.close()
+
+
+def run(
+    g: Graph,
+    variants: Sequence[tuple[int, dict[str, Any]]],
+    targets: Targets,
+    on_row: Callable[[int, RowResult], None],
+    *,
+    client: Any = None,
+    workers: int | None = None,
+    cache_dir: str | os.PathLike[str] | None = None,
+    worker_cache: bool = False,
+) -> Totals:
+    """Run ``variants`` (index, params) and call ``on_row`` on the client as each finishes."""
+    from distributed import as_completed
+
+    if not variants:  # all done already (a resumed sweep): no cluster needed
+        return Totals()
+    bp = blueprint(g, None if cache_dir is None else str(cache_dir), worker_cache)
+    bp_key = f"graph-{bp.token}"
+    embedded = client is None
+    visible = None
+    if embedded and (cache_dir is not None or worker_cache):  # the workers' disk is ours
+        visible = DiskCache(default_cache_dir() if worker_cache else cache_dir)
+    seen: dict[str, tuple[float, str]] = {}
+    with connect(client, workers) as c:
+        threads = sum(w.get("nthreads", 1) for w in c.scheduler_info()["workers"].values())
+        # a few variants to a task when there are many per thread: Dask's overhead per task
+        # is paid once per few light variants, and the table still grows steadily
+        chunk = max(1, min(16, len(variants) // (8 * max(threads, 1))))
+        dsk, rows, chunks, totals = build(g, bp_key, variants, targets, visible, chunk)
+        if not rows:
+            return totals
+        dsk[bp_key] = bp
+        futures = c.get(dsk, list(chunks), sync=False, optimize_graph=False)
+        pending = as_completed(futures)
+        resubmitted: dict[str, int] = {}
+        try:
+            for batch in pending.batches():  # one gather per batch: no round trip per task
+                done = [f for f in batch if f.status == "finished"]
+                try:
+                    results = dict(zip([f.key for f in done], c.gather(done), strict=True))
+                except Exception:  # lost meanwhile (a worker died): each on its own below
+                    results = {}
+                for fut in batch:
+                    if fut.cancelled() and resubmitted.get(fut.key, 0) < 8:
+                        # the same keys of an interrupted sweep, still being cancelled on a
+                        # shared scheduler, cancel ours too: ask again (we never cancel ours)
+                        resubmitted[fut.key] = resubmitted.get(fut.key, 0) + 1
+                        time.sleep(0.1 * resubmitted[fut.key])
+                        (again,) = c.get(dsk, [fut.key], sync=False, optimize_graph=False)
+                        futures.append(again)
+                        pending.add(again)
+                        continue
+                    if fut.key in results:
+                        finished = results[fut.key]
+                    else:
+                        finished = _chunk_result(fut, chunks[fut.key])
+                    fut.release()
+                    for row_key, result in finished:
+                        seen.update(result.costs)
+                        for index in rows[row_key]:
+                            on_row(index, result)
+        finally:
+            c.cancel(futures)
+    totals.computed = sum(1 for _, st in seen.values() if st == "computed")
+    totals.cached = sum(1 for _, st in seen.values() if st == "cached")
+    return totals
+
+
+def _chunk_result(fut: Any, row_keys: list[str]) -> list[tuple[str, RowResult]]:
+    try:
+        return fut.result()
+    except Exception as exc:  # KilledWorker after too many deaths, or a bug of ours
+        if type(exc).__name__ == "KilledWorker":
+            msg = "the Dask workers running this variant kept dying (out of memory?)"
+        else:
+            msg = one_line(exc)
+        return [(k, RowResult(msg, 0.0, {}, {}, None, {})) for k in row_keys]
