@@ -9,6 +9,7 @@ import textwrap
 from pathlib import Path
 
 import pytest
+from tools import cli
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -23,16 +24,6 @@ nodes:
     count: "=n"
     radius: "=r"
 """
-
-
-def cli(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(
-        [sys.executable, "-m", "formgraph.cli", *args],
-        capture_output=True,
-        text=True,
-        cwd=cwd,
-        timeout=120,
-    )
 
 
 @pytest.fixture

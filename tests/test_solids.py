@@ -2,10 +2,7 @@
 
 from __future__ import annotations
 
-import re
 import shutil
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -13,6 +10,7 @@ import pytest
 import trimesh
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from tools import admesh, cli
 
 import formgraph as fg
 from formgraph.errors import BudgetError
@@ -37,27 +35,6 @@ def tm(mesh: fg.Mesh) -> trimesh.Trimesh:
 def is_solid(mesh: fg.Mesh) -> bool:
     t = tm(mesh)
     return mesh.is_watertight and t.is_watertight and t.is_winding_consistent and t.volume > 0
-
-
-def admesh(path: Path) -> dict[str, float]:
-    report = subprocess.run(["admesh", str(path)], capture_output=True, text=True).stdout
-    names = (
-        "Number of parts",
-        "Volume",
-        "Degenerate facets",
-        "Edges fixed",
-        "Facets removed",
-        "Facets added",
-        "Facets reversed",
-        "Backwards edges",
-    )
-    out = {n: float(re.search(rf"{n}\s*:\s*(-?[\d.]+)", report).group(1)) for n in names}
-    m = re.search(r"Facets with 1 disconnected edge\s*:\s*(\d+)", report)
-    out["open"] = float(m.group(1))
-    return out
-
-
-needs_admesh = pytest.mark.skipif(shutil.which("admesh") is None, reason="admesh not installed")
 
 
 # ------------------------------------------------------------------------------ primitives
@@ -270,16 +247,6 @@ def test_a_revolve_to_the_axis_collapses_its_poles():
 
 
 # ------------------------------------------------------------------------------ --strict
-
-
-def cli(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(
-        [sys.executable, "-m", "formgraph.cli", *args],
-        capture_output=True,
-        text=True,
-        cwd=cwd,
-        timeout=120,
-    )
 
 
 def test_run_strict_turns_warnings_into_exit_1(tmp_path):
