@@ -10,10 +10,12 @@ are evaluated by the :class:`formgraph.language.LanguageRun` mixin.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import sys
 import time
 import warnings as _warnings
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -99,6 +101,7 @@ class _Run(LanguageRun):
         self.out_dir = str(self.out_path)
         self.total = 0
         self.started: set[str] = set()  # nodes that began computing, for the progress line
+        self.quiet = False  # inside run(): numpy's warnings are silenced once, not per node
 
     def where(self, name: str, port: str | None = None) -> Where:
         nd = self.g._nodes[name]
@@ -111,6 +114,16 @@ class _Run(LanguageRun):
         A node whose key already has an identity (from an earlier run) is not even fetched
         unless a node that must compute needs its value.
         """
+        if self.quiet:
+            return self._run(targets)
+        with _quiet_numpy():  # entered once per run, not per node (~3 us each)
+            self.quiet = True
+            try:
+                return self._run(targets)
+            finally:
+                self.quiet = False
+
+    def _run(self, targets: list[str]) -> None:
         order = self.g._order(targets)
         self.total = len(order)
         for n in order:  # the budget applies to every count known before anything runs
@@ -338,10 +351,7 @@ class _Run(LanguageRun):
         self.started.add(name)
         t0 = time.perf_counter()
         try:
-            with np.errstate(all="ignore"), _warnings.catch_warnings():
-                # numpy's overflow/invalid-value chatter never reaches a user: a result that
-                # is not finite is refused (check_output, the geometry types), located
-                _warnings.simplefilter("ignore", RuntimeWarning)
+            with contextlib.nullcontext() if self.quiet else _quiet_numpy():
                 if isinstance(spec, SubgraphSpec):
                     value = self.run_subgraph(name, nd, spec, kwargs, env)
                 else:
@@ -442,6 +452,15 @@ class _Run(LanguageRun):
                 nd.type,
                 f"returned a value that does not fit its output {out_type.name}: {exc}",
             ) from None
+
+
+@contextlib.contextmanager
+def _quiet_numpy() -> Iterator[None]:
+    """numpy's overflow/invalid-value chatter never reaches a user: a result that is not
+    finite is refused (check_output, the geometry types), located."""
+    with np.errstate(all="ignore"), _warnings.catch_warnings():
+        _warnings.simplefilter("ignore", RuntimeWarning)
+        yield
 
 
 _PACKAGE = os.path.dirname(os.path.abspath(__file__))

@@ -105,16 +105,34 @@ class SegmentTree:
 
         # Leaf capsules: axis from the first segment's start to the last one's end, radius
         # the farthest segment end from that axis (a capsule is convex, so it then holds
-        # every segment whole). Coordinates one by one: contiguous, and squared distances
-        # until the one square root of the maximum.
-        ca = self.a.reshape(n_leaves, leaf, 2)
-        cb = self.b.reshape(n_leaves, leaf, 2)
-        axa = ca[:, 0]
-        axb = cb[:, -1]
-        ends = np.ascontiguousarray(np.concatenate([ca, cb], axis=1).transpose(1, 2, 0))
-        ax, ay, bx, by = (np.ascontiguousarray(c) for c in (*axa.T, *axb.T))
-        d2 = _dist2(ends[:, 0], ends[:, 1], ax, ay, bx, by)  # ends: (2 leaf, 2, n_leaves)
-        rad = np.sqrt(d2.max(axis=0))
+        # every segment whole). The axis ends are on it; in a chain (each segment starting
+        # where the one before ends, as a polyline's do) the other ends are the starts, so
+        # only those are measured. Strided coordinate views, squared distances until the
+        # one square root of the maximum.
+        axa = self.a[0::leaf]
+        axb = self.b[leaf - 1 :: leaf]
+        ax, ay, bx, by = axa[:, 0], axa[:, 1], axb[:, 0], axb[:, 1]
+        ux, uy = bx - ax, by - ay
+        len2 = ux * ux + uy * uy
+        inv = np.divide(1.0, len2, out=np.zeros_like(len2), where=len2 > 0)
+        chain = np.array_equal(a[1:], b[:-1])
+        ends = [self.a[k::leaf] for k in range(1, leaf)]
+        if not chain:
+            ends += [self.b[k::leaf] for k in range(leaf - 1)]
+        d2 = np.zeros(n_leaves)
+        for e in ends:
+            dx, dy = e[:, 0] - ax, e[:, 1] - ay
+            t = dx * ux
+            t += dy * uy
+            t *= inv
+            np.minimum(np.maximum(t, 0.0, out=t), 1.0, out=t)
+            dx -= t * ux
+            dy -= t * uy
+            dx *= dx
+            dy *= dy
+            dx += dy
+            np.maximum(d2, dx, out=d2)
+        rad = np.sqrt(d2)
         # Missing leaves copy the last real axis (a true curve point keeps the upper bound
         # valid) with radius -inf, so their lower bound is +inf and they are never entered.
         extra = width - n_leaves
