@@ -252,9 +252,16 @@ def _children(ci: np.ndarray, cj: np.ndarray, gaps: np.ndarray, h: float):
     ``h`` would be dropped once sampled, so it is dropped now (the cells kept are the same,
     with fewer samples to evaluate).
     """
-    bound = (gaps.T[:, None, :] - h * _SAMPLE_TO_CORNER[None]).max(axis=2)  # (m, 9)
-    child_bound = bound[:, _CHILD_SAMPLES].min(axis=2)  # (m, 4)
-    keep = child_bound <= h * _HALF_DIAGONAL
+    # (Reductions over the short axes written out: (9, m) and (4, m) arrays, long rows.)
+    corner_bound = gaps[:, None, :] - h * _SAMPLE_TO_CORNER.T[:, :, None]  # (4, 9, m)
+    bound = np.maximum(
+        np.maximum(corner_bound[0], corner_bound[1]), np.maximum(corner_bound[2], corner_bound[3])
+    )  # (9, m)
+    s = _CHILD_SAMPLES.T
+    child_bound = np.minimum(
+        np.minimum(bound[s[0]], bound[s[1]]), np.minimum(bound[s[2]], bound[s[3]])
+    )
+    keep = (child_bound <= h * _HALF_DIAGONAL).T  # (m, 4)
     ci = (2 * ci[:, None] + np.array([0, 0, 1, 1]))[keep]
     cj = (2 * cj[:, None] + np.array([0, 1, 0, 1]))[keep]
     return ci, cj
@@ -494,8 +501,9 @@ def offset_polylines(
         raise ValueError(f"smooth must be a whole number of passes >= 0, got {smooth}")
     if not (np.isfinite(simplify) and simplify >= 0):
         raise ValueError(f"simplify must be a tolerance >= 0, got {simplify}")
-    pts = np.concatenate([a, b])
-    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    # (Per coordinate: numpy reduces an (n, 2) array along its long axis slowly.)
+    lo = np.array([min(a[:, k].min(), b[:, k].min()) for k in range(2)])
+    hi = np.array([max(a[:, k].max(), b[:, k].max()) for k in range(2)])
     extent = float((hi - lo).max())
     if cell is None:
         cell = default_cell(extent, distance)

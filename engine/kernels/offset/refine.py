@@ -252,9 +252,10 @@ def _smooth_runs(tree: SegmentTree) -> np.ndarray:
     if run is None:
         a, b = tree.a[: tree.n], tree.b[: tree.n]
         u = b - a
-        joined = (b[:-1] == a[1:]).all(axis=1)
-        length = np.hypot(u[:, 0], u[:, 1])
-        cos = np.einsum("ij,ij->i", u[:-1], u[1:])
+        # (Per coordinate: numpy reduces the short axis of an (n, 2) array slowly.)
+        joined = (b[:-1, 0] == a[1:, 0]) & (b[:-1, 1] == a[1:, 1])
+        length = np.sqrt(u[:, 0] * u[:, 0] + u[:, 1] * u[:, 1])
+        cos = u[:-1, 0] * u[1:, 0] + u[:-1, 1] * u[1:, 1]
         smooth = joined & (cos > COS30 * length[:-1] * length[1:]) & (length[:-1] > 0)
         run = np.concatenate([[0], np.cumsum(~smooth)])
         tree._smooth_run = run
