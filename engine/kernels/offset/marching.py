@@ -512,7 +512,10 @@ def offset_polylines(
         raise ValueError(f"cell must be a positive finite number, got {cell}")
 
     tree = SegmentTree(a, b)
-    closed_a, closed_b = a[seg_closed], b[seg_closed]
+    if seg_closed.all():  # (a boolean row selection of every row costs a copy's time)
+        closed_a, closed_b = a, b
+    else:
+        closed_a, closed_b = a[seg_closed], b[seg_closed]
     radius = abs(distance)
     for halvings in range(_MAX_HALVINGS + 1):
         origin, ncx, ncy, levels = _grid(lo, hi, distance, cell, max_cells)

@@ -268,16 +268,18 @@ def _between(u: np.ndarray, c: np.ndarray, p: np.ndarray) -> np.ndarray:
     return (along > 0) & (along < np.einsum("ij,ij->i", c, c))
 
 
-def _fits(loops: Loops, i: np.ndarray, j: np.ndarray, p: np.ndarray, gap) -> np.ndarray:
-    """Whether ``p`` can go between vertices ``i`` and ``j = next(i)`` without a local fold.
+def _fits(
+    xy: np.ndarray, nxt: np.ndarray, prev: np.ndarray, i: np.ndarray, p: np.ndarray, gap
+) -> np.ndarray:
+    """Whether ``p`` can go between vertices ``i`` and ``j = nxt[i]`` without a local fold.
 
     The new chords ``i -> p -> j`` must not cross the chords just before and after, and
-    ``p`` must not sit on either end.
+    ``p`` must not sit on either end. (``nxt``, ``prev``: the loops' links, computed once
+    per round.)
     """
-    nxt = loops.next
-    prev = np.empty_like(nxt)
-    prev[nxt] = np.arange(nxt.size)
-    xy = loops.xy
+    if i.size == 0:
+        return np.zeros(0, dtype=bool)
+    j = nxt[i]
     before, u, w, after = xy[prev[i]], xy[i], xy[j], xy[nxt[j]]
     apart = (np.hypot(*(p - u).T) > gap) & (np.hypot(*(p - w).T) > gap)
     # Not back on the chords next to this one (a vertex found again from the other side).
@@ -337,7 +339,14 @@ def refine_chords(
         todo = np.flatnonzero(loops.todo)
         if todo.size == 0:
             break
-        nxt = loops.next[todo]
+        links = loops.next
+        back = np.empty_like(links)
+        back[links] = np.arange(links.size)
+
+        def fits(i, p, gap, links=links, back=back, xy=loops.xy):
+            return _fits(xy, links, back, i, p, gap)
+
+        nxt = links[todo]
         u, c = loops.xy[todo], loops.xy[nxt] - loops.xy[todo]
         nu, nw = loops.normal[todo], loops.normal_in[nxt]
         clen = np.maximum(np.hypot(c[:, 0], c[:, 1]), 1e-300)
@@ -402,7 +411,7 @@ def refine_chords(
         # (Only those need a query: that no other segment comes closer.)
         near = tree.query(kr[ok], radius - eps, radius + eps)
         ok[ok] = near.exact & (np.abs(near.dist - radius) <= eps)
-        ok &= _fits(loops, todo[rows], nxt[rows], kr, gap[rows])
+        ok &= fits(todo[rows], kr, gap[rows])
         n_in = unit(kr - (tree.a[su] + tu[:, None] * (tree.b[su] - tree.a[su])))
         n_out = unit(kr - (tree.a[sw] + tw[:, None] * (tree.b[sw] - tree.a[sw])))
         take(rows, ok, kr, n_out, sw, n_in, su)
@@ -417,7 +426,7 @@ def refine_chords(
             start = np.where(reach_k[rows, None], k[rows], u[rows] + c[rows] / 2)
             ends = loops.seg[todo[rows]], loops.seg_in[nxt[rows]]
             ok, p2, n_in, s_in, n_out, s_out = _corner(tree, *ends, start, radius, tol)
-            ok &= _fits(loops, todo[rows], nxt[rows], p2, gap[rows])
+            ok &= fits(todo[rows], p2, gap[rows])
             ok &= np.hypot(*(p2 - u[rows]).T) < 0.9 * radius
             take(rows, ok, p2, n_out, s_out, n_in, s_in)
         # 3. The chord point below k, moved along the gradient (projected above).
@@ -432,7 +441,7 @@ def refine_chords(
         rows = np.flatnonzero(~found & inside)
         ok, p4, n4, s4 = _crossing(tree, m[rows], k[rows], dist_m[rows], radius, tol)
         # (That segment may meet the level again past the chord's ends, folding the loop.)
-        ok &= _between(u[rows], c[rows], p4) & _fits(loops, todo[rows], nxt[rows], p4, gap[rows])
+        ok &= _between(u[rows], c[rows], p4) & fits(todo[rows], p4, gap[rows])
         take(rows, ok, p4, n4, s4)
         # 5. Straight across the chord, toward the level: out of the region (on the
         # loop's left) if the chord point is in it, else into it. This also finds a spike
@@ -444,10 +453,10 @@ def refine_chords(
         end = m[rows] + np.where(region, -1.0, 1.0)[:, None] * reach[:, None] * left
         ok, p5, n5, s5 = _crossing(tree, m[rows], end, dist_m[rows], radius, tol)
         ok &= (reach > 0) & _between(u[rows], c[rows], p5)
-        take(rows, ok & _fits(loops, todo[rows], nxt[rows], p5, gap[rows]), p5, n5, s5)
+        take(rows, ok & fits(todo[rows], p5, gap[rows]), p5, n5, s5)
         # 6. A projection that slid toward an end is still a point of the level.
         last = ~found[slid_rows] & _between(u[slid_rows], c[slid_rows], slid_p)
-        last &= _fits(loops, todo[slid_rows], nxt[slid_rows], slid_p, gap[slid_rows])
+        last &= fits(todo[slid_rows], slid_p, gap[slid_rows])
         take(slid_rows, last, slid_p, slid_n, slid_s)
         loops = loops.insert(todo[found], pick, np.flatnonzero(found))
     return loops
