@@ -193,8 +193,9 @@ class SegmentTree:
         if q == 0:
             empty = np.zeros(0)
             return Nearest(empty, np.zeros(0, dtype=bool), np.zeros(0, dtype=np.int64), empty)
-        lo = np.broadcast_to(np.asarray(lo, dtype=float), (q,))
-        hi = np.broadcast_to(np.asarray(hi, dtype=float), (q,))
+        lo, hi = (np.asarray(v, dtype=float) for v in (lo, hi))
+        lo = np.full(q, lo) if lo.ndim == 0 else np.broadcast_to(lo, (q,))
+        hi = np.full(q, hi) if hi.ndim == 0 else np.broadcast_to(hi, (q,))
         px, py = np.ascontiguousarray(p[:, 0]), np.ascontiguousarray(p[:, 1])
         hi2 = np.square(np.maximum(hi, 0.0))
         lo2 = np.where(lo > 0, np.square(lo), -1.0)
@@ -204,7 +205,7 @@ class SegmentTree:
         # capsules tested), many go two levels a step.
         level = min(self.depth, max(0, int(np.log2(max(_PAIRS // q, 1)))))
         qi = np.arange(q).repeat(2**level)
-        node = np.tile(np.arange(2**level), q)
+        node = _fan_out(np.zeros(q, dtype=np.int64), 2**level)
         while True:
             ax, ay, ux, uy, inv, rad = self._levels[level]
             nux, nuy = ux.take(node), uy.take(node)
@@ -245,10 +246,10 @@ class SegmentTree:
             fan = 2**jump
             level += jump
             qi = qi.repeat(fan)
-            node = np.add.outer(node * fan, np.arange(fan)).ravel()
+            node = _fan_out(node, fan)
 
         # Leaves: brute force over their segments.
-        seg = np.add.outer(node * self.leaf, np.arange(self.leaf)).ravel()
+        seg = _fan_out(node, self.leaf)
         qs = qi.repeat(self.leaf)
         ax, ay, ux, uy, inv = self._segs
         dx = px.take(qs)
@@ -289,6 +290,24 @@ class SegmentTree:
             out[far] = np.maximum(best[far], np.nextafter(hi[far], np.inf))
         segment[~exact] = -1
         return Nearest(out, exact, segment, param)
+
+
+_PATTERNS: dict[int, np.ndarray] = {}  # 0, 1, ..., fan - 1 repeated, per fan (grown as needed)
+
+
+def _fan_out(node: np.ndarray, fan: int) -> np.ndarray:
+    """The children ``node * fan + k``, ``k < fan``, of every node, flattened node by node.
+
+    (A repeat plus a slice of a stored ``0, 1, ..., fan - 1`` pattern: numpy's broadcast
+    ``add.outer`` crawls over a short last axis.)
+    """
+    out = (node * fan).repeat(fan)
+    pattern = _PATTERNS.get(fan)
+    if pattern is None or pattern.size < out.size:
+        pattern = np.tile(np.arange(fan), max(2 * out.size // fan, 4096))
+        _PATTERNS[fan] = pattern
+    out += pattern[: out.size]
+    return out
 
 
 def _dist2(
