@@ -161,13 +161,14 @@ class SegmentTree:
         # bound in `query` (the node holding the bound's own point must never be lost to
         # rounding); a missing node's is NaN, which no test passes.
         levels = levels[::-1]
-        cut = np.cumsum([lv[0].shape[0] for lv in levels])[:-1]
+        bounds = np.cumsum([0] + [lv[0].shape[0] for lv in levels]).tolist()
         ax, ay, bx, by, rad = (np.concatenate([lv[k] for lv in levels]) for k in range(5))
         rad = np.where(np.isneginf(rad), np.nan, rad * (1 + 1e-12))
-        fields = _fields(np.stack([ax, ay], axis=1), np.stack([bx, by], axis=1)) + (rad,)
-        split = [np.split(f, cut) for f in fields]
-        self._levels = [tuple(f[k] for f in split) for k in range(len(levels))]
-        self._segs = _fields(self.a, self.b)
+        fields = _fields(ax, ay, bx, by) + (rad,)
+        self._levels = [
+            tuple(f[lo:hi] for f in fields) for lo, hi in zip(bounds[:-1], bounds[1:], strict=True)
+        ]
+        self._segs = _fields(self.a[:, 0], self.a[:, 1], self.b[:, 0], self.b[:, 1])
 
     def query(
         self,
@@ -332,18 +333,13 @@ def _dist2(
     return dx
 
 
-def _fields(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, ...]:
-    """Contiguous ``(ax, ay, ux, uy, 1 / |u|^2)`` of segments ``a -> b`` (``u = b - a``)."""
-    u = b - a
-    len2 = u[:, 0] ** 2 + u[:, 1] ** 2
+def _fields(ax, ay, bx, by) -> tuple[np.ndarray, ...]:
+    """Contiguous ``(ax, ay, ux, uy, 1 / |u|^2)`` of segments ``a -> b`` (``u = b - a``),
+    from their coordinate columns."""
+    ux, uy = bx - ax, by - ay
+    len2 = ux * ux + uy * uy
     inv = np.divide(1.0, len2, out=np.zeros_like(len2), where=len2 > 0)
-    return (
-        np.ascontiguousarray(a[:, 0]),
-        np.ascontiguousarray(a[:, 1]),
-        np.ascontiguousarray(u[:, 0]),
-        np.ascontiguousarray(u[:, 1]),
-        inv,
-    )
+    return np.ascontiguousarray(ax), np.ascontiguousarray(ay), ux, uy, inv
 
 
 class RowParity:
