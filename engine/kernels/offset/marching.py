@@ -341,7 +341,7 @@ def _thin_parts(field: _Field, ids, values, feet, cells, ncx: int) -> bool:
     value = _store_lookup(ids, values)
     foot = _store_lookup(ids, feet)
     near = (lambda f: f < field.level) if field.level > 0 else (lambda f: f > field.level)
-    both = []
+    asked = []
     for step in (1, nx):  # bottom edges, then left edges, of every candidate cell
         f0, f1 = value(cells), value(cells + step)
         p0, p1 = foot(cells), foot(cells + step)
@@ -361,16 +361,17 @@ def _thin_parts(field: _Field, ids, values, feet, cells, ncx: int) -> bool:
         x = x0 + t[:, None] * field.cell * along
         bound = np.hypot(*(x - p0).T)
         ask = np.flatnonzero((t > 0) & (t < 1) & (bound > radius))
-        if ask.size:
-            far = field.tree.query(x[ask], radius, radius + field.cell).dist > radius
-            hit = e[ask[far]]
-            # A bottom edge also belongs to the cell below, a left edge to the cell left.
-            both.append(np.stack([hit, hit - (nx if step == 1 else 1)]))
+        # A bottom edge also belongs to the cell below, a left edge to the cell left.
+        asked.append((x[ask], e[ask], e[ask] - (nx if step == 1 else 1)))
     if _hidden_island(field, cells, value, foot, near, nx):
         return True
-    if not both:
+    x, own, other = (np.concatenate(v) for v in zip(*asked, strict=True))
+    if x.shape[0] == 0:
         return False
-    owners = np.concatenate(both, axis=1)
+    far = field.tree.query(x, radius, radius + field.cell).dist > radius  # (one query for both)
+    if not far.any():
+        return False
+    owners = np.stack([own[far], other[far]])
     _, count = unique_ids(owners, return_counts=True)
     if (count >= 2).any():
         return True
