@@ -222,7 +222,8 @@ def _detours(loops: Loops, gap: float) -> np.ndarray:
         a, b = order[:-1], order[1:]
         same = (
             (loops.loop[a] == loops.loop[b])
-            & (key[a] == key[b]).all(axis=1)
+            & (key[a, 0] == key[b, 0])
+            & (key[a, 1] == key[b, 1])
             & (np.hypot(*(loops.xy[a] - loops.xy[b]).T) < gap)
         )
         i, j = np.minimum(a[same], b[same]), np.maximum(a[same], b[same])
