@@ -175,6 +175,7 @@ class SegmentTree:
         points: np.ndarray,
         lo: np.ndarray | float = 0.0,
         hi: np.ndarray | float = np.inf,
+        upper: np.ndarray | None = None,
     ) -> Nearest:
         """Distance from each point to the nearest segment.
 
@@ -184,6 +185,9 @@ class SegmentTree:
         lo, hi : float or (q,) float
             Band in which the distance must be exact; outside it the result is only
             certified to lie below ``lo`` or above ``hi``. Defaults: exact everywhere.
+        upper : (q,) float, optional
+            Known upper bounds of the distances (the distance to some point of the
+            segments; inf where none): a tight one prunes the search from the start.
 
         Returns
         -------
@@ -200,7 +204,8 @@ class SegmentTree:
         px, py = np.ascontiguousarray(p[:, 0]), np.ascontiguousarray(p[:, 1])
         hi2 = np.square(np.maximum(hi, 0.0))
         lo2 = np.where(lo > 0, np.square(lo), -1.0)
-        best2 = np.full(q, np.inf)  # squared distance to the nearest curve point seen
+        # Squared distance to the nearest curve point seen.
+        best2 = np.full(q, np.inf) if upper is None else np.square(np.asarray(upper, float))
         # Levels are visited in jumps that keep about _PAIRS (point, node) pairs per visit:
         # few points start deep and skip levels (numpy calls cost more than the few more
         # capsules tested), many go two levels a step.

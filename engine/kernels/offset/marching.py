@@ -114,9 +114,12 @@ class _Field:
         self.cell = cell
         self.level = level
 
-    def at(self, i: np.ndarray, j: np.ndarray, band: float) -> tuple[np.ndarray, np.ndarray]:
+    def at(
+        self, i: np.ndarray, j: np.ndarray, band: float, near: np.ndarray | None = None
+    ) -> tuple[np.ndarray, np.ndarray]:
         """Values at samples ``(i, j)``, and their nearest input points (NaN where the value
-        is only certified, more than ``band`` from the level)."""
+        is only certified, more than ``band`` from the level). ``near`` (m, 2), optional:
+        known input points (NaN: none), whose distances seed the search's upper bound."""
         d = self.level
         if self.parity is None:
             inside = np.zeros(i.size, dtype=bool)
@@ -133,7 +136,11 @@ class _Field:
         ask = np.flatnonzero(hi >= 0)
         if ask.size:
             pts = self.origin + np.stack([j[ask], i[ask]], axis=-1) * self.cell
-            near = self.tree.query(pts, lo[ask], hi[ask])
+            upper = None
+            if near is not None:
+                upper = np.hypot(*(pts - near[ask]).T)
+                upper[np.isnan(upper)] = np.inf
+            near = self.tree.query(pts, lo[ask], hi[ask], upper=upper)
             f[ask] = near.dist
             exact = ask[near.exact]
             seg = near.segment[near.exact]
@@ -215,7 +222,10 @@ def _band_cells(field: _Field, ncx: int, ncy: int, levels: int):
             before = (pi[old] // 2) * (w // 2 + 1) + pj[old] // 2
             values[old], feet[old] = value(before), foot(before)
             new = ~old
-            values[new], feet[new] = field.at(pi[new] * step, pj[new] * step, band)
+            # The nearest input point of the parent corner below-left of a new sample (a
+            # corner of the parent cell it lies in, so sampled) bounds its distance.
+            below = (pi[new] // 2) * (w // 2 + 1) + pj[new] // 2
+            values[new], feet[new] = field.at(pi[new] * step, pj[new] * step, band, foot(below))
         value = _store_lookup(pid, values)
         foot = _store_lookup(pid, feet)
         corner = ci * w + cj
