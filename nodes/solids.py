@@ -189,7 +189,7 @@ def weld(
     """Merge vertices closer than the tolerance; drop the faces that collapse.
 
     Closeness is transitive (a chain of close vertices becomes one); each group keeps the
-    position of its first vertex; unused vertices are removed. Cells one tolerance wide
+    position of its first vertex; unused vertices are removed. Sparse cells one tolerance wide
     make it O(n log n).
 
     Parameters

@@ -116,14 +116,36 @@ def test_a_non_finite_vector_says_so():
         _graph("  s: {type: mesh.sphere, radius: 1, center: [.nan, 0, 0]}\n").evaluate("s")
 
 
-@pytest.mark.parametrize("tolerance", [1e-320, 1e-200, 5e-324])
-def test_a_tiny_weld_tolerance_is_called_too_small(tolerance):
-    # the cell numbers used to wrap around int64 and the message said "too coarse"
+@pytest.mark.parametrize("tolerance", [1e-320, 1e-200, 5e-324, 1e-3])
+def test_a_tolerance_tiny_against_the_coordinates_still_welds(tolerance):
+    # the dense weld grid refused these (its cells would number more than 2^62); the sparse
+    # one only stores occupied cells. A sphere's vertices are all farther apart than 1e-3.
     g = fg.Graph()
-    g.add("s", "mesh.sphere", radius=1e10, segments=400)
+    g.add("s", "mesh.sphere", radius=1e10, segments=64)
     g.add("w", "mesh.weld", mesh="@s", tolerance=tolerance)
-    with pytest.raises(fg.NodeError, match=r"input 'tolerance'.*too small.*0 merges exact"):
-        g.evaluate("w")
+    s, w = g.evaluate("s"), g.evaluate("w")
+    assert w.n_vertices == s.n_vertices and w.is_watertight
+
+
+def test_a_small_tolerance_on_huge_coordinates_matches_a_kd_tree():
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+
+    from formgraph.kernels.mesh import measure as km
+    from formgraph.kernels.mesh import repair as kr
+
+    rng = np.random.default_rng(7)
+    pts = 1e10 * rng.normal(size=(300, 3))
+    pts = np.concatenate([pts, pts[:100] + rng.normal(0, 3e-4, (100, 3))])  # near copies
+    i, j = kr._close_pairs(pts, 1e-3)
+    root, _ = km.union_find(len(pts), i, j)
+    pairs = np.array(sorted(cKDTree(pts).query_pairs(1e-3)), dtype=np.int64).reshape(-1, 2)
+    assert len(pairs) > 20  # the near copies are found
+    graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(len(pts),) * 2)
+    _, labels = connected_components(graph, directed=False)
+    assert len(set(zip(root.tolist(), labels.tolist(), strict=True))) == labels.max() + 1
+    assert len(set(root.tolist())) == labels.max() + 1
 
 
 def test_weld_tolerance_zero_merges_only_exact_duplicates():

@@ -1,8 +1,8 @@
 """Mesh repair on flat arrays: weld close vertices, orient faces, cap boundary loops.
 
 - :func:`weld`: vertices closer than a tolerance merged (transitively), faces that collapse
-  dropped; neighbours found in a uniform grid of cells one tolerance wide, so only the 27
-  cells around a point are searched;
+  dropped; neighbours found in a sparse (hashed) grid of cells one tolerance wide, so only
+  the 27 cells around a point are searched, whatever the size of the coordinates;
 - :func:`orient`: one orientation per connected part, found by a parity union-find over the
   faces (two faces sharing an edge the same way must differ), then each closed part turned
   outward by its signed volume;
@@ -38,34 +38,53 @@ def weld_tolerance(vertices: np.ndarray) -> float:
     return RELATIVE_TOLERANCE * float(np.linalg.norm(v.max(axis=0) - v.min(axis=0)))
 
 
+def _cell_hash(q: np.ndarray, salt: int) -> np.ndarray:
+    """A 64-bit hash of int64 cell coordinates ``q`` (k, 3), salted."""
+    b = q.view(np.uint64)
+    return _mix(_mix(_mix(b[:, 0] ^ np.uint64(salt)) ^ b[:, 1]) ^ b[:, 2])
+
+
 def _close_pairs(v: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
-    """All pairs ``i < j`` with ``|v[i] - v[j]| <= tol`` (cells of side ``tol``)."""
+    """All pairs ``i < j`` with ``|v[i] - v[j]| <= tol`` (cells of side about ``tol``).
+
+    The cells are sparse: each point's three int64 cell numbers, relative to the bounding
+    box's minimum, are hashed and sorted, so only occupied cells cost anything and a tolerance
+    that is tiny against the coordinates works (a radius-1e10 sphere welded at 1e-3).
+    """
     lo = v.min(axis=0)
-    # the grid is checked in floats first: a tiny tolerance makes cell numbers that do not
-    # fit an int64 (or are infinite), and the cast would silently wrap them
+    # a cell a little wider than tol absorbs the rounding of (v - lo) / side: two points
+    # within tol then never land two cells apart (the error is below 8 eps max|v|)
+    side = tol + 8 * np.finfo(np.float64).eps * float(np.abs(v).max())
     with np.errstate(over="ignore"):
-        qf = np.floor((v - lo) / tol)
-        grid = float(np.prod(qf.max(axis=0) + 3))  # room for the -1 / +1 neighbours
-    if not np.isfinite(grid) or grid >= 2.0**62:
+        qf = np.floor((v - lo) / side)
+    # only the cell numbers themselves must fit an int64 (with room for the +-1 neighbours)
+    if not np.isfinite(qf).all() or qf.max() >= 2.0**62:
         raise ValueError(
-            f"weld tolerance {tol:g} is too small for a mesh this large (its cells would "
-            "number more than 2^62); 0 merges exact duplicates only"
+            f"weld tolerance {tol:g} is too small for a mesh this large (a cell number "
+            "along an axis would pass 2^62); 0 merges exact duplicates only"
         )
-    q = qf.astype(np.int64)
-    dims = q.max(axis=0) + 3
-    q += 1
-    key = (q[:, 0] * dims[1] + q[:, 1]) * dims[2] + q[:, 2]
-    cells, cell_of, counts = np.unique(key, return_inverse=True, return_counts=True)
-    order = np.argsort(cell_of)
-    start = np.zeros(cells.size + 1, dtype=np.int64)
-    np.cumsum(counts, out=start[1:])
+    q = np.ascontiguousarray(qf.astype(np.int64))
+    for salt in (0, 0x9E3779B97F4A7C15, 0x2545F4914F6CDD1D):
+        h = _cell_hash(q, salt)
+        order = np.argsort(h, kind="stable")
+        hs = h[order]
+        new_cell = np.r_[True, hs[1:] != hs[:-1]]
+        starts = np.flatnonzero(new_cell)
+        cells, rep = hs[starts], q[order[starts]]
+        # a hash collision would put two cells in one bucket: check, and re-salt
+        if np.array_equal(q[order], rep[np.cumsum(new_cell) - 1]):
+            break
+    else:  # pragma: no cover - three 64-bit collisions in a row
+        raise ValueError("weld could not hash its cells without collisions")
+    counts = np.diff(np.r_[starts, len(v)])
+    start = np.r_[starts, len(v)]
     # the cell itself and the 13 neighbours "after" it: each unordered cell pair once
     offsets = [(dx, dy, dz) for dx in (-1, 0, 1) for dy in (-1, 0, 1) for dz in (-1, 0, 1)]
     found = []
     for dx, dy, dz in offsets[13:]:
-        target = cells + (dx * dims[1] + dy) * dims[2] + dz
-        pos = np.minimum(np.searchsorted(cells, target), cells.size - 1)
-        hit = np.flatnonzero(cells[pos] == target)
+        target = rep + np.array([dx, dy, dz], dtype=np.int64)
+        pos = np.minimum(np.searchsorted(cells, _cell_hash(target, salt)), cells.size - 1)
+        hit = np.flatnonzero((rep[pos] == target).all(axis=1))
         found.append((dx, dy, dz, hit, pos[hit]))
     # pairs to compare: na * nb between two cells, na (na - 1) / 2 within one
     total = 0
@@ -74,9 +93,15 @@ def _close_pairs(v: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
         same = (dx, dy, dz) == (0, 0, 0)
         total += int(np.sum(na * (nb - 1) // 2 if same else na * nb))
     if total > MAX_PAIRS:
+        why = (
+            "use a smaller tolerance"
+            if side < 2 * tol
+            else f"the coordinates' float spacing ({side - tol:.3g}) is coarser than the "
+            "tolerance, so the cells cannot be smaller"
+        )
         raise ValueError(
             f"weld tolerance {tol:g} is too coarse for this mesh: {total:,} vertex pairs fall "
-            f"within a cell of each other (limit {MAX_PAIRS:,}); use a smaller tolerance"
+            f"within a cell of each other (limit {MAX_PAIRS:,}); {why}"
         )
     ii, jj = [], []
     for dx, dy, dz, ca, cb in found:
@@ -93,8 +118,10 @@ def _close_pairs(v: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
         jj.append(j[keep])
     i = np.concatenate(ii) if ii else np.zeros(0, np.int64)
     j = np.concatenate(jj) if jj else np.zeros(0, np.int64)
-    d2 = np.einsum("ij,ij->i", v[i] - v[j], v[i] - v[j])
-    close = d2 <= tol * tol
+    # compared in units of tol: tol * tol underflows for a tiny tolerance
+    with np.errstate(over="ignore"):
+        d = (v[i] - v[j]) / tol
+        close = np.einsum("ij,ij->i", d, d) <= 1.0
     return i[close], j[close]
 
 
