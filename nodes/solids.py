@@ -259,12 +259,28 @@ def cap(mesh: Mesh, *, ctx: Context) -> Mesh:
     outlines stay inside); any other loop a fan of triangles to its centroid. The new
     faces run each loop opposite to its neighbours, so orientation stays consistent.
 
+    A flat open sheet (a part lying in one plane, e.g. ``mesh.plane`` or two triangles of a
+    square) has nothing to enclose: its outline's cap lies on the sheet itself, giving a
+    two-sided shell of zero volume (doubled faces, often non-manifold edges) that no slicer
+    prints. It is still capped as asked, with a warning; ``mesh.solidify`` is the way to make
+    a flat sheet printable (it gives it a thickness).
+
     Parameters
     ----------
     mesh : Mesh
         An oriented manifold mesh (mesh.weld and mesh.orient make one).
     """
-    return Mesh(*_topology("mesh", _clipping, ctx, kr.cap, *_arrays(mesh)))
+    out = Mesh(*_topology("mesh", _clipping, ctx, kr.cap, *_arrays(mesh)))
+    if out.n_faces > mesh.n_faces:
+        flat = kr.flat_open_parts(*_arrays(mesh))
+        if flat:
+            ctx.warn(
+                f"{flat} part{'s' if flat != 1 else ''} of the mesh "
+                f"{'are flat open sheets' if flat != 1 else 'is a flat open sheet'}: capping "
+                "its outline lays the cap on the sheet, a two-sided shell of zero volume "
+                "(not printable); use mesh.solidify to give a flat sheet a thickness"
+            )
+    return out
 
 
 @node("mesh.solidify", version=1)

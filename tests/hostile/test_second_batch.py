@@ -326,3 +326,34 @@ def test_drawing_a_graph_reads_its_node_table_a_fixed_number_of_times(monkeypatc
     monkeypatch.setattr(fg.Graph, "nodes", property(lambda self: calls.append(1) or table(self)))
     fg.draw_graph(g)
     assert len(calls) < 10
+
+
+@pytest.mark.parametrize(
+    ("vertices", "faces"),
+    [
+        ([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], [[0, 1, 2], [0, 2, 3]]),  # a square
+        ([[0, 0, 0], [1, 0, 0], [1, 1, 0], [-1, 0, 0], [-1, -1, 0]], [[0, 1, 2], [0, 3, 4]]),
+        ([[0, 0, 0], [1, 0, 1], [1, 1, 2]], [[0, 1, 2]]),  # one tilted triangle
+    ],
+)
+def test_capping_a_flat_sheet_warns_that_it_has_no_volume(vertices, faces):
+    g = fg.Graph()
+    g.add("a", "mesh.from_faces", vertices=vertices, faces=faces)
+    g.add("c", "mesh.cap", mesh="@a")
+    with pytest.warns(fg.FormgraphWarning, match=r"flat open sheet.*zero volume.*mesh\.solidify"):
+        m = g.evaluate("c")
+    assert m.volume == pytest.approx(0.0, abs=1e-12)
+
+
+def test_capping_a_plane_warns_but_a_tube_or_a_cup_does_not():
+    g = fg.Graph()
+    g.add("p", "mesh.plane", divisions=[3, 2], center=[5, 0, 0])
+    g.add("t", "mesh.cylinder", radius=1, height=2, caps=False)
+    g.add("m", "mesh.merge", meshes=["@p", "@t"])
+    g.add("c", "mesh.cap", mesh="@m")
+    with pytest.warns(fg.FormgraphWarning, match=r"^.*1 part of the mesh is a flat open sheet"):
+        g.evaluate("c")
+    g.add("ct", "mesh.cap", mesh="@t")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", fg.FormgraphWarning)
+        assert g.evaluate("ct").is_watertight
