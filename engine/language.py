@@ -113,14 +113,25 @@ def child_graph(self: Any, spec: SubgraphSpec) -> Any:
     return child
 
 
-def _check_count(loop: str, where: Any, count: int, budget: int) -> None:
-    """Refuse a repeat whose items would cost more than the element budget."""
-    if count * ITEM_ELEMENTS > budget:
+def _check_count(loop: str, where: Any, count: int, budget: int, scale: int = 1) -> None:
+    """Refuse a repeat whose items would cost more than the element budget.
+
+    ``scale`` is how many times the enclosing repeats run this graph (a repeated subgraph
+    node that holds this repeat runs it once per outer item): the items cost the product.
+    """
+    total = count * scale
+    if total * ITEM_ELEMENTS > budget:
+        runs = (
+            f"{count:,} items for each of the {scale:,} items of the repeats around it "
+            f"({total:,} in all)"
+            if scale > 1
+            else f"{count:,} items"
+        )
         raise BudgetError(
             [
                 Problem(
                     where,
-                    f"repeat '{loop}' would run {count:,} items, over the budget of "
+                    f"repeat '{loop}' would run {runs}, over the budget of "
                     f"{budget:,} (each item is a node run and counts as {ITEM_ELEMENTS:,} "
                     f"elements, so at most {budget // ITEM_ELEMENTS:,} items; raise it with "
                     "budget= or --budget if you mean it, or place copies with "
@@ -142,6 +153,9 @@ class LanguageRun:
     item_values: dict[str, dict[int, Any]]
     inner: dict[str, Any]
     stats: dict[str, Any]
+    #: how many times the repeats around this run run it (1 at the top; a repeated
+    #: subgraph node's run of its file has the product of the enclosing counts)
+    scale: int = 1
 
     def repeat_items(self, name: str) -> tuple[list[Any], list[Any]]:
         """The items of a repeated node and their key tokens (memoized; budget checked)."""
@@ -160,7 +174,8 @@ class LanguageRun:
             value = self.resolve(name, "repeat", src)
             token = None if isinstance(src, (Literal, Expr)) else self.key_part_items(name, src)
         if isinstance(value, Points):
-            _check_count(r.name, where, len(value), self.g.budget)  # before a list of lists
+            # before a list of lists
+            _check_count(r.name, where, len(value), self.g.budget, self.scale)
             value = value.xyz.tolist()
         elif isinstance(value, float) and value.is_integer():
             value = int(value)
@@ -169,7 +184,7 @@ class LanguageRun:
                 raise GraphError([Problem(where, f"a repeat count must be >= 0, got {value}")])
             count = value
         elif isinstance(value, (list, tuple)):
-            _check_count(r.name, where, len(value), self.g.budget)
+            _check_count(r.name, where, len(value), self.g.budget, self.scale)
             problem = loop_item_problem(value)
             if problem:
                 raise GraphError([Problem(where, f"repeat '{r.name}': {problem}")])
@@ -184,7 +199,7 @@ class LanguageRun:
                     )
                 ]
             )
-        _check_count(r.name, where, count, self.g.budget)
+        _check_count(r.name, where, count, self.g.budget, self.scale)
         values = list(range(count)) if isinstance(value, int) else list(value)
         if token is None:
             tokens = values
@@ -308,6 +323,9 @@ class LanguageRun:
             )
         }
         run = type(self)(child, values, tokens)
+        # a repeated subgraph node runs its file once per item: its own repeats cost the
+        # product, budgeted when the child's counts are known, before its items run
+        run.scale = self.scale * (len(self.items[name][0]) if nd.repeat is not None else 1)
         targets = list(dict.fromkeys(w.node for w in spec.output_wires.values()))
         chain = f" (in the subgraph '{name}' of {self.g.file_label})"
         try:

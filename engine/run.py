@@ -357,6 +357,8 @@ class _Run(LanguageRun):
                 else:
                     value = spec.func(**kwargs)
         except BudgetError as exc:
+            if isinstance(spec, SubgraphSpec):
+                raise  # already names the subgraph's file, line and node
             raise BudgetError(
                 [Problem(self.where(name), p.message) for p in exc.problems]
             ) from None

@@ -108,6 +108,28 @@ def test_two_files_that_include_each_other_are_a_cycle(tmp_path, capsys):
     assert "b.yaml:4: node 'y': include cycle: a.yaml -> b.yaml -> a.yaml" in err
 
 
+@pytest.mark.parametrize(("outer", "inner", "refused"), [(40, 40, True), (20, 20, False)])
+def test_a_repeated_subgraph_budgets_its_own_repeat_times_the_outer_count(
+    tmp_path, outer, inner, refused
+):
+    # each repeat alone fits 1,000 items; nested they run outer * inner
+    (tmp_path / "ring.yaml").write_text(
+        f"formgraph: 1\nparams: {{n: {inner}}}\noutputs: {{c: '@c'}}\nnodes:\n"
+        "  c: {type: nurbs.circle, repeat: {j: '=n'}, radius: '=1 + j'}\n"
+    )
+    (tmp_path / "top.yaml").write_text(
+        f"formgraph: 1\nnodes:\n  r: {{type: ring.yaml, repeat: {{i: {outer}}}, n: {inner}}}\n"
+    )
+    g = fg.load(tmp_path / "top.yaml", out_dir=tmp_path / "out", budget=1_000_000)
+    if not refused:
+        assert len(g.evaluate("r")) == outer * inner
+        return
+    with pytest.raises(fg.BudgetError, match=r"ring.yaml:5: node 'c', input 'repeat': .*") as e:
+        g.evaluate("r")
+    assert f"{inner} items for each of the {outer} items" in str(e.value)
+    assert f"({outer * inner:,} in all)" in str(e.value)
+
+
 # ---------------------------------------------------------------------------- solids
 
 
