@@ -379,3 +379,28 @@ def test_capping_a_plane_warns_but_a_tube_or_a_cup_does_not():
     with warnings.catch_warnings():
         warnings.simplefilter("error", fg.FormgraphWarning)
         assert g.evaluate("ct").is_watertight
+
+
+@pytest.mark.parametrize(
+    ("type_", "inputs", "port"),
+    [
+        ("mesh.solidify", {"mesh": "@p", "thickness": 1e308, "offset": 1}, "thickness"),
+        ("mesh.solidify", {"mesh": "@p", "thickness": 1e308, "offset": -1}, "thickness"),
+        (
+            "mesh.solidify",
+            {"mesh": "@p", "thickness": 1, "thickness_map": "thickness * 1e308", "offset": 1},
+            "thickness_map",
+        ),
+        ("mesh.sphere", {"radius": 1e308, "center": [1.7e308, 0, 0]}, "radius"),
+        ("mesh.cylinder", {"radius": 1e308, "height": 1, "center": [1.7e308, 0, 0]}, "radius"),
+        ("mesh.cylinder", {"radius": 1, "height": 1.7e308, "center": [0, 0, 1e308]}, "height"),
+        ("mesh.torus", {"major": 1e308, "minor": 1, "center": [1.7e308, 0, 0]}, "major"),
+        ("mesh.plane", {"size": [1e308, 1], "center": [1.7e308, 0, 0]}, "size"),
+    ],
+)
+def test_a_size_that_overflows_the_floats_is_blamed_not_the_mesh(type_, inputs, port):
+    g = fg.Graph()
+    g.add("p", "mesh.plane")
+    g.add("x", type_, **inputs)
+    with pytest.raises(fg.NodeError, match=rf"input '{port}' .*beyond the largest float"):
+        g.evaluate("x")
