@@ -130,6 +130,25 @@ def test_a_repeated_subgraph_budgets_its_own_repeat_times_the_outer_count(
     assert f"({outer * inner:,} in all)" in str(e.value)
 
 
+@pytest.mark.parametrize(
+    ("outputs", "error"),
+    [
+        ("outputs: {c: '@c'\n", "part.yaml:3: not valid YAML"),
+        ("outputs: 3\n", "part.yaml:2: 'outputs' must be a mapping"),
+        ("", "part.yaml:1: a graph used as a node needs 'outputs:'"),
+    ],
+)
+def test_a_broken_subgraph_file_reports_only_its_real_error(tmp_path, capsys, outputs, error):
+    # a file that is not YAML also got a spurious "needs 'outputs:'" line
+    (tmp_path / "part.yaml").write_text(
+        f"formgraph: 1\n{outputs}nodes:\n  c: {{type: nurbs.circle, radius: 1}}\n"
+    )
+    (tmp_path / "top.yaml").write_text("formgraph: 1\nnodes:\n  n: {type: part.yaml}\n")
+    code, err = _run(tmp_path, "top.yaml", capsys)
+    lines = [ln for ln in err.splitlines() if "part.yaml" in ln]
+    assert code == 1 and len(lines) == 1 and f"{os.sep}{error}" in lines[0], err
+
+
 # ---------------------------------------------------------------------------- solids
 
 
