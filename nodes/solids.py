@@ -442,6 +442,10 @@ def measure(mesh: Mesh, *, ctx: Context) -> MeshMeasures:
     theorem; 0, with a warning, for a mesh that is not watertight), ``watertight`` (every
     edge on exactly two faces), ``size`` and ``center`` of the bounding box, ``faces``.
 
+    The volume is signed: a closed mesh whose faces point inward measures negative, with a
+    warning (``mesh.orient`` turns it outward); a closed mesh whose faces disagree across
+    some edges warns that its volume means nothing until it is oriented.
+
     Parameters
     ----------
     mesh : Mesh
@@ -454,6 +458,18 @@ def measure(mesh: Mesh, *, ctx: Context) -> MeshMeasures:
     elif not watertight:
         open_edges = int(np.count_nonzero(mesh.edge_table.counts != 2))
         ctx.warn(f"mesh is not watertight ({open_edges} open or non-manifold edges): volume 0")
+    else:
+        disagree = int(np.count_nonzero(mesh.edge_table.same_way))
+        if disagree:
+            ctx.warn(
+                f"the faces disagree in orientation across {disagree} edges, so the volume "
+                f"({volume:g}) means nothing; mesh.orient makes them agree"
+            )
+        elif volume < 0:
+            ctx.warn(
+                f"the mesh faces inward: its volume is negative ({volume:g}); mesh.orient "
+                "turns it outward"
+            )
     lo, hi = mesh.bounds
     return MeshMeasures(
         area=mesh.area,

@@ -423,3 +423,24 @@ def test_a_size_that_overflows_the_floats_is_blamed_not_the_mesh(type_, inputs, 
     g.add("x", type_, **inputs)
     with pytest.raises(fg.NodeError, match=rf"input '{port}' .*beyond the largest float"):
         g.evaluate("x")
+
+
+def test_measuring_an_inward_or_misoriented_closed_mesh_warns():
+    g = fg.Graph()
+    g.add("b", "mesh.box")
+    g.add("f", "mesh.flip", mesh="@b")
+    g.add("m", "mesh.measure", mesh="@f")
+    with pytest.warns(fg.FormgraphWarning, match=r"faces inward.*negative \(-1\).*mesh\.orient"):
+        assert g.evaluate("m").volume == pytest.approx(-1.0)
+    # a box with its floor turned (a Mesh from Python; mesh.from_faces refuses it): closed,
+    # but its faces disagree across the floor's 4 edges
+    v = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]]
+    faces = [0, 1, 2, 3, 4, 5, 6, 7, 0, 1, 5, 4, 1, 2, 6, 5, 2, 3, 7, 6, 3, 0, 4, 7]
+    x = fg.Mesh(np.array(v, float), np.array(faces), np.arange(0, 25, 4))
+    g.add("mx", "mesh.measure", mesh=x)
+    with pytest.warns(fg.FormgraphWarning, match=r"disagree in orientation across 4 edges"):
+        g.evaluate("mx")
+    g.add("mb", "mesh.measure", mesh="@b")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", fg.FormgraphWarning)
+        assert g.evaluate("mb").volume == pytest.approx(1.0)
