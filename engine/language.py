@@ -52,7 +52,12 @@ def input_names(value: Input, pt: Any) -> set[str]:
         return set(value.compiled.names)
     if isinstance(value, Items):
         return {n for i in value.items for n in input_names(i, pt)}
-    if isinstance(value, Literal) and pt.is_expression and isinstance(value.value, str):
+    if (
+        isinstance(value, Literal)
+        and pt is not None
+        and pt.is_expression
+        and isinstance(value.value, str)
+    ):
         from .expr import compile_expression
 
         try:
@@ -156,6 +161,7 @@ class LanguageRun:
     #: how many times the repeats around this run run it (1 at the top; a repeated
     #: subgraph node's run of its file has the product of the enclosing counts)
     scale: int = 1
+    registry: dict[str, Any]
 
     def repeat_items(self, name: str) -> tuple[list[Any], list[Any]]:
         """The items of a repeated node and their key tokens (memoized; budget checked)."""
@@ -207,6 +213,40 @@ class LanguageRun:
             tokens = [{"source": token, "index": k} for k in range(count)]
         self.items[name] = (values, tokens)
         return self.items[name]
+
+    def precheck_nested(self, name: str) -> None:
+        """Budget a repeated subgraph node's inner repeats before anything runs.
+
+        Each inner repeat whose count is known without running (no wire; its expression
+        reads only params the node gives as literals or leaves at their defaults) is
+        checked at the outer count times its own. Others are checked as each item's run of
+        the file starts (see :attr:`scale`).
+        """
+        nd = self.g._nodes[name]
+        spec = self.registry[nd.type]
+        if nd.repeat is None or not isinstance(spec, SubgraphSpec):
+            return
+        count = len(self.repeat_items(name)[0])
+        child = self.g._child(spec)
+        given = {p: v for p, v in nd.inputs.items() if p in child._params}
+        values = dict(child._values)
+        values.update({p: v.value for p, v in given.items() if isinstance(v, Literal)})
+        unknown = {p for p, v in given.items() if not isinstance(v, Literal)}
+        probe = type(self)(child, values, {})
+        probe.scale = self.scale * count
+        for inner, ind in child._nodes.items():
+            r = ind.repeat
+            if r is None or wires_of(r.source) or input_names(r.source, None) & unknown:
+                continue
+            chain = f" (in the subgraph '{name}' of {self.g.file_label})"
+            try:
+                probe.repeat_items(inner)
+                probe.precheck_nested(inner)
+            except BudgetError as exc:
+                problems = [Problem(p.where, p.message + chain) for p in exc.problems]
+                raise BudgetError(problems) from None
+            except GraphError:
+                continue  # a bad count is reported, with its line, when the item runs
 
     def key_part_items(self, name: str, src: Input) -> Any:
         if isinstance(src, Wire):

@@ -130,6 +130,7 @@ class _Run(LanguageRun):
             r = self.g._nodes[n].repeat
             if r is not None and not wires_of(r.source):
                 self.repeat_items(n)
+                self.precheck_nested(n)
         for n in order:
             key = self.key(n)
             if key in self.g._identity and not self.registry[self.g._nodes[n].type].is_export:

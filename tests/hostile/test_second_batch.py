@@ -128,6 +128,22 @@ def test_a_repeated_subgraph_budgets_its_own_repeat_times_the_outer_count(
         g.evaluate("r")
     assert f"{inner} items for each of the {outer} items" in str(e.value)
     assert f"({outer * inner:,} in all)" in str(e.value)
+    assert "(in the subgraph 'r' of " in str(e.value)
+
+
+def test_a_nested_repeat_is_refused_before_the_nodes_upstream_run(tmp_path):
+    (tmp_path / "ring.yaml").write_text(
+        "formgraph: 1\nparams: {n: 40, r: 1.0}\noutputs: {c: '@c'}\nnodes:\n"
+        "  c: {type: nurbs.circle, repeat: {j: '=n'}, radius: '=r + j'}\n"
+    )
+    (tmp_path / "top.yaml").write_text(
+        "formgraph: 1\nnodes:\n  b: {type: mesh.box}\n  m: {type: mesh.measure, mesh: '@b'}\n"
+        "  r: {type: ring.yaml, repeat: {i: 40}, r: '@m.area'}\n"
+    )
+    g = fg.load(tmp_path / "top.yaml", out_dir=tmp_path / "out", budget=1_000_000)
+    with pytest.raises(fg.BudgetError, match=r"ring.yaml:5: .*1,600 in all"):
+        g.evaluate("r")
+    assert g.stats == {} or all(st.status != "computed" for st in g.stats.values())
 
 
 @pytest.mark.parametrize(
