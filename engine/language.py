@@ -52,7 +52,12 @@ def input_names(value: Input, pt: Any) -> set[str]:
         return set(value.compiled.names)
     if isinstance(value, Items):
         return {n for i in value.items for n in input_names(i, pt)}
-    if isinstance(value, Literal) and pt.is_expression and isinstance(value.value, str):
+    if (
+        isinstance(value, Literal)
+        and pt is not None
+        and pt.is_expression
+        and isinstance(value.value, str)
+    ):
         from .expr import compile_expression
 
         try:
@@ -113,14 +118,25 @@ def child_graph(self: Any, spec: SubgraphSpec) -> Any:
     return child
 
 
-def _check_count(loop: str, where: Any, count: int, budget: int) -> None:
-    """Refuse a repeat whose items would cost more than the element budget."""
-    if count * ITEM_ELEMENTS > budget:
+def _check_count(loop: str, where: Any, count: int, budget: int, scale: int = 1) -> None:
+    """Refuse a repeat whose items would cost more than the element budget.
+
+    ``scale`` is how many times the enclosing repeats run this graph (a repeated subgraph
+    node that holds this repeat runs it once per outer item): the items cost the product.
+    """
+    total = count * scale
+    if total * ITEM_ELEMENTS > budget:
+        runs = (
+            f"{count:,} items for each of the {scale:,} items of the repeats around it "
+            f"({total:,} in all)"
+            if scale > 1
+            else f"{count:,} items"
+        )
         raise BudgetError(
             [
                 Problem(
                     where,
-                    f"repeat '{loop}' would run {count:,} items, over the budget of "
+                    f"repeat '{loop}' would run {runs}, over the budget of "
                     f"{budget:,} (each item is a node run and counts as {ITEM_ELEMENTS:,} "
                     f"elements, so at most {budget // ITEM_ELEMENTS:,} items; raise it with "
                     "budget= or --budget if you mean it, or place copies with "
@@ -142,6 +158,10 @@ class LanguageRun:
     item_values: dict[str, dict[int, Any]]
     inner: dict[str, Any]
     stats: dict[str, Any]
+    #: how many times the repeats around this run run it (1 at the top; a repeated
+    #: subgraph node's run of its file has the product of the enclosing counts)
+    scale: int = 1
+    registry: dict[str, Any]
 
     def repeat_items(self, name: str) -> tuple[list[Any], list[Any]]:
         """The items of a repeated node and their key tokens (memoized; budget checked)."""
@@ -160,7 +180,8 @@ class LanguageRun:
             value = self.resolve(name, "repeat", src)
             token = None if isinstance(src, (Literal, Expr)) else self.key_part_items(name, src)
         if isinstance(value, Points):
-            _check_count(r.name, where, len(value), self.g.budget)  # before a list of lists
+            # before a list of lists
+            _check_count(r.name, where, len(value), self.g.budget, self.scale)
             value = value.xyz.tolist()
         elif isinstance(value, float) and value.is_integer():
             value = int(value)
@@ -169,7 +190,7 @@ class LanguageRun:
                 raise GraphError([Problem(where, f"a repeat count must be >= 0, got {value}")])
             count = value
         elif isinstance(value, (list, tuple)):
-            _check_count(r.name, where, len(value), self.g.budget)
+            _check_count(r.name, where, len(value), self.g.budget, self.scale)
             problem = loop_item_problem(value)
             if problem:
                 raise GraphError([Problem(where, f"repeat '{r.name}': {problem}")])
@@ -184,7 +205,7 @@ class LanguageRun:
                     )
                 ]
             )
-        _check_count(r.name, where, count, self.g.budget)
+        _check_count(r.name, where, count, self.g.budget, self.scale)
         values = list(range(count)) if isinstance(value, int) else list(value)
         if token is None:
             tokens = values
@@ -192,6 +213,40 @@ class LanguageRun:
             tokens = [{"source": token, "index": k} for k in range(count)]
         self.items[name] = (values, tokens)
         return self.items[name]
+
+    def precheck_nested(self, name: str) -> None:
+        """Budget a repeated subgraph node's inner repeats before anything runs.
+
+        Each inner repeat whose count is known without running (no wire; its expression
+        reads only params the node gives as literals or leaves at their defaults) is
+        checked at the outer count times its own. Others are checked as each item's run of
+        the file starts (see :attr:`scale`).
+        """
+        nd = self.g._nodes[name]
+        spec = self.registry[nd.type]
+        if nd.repeat is None or not isinstance(spec, SubgraphSpec):
+            return
+        count = len(self.repeat_items(name)[0])
+        child = self.g._child(spec)
+        given = {p: v for p, v in nd.inputs.items() if p in child._params}
+        values = dict(child._values)
+        values.update({p: v.value for p, v in given.items() if isinstance(v, Literal)})
+        unknown = {p for p, v in given.items() if not isinstance(v, Literal)}
+        probe = type(self)(child, values, {})
+        probe.scale = self.scale * count
+        for inner, ind in child._nodes.items():
+            r = ind.repeat
+            if r is None or wires_of(r.source) or input_names(r.source, None) & unknown:
+                continue
+            chain = f" (in the subgraph '{name}' of {self.g.file_label})"
+            try:
+                probe.repeat_items(inner)
+                probe.precheck_nested(inner)
+            except BudgetError as exc:
+                problems = [Problem(p.where, p.message + chain) for p in exc.problems]
+                raise BudgetError(problems) from None
+            except GraphError:
+                continue  # a bad count is reported, with its line, when the item runs
 
     def key_part_items(self, name: str, src: Input) -> Any:
         if isinstance(src, Wire):
@@ -308,6 +363,9 @@ class LanguageRun:
             )
         }
         run = type(self)(child, values, tokens)
+        # a repeated subgraph node runs its file once per item: its own repeats cost the
+        # product, budgeted when the child's counts are known, before its items run
+        run.scale = self.scale * (len(self.items[name][0]) if nd.repeat is not None else 1)
         targets = list(dict.fromkeys(w.node for w in spec.output_wires.values()))
         chain = f" (in the subgraph '{name}' of {self.g.file_label})"
         try:

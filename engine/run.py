@@ -130,6 +130,7 @@ class _Run(LanguageRun):
             r = self.g._nodes[n].repeat
             if r is not None and not wires_of(r.source):
                 self.repeat_items(n)
+                self.precheck_nested(n)
         for n in order:
             key = self.key(n)
             if key in self.g._identity and not self.registry[self.g._nodes[n].type].is_export:
@@ -357,6 +358,8 @@ class _Run(LanguageRun):
                 else:
                     value = spec.func(**kwargs)
         except BudgetError as exc:
+            if isinstance(spec, SubgraphSpec):
+                raise  # already names the subgraph's file, line and node
             raise BudgetError(
                 [Problem(self.where(name), p.message) for p in exc.problems]
             ) from None

@@ -163,7 +163,9 @@ class Includes:
         )
         outline = Outline(label, doc.params, doc.nodes, subs, doc.outputs, doc.output_lines)
         own = check_graph(outline, doc.problems)
-        if not doc.outputs:
+        # a file that could not be read, or whose outputs: is malformed, already says so
+        malformed = any("'outputs' must be" in p.message for p in doc.problems)
+        if doc.top_keys is not None and not doc.outputs and not malformed:
             own.append(
                 Problem(
                     Where(label, 1),

@@ -35,6 +35,9 @@ class Document:
     problems: list[Problem] = field(default_factory=list)
     outputs: dict[str, Any] = field(default_factory=dict)  # name -> wire, used as a subgraph
     output_lines: dict[str, int] = field(default_factory=dict)
+    #: the top-level keys written, or None when the file could not be read as a mapping
+    #: (not YAML, too large, ...): then its problems say all there is to say
+    top_keys: tuple[str, ...] | None = None
 
 
 def _line(node: yaml.Node) -> int:
@@ -95,6 +98,7 @@ def parse(text: str, file: str = "<graph>") -> Document:
         elif key not in TOP_KEYS:
             problem(f"unknown top-level key '{key}' (expected {', '.join(TOP_KEYS)})", _line(k))
         top[key] = (k, v)
+    doc.top_keys = tuple(top)
 
     if "formgraph" not in top:
         problem("missing 'formgraph: 1' (the format version)", 1)

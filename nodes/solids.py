@@ -50,6 +50,29 @@ def _clipping(ctx: Context, fn: Callable[..., Any], *args: Any) -> Any:
         raise
 
 
+def _within_floats(arrays: Any, port: str, inputs: str) -> Any:
+    """Kernel output arrays, or an error naming the scalar input that overflowed them.
+
+    The inputs are finite, so a non-finite vertex means a size (or thickness) large enough
+    that a coordinate passed the largest float: that input is to blame, not the mesh.
+    """
+    v = arrays[0]
+    ok = np.isfinite(v).all(axis=1)
+    if not ok.all():
+        i = int(np.argmin(ok))
+        raise InputError(
+            port,
+            f"{inputs} put vertex {i} at [{', '.join(f'{c:g}' for c in v[i])}], beyond the "
+            f"largest float (about {np.finfo(np.float64).max:.3g}); use smaller values",
+        )
+    return arrays
+
+
+def _fmt(x: Any) -> str:
+    a = np.atleast_1d(np.asarray(x, dtype=float))
+    return f"{a[0]:g}" if a.size == 1 else f"[{', '.join(f'{c:g}' for c in a)}]"
+
+
 # ------------------------------------------------------------------------------ primitives
 
 
@@ -83,9 +106,12 @@ def cylinder(
     """
     ctx.guard(6 * segments, "face corners")
     try:
-        return Mesh(*kp.cylinder(radius, height, segments, caps, center))
+        arrays = kp.cylinder(radius, height, segments, caps, center)
     except ValueError as exc:
         raise InputError("radius" if "radius" in str(exc) else "height", str(exc)) from None
+    port = "radius" if radius >= height / 2 else "height"
+    what = f"radius {radius:g}, height {height:g} and center {_fmt(center)}"
+    return Mesh(*_within_floats(arrays, port, what))
 
 
 @node("mesh.sphere", version=1)
@@ -112,9 +138,11 @@ def sphere(
     """
     ctx.guard(segments * max(2, segments // 2), "faces")
     try:
-        return Mesh(*kp.sphere(radius, segments, center))
+        arrays = kp.sphere(radius, segments, center)
     except ValueError as exc:
         raise InputError("radius", str(exc)) from None
+    what = f"radius {radius:g} and center {_fmt(center)}"
+    return Mesh(*_within_floats(arrays, "radius", what))
 
 
 @node("mesh.torus", version=1)
@@ -144,9 +172,11 @@ def torus(
     """
     ctx.guard(segments_u * segments_v, "faces")
     try:
-        return Mesh(*kp.torus(major, minor, segments_u, segments_v, center))
+        arrays = kp.torus(major, minor, segments_u, segments_v, center)
     except ValueError as exc:
         raise InputError("minor", str(exc)) from None
+    what = f"major {major:g}, minor {minor:g} and center {_fmt(center)}"
+    return Mesh(*_within_floats(arrays, "major", what))
 
 
 @node("mesh.plane", version=1)
@@ -174,9 +204,10 @@ def plane(
         raise InputError("divisions", f"divisions takes [nx, ny], got {list(divisions)}")
     ctx.guard(float(divisions[0] + 1) * float(divisions[1] + 1), "vertices")
     try:
-        return Mesh(*kp.plane(size, divisions, center))
+        arrays = kp.plane(size, divisions, center)
     except ValueError as exc:
         raise InputError("size" if "size" in str(exc) else "divisions", str(exc)) from None
+    return Mesh(*_within_floats(arrays, "size", f"size {_fmt(size)} and center {_fmt(center)}"))
 
 
 # ---------------------------------------------------------------------------------- repair
@@ -189,7 +220,7 @@ def weld(
     """Merge vertices closer than the tolerance; drop the faces that collapse.
 
     Closeness is transitive (a chain of close vertices becomes one); each group keeps the
-    position of its first vertex; unused vertices are removed. Cells one tolerance wide
+    position of its first vertex; unused vertices are removed. Sparse cells one tolerance wide
     make it O(n log n).
 
     Parameters
@@ -259,12 +290,28 @@ def cap(mesh: Mesh, *, ctx: Context) -> Mesh:
     outlines stay inside); any other loop a fan of triangles to its centroid. The new
     faces run each loop opposite to its neighbours, so orientation stays consistent.
 
+    A flat open sheet (a part lying in one plane, e.g. ``mesh.plane`` or two triangles of a
+    square) has nothing to enclose: its outline's cap lies on the sheet itself, giving a
+    two-sided shell of zero volume (doubled faces, often non-manifold edges) that no slicer
+    prints. It is still capped as asked, with a warning; ``mesh.solidify`` is the way to make
+    a flat sheet printable (it gives it a thickness).
+
     Parameters
     ----------
     mesh : Mesh
         An oriented manifold mesh (mesh.weld and mesh.orient make one).
     """
-    return Mesh(*_topology("mesh", _clipping, ctx, kr.cap, *_arrays(mesh)))
+    out = Mesh(*_topology("mesh", _clipping, ctx, kr.cap, *_arrays(mesh)))
+    if out.n_faces > mesh.n_faces:
+        flat = kr.flat_open_parts(*_arrays(mesh))
+        if flat:
+            ctx.warn(
+                f"{flat} part{'s' if flat != 1 else ''} of the mesh "
+                f"{'are flat open sheets' if flat != 1 else 'is a flat open sheet'}: capping "
+                "its outline lays the cap on the sheet, a two-sided shell of zero volume "
+                "(not printable); use mesh.solidify to give a flat sheet a thickness"
+            )
+    return out
 
 
 @node("mesh.solidify", version=1)
@@ -314,9 +361,15 @@ def solidify(
                 f"{i} ({', '.join(f'{c:.6g}' for c in v[i])}); a thickness must be > 0",
             )
     try:
-        return Mesh(*_topology("mesh", ks.solidify, *_arrays(mesh), t, offset))
+        arrays = _topology("mesh", ks.solidify, *_arrays(mesh), t, offset)
     except ValueError as exc:
         raise InputError("mesh", str(exc)) from None
+    port, what = (
+        ("thickness_map", f"the thickness map's values (up to {float(np.max(t)):g})")
+        if thickness_map is not None
+        else ("thickness", f"thickness {thickness:g}")
+    )
+    return Mesh(*_within_floats(arrays, port, f"{what} with offset {offset:g}"))
 
 
 # -------------------------------------------------------------------------------- booleans
@@ -389,6 +442,10 @@ def measure(mesh: Mesh, *, ctx: Context) -> MeshMeasures:
     theorem; 0, with a warning, for a mesh that is not watertight), ``watertight`` (every
     edge on exactly two faces), ``size`` and ``center`` of the bounding box, ``faces``.
 
+    The volume is signed: a closed mesh whose faces point inward measures negative, with a
+    warning (``mesh.orient`` turns it outward); a closed mesh whose faces disagree across
+    some edges warns that its volume means nothing until it is oriented.
+
     Parameters
     ----------
     mesh : Mesh
@@ -401,6 +458,18 @@ def measure(mesh: Mesh, *, ctx: Context) -> MeshMeasures:
     elif not watertight:
         open_edges = int(np.count_nonzero(mesh.edge_table.counts != 2))
         ctx.warn(f"mesh is not watertight ({open_edges} open or non-manifold edges): volume 0")
+    else:
+        disagree = int(np.count_nonzero(mesh.edge_table.same_way))
+        if disagree:
+            ctx.warn(
+                f"the faces disagree in orientation across {disagree} edges, so the volume "
+                f"({volume:g}) means nothing; mesh.orient makes them agree"
+            )
+        elif volume < 0:
+            ctx.warn(
+                f"the mesh faces inward: its volume is negative ({volume:g}); mesh.orient "
+                "turns it outward"
+            )
     lo, hi = mesh.bounds
     return MeshMeasures(
         area=mesh.area,

@@ -108,6 +108,63 @@ def test_two_files_that_include_each_other_are_a_cycle(tmp_path, capsys):
     assert "b.yaml:4: node 'y': include cycle: a.yaml -> b.yaml -> a.yaml" in err
 
 
+@pytest.mark.parametrize(("outer", "inner", "refused"), [(40, 40, True), (20, 20, False)])
+def test_a_repeated_subgraph_budgets_its_own_repeat_times_the_outer_count(
+    tmp_path, outer, inner, refused
+):
+    # each repeat alone fits 1,000 items; nested they run outer * inner
+    (tmp_path / "ring.yaml").write_text(
+        f"formgraph: 1\nparams: {{n: {inner}}}\noutputs: {{c: '@c'}}\nnodes:\n"
+        "  c: {type: nurbs.circle, repeat: {j: '=n'}, radius: '=1 + j'}\n"
+    )
+    (tmp_path / "top.yaml").write_text(
+        f"formgraph: 1\nnodes:\n  r: {{type: ring.yaml, repeat: {{i: {outer}}}, n: {inner}}}\n"
+    )
+    g = fg.load(tmp_path / "top.yaml", out_dir=tmp_path / "out", budget=1_000_000)
+    if not refused:
+        assert len(g.evaluate("r")) == outer * inner
+        return
+    with pytest.raises(fg.BudgetError, match=r"ring.yaml:5: node 'c', input 'repeat': .*") as e:
+        g.evaluate("r")
+    assert f"{inner} items for each of the {outer} items" in str(e.value)
+    assert f"({outer * inner:,} in all)" in str(e.value)
+    assert "(in the subgraph 'r' of " in str(e.value)
+
+
+def test_a_nested_repeat_is_refused_before_the_nodes_upstream_run(tmp_path):
+    (tmp_path / "ring.yaml").write_text(
+        "formgraph: 1\nparams: {n: 40, r: 1.0}\noutputs: {c: '@c'}\nnodes:\n"
+        "  c: {type: nurbs.circle, repeat: {j: '=n'}, radius: '=r + j'}\n"
+    )
+    (tmp_path / "top.yaml").write_text(
+        "formgraph: 1\nnodes:\n  b: {type: mesh.box}\n  m: {type: mesh.measure, mesh: '@b'}\n"
+        "  r: {type: ring.yaml, repeat: {i: 40}, r: '@m.area'}\n"
+    )
+    g = fg.load(tmp_path / "top.yaml", out_dir=tmp_path / "out", budget=1_000_000)
+    with pytest.raises(fg.BudgetError, match=r"ring.yaml:5: .*1,600 in all"):
+        g.evaluate("r")
+    assert g.stats == {} or all(st.status != "computed" for st in g.stats.values())
+
+
+@pytest.mark.parametrize(
+    ("outputs", "error"),
+    [
+        ("outputs: {c: '@c'\n", "part.yaml:3: not valid YAML"),
+        ("outputs: 3\n", "part.yaml:2: 'outputs' must be a mapping"),
+        ("", "part.yaml:1: a graph used as a node needs 'outputs:'"),
+    ],
+)
+def test_a_broken_subgraph_file_reports_only_its_real_error(tmp_path, capsys, outputs, error):
+    # a file that is not YAML also got a spurious "needs 'outputs:'" line
+    (tmp_path / "part.yaml").write_text(
+        f"formgraph: 1\n{outputs}nodes:\n  c: {{type: nurbs.circle, radius: 1}}\n"
+    )
+    (tmp_path / "top.yaml").write_text("formgraph: 1\nnodes:\n  n: {type: part.yaml}\n")
+    code, err = _run(tmp_path, "top.yaml", capsys)
+    lines = [ln for ln in err.splitlines() if "part.yaml" in ln]
+    assert code == 1 and len(lines) == 1 and f"{os.sep}{error}" in lines[0], err
+
+
 # ---------------------------------------------------------------------------- solids
 
 
@@ -116,14 +173,36 @@ def test_a_non_finite_vector_says_so():
         _graph("  s: {type: mesh.sphere, radius: 1, center: [.nan, 0, 0]}\n").evaluate("s")
 
 
-@pytest.mark.parametrize("tolerance", [1e-320, 1e-200, 5e-324])
-def test_a_tiny_weld_tolerance_is_called_too_small(tolerance):
-    # the cell numbers used to wrap around int64 and the message said "too coarse"
+@pytest.mark.parametrize("tolerance", [1e-320, 1e-200, 5e-324, 1e-3])
+def test_a_tolerance_tiny_against_the_coordinates_still_welds(tolerance):
+    # the dense weld grid refused these (its cells would number more than 2^62); the sparse
+    # one only stores occupied cells. A sphere's vertices are all farther apart than 1e-3.
     g = fg.Graph()
-    g.add("s", "mesh.sphere", radius=1e10, segments=400)
+    g.add("s", "mesh.sphere", radius=1e10, segments=64)
     g.add("w", "mesh.weld", mesh="@s", tolerance=tolerance)
-    with pytest.raises(fg.NodeError, match=r"input 'tolerance'.*too small.*0 merges exact"):
-        g.evaluate("w")
+    s, w = g.evaluate("s"), g.evaluate("w")
+    assert w.n_vertices == s.n_vertices and w.is_watertight
+
+
+def test_a_small_tolerance_on_huge_coordinates_matches_a_kd_tree():
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+
+    from formgraph.kernels.mesh import measure as km
+    from formgraph.kernels.mesh import repair as kr
+
+    rng = np.random.default_rng(7)
+    pts = 1e10 * rng.normal(size=(300, 3))
+    pts = np.concatenate([pts, pts[:100] + rng.normal(0, 3e-4, (100, 3))])  # near copies
+    i, j = kr._close_pairs(pts, 1e-3)
+    root, _ = km.union_find(len(pts), i, j)
+    pairs = np.array(sorted(cKDTree(pts).query_pairs(1e-3)), dtype=np.int64).reshape(-1, 2)
+    assert len(pairs) > 20  # the near copies are found
+    graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(len(pts),) * 2)
+    _, labels = connected_components(graph, directed=False)
+    assert len(set(zip(root.tolist(), labels.tolist(), strict=True))) == labels.max() + 1
+    assert len(set(root.tolist())) == labels.max() + 1
 
 
 def test_weld_tolerance_zero_merges_only_exact_duplicates():
@@ -304,3 +383,80 @@ def test_drawing_a_graph_reads_its_node_table_a_fixed_number_of_times(monkeypatc
     monkeypatch.setattr(fg.Graph, "nodes", property(lambda self: calls.append(1) or table(self)))
     fg.draw_graph(g)
     assert len(calls) < 10
+
+
+@pytest.mark.parametrize(
+    ("vertices", "faces"),
+    [
+        ([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], [[0, 1, 2], [0, 2, 3]]),  # a square
+        ([[0, 0, 0], [1, 0, 0], [1, 1, 0], [-1, 0, 0], [-1, -1, 0]], [[0, 1, 2], [0, 3, 4]]),
+        ([[0, 0, 0], [1, 0, 1], [1, 1, 2]], [[0, 1, 2]]),  # one tilted triangle
+    ],
+)
+def test_capping_a_flat_sheet_warns_that_it_has_no_volume(vertices, faces):
+    g = fg.Graph()
+    g.add("a", "mesh.from_faces", vertices=vertices, faces=faces)
+    g.add("c", "mesh.cap", mesh="@a")
+    with pytest.warns(fg.FormgraphWarning, match=r"flat open sheet.*zero volume.*mesh\.solidify"):
+        m = g.evaluate("c")
+    assert m.volume == pytest.approx(0.0, abs=1e-12)
+
+
+def test_capping_a_plane_warns_but_a_tube_or_a_cup_does_not():
+    g = fg.Graph()
+    g.add("p", "mesh.plane", divisions=[3, 2], center=[5, 0, 0])
+    g.add("t", "mesh.cylinder", radius=1, height=2, caps=False)
+    g.add("m", "mesh.merge", meshes=["@p", "@t"])
+    g.add("c", "mesh.cap", mesh="@m")
+    with pytest.warns(fg.FormgraphWarning, match=r"^.*1 part of the mesh is a flat open sheet"):
+        g.evaluate("c")
+    g.add("ct", "mesh.cap", mesh="@t")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", fg.FormgraphWarning)
+        assert g.evaluate("ct").is_watertight
+
+
+@pytest.mark.parametrize(
+    ("type_", "inputs", "port"),
+    [
+        ("mesh.solidify", {"mesh": "@p", "thickness": 1e308, "offset": 1}, "thickness"),
+        ("mesh.solidify", {"mesh": "@p", "thickness": 1e308, "offset": -1}, "thickness"),
+        (
+            "mesh.solidify",
+            {"mesh": "@p", "thickness": 1, "thickness_map": "thickness * 1e308", "offset": 1},
+            "thickness_map",
+        ),
+        ("mesh.sphere", {"radius": 1e308, "center": [1.7e308, 0, 0]}, "radius"),
+        ("mesh.cylinder", {"radius": 1e308, "height": 1, "center": [1.7e308, 0, 0]}, "radius"),
+        ("mesh.cylinder", {"radius": 1, "height": 1.7e308, "center": [0, 0, 1e308]}, "height"),
+        ("mesh.torus", {"major": 1e308, "minor": 1, "center": [1.7e308, 0, 0]}, "major"),
+        ("mesh.plane", {"size": [1e308, 1], "center": [1.7e308, 0, 0]}, "size"),
+    ],
+)
+def test_a_size_that_overflows_the_floats_is_blamed_not_the_mesh(type_, inputs, port):
+    g = fg.Graph()
+    g.add("p", "mesh.plane")
+    g.add("x", type_, **inputs)
+    with pytest.raises(fg.NodeError, match=rf"input '{port}' .*beyond the largest float"):
+        g.evaluate("x")
+
+
+def test_measuring_an_inward_or_misoriented_closed_mesh_warns():
+    g = fg.Graph()
+    g.add("b", "mesh.box")
+    g.add("f", "mesh.flip", mesh="@b")
+    g.add("m", "mesh.measure", mesh="@f")
+    with pytest.warns(fg.FormgraphWarning, match=r"faces inward.*negative \(-1\).*mesh\.orient"):
+        assert g.evaluate("m").volume == pytest.approx(-1.0)
+    # a box with its floor turned (a Mesh from Python; mesh.from_faces refuses it): closed,
+    # but its faces disagree across the floor's 4 edges
+    v = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]]
+    faces = [0, 1, 2, 3, 4, 5, 6, 7, 0, 1, 5, 4, 1, 2, 6, 5, 2, 3, 7, 6, 3, 0, 4, 7]
+    x = fg.Mesh(np.array(v, float), np.array(faces), np.arange(0, 25, 4))
+    g.add("mx", "mesh.measure", mesh=x)
+    with pytest.warns(fg.FormgraphWarning, match=r"disagree in orientation across 4 edges"):
+        g.evaluate("mx")
+    g.add("mb", "mesh.measure", mesh="@b")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", fg.FormgraphWarning)
+        assert g.evaluate("mb").volume == pytest.approx(1.0)

@@ -1,8 +1,8 @@
 """Mesh repair on flat arrays: weld close vertices, orient faces, cap boundary loops.
 
 - :func:`weld`: vertices closer than a tolerance merged (transitively), faces that collapse
-  dropped; neighbours found in a uniform grid of cells one tolerance wide, so only the 27
-  cells around a point are searched;
+  dropped; neighbours found in a sparse (hashed) grid of cells one tolerance wide, so only
+  the 27 cells around a point are searched, whatever the size of the coordinates;
 - :func:`orient`: one orientation per connected part, found by a parity union-find over the
   faces (two faces sharing an edge the same way must differ), then each closed part turned
   outward by its signed volume;
@@ -19,7 +19,15 @@ from .halfedge import build_halfedges
 from .measure import edge_table, face_areas, next_corner, signed_volume, union_find
 from .meshops import reverse_faces, triangulate
 
-__all__ = ["cap", "compact", "drop_collapsed", "orient", "weld", "weld_tolerance"]
+__all__ = [
+    "cap",
+    "compact",
+    "drop_collapsed",
+    "flat_open_parts",
+    "orient",
+    "weld",
+    "weld_tolerance",
+]
 
 MeshArrays = tuple[np.ndarray, np.ndarray, np.ndarray]
 
@@ -38,34 +46,53 @@ def weld_tolerance(vertices: np.ndarray) -> float:
     return RELATIVE_TOLERANCE * float(np.linalg.norm(v.max(axis=0) - v.min(axis=0)))
 
 
+def _cell_hash(q: np.ndarray, salt: int) -> np.ndarray:
+    """A 64-bit hash of int64 cell coordinates ``q`` (k, 3), salted."""
+    b = q.view(np.uint64)
+    return _mix(_mix(_mix(b[:, 0] ^ np.uint64(salt)) ^ b[:, 1]) ^ b[:, 2])
+
+
 def _close_pairs(v: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
-    """All pairs ``i < j`` with ``|v[i] - v[j]| <= tol`` (cells of side ``tol``)."""
+    """All pairs ``i < j`` with ``|v[i] - v[j]| <= tol`` (cells of side about ``tol``).
+
+    The cells are sparse: each point's three int64 cell numbers, relative to the bounding
+    box's minimum, are hashed and sorted, so only occupied cells cost anything and a tolerance
+    that is tiny against the coordinates works (a radius-1e10 sphere welded at 1e-3).
+    """
     lo = v.min(axis=0)
-    # the grid is checked in floats first: a tiny tolerance makes cell numbers that do not
-    # fit an int64 (or are infinite), and the cast would silently wrap them
+    # a cell a little wider than tol absorbs the rounding of (v - lo) / side: two points
+    # within tol then never land two cells apart (the error is below 8 eps max|v|)
+    side = tol + 8 * np.finfo(np.float64).eps * float(np.abs(v).max())
     with np.errstate(over="ignore"):
-        qf = np.floor((v - lo) / tol)
-        grid = float(np.prod(qf.max(axis=0) + 3))  # room for the -1 / +1 neighbours
-    if not np.isfinite(grid) or grid >= 2.0**62:
+        qf = np.floor((v - lo) / side)
+    # only the cell numbers themselves must fit an int64 (with room for the +-1 neighbours)
+    if not np.isfinite(qf).all() or qf.max() >= 2.0**62:
         raise ValueError(
-            f"weld tolerance {tol:g} is too small for a mesh this large (its cells would "
-            "number more than 2^62); 0 merges exact duplicates only"
+            f"weld tolerance {tol:g} is too small for a mesh this large (a cell number "
+            "along an axis would pass 2^62); 0 merges exact duplicates only"
         )
-    q = qf.astype(np.int64)
-    dims = q.max(axis=0) + 3
-    q += 1
-    key = (q[:, 0] * dims[1] + q[:, 1]) * dims[2] + q[:, 2]
-    cells, cell_of, counts = np.unique(key, return_inverse=True, return_counts=True)
-    order = np.argsort(cell_of)
-    start = np.zeros(cells.size + 1, dtype=np.int64)
-    np.cumsum(counts, out=start[1:])
+    q = np.ascontiguousarray(qf.astype(np.int64))
+    for salt in (0, 0x9E3779B97F4A7C15, 0x2545F4914F6CDD1D):
+        h = _cell_hash(q, salt)
+        order = np.argsort(h, kind="stable")
+        hs = h[order]
+        new_cell = np.r_[True, hs[1:] != hs[:-1]]
+        starts = np.flatnonzero(new_cell)
+        cells, rep = hs[starts], q[order[starts]]
+        # a hash collision would put two cells in one bucket: check, and re-salt
+        if np.array_equal(q[order], rep[np.cumsum(new_cell) - 1]):
+            break
+    else:  # pragma: no cover - three 64-bit collisions in a row
+        raise ValueError("weld could not hash its cells without collisions")
+    counts = np.diff(np.r_[starts, len(v)])
+    start = np.r_[starts, len(v)]
     # the cell itself and the 13 neighbours "after" it: each unordered cell pair once
     offsets = [(dx, dy, dz) for dx in (-1, 0, 1) for dy in (-1, 0, 1) for dz in (-1, 0, 1)]
     found = []
     for dx, dy, dz in offsets[13:]:
-        target = cells + (dx * dims[1] + dy) * dims[2] + dz
-        pos = np.minimum(np.searchsorted(cells, target), cells.size - 1)
-        hit = np.flatnonzero(cells[pos] == target)
+        target = rep + np.array([dx, dy, dz], dtype=np.int64)
+        pos = np.minimum(np.searchsorted(cells, _cell_hash(target, salt)), cells.size - 1)
+        hit = np.flatnonzero((rep[pos] == target).all(axis=1))
         found.append((dx, dy, dz, hit, pos[hit]))
     # pairs to compare: na * nb between two cells, na (na - 1) / 2 within one
     total = 0
@@ -74,9 +101,15 @@ def _close_pairs(v: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
         same = (dx, dy, dz) == (0, 0, 0)
         total += int(np.sum(na * (nb - 1) // 2 if same else na * nb))
     if total > MAX_PAIRS:
+        why = (
+            "use a smaller tolerance"
+            if side < 2 * tol
+            else f"the coordinates' float spacing ({side - tol:.3g}) is coarser than the "
+            "tolerance, so the cells cannot be smaller"
+        )
         raise ValueError(
             f"weld tolerance {tol:g} is too coarse for this mesh: {total:,} vertex pairs fall "
-            f"within a cell of each other (limit {MAX_PAIRS:,}); use a smaller tolerance"
+            f"within a cell of each other (limit {MAX_PAIRS:,}); {why}"
         )
     ii, jj = [], []
     for dx, dy, dz, ca, cb in found:
@@ -93,8 +126,10 @@ def _close_pairs(v: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
         jj.append(j[keep])
     i = np.concatenate(ii) if ii else np.zeros(0, np.int64)
     j = np.concatenate(jj) if jj else np.zeros(0, np.int64)
-    d2 = np.einsum("ij,ij->i", v[i] - v[j], v[i] - v[j])
-    close = d2 <= tol * tol
+    # compared in units of tol: tol * tol underflows for a tiny tolerance
+    with np.errstate(over="ignore"):
+        d = (v[i] - v[j]) / tol
+        close = np.einsum("ij,ij->i", d, d) <= 1.0
     return i[close], j[close]
 
 
@@ -422,3 +457,57 @@ def cap(
     caps = np.concatenate([tri, fans])
     out_fo = np.concatenate([fo, fo[-1] + np.arange(3, caps.size + 1, 3)])
     return np.concatenate([v, new_v]), np.concatenate([fi, caps]), out_fo
+
+
+def flat_open_parts(
+    vertices: np.ndarray,
+    face_indices: np.ndarray,
+    face_offsets: np.ndarray,
+    planar_tolerance: float = 1e-6,
+) -> int:
+    """How many connected parts are flat open sheets (all in one plane, with a boundary).
+
+    Capping such a part fills its outline in its own plane: the cap lies on the sheet, and
+    the result is a two-sided shell of zero volume, doubled and usually non-manifold, which
+    no slicer can print. Parts are joined by shared vertices (a parallel union-find); each
+    one's plane is the least-squares plane of its vertices (the smallest eigenvector of their
+    covariance, batched), and it is flat when every vertex lies within ``planar_tolerance``
+    of the part's bounding-box diagonal from that plane.
+
+    Returns
+    -------
+    int
+        The number of flat parts that have at least one boundary edge.
+    """
+    v = np.asarray(vertices, dtype=np.float64)
+    fi = np.asarray(face_indices, dtype=np.int64)
+    fo = np.asarray(face_offsets, dtype=np.int64)
+    if fi.size == 0:
+        return 0
+    root, _ = union_find(len(v), fi, fi[next_corner(fo)])
+    used = np.zeros(len(v), dtype=bool)
+    used[fi] = True
+    parts, part = np.unique(root[used], return_inverse=True)
+    p = v[used]
+    count = np.bincount(part, minlength=parts.size)[:, None]
+    mean = np.stack([np.bincount(part, p[:, k], parts.size) for k in range(3)], 1) / count
+    d = p - mean[part]
+    cov = np.zeros((parts.size, 3, 3))
+    for a in range(3):
+        for b in range(a, 3):
+            cov[:, a, b] = cov[:, b, a] = np.bincount(part, d[:, a] * d[:, b], parts.size)
+    normal = np.linalg.eigh(cov)[1][:, :, 0]  # eigenvalues ascending: the plane's normal
+    dist = np.abs(np.einsum("ij,ij->i", d, normal[part]))
+    far = np.zeros(parts.size)
+    np.maximum.at(far, part, dist)
+    hi = np.full((parts.size, 3), -np.inf)
+    lo = np.full((parts.size, 3), np.inf)
+    np.maximum.at(hi, part, p)
+    np.minimum.at(lo, part, p)
+    flat = far <= planar_tolerance * np.linalg.norm(hi - lo, axis=1)
+    t = edge_table(fi, fo, len(v))
+    open_vertex = t.vertices[t.counts == 1, 0]
+    has_open = np.zeros(parts.size, dtype=bool)
+    where = np.searchsorted(parts, root[open_vertex])
+    has_open[where] = True
+    return int(np.count_nonzero(flat & has_open))
