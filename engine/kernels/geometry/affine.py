@@ -97,18 +97,26 @@ def align_z(directions: np.ndarray) -> np.ndarray:
     if (length <= 1e-300).any():
         i = int(np.argmax(length <= 1e-300))
         raise ValueError(f"align direction {i} is zero; cannot orient a copy along it")
+    # the horizontal unit direction (x, y) / rho, from the given components scaled by the
+    # larger of them: dividing by a rounded subnormal rho (a direction a hair from -z)
+    # would cost up to 30 bits and leave R visibly non-orthogonal
+    big = np.maximum(np.abs(d[:, 0]), np.abs(d[:, 1]))
+    hx = d[:, 0] / np.where(big > 0, big, 1.0)
+    hy = d[:, 1] / np.where(big > 0, big, 1.0)
+    hr = np.hypot(hx, hy)
+    ux = hx / np.where(hr > 0, hr, 1.0)
+    uy = hy / np.where(hr > 0, hr, 1.0)
     d = d / length[:, None]
     x, y, z = d.T
     c = z
-    rho = np.hypot(x, y)
-    flip = (c < 0) & (rho == 0)
+    flip = (c < 0) & (big == 0)
     # [v]x^2 / (1 + c) needs x^2 k, x y k, y^2 k with k = 1 / (1 + c); for c < 0 they are
     # (x / rho)^2 (1 - c), ...: x^2 + y^2 itself can underflow to a subnormal whose
     # reciprocal overflows (then 0 * inf made NaN)
     below = c < 0
-    safe = np.where(rho > 0, rho, 1.0)
-    sx = np.where(below, (x / safe) * np.sqrt(1.0 - c), x / np.sqrt(np.where(below, 1.0, 1.0 + c)))
-    sy = np.where(below, (y / safe) * np.sqrt(1.0 - c), y / np.sqrt(np.where(below, 1.0, 1.0 + c)))
+    root = np.sqrt(np.where(below, 1.0, 1.0 + c))
+    sx = np.where(below, ux * np.sqrt(1.0 - c), x / root)
+    sy = np.where(below, uy * np.sqrt(1.0 - c), y / root)
     # v = (-y, x, 0); [v]x^2 / (1 + c) written out
     m = np.empty((len(d), 3, 3))
     m[:, 0, 0] = 1.0 - sx * sx
