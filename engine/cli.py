@@ -10,7 +10,6 @@ import argparse
 import json
 import os
 import sys
-import time
 import traceback
 import warnings
 from collections.abc import Sequence
@@ -20,6 +19,7 @@ import yaml
 
 from .errors import FormgraphError, FormgraphWarning, GraphError
 from .registry import DEFAULT_BUDGET
+from .terminal import StatusLine
 
 
 class UsageError(Exception):
@@ -197,31 +197,15 @@ def _number(text: str) -> Any:
         return text  # the param's check then says what was expected
 
 
-class _ProgressLine:
+class _ProgressLine(StatusLine):
     """'cooking node (k/n)' on a terminal, for runs that take more than a moment."""
 
     def __init__(self, stream: Any):
-        self.stream = stream
-        self.enabled = hasattr(stream, "isatty") and stream.isatty()
-        self.start = time.perf_counter()
-        self.last = -float("inf")
-        self.shown = False
+        # quiet for the first half second, then at most 20 updates a second
+        super().__init__(stream, quiet_for=0.5, interval=0.05)
 
     def __call__(self, node: str, done: int, total: int) -> None:
-        # Quiet for the first half second, then at most 20 updates a second (a write per
-        # node would cost a chain of small nodes more than the nodes themselves).
-        now = time.perf_counter()
-        if not self.enabled or now - self.start < 0.5 or now - self.last < 0.05:
-            return
-        self.last = now
-        self.stream.write(f"\r\x1b[Kcooking '{node}' ({done + 1}/{total} nodes)")
-        self.stream.flush()
-        self.shown = True
-
-    def clear(self) -> None:
-        if self.shown:
-            self.stream.write("\r\x1b[K")
-            self.stream.flush()
+        self.show(f"cooking '{node}' ({done + 1}/{total} nodes)")
 
 
 def _profile_table(stats: dict[str, Any], nodes: dict[str, str]) -> str:

@@ -33,6 +33,7 @@ from .errors import ParamError, Problem, Where
 from .graph import Graph
 from .sampling import Domain, domain, parse_spec, sample
 from .sweep_dask import SweepError, Targets, Totals
+from .terminal import StatusLine
 
 __all__ = [
     "EACH_WORKER",
@@ -254,28 +255,14 @@ class _Table:
             self.fd = None
 
 
-class TerminalProgress:
+class TerminalProgress(StatusLine):
     """'sweep 37/200 done, 2 failed, 4.1/s, ETA 0:40' on a terminal, at most 10 times a second."""
 
     def __init__(self, stream: Any = None):
-        self.stream = stream if stream is not None else sys.stderr
-        self.enabled = hasattr(self.stream, "isatty") and self.stream.isatty()
-        self.last = 0.0
-        self.shown = False
+        super().__init__(stream if stream is not None else sys.stderr, interval=0.1)
 
     def __call__(self, done: int, total: int, failed: int, rate: float) -> None:
-        now = time.perf_counter()
-        if not self.enabled or (now - self.last < 0.1 and done < total):
-            return
-        self.last = now
-        self.stream.write("\r\x1b[K" + progress_text(done, total, failed, rate))
-        self.stream.flush()
-        self.shown = True
-
-    def clear(self) -> None:
-        if self.shown:
-            self.stream.write("\r\x1b[K")
-            self.stream.flush()
+        self.show(progress_text(done, total, failed, rate), force=done >= total)
 
 
 def progress_text(done: int, total: int, failed: int, rate: float) -> str:
