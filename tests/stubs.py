@@ -6,7 +6,7 @@ so the shipped catalogue never contains them.
 
 from __future__ import annotations
 
-from typing import Annotated
+from typing import Annotated, NamedTuple
 
 import numpy as np
 
@@ -143,3 +143,20 @@ def pair(a: float, b: float) -> list[float]:
     """
     CALLS.append("pair")
     return [a, b]
+
+
+class Split(NamedTuple):
+    lo: float
+    hi: float
+
+
+@node("stub.split", version=1)
+def split(x: float) -> Split:
+    """x - 1 and x + 1 (a node with two named outputs).
+
+    Parameters
+    ----------
+    x : float
+        The number.
+    """
+    return Split(x - 1.0, x + 1.0)

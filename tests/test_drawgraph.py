@@ -6,7 +6,6 @@ from __future__ import annotations
 import re
 import xml.etree.ElementTree as ET
 from pathlib import Path
-from typing import NamedTuple
 
 import numpy as np
 import pytest
@@ -18,7 +17,6 @@ from formgraph.cli import main
 from formgraph.drawgraph import MARKS, draw_graph, node_marks
 from formgraph.drawing import Text, text_width
 from formgraph.model import wires_of
-from formgraph.registry import node
 
 ROOT = Path(__file__).resolve().parents[1]
 GRAPHS = sorted((ROOT / "graphs").glob("*.yaml"))
@@ -262,26 +260,9 @@ def test_cli_graph_svg_png_and_run(tmp_path, capsys, monkeypatch):
     assert main(["graph", str(f)]) == 0 and (tmp_path / "vase.svg").is_file()
 
 
-class _Split(NamedTuple):
-    lo: float
-    hi: float
-
-
-@node("drawtest.split")
-def _split(x: float) -> _Split:
-    """x - 1 and x + 1 (a node with two named outputs).
-
-    Parameters
-    ----------
-    x : float
-        The number.
-    """
-    return _Split(x - 1.0, x + 1.0)
-
-
 def test_a_node_with_several_outputs_gets_a_row_and_an_anchor_per_output():
     g = fg.Graph()
-    g.add("s", "drawtest.split", x=3.0)
+    g.add("s", "stub.split", x=3.0)
     g.add("c", "points.circle", count=4, radius="@s.hi")
     root = parse(draw_graph(g).svg)
     outputs = [t.text for t in by_class(root, "text", "output-type")]

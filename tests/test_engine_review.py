@@ -9,7 +9,6 @@ from __future__ import annotations
 import io
 import json
 import tracemalloc
-from typing import NamedTuple
 
 import numpy as np
 import pytest
@@ -22,23 +21,6 @@ from formgraph.geometry import Curve, ParametricCurve
 from formgraph.registry import node
 
 # ------------------------------------------------------------------ probe node types
-
-
-class _Split(NamedTuple):
-    lo: float
-    hi: float
-
-
-@node("review.split")
-def _split(x: float) -> _Split:
-    """x - 1 and x + 1 (a node with two named outputs).
-
-    Parameters
-    ----------
-    x : float
-        The number.
-    """
-    return _Split(x - 1.0, x + 1.0)
 
 
 @node("review.lines")
@@ -140,7 +122,7 @@ def test_multi_output_node_survives_the_disk_cache(tmp_path):
     # list and '@s.hi' raises a raw AttributeError out of evaluate().
     def build() -> fg.Graph:
         g = fg.Graph(cache_dir=tmp_path)
-        g.add("s", "review.split", x=2.0)
+        g.add("s", "stub.split", x=2.0)
         g.add("a", "stub.add", a="@s.hi", label="x")
         return g
 
