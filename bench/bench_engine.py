@@ -11,8 +11,8 @@ from __future__ import annotations
 import numpy as np
 
 import formgraph as fg
+from formgraph.core.registry import node
 from formgraph.geometry import Points
-from formgraph.registry import node
 
 N_POINTS = 10_000
 N_NODES = 200

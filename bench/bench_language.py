@@ -13,9 +13,9 @@ from __future__ import annotations
 import numpy as np
 
 import formgraph as fg
+from formgraph.core.registry import Context, node
 from formgraph.geometry import Mesh, Points
 from formgraph.kernels.mesh.meshops import rotation_matrix
-from formgraph.registry import Context, node
 
 N_COPIES = 10_000
 N_ITEMS = 1_000

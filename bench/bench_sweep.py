@@ -37,8 +37,8 @@ def _sweep(g: fg.Graph, vary: dict, client) -> tuple[float, fg.Sweep]:
 
 
 def run(table) -> None:
-    from formgraph.sampling import domain, sample
-    from formgraph.sweep_dask import connect
+    from formgraph.sweeps.cluster import connect
+    from formgraph.sweeps.sampling import domain, sample
 
     t0 = time.perf_counter()
     embedded = connect(None, workers=2)  # the cluster fg.sweep starts when given none

@@ -13,8 +13,7 @@ from collections.abc import Iterable
 from typing import Any
 
 from . import geometry
-from .drawgraph import draw_graph
-from .errors import (
+from .core.errors import (
     BudgetError,
     CycleError,
     ExpressionError,
@@ -26,6 +25,9 @@ from .errors import (
     ParamError,
     PathError,
 )
+from .core.registry import node_types
+from .drawgraph.layout import draw_graph
+from .evaluation.graph import Graph, NodeStat, load
 from .geometry import (
     Curve,
     Mesh,
@@ -36,9 +38,7 @@ from .geometry import (
     Points,
     Surface,
 )
-from .graph import Graph, NodeStat, load
-from .registry import node_types
-from .sweep import Sweep, sweep
+from .sweeps.api import Sweep, sweep
 
 
 def show(source: Any, node: str | Iterable[str] | None = None, **kwargs: Any) -> Any:

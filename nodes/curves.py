@@ -7,12 +7,12 @@ from typing import Annotated, Any, NamedTuple
 
 import numpy as np
 
-from formgraph.errors import InputError
+from formgraph.core.errors import InputError
+from formgraph.core.registry import Context, Range, node
+from formgraph.core.types import Expression, Variables
 from formgraph.geometry import Curve, NurbsCurve, ParametricCurve, Points
 from formgraph.kernels import curves as kc
 from formgraph.kernels.curves import measure as kmeasure
-from formgraph.registry import Context, Range, node
-from formgraph.types import Expression, Variables
 
 
 @node("curves.polyline", version=1)

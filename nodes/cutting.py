@@ -14,14 +14,14 @@ from typing import Annotated, Any
 
 import numpy as np
 
-from formgraph.errors import InputError
+from formgraph.core.errors import InputError
+from formgraph.core.registry import Context, Range, node
+from formgraph.core.types import Vec3
 from formgraph.geometry import Curve, NurbsCurve, frozen_array
 from formgraph.kernels.curves import regions as kregions
 from formgraph.kernels.curves import sampling as ksampling
 from formgraph.kernels.curves import shapes as kshapes
 from formgraph.kernels.curves import text as ktext
-from formgraph.registry import Context, Range, node
-from formgraph.types import Vec3
 
 _TOLERANCE = 1e-5  # default sampling tolerance of region booleans, relative to the extent
 

@@ -13,7 +13,9 @@ from typing import Annotated
 
 import numpy as np
 
-from formgraph.errors import InputError
+from formgraph.core.errors import InputError
+from formgraph.core.registry import Context, Range, node
+from formgraph.core.types import OutputPath, entries_of
 from formgraph.geometry import Curve, Mesh, NurbsCurve
 from formgraph.kernels import nurbs
 from formgraph.kernels.io import (
@@ -29,8 +31,6 @@ from formgraph.kernels.io import (
     svg_bytes,
 )
 from formgraph.kernels.io.colors import css_color
-from formgraph.registry import Context, Range, node
-from formgraph.types import OutputPath, entries_of
 
 _CIRCLE_TOL = 1e-9  # relative: a rational quadratic piece closer than this to a circle is one
 

@@ -13,7 +13,9 @@ from typing import Annotated, Any, NamedTuple
 
 import numpy as np
 
-from formgraph.errors import InputError
+from formgraph.core.errors import InputError
+from formgraph.core.registry import Context, Range, node
+from formgraph.core.types import SameAs, Vec3
 from formgraph.geometry import (
     Curve,
     Geometry,
@@ -28,8 +30,6 @@ from formgraph.geometry import (
 )
 from formgraph.kernels.geometry import affine, instancing
 from formgraph.kernels.mesh import meshops
-from formgraph.registry import Context, Range, node
-from formgraph.types import SameAs, Vec3
 
 
 class _Shared:

@@ -12,7 +12,9 @@ from typing import Annotated
 
 import numpy as np
 
-from formgraph.errors import InputError
+from formgraph.core.errors import InputError
+from formgraph.core.registry import Context, Range, node
+from formgraph.core.types import Faces, Vec3
 from formgraph.geometry import Mesh, Points
 from formgraph.kernels.mesh import (
     HalfEdges,
@@ -21,8 +23,6 @@ from formgraph.kernels.mesh import (
     meshops,
     subdivision,
 )
-from formgraph.registry import Context, Range, node
-from formgraph.types import Faces, Vec3
 
 
 def _arrays(mesh: Mesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

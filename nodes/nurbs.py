@@ -12,7 +12,9 @@ from typing import Annotated, Any
 
 import numpy as np
 
-from formgraph.errors import InputError
+from formgraph.core.errors import InputError
+from formgraph.core.registry import Context, Range, node
+from formgraph.core.types import SameAs, Vec3
 from formgraph.geometry import (
     Curve,
     Mesh,
@@ -23,8 +25,6 @@ from formgraph.geometry import (
     Surface,
 )
 from formgraph.kernels import nurbs as K
-from formgraph.registry import Context, Range, node
-from formgraph.types import SameAs, Vec3
 
 CurveTuple = tuple[np.ndarray, int, np.ndarray, "np.ndarray | None"]
 

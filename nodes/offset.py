@@ -6,10 +6,10 @@ from typing import Annotated
 
 import numpy as np
 
-from formgraph.errors import InputError
+from formgraph.core.errors import InputError
+from formgraph.core.registry import Context, Range, node
 from formgraph.geometry import Curve, NurbsCurve
 from formgraph.kernels.offset import default_cell, grid_cells, offset_polylines
-from formgraph.registry import Context, Range, node
 
 _TOLERANCE = 1e-3  # the kernel's accuracy, as a fraction of the input's extent
 _SAMPLE_SHARE = 0.1  # sampling error allowed, as a share of that (and of the cell)

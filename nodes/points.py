@@ -6,9 +6,9 @@ from typing import Annotated
 
 import numpy as np
 
+from formgraph.core.registry import Context, Range, node
+from formgraph.core.types import Vec3
 from formgraph.geometry import Points
-from formgraph.registry import Context, Range, node
-from formgraph.types import Vec3
 
 
 @node("points.list", version=1)

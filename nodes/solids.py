@@ -13,15 +13,15 @@ from typing import Annotated, Any, NamedTuple
 
 import numpy as np
 
-from formgraph.errors import InputError
+from formgraph.core.errors import InputError
+from formgraph.core.registry import Context, Range, node
+from formgraph.core.types import Expression, Variables, Vec3
 from formgraph.geometry import Mesh
 from formgraph.kernels.mesh import MeshTopologyError, meshops
 from formgraph.kernels.mesh import boolean as kb
 from formgraph.kernels.mesh import primitives as kp
 from formgraph.kernels.mesh import repair as kr
 from formgraph.kernels.mesh import solidify as ks
-from formgraph.registry import Context, Range, node
-from formgraph.types import Expression, Variables, Vec3
 
 
 def _arrays(mesh: Mesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -6,12 +6,12 @@ from typing import Annotated
 
 import numpy as np
 
-from formgraph.errors import InputError
+from formgraph.core.errors import InputError
+from formgraph.core.registry import Context, node
+from formgraph.core.types import Expression, Variables
 from formgraph.geometry import Mesh, NurbsSurface, ParametricSurface, Points
 from formgraph.kernels import curves as kc
 from formgraph.kernels.mesh import grid_faces
-from formgraph.registry import Context, node
-from formgraph.types import Expression, Variables
 
 
 def _rows(points: list[Points], closed_u: bool, closed_v: bool) -> np.ndarray:

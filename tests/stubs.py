@@ -10,10 +10,10 @@ from typing import Annotated, NamedTuple
 
 import numpy as np
 
-from formgraph.errors import InputError
+from formgraph.core.errors import InputError
+from formgraph.core.registry import Context, Range, node
+from formgraph.core.types import OutputPath
 from formgraph.geometry import Points
-from formgraph.registry import Context, Range, node
-from formgraph.types import OutputPath
 
 CALLS: list[str] = []
 

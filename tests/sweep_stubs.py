@@ -14,8 +14,8 @@ from typing import NamedTuple
 
 import numpy as np
 
+from formgraph.core.registry import node
 from formgraph.geometry import Curve, Mesh
-from formgraph.registry import node
 
 
 def calls(log: str | os.PathLike[str]) -> list[str]:

@@ -15,7 +15,7 @@ from hypothesis import strategies as st
 from stubs import CALLS
 
 import formgraph as fg
-from formgraph.cache import DiskCache, MemoryCache, canonical, key_of, key_text
+from formgraph.evaluation.cache import DiskCache, MemoryCache, canonical, key_of, key_text
 
 
 def graph(cache_dir: Path) -> fg.Graph:

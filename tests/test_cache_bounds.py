@@ -9,8 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from formgraph.cache import DiskCache, key_of, parse_size
-from formgraph.cli import main
+from formgraph.cli.main import main
+from formgraph.evaluation.cache import DiskCache, key_of, parse_size
 
 
 @pytest.fixture

@@ -133,7 +133,7 @@ def test_readme_catalogue_is_current():
         [
             sys.executable,
             "-c",
-            "from formgraph.catalogue import readme_table; print(readme_table())",
+            "from formgraph.language.catalogue import readme_table; print(readme_table())",
         ],
         capture_output=True,
         text=True,
@@ -141,7 +141,7 @@ def test_readme_catalogue_is_current():
     )
     readme = (ROOT / "README.md").read_text()
     assert r.stdout.strip() in readme, (
-        "README catalogue is stale: python -m formgraph.catalogue README.md"
+        "README catalogue is stale: python -m formgraph.language.catalogue README.md"
     )
 
 
@@ -159,7 +159,7 @@ def test_schema_accepts_expressions_inside_coordinates():
 def test_progress_line_on_a_terminal_only():
     import io
 
-    from formgraph.cli import _ProgressLine
+    from formgraph.cli.main import _ProgressLine
 
     class Terminal(io.StringIO):
         def isatty(self):

@@ -13,10 +13,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import formgraph as fg
-from formgraph.cli import main
-from formgraph.drawgraph import MARKS, draw_graph, node_marks
-from formgraph.drawing import Text, text_width
-from formgraph.model import wires_of
+from formgraph.cli.main import main
+from formgraph.drawgraph.layout import MARKS, draw_graph, node_marks
+from formgraph.drawgraph.shapes import Text, text_width
+from formgraph.language.model import wires_of
 
 ROOT = Path(__file__).resolve().parents[1]
 GRAPHS = sorted((ROOT / "graphs").glob("*.yaml"))

@@ -14,11 +14,11 @@ import numpy as np
 import pytest
 
 import formgraph as fg
-from formgraph.cache import FORMAT, DiskCache
-from formgraph.cli import main
-from formgraph.expr import compile_expression
+from formgraph.cli.main import main
+from formgraph.core.registry import node
+from formgraph.evaluation.cache import FORMAT, DiskCache
 from formgraph.geometry import Curve, ParametricCurve
-from formgraph.registry import node
+from formgraph.language.expr import compile_expression
 
 # ------------------------------------------------------------------ probe node types
 

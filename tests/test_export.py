@@ -178,12 +178,12 @@ def test_a_failing_write_leaves_the_old_file(tmp_path, monkeypatch):
     old = target.read_bytes()
     folder = target.parent
     if os.geteuid() == 0:  # root writes into read-only folders: make the rename fail instead
-        import formgraph.safety
+        import formgraph.core.safety
 
         def refuse(*args, **kwargs):
             raise PermissionError(13, "Permission denied", str(target))
 
-        monkeypatch.setattr(formgraph.safety.os, "replace", refuse)
+        monkeypatch.setattr(formgraph.core.safety.os, "replace", refuse)
     else:
         folder.chmod(0o555)
     try:

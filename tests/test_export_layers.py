@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 
 import formgraph as fg
+from formgraph.core.types import Entries, entries_of, port_type
 from formgraph.kernels.io.colors import CSS_COLORS, css_color
-from formgraph.types import Entries, entries_of, port_type
 
 SVG = "{http://www.w3.org/2000/svg}"
 

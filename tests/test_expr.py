@@ -9,8 +9,8 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from formgraph.errors import ExpressionError
-from formgraph.expr import Bound, compile_expression
+from formgraph.core.errors import ExpressionError
+from formgraph.language.expr import Bound, compile_expression
 
 
 @pytest.mark.parametrize(

@@ -295,10 +295,10 @@ def test_curves_copy_to_points_are_exact_copies():
 def test_copy_to_points_against_mesh_transform_per_point(n, seed, mirror):
     from pathlib import Path
 
+    from formgraph.core.registry import Context
     from formgraph.kernels.mesh import meshops
     from formgraph.nodes.geometry import mesh_copy_to_points
     from formgraph.nodes.mesh import transform as mesh_transform
-    from formgraph.registry import Context
 
     rng = np.random.default_rng(seed)
     part = _part()

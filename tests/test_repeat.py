@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 from stubs import CALLS
 
 import formgraph as fg
-from formgraph.cli import main
+from formgraph.cli.main import main
 
 RINGS = """\
 formgraph: 1

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 import formgraph as fg
+from formgraph.core.types import Expression, Faces, OutputPath, Vec3
 from formgraph.geometry import Curve, Mesh, NurbsCurve, NurbsSurface, Points, Surface
-from formgraph.types import Expression, Faces, OutputPath, Vec3
 
 NODE_TYPES = [n for n in fg.node_types() if not n.startswith(("stub.", "bench."))]
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import formgraph as fg
-from formgraph.safety import path_problem, write_atomic
+from formgraph.core.safety import path_problem, write_atomic
 
 
 @pytest.mark.parametrize(

@@ -10,8 +10,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import formgraph as fg
-from formgraph.sampling import Domain, domain, parse_spec, sample
-from formgraph.sweep import progress_text
+from formgraph.sweeps.api import progress_text
+from formgraph.sweeps.sampling import Domain, domain, parse_spec, sample
 
 
 def graph() -> fg.Graph:
@@ -135,7 +135,7 @@ def test_progress_text():
 def test_the_progress_line_shows_on_a_terminal_only():
     import io
 
-    from formgraph.sweep import TerminalProgress
+    from formgraph.sweeps.api import TerminalProgress
 
     class Terminal(io.StringIO):
         def isatty(self) -> bool:

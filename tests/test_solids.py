@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 from tools import admesh, cli
 
 import formgraph as fg
-from formgraph.errors import BudgetError
+from formgraph.core.errors import BudgetError
 from formgraph.kernels.io import mesh_report
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -1,4 +1,4 @@
-"""Subgraphs: graph files used as node types (engine/subgraph.py)."""
+"""Subgraphs: graph files used as node types (engine/language/subgraph.py, engine/evaluation/items.py)."""
 
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 import formgraph as fg
-from formgraph.catalogue import json_schema
-from formgraph.cli import main
+from formgraph.cli.main import main
+from formgraph.language.catalogue import json_schema
 
 RING = """\
 formgraph: 1
@@ -328,7 +328,7 @@ def test_watch_reloads_when_a_subgraph_file_changes(tree):
 def test_a_new_version_of_a_node_inside_changes_the_subgraphs_key(tree, monkeypatch):
     import dataclasses
 
-    from formgraph import registry
+    from formgraph.core import registry
 
     before = fg.load(tree / "top.yaml").node_types()["parts/ring.yaml"].digest
     spec = registry._REGISTRY["nurbs.sweep"]

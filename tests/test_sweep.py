@@ -24,7 +24,7 @@ import sweep_stubs
 from distributed import Client, LocalCluster
 
 import formgraph as fg
-from formgraph.cli import main as cli_main
+from formgraph.cli.main import main as cli_main
 from formgraph.viewer.sheet import CELL, FAILED, LABEL_HEIGHT
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -372,8 +372,8 @@ def test_repeated_and_subgraph_nodes_sweep_like_a_plain_loop(client):
 
 
 def test_subgraph_files_travel_with_the_graph(tmp_path):
-    from formgraph.sweep_dask import blueprint
-    from formgraph.sweep_tasks import _graph_file
+    from formgraph.sweeps.cluster import blueprint
+    from formgraph.sweeps.tasks import _graph_file
 
     for rel in ("lamp.yaml", "parts/ring.yaml"):
         (tmp_path / rel).parent.mkdir(exist_ok=True)
@@ -421,7 +421,7 @@ def test_ctrl_c_leaves_a_valid_table_and_the_rerun_completes_it(tmp_path):
     out = tmp_path / "out"
     code = (
         "import sys; sys.path.insert(0, sys.argv[1]); import sweep_stubs; "
-        "from formgraph.cli import main; sys.exit(main(sys.argv[2:]))"
+        "from formgraph.cli.main import main; sys.exit(main(sys.argv[2:]))"
     )
     args = [sys.executable, "-c", code, str(ROOT / "tests"), "sweep", str(graph)]
     args += ["--vary", "a=1:12:12", "--measure", "per", "--workers", "1", "--out", str(out)]

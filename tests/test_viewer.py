@@ -11,6 +11,8 @@ import numpy as np
 import pytest
 
 import formgraph as fg
+from formgraph.core.registry import node
+from formgraph.core.types import OutputPath
 from formgraph.geometry import (
     Mesh,
     NurbsCurve,
@@ -21,8 +23,6 @@ from formgraph.geometry import (
 )
 from formgraph.kernels import nurbs
 from formgraph.kernels.mesh import meshops
-from formgraph.registry import node
-from formgraph.types import OutputPath
 
 pv = pytest.importorskip("pyvista")
 pv.OFF_SCREEN = True
@@ -37,7 +37,7 @@ SIZE = (400, 300)
 
 
 @node("viewertest.save", version=1)
-def save(points: Points, path: OutputPath, *, ctx: fg.registry.Context) -> str:
+def save(points: Points, path: OutputPath, *, ctx: fg.core.registry.Context) -> str:
     """A test export: writes the number of points.
 
     Parameters
@@ -385,7 +385,7 @@ def write(path: Path, text: str) -> None:
 
 
 def test_cli_view_screenshot(tmp_path, capsys):
-    from formgraph.cli import main
+    from formgraph.cli.main import main
 
     f = tmp_path / "ring.yaml"
     write(f, RING.format(count=7))

@@ -240,7 +240,7 @@ def test_fg_show_takes_several_nodes_and_a_layout():
 
 
 def test_cli_view_several_nodes_side_by_side(tmp_path):
-    from formgraph.cli import main
+    from formgraph.cli.main import main
 
     f = tmp_path / "boxes.yaml"
     two_boxes_graph().save(f)

@@ -138,7 +138,7 @@ def test_headless_watch_starting_on_a_broken_file_writes_nothing(tmp_path):
 
 
 def test_watch_without_a_display_or_screenshot_says_what_to_do(tmp_path, capsys, monkeypatch):
-    from formgraph.cli import main
+    from formgraph.cli.main import main
 
     f = tmp_path / "ring.yaml"
     write(f, RING.format(count=5))
@@ -160,7 +160,7 @@ def test_cli_watch_screenshot_runs_until_stopped(tmp_path):
 
     f, png = tmp_path / "ring.yaml", tmp_path / "ring.png"
     write(f, RING.format(count=5))
-    cmd = [sys.executable, "-m", "formgraph.cli", "watch", str(f), "outline"]
+    cmd = [sys.executable, "-m", "formgraph.cli.main", "watch", str(f), "outline"]
     cmd += ["--screenshot", str(png), "--size", "320x240", "--interval", "0.05"]
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:

@@ -18,7 +18,7 @@ needs_admesh = pytest.mark.skipif(
 def cli(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
     """Run ``formgraph ARGS`` as a user would, in a fresh interpreter."""
     return subprocess.run(
-        [sys.executable, "-m", "formgraph.cli", *args],
+        [sys.executable, "-m", "formgraph.cli.main", *args],
         capture_output=True,
         text=True,
         cwd=cwd,

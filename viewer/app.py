@@ -16,10 +16,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from formgraph.check import param_kind
-from formgraph.errors import FormgraphError, GraphError, Problem, Where
-from formgraph.graph import Graph, load
-from formgraph.model import Items, Wire, parse_input
+from formgraph.core.errors import FormgraphError, GraphError, Problem, Where
+from formgraph.evaluation.graph import Graph, load
+from formgraph.language.check import param_kind
+from formgraph.language.model import Items, Wire, parse_input
 
 from .scene import PALETTE, TEXT_COLOR, Scene, fit_scenes
 
@@ -57,7 +57,7 @@ def shown_nodes(graph: Graph, node: str | Iterable[str] | None = None) -> list[s
 
 
 def _check_target(graph: Graph, registry: dict[str, Any], target: str) -> None:
-    from formgraph.check import suggest
+    from formgraph.language.check import suggest
 
     where = Where(graph.file)
     if target in graph.nodes:

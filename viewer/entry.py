@@ -11,7 +11,7 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
-from formgraph.graph import Graph, load
+from formgraph.evaluation.graph import Graph, load
 
 from .app import Session, shown_nodes
 

@@ -38,8 +38,8 @@ def render_gallery(
     size: tuple[int, int] = (640, 480),
 ) -> list[Entry]:
     """Render the results of every ``graphs_dir/*.yaml`` to ``out_dir/NAME.png``."""
-    from formgraph.errors import FormgraphError
-    from formgraph.graph import load
+    from formgraph.core.errors import FormgraphError
+    from formgraph.evaluation.graph import load
 
     from .entry import screenshot
 

@@ -20,9 +20,9 @@ from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
 from typing import Any
 
-from formgraph.errors import FormgraphError
-from formgraph.graph import load
-from formgraph.registry import DEFAULT_BUDGET
+from formgraph.core.errors import FormgraphError
+from formgraph.core.registry import DEFAULT_BUDGET
+from formgraph.evaluation.graph import load
 
 from .app import Session
 from .entry import _window_title
@@ -70,7 +70,7 @@ class _Watched:
     def _load(self, memory: Any) -> tuple[Any, dict[str, Any]]:
         """The file's graph (sharing ``memory``, the previous version's cache) and the
         ``--set`` params read against it; the files to watch become its files."""
-        from formgraph.cli import parse_sets
+        from formgraph.cli.main import parse_sets
 
         graph = load(self.path, out_dir=self.out_dir, budget=self.budget)
         self.files = [self.path, *graph.files[1:]]
@@ -132,7 +132,7 @@ class Watcher(_Watched):
         Returns True when the new version is drawn; False when it is broken, in which case
         its error is shown in the window and on stderr and the last good geometry stays.
         """
-        from formgraph.cli import UsageError
+        from formgraph.cli.main import UsageError
 
         self.stamp = self._stamp()
         self.reloads += 1
@@ -199,7 +199,7 @@ def watch(
     """
     for item in sets:
         if "=" not in item:
-            from formgraph.cli import UsageError
+            from formgraph.cli.main import UsageError
 
             raise UsageError(f"--set takes NAME=VALUE, got {item!r}")
     from .entry import make_plotter, view_count
@@ -305,7 +305,7 @@ class ScreenshotWatcher(_Watched):
 
     def reload(self) -> bool:
         """Load, evaluate and render the file once; True when a new PNG was written."""
-        from formgraph.cli import UsageError
+        from formgraph.cli.main import UsageError
 
         from .entry import make_plotter
 

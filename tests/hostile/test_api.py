@@ -8,7 +8,7 @@ import warnings
 import pytest
 
 import formgraph as fg
-from formgraph import cli
+from formgraph.cli import main as cli
 
 
 @pytest.fixture

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import formgraph as fg
-from formgraph import cache as _cache
+from formgraph.evaluation import cache as _cache
 
 KEY = "ab" + "0" * 38
 

@@ -10,7 +10,8 @@ from pathlib import Path
 import pytest
 
 import formgraph as fg
-from formgraph import cli, safety
+from formgraph.cli import main as cli
+from formgraph.core import safety
 
 BOX = """\
 formgraph: 1
@@ -119,7 +120,7 @@ def test_a_temp_file_left_by_a_killed_write_is_removed_by_the_next(tmp_path):
     out.mkdir()
     killed = (
         "import os, sys\n"
-        "from formgraph import safety\n"
+        "from formgraph.core import safety\n"
         "os.replace = lambda *a: os._exit(9)  # killed between writing and renaming\n"
         "safety.write_atomic(sys.argv[1], 'box.stl', b'x' * 100000)\n"
     )

@@ -131,7 +131,7 @@ def test_surface_knot_insertion_errors_name_the_input():
 
 def test_grid_weights_validate_against_the_json_schema():
     jsonschema = pytest.importorskip("jsonschema")
-    from formgraph.catalogue import json_schema
+    from formgraph.language.catalogue import json_schema
 
     doc = {
         "formgraph": 1,

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import formgraph as fg
-from formgraph import cli
+from formgraph.cli import main as cli
 
 
 def _graph(text: str) -> fg.Graph:

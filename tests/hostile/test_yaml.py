@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import formgraph as fg
-from formgraph import yamlio, yamlread
+from formgraph.language import yamlio, yamlread
 
 
 def _graph(inputs: str, node_type: str = "points.circle") -> fg.Graph:

@@ -1,5 +1,5 @@
 """The graph: params and nodes, checked whole, evaluated on demand through the caches
-(one evaluation call is a run of :mod:`formgraph.run`).
+(one evaluation call is a run of :mod:`formgraph.evaluation.run`).
 
 Evaluation is pull-based: asking for a node evaluates only its ancestors. Each node's cache
 key hashes its type, implementation version, resolved literal inputs and the identities of
@@ -18,9 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from . import cache as _cache
-from .check import Outline, check_graph, check_param_value
-from .errors import (
+from ..core.errors import (
     CycleError,
     ExpressionError,
     GraphError,
@@ -28,13 +26,14 @@ from .errors import (
     Problem,
     Where,
 )
-from .language import child_graph, node_spec_of
-from .model import NodeDef, ParamDef, parse_input
-from .registry import DEFAULT_BUDGET, NodeSpec, node_types
+from ..core.registry import DEFAULT_BUDGET, NodeSpec, node_types
+from ..core.types import TypeMismatch, describe, type_by_name
+from ..language.check import Outline, check_graph, check_param_value
+from ..language.model import NodeDef, ParamDef, parse_input
+from ..language.subgraph import Includes, SubgraphSpec, is_graph_type
+from ..language.yamlio import MAX_BYTES, MAX_DEPTH, dump, parse
+from . import cache as _cache
 from .run import NodeStat, Step, _Run
-from .subgraph import Includes, SubgraphSpec, is_graph_type
-from .types import TypeMismatch, describe, type_by_name
-from .yamlio import MAX_BYTES, MAX_DEPTH, dump, parse
 
 __all__ = ["Graph", "NodeStat", "Step", "load"]
 
@@ -185,11 +184,37 @@ class Graph:
     def as_node_spec(self) -> SubgraphSpec:
         """This graph as a node type, as another graph using its file sees it (its params
         as inputs, its ``outputs:`` as outputs): what ``formgraph nodes part.yaml`` prints."""
-        return node_spec_of(self)
+        if not self.file:
+            raise GraphError("only a graph read from a file can be used as a node")
+        path = Path(self.file)
+        nd = NodeDef.make(path.name, path.name, {})
+        spec, problems = Includes(path.resolve().parent).load(
+            nd, str(path), path.resolve().parent, [], ()
+        )
+        if spec is None:
+            raise GraphError(problems)
+        return spec
 
     def _child(self, spec: SubgraphSpec) -> Graph:
         """The graph of a subgraph file, sharing this graph's caches and settings."""
-        return child_graph(self, spec)
+        child = self._children.get(spec.path)
+        if child is None:
+            doc = spec.document
+            assert doc is not None
+            child = type(self)(file=spec.label, description=doc.description, out_dir=self.out_dir)
+            child.budget = self.budget
+            child.memory, child.disk = self.memory, self.disk
+            child._identity, child._digests, child._written = (
+                self._identity,
+                self._digests,
+                self._written,
+            )
+            child._params, child._nodes, child.outputs = doc.params, doc.nodes, doc.outputs
+            child._values = {n: p.default for n, p in doc.params.items()}
+            child._subgraphs = dict(spec.subgraphs)
+            child._checked = True  # checked with this graph
+            self._children[spec.path] = child
+        return child
 
     def add_param(
         self,
@@ -288,7 +313,7 @@ class Graph:
         for name, value in params.items():
             p = self._params.get(name)
             if p is None:
-                from .check import suggest
+                from ..language.check import suggest
 
                 problems.append(
                     Problem(
@@ -344,7 +369,7 @@ class Graph:
         names = _node_names(nodes)
         for n in names:
             if n not in self._nodes:
-                from .check import suggest
+                from ..language.check import suggest
 
                 raise GraphError(f"{self.file_label}: no node '{n}'{suggest(n, self._nodes)}")
         run = _Run(self, values)

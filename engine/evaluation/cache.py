@@ -33,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-from .geometry import STORABLE, Geometry, from_state
+from ..geometry import STORABLE, Geometry, from_state
 
 FORMAT = 1
 MAX_INFLATE = 16  # ours are stored uncompressed (1x); anything far beyond is hostile

@@ -1,4 +1,4 @@
-"""Rasterize a :class:`~formgraph.drawing.Drawing` to PNG with Pillow.
+"""Rasterize the shapes of a :class:`~formgraph.drawgraph.drawing.Drawing` to PNG with Pillow.
 
 Pillow is already installed with pyvista (which needs it for its images); it draws the same
 shapes the SVG holds, supersampled twice and averaged down for smooth edges. The text is
@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from .drawing import Circle, Drawing, Rect, Text, Wire
+from .shapes import Circle, Rect, Shape, Text, Wire
 
 __all__ = ["rasterize"]
 
@@ -51,16 +51,16 @@ def _dashes(points: np.ndarray, on: float, off: float) -> list[np.ndarray]:
     return pieces
 
 
-def rasterize(drawing: Drawing, scale: float = 2.0) -> bytes:
-    """PNG bytes of ``drawing`` at ``scale`` pixels per unit."""
+def rasterize(shapes: list[Shape], width: float, height: float, scale: float = 2.0) -> bytes:
+    """PNG bytes of ``shapes`` on a white ``width`` x ``height`` page, ``scale`` pixels per unit."""
     from PIL import Image, ImageDraw
 
     k = scale * SUPERSAMPLE
-    size = (max(1, int(np.ceil(drawing.width * k))), max(1, int(np.ceil(drawing.height * k))))
+    size = (max(1, int(np.ceil(width * k))), max(1, int(np.ceil(height * k))))
     img = Image.new("RGB", size, "white")
     draw = ImageDraw.Draw(img)
     anchors = {"start": "ls", "middle": "ms", "end": "rs"}
-    for s in drawing.shapes:
+    for s in shapes:
         if isinstance(s, Rect):
             box = [s.x * k, s.y * k, (s.x + s.w) * k, (s.y + s.h) * k]
             fill = None if s.fill == "none" else s.fill

@@ -24,10 +24,11 @@ from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from .drawing import Circle, Drawing, Rect, Text, Wire, text_width
-from .errors import FormgraphError
-from .model import Expr, Items, Literal, exprs_of, parse_input, wires_of
-from .registry import node_types
+from ..core.errors import FormgraphError
+from ..core.registry import node_types
+from ..language.model import Expr, Items, Literal, exprs_of, parse_input, wires_of
+from .drawing import Drawing
+from .shapes import Circle, Rect, Text, Wire, text_width
 
 __all__ = ["MARKS", "draw_graph", "failed_nodes", "node_marks"]
 
@@ -183,7 +184,7 @@ def _type_name(pt: Any) -> str:
 
 def _param_names(value: Any, port_type: Any, params: set[str]) -> list[str]:
     """The params that an input's expressions (or expression-typed text) read."""
-    from .expr import compile_expression
+    from ..language.expr import compile_expression
 
     names: set[str] = set()
     for e in exprs_of(value):

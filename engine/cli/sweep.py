@@ -1,4 +1,5 @@
-"""The ``formgraph sweep`` and ``formgraph cache`` commands (wired into :mod:`formgraph.cli`)."""
+"""The ``formgraph sweep`` and ``formgraph cache`` commands (wired into
+:mod:`formgraph.cli.main`)."""
 
 from __future__ import annotations
 
@@ -6,13 +7,14 @@ import argparse
 import os
 import sys
 import time
-from collections.abc import Callable
 from typing import Any
+
+from .options import UsageError, graph_options, parse_sets, size_text
 
 __all__ = ["add_parsers", "cmd_cache", "cmd_sweep"]
 
 
-def add_parsers(sub: Any, graph_options: Callable[[argparse.ArgumentParser], None]) -> None:
+def add_parsers(sub: Any) -> None:
     """Add the ``sweep`` and ``cache`` subcommands to the CLI's subparsers."""
     sw = sub.add_parser(
         "sweep",
@@ -69,13 +71,11 @@ def add_parsers(sub: Any, graph_options: Callable[[argparse.ArgumentParser], Non
     )
 
 
-def cmd_sweep(
-    args: argparse.Namespace, UsageError: type[Exception], parse_sets: Callable[..., Any]
-) -> int:
-    """``formgraph sweep`` (``UsageError`` and ``parse_sets`` are the CLI's own)."""
-    from .cache import default_cache_dir
-    from .graph import load
-    from .sweep import EACH_WORKER, TerminalProgress, sweep
+def cmd_sweep(args: argparse.Namespace) -> int:
+    """``formgraph sweep``."""
+    from ..evaluation.cache import default_cache_dir
+    from ..evaluation.graph import load
+    from ..sweeps.api import EACH_WORKER, TerminalProgress, sweep
 
     if args.workers is not None and args.workers < 1:
         raise UsageError(f"--workers takes a positive count, got {args.workers}")
@@ -127,10 +127,9 @@ def cmd_sweep(
     return 0
 
 
-def cmd_cache(args: argparse.Namespace, UsageError: type[Exception], *_: Any) -> int:
+def cmd_cache(args: argparse.Namespace) -> int:
     """``formgraph cache info|clear|prune``."""
-    from .cache import DiskCache, default_cache_dir, parse_size
-    from .cli import _size
+    from ..evaluation.cache import DiskCache, default_cache_dir, parse_size
 
     limit = None
     for text, where in (
@@ -145,20 +144,23 @@ def cmd_cache(args: argparse.Namespace, UsageError: type[Exception], *_: Any) ->
     cache = DiskCache(args.cache_dir or default_cache_dir(), max_bytes=limit)
     if args.action == "clear":
         n, freed = cache.clear()
-        print(f"{cache.root}: removed {n:,} entries ({_size(freed)})")
+        print(f"{cache.root}: removed {n:,} entries ({size_text(freed)})")
         return 0
     if args.action == "prune":
         n, freed = cache.prune()
         info = cache.info()
         print(
-            f"{cache.root}: removed {n:,} entries ({_size(freed)}); {info.entries:,} left "
-            f"({_size(info.bytes)} of {_size(info.max_bytes)})"
+            f"{cache.root}: removed {n:,} entries ({size_text(freed)}); {info.entries:,} left "
+            f"({size_text(info.bytes)} of {size_text(info.max_bytes)})"
         )
         return 0
     info = cache.info()
     print(f"cache: {info.root}")
     print(f"entries: {info.entries:,}")
-    print(f"size: {_size(info.bytes)} of {_size(info.max_bytes)} (least recently used go first)")
+    print(
+        f"size: {size_text(info.bytes)} of {size_text(info.max_bytes)} "
+        "(least recently used go first)"
+    )
     if info.oldest is not None:
         fmt = "%Y-%m-%d %H:%M"
         print(

@@ -1,10 +1,10 @@
 """Reading and writing graph files.
 
-Reading uses PyYAML's safe loading only, through :mod:`formgraph.yamlread` (libyaml, YAML 1.2
-numbers, a cost bounded by what is accepted): the text is composed into a node tree (to keep
-the line of every node and input), then each value is built, so a ``!!python/...`` tag is
-refused with its line. Duplicate keys, which YAML would silently resolve to the last one, are
-reported; merge keys (``<<: *base``) are resolved.
+Reading uses PyYAML's safe loading only, through :mod:`formgraph.language.yamlread`
+(libyaml, YAML 1.2 numbers, a cost bounded by what is accepted): the text is composed into a
+node tree (to keep the line of every node and input), then each value is built, so a
+``!!python/...`` tag is refused with its line. Duplicate keys, which YAML would silently
+resolve to the last one, are reported; merge keys (``<<: *base``) are resolved.
 """
 
 from __future__ import annotations
@@ -15,10 +15,10 @@ from typing import Any
 
 import yaml
 
+from ..core.errors import Problem, Where
+from ..core.types import TypeMismatch, describe, type_by_name
 from . import yamlread
-from .errors import Problem, Where
 from .model import NodeDef, ParamDef
-from .types import TypeMismatch, describe, type_by_name
 
 FORMAT_VERSION = 1
 MAX_BYTES = 16 * 1024 * 1024

@@ -17,9 +17,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from .cache import default_cache_dir, key_of
-from .errors import FormgraphError
-from .graph import Graph, Step
+from ..core.errors import FormgraphError
+from ..evaluation.cache import default_cache_dir, key_of
+from ..evaluation.graph import Graph, Step
 
 __all__ = ["Blueprint", "Outcome", "RowResult", "run_rows", "run_step"]
 
@@ -105,7 +105,7 @@ def _graph_file(bp: Blueprint) -> str:
             return bp.path
     except (OSError, UnicodeDecodeError):
         pass
-    from .safety import path_problem
+    from ..core.safety import path_problem
 
     scratch = Path(tempfile.mkdtemp(prefix="formgraph-graph-"))
     for rel, text in bp.files.items():

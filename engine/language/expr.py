@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from .errors import ExpressionError
+from ..core.errors import ExpressionError
 
 MAX_LENGTH = 4000
 MAX_NODES = 2000

@@ -15,25 +15,9 @@ import warnings
 from collections.abc import Sequence
 from typing import Any
 
-import yaml
-
-from .errors import FormgraphError, FormgraphWarning, GraphError
-from .registry import DEFAULT_BUDGET
-from .terminal import StatusLine
-
-
-class UsageError(Exception):
-    """A command line that does not make sense (exit code 2)."""
-
-
-def _budget(text: str) -> int:
-    try:
-        value = int(text.replace("_", ""))
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"must be at least 1, got {value}")
-    return value
+from ..core.errors import FormgraphError, FormgraphWarning, GraphError
+from ..core.terminal import StatusLine
+from .options import UsageError, graph_options, parse_sets, size_text
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -42,26 +26,6 @@ def _parser() -> argparse.ArgumentParser:
     )
     ap.add_argument("--debug", action="store_true", help="show Python tracebacks")
     sub = ap.add_subparsers(dest="command", required=True, metavar="COMMAND")
-
-    def graph_options(p: argparse.ArgumentParser) -> None:
-        p.add_argument(
-            "--set",
-            action="extend",
-            nargs="+",
-            default=[],
-            metavar="NAME=VALUE",
-            help="override graph params (parsed by each param's type); several may follow "
-            "one --set",
-        )
-        p.add_argument(
-            "--budget",
-            type=_budget,
-            default=DEFAULT_BUDGET,
-            help=f"element budget per node (default {DEFAULT_BUDGET:,})",
-        )
-        p.add_argument(
-            "--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS
-        )
 
     run = sub.add_parser("run", help="evaluate nodes (default: every sink) and write exports")
     run.add_argument("graph")
@@ -141,60 +105,10 @@ def _parser() -> argparse.ArgumentParser:
         "--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS
     )
 
-    from .cli_sweep import add_parsers
+    from .sweep import add_parsers
 
-    add_parsers(sub, graph_options)
+    add_parsers(sub)
     return ap
-
-
-def parse_sets(graph: Any, items: Sequence[str]) -> dict[str, Any]:
-    """``NAME=VALUE`` pairs parsed by each param's type (YAML scalars, lists allowed)."""
-    out: dict[str, Any] = {}
-    defs = graph.param_defs
-    for item in items:
-        name, sep, text = item.partition("=")
-        name = name.strip()
-        if not sep or not name:
-            raise UsageError(f"--set takes NAME=VALUE, got {item!r} (node names go before --set)")
-        if name not in defs:
-            from .check import suggest
-
-            raise GraphError(
-                f"--set {name}: unknown param{suggest(name, defs)}; params are "
-                f"{', '.join(defs) or 'none'}"
-            )
-        from .check import param_kind
-        from .yamlread import load_value
-
-        kind = param_kind(defs[name])
-        if kind is str:
-            value: Any = text
-        elif kind in (int, float):
-            value = _number(text)
-            if kind is float and isinstance(value, int):
-                value = float(value)
-        else:
-            try:
-                value = load_value(text)  # YAML 1.2 numbers, as in the graph file
-            except (yaml.YAMLError, ValueError, TypeError, RecursionError) as exc:
-                shown = text if len(text) <= 40 else text[:37] + "..."
-                why = getattr(exc, "problem", None) or exc
-                raise UsageError(f"--set {name}: cannot read {shown!r}: {why}") from None
-        out[name] = value
-    return out
-
-
-def _number(text: str) -> Any:
-    """A number as people type it: 3, -2.5, 1e3, 0x10 (YAML 1.1 would read 1e3 as text)."""
-    for parse in (int, float):
-        try:
-            return parse(text.strip().replace("_", ""))
-        except ValueError:
-            pass
-    try:
-        return int(text.strip(), 0)
-    except ValueError:
-        return text  # the param's check then says what was expected
 
 
 class _ProgressLine(StatusLine):
@@ -209,13 +123,13 @@ class _ProgressLine(StatusLine):
 
 
 def _profile_table(stats: dict[str, Any], nodes: dict[str, str]) -> str:
-    from .cache import sizeof  # noqa: F401  (sizes come with the stats)
+    from ..evaluation.cache import sizeof  # noqa: F401  (sizes come with the stats)
 
     rows = [f"{'node':<24} {'type':<24} {'status':<9} {'seconds':>9} {'size':>10}  warnings"]
     total = 0.0
     for name, st in stats.items():
         total += st.seconds
-        size = _size(st.nbytes)
+        size = size_text(st.nbytes)
         items = getattr(st, "items", None)
         notes = list(st.warnings)
         if items is not None:  # a repeated node: one row, with how many of its items ran
@@ -228,14 +142,6 @@ def _profile_table(stats: dict[str, Any], nodes: dict[str, str]) -> str:
     return "\n".join(rows)
 
 
-def _size(n: int) -> str:
-    for unit in ("B", "KiB", "MiB", "GiB"):
-        if n < 1024 or unit == "GiB":
-            return f"{n:.0f} {unit}" if unit == "B" else f"{n:.1f} {unit}"
-        n /= 1024
-    return str(n)
-
-
 def _describe(value: Any) -> str:
     if isinstance(value, str) and os.path.isabs(value):
         if os.path.isfile(value):
@@ -245,8 +151,8 @@ def _describe(value: Any) -> str:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    from .cache import default_cache_dir
-    from .graph import load
+    from ..evaluation.cache import default_cache_dir
+    from ..evaluation.graph import load
 
     cache_dir = None if args.no_cache else (args.cache_dir or default_cache_dir())
     g = load(args.graph, out_dir=args.out, cache_dir=cache_dir, budget=args.budget)
@@ -279,8 +185,8 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 
 def cmd_check(args: argparse.Namespace) -> int:
-    from .check import param_warnings
-    from .graph import load
+    from ..evaluation.graph import load
+    from ..language.check import param_warnings
 
     g = load(args.graph)
     for p in param_warnings(g.param_defs, g.file_label):
@@ -314,7 +220,7 @@ def _no_window(command: str, args: argparse.Namespace) -> None:
 
 
 def cmd_view(args: argparse.Namespace) -> int:
-    from . import graph as _graph
+    from ..evaluation import graph as _graph
 
     try:
         from formgraph import viewer
@@ -367,9 +273,9 @@ def cmd_watch(args: argparse.Namespace) -> int:
 def cmd_graph(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    from .cache import default_cache_dir
-    from .drawgraph import draw_graph, failed_nodes
-    from .graph import load
+    from ..drawgraph.layout import draw_graph, failed_nodes
+    from ..evaluation.cache import default_cache_dir
+    from ..evaluation.graph import load
 
     output = args.output or f"{Path(args.graph).stem}.svg"
     if output != "-" and Path(output).suffix.lower() not in (".svg", ".png"):
@@ -404,15 +310,15 @@ def cmd_graph(args: argparse.Namespace) -> int:
 
 
 def cmd_nodes(args: argparse.Namespace) -> int:
-    from .catalogue import catalogue_text, markdown, node_text
-    from .check import suggest
-    from .registry import node_types
+    from ..core.registry import node_types
+    from ..language.catalogue import catalogue_text, markdown, node_text
+    from ..language.check import suggest
 
     if args.markdown:
         sys.stdout.write(markdown())
         return 0
     if args.type and args.type.endswith((".yaml", ".yml")):  # a graph file's interface
-        from .graph import load
+        from ..evaluation.graph import load
 
         g = load(args.type)
         print(node_text(g.as_node_spec()))
@@ -428,7 +334,7 @@ def cmd_nodes(args: argparse.Namespace) -> int:
 
 
 def cmd_schema(args: argparse.Namespace) -> int:
-    from .catalogue import json_schema
+    from ..language.catalogue import json_schema
 
     json.dump(json_schema(), sys.stdout, indent=2)
     sys.stdout.write("\n")
@@ -449,11 +355,9 @@ COMMANDS = {
 
 
 def _sweep_command(name: str, args: argparse.Namespace) -> int:
-    from . import cli_sweep
+    from . import sweep as cli_sweep
 
-    # this module's own UsageError and parse_sets: under `python -m formgraph.cli` it runs
-    # as __main__, and an imported copy's UsageError would not be the one main() catches
-    return getattr(cli_sweep, name)(args, UsageError, parse_sets)
+    return getattr(cli_sweep, name)(args)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

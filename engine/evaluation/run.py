@@ -5,7 +5,7 @@ identity from an earlier run is not even fetched unless a node that must compute
 value. Each node's cache key hashes its type, implementation version, resolved literal
 inputs and the identities of its wired inputs; a node recomputed to an output identical to
 its previous one keeps its previous identity (early cutoff). Repeated and subgraph nodes
-are evaluated by the :class:`formgraph.language.LanguageRun` mixin.
+are evaluated by the :class:`formgraph.evaluation.items.LanguageRun` mixin.
 """
 
 from __future__ import annotations
@@ -15,16 +15,14 @@ import os
 import sys
 import time
 import warnings as _warnings
-from collections.abc import Iterator
-from dataclasses import dataclass, field
+from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any, Protocol
 
 import numpy as np
 
-from . import cache as _cache
-from . import safety
-from .errors import (
+from ..core import safety
+from ..core.errors import (
     BudgetError,
     ExpressionError,
     FormgraphWarning,
@@ -35,41 +33,38 @@ from .errors import (
     Problem,
     Where,
 )
-from .language import LanguageRun, file_stamp, input_names, reads_loop
-from .model import Expr, Input, Items, Literal, NodeDef, Wire, wires_of
-from .registry import Context, NodeSpec, node_types
-from .subgraph import SubgraphSpec
-from .types import Entries, TypeMismatch
+from ..core.registry import Context, NodeSpec, node_types
+from ..core.types import Entries, TypeMismatch
+from ..language.model import Expr, Input, Items, Literal, NodeDef, Wire, wires_of
+from ..language.subgraph import SubgraphSpec
+from . import cache as _cache
+from .items import LanguageRun, file_stamp, input_names, reads_loop
+from .stats import NodeStat, Step
 
-if TYPE_CHECKING:
-    from .graph import Graph
-
-__all__ = ["NodeStat", "Step"]
-
-
-@dataclass
-class NodeStat:
-    """What happened to one node in the last evaluation."""
-
-    status: str  # 'computed' or 'cached'
-    seconds: float = 0.0
-    nbytes: int = 0
-    warnings: list[str] = field(default_factory=list)
-    source: str = ""  # where a cached value came from: 'memory' or 'disk'
-    items: int | None = None  # a repeated node: how many items it has
-    computed_items: int = 0  # ... and how many of them were computed (not cached)
-    inner: dict[str, NodeStat] | None = None  # a subgraph node: its own nodes' stats
+__all__ = ["GraphView", "NodeStat", "Step"]  # the records are in .stats
 
 
-@dataclass(frozen=True)
-class Step:
-    """One node of an evaluation plan (see :meth:`formgraph.Graph.plan`)."""
+class GraphView(Protocol):
+    """What a run sees of its graph (a :class:`formgraph.Graph` is one): its nodes, the
+    caches and identity tables it shares with its subgraphs, and its settings. The run
+    depends on this narrow view, not on the Graph class, as the check does on ``Outline``."""
 
-    name: str
-    key: str  # the node's cache key for the planned params
-    upstream: tuple[str, ...]  # the nodes whose outputs it reads, each once
-    export: bool  # an export node (writes a file into the output directory)
-    upstream_keys: tuple[str, ...] = ()  # their keys, in the same order
+    file_label: str
+    out_dir: Any
+    budget: int
+    progress: Callable[[str, int, int], None] | None
+    memory: Any  # the bounded memory cache (formgraph.evaluation.cache)
+    disk: Any  # the disk cache, or None
+    _nodes: dict[str, NodeDef]
+    _subgraphs: dict[str, SubgraphSpec]
+    _identity: dict[str, str]  # key -> identity of the value it holds
+    _digests: dict[str, str]  # key -> content digest of the value
+    _written: dict[str, Any]  # key of an export -> (size, mtime) of the file it wrote
+    _last: dict[str, tuple[str, str]]  # node -> (key, identity) of its last value
+
+    def _order(self, targets: Any) -> list[str]: ...
+
+    def _child(self, spec: SubgraphSpec) -> GraphView: ...
 
 
 class _Run(LanguageRun):
@@ -77,7 +72,7 @@ class _Run(LanguageRun):
 
     def __init__(
         self,
-        g: Graph,
+        g: GraphView,
         values: dict[str, Any],
         tokens: dict[str, Any] | None = None,
         pure: bool = False,
@@ -190,7 +185,7 @@ class _Run(LanguageRun):
             return [self.key_part(name, port, spec, i) for i in value.items]
         pt = spec.inputs[port].type
         if pt.is_expression:  # the text, and the values of the params the text reads
-            from .expr import compile_expression
+            from ..language.expr import compile_expression
 
             text = self.resolve(name, port, value)
             try:
@@ -430,7 +425,7 @@ class _Run(LanguageRun):
     def bind_expression(
         self, name: str, port: str, pt: Any, text: Any, env: dict[str, Any] | None = None
     ) -> Any:
-        from .expr import Bound, compile_expression
+        from ..language.expr import Bound, compile_expression
 
         values = self.values if env is None else env
         allowed = set(values) | set(pt.variables)

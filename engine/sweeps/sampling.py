@@ -17,10 +17,10 @@ from typing import Any
 
 import numpy as np
 
-from .check import check_param_value, suggest
-from .errors import ParamError, Problem, Where
-from .graph import Graph
-from .types import TypeMismatch
+from ..core.errors import ParamError, Problem, Where
+from ..core.types import TypeMismatch
+from ..evaluation.graph import Graph
+from ..language.check import check_param_value, suggest
 
 __all__ = ["Domain", "domain", "param_kind", "parse_spec", "sample"]
 

@@ -7,7 +7,7 @@ whole sweep. A variant's own nodes run in its row (``row-<hash of its target key
 identical variants share), a few rows to a task when there are many: Dask's linear fusion,
 done by what variants share, so the per-task overhead is paid once per few variants. A node
 the client sees in the disk cache is loaded instead (evaluated on a worker that lacks it),
-and its ancestors are not scheduled. The tasks themselves are :mod:`formgraph.sweep_tasks`.
+and its ancestors are not scheduled. The tasks themselves are :mod:`formgraph.sweeps.tasks`.
 
 Workers receive the graph once, as its YAML text (a task of its own, ``graph-<token>``),
 never a file path: nothing here assumes a shared filesystem. Shared nodes' outputs travel
@@ -32,10 +32,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from .cache import DiskCache, default_cache_dir, key_of
-from .errors import FormgraphError
-from .graph import Graph, Step
-from .sweep_tasks import (
+from ..core.errors import FormgraphError
+from ..evaluation.cache import DiskCache, default_cache_dir, key_of
+from ..evaluation.graph import Graph, Step
+from .tasks import (
     Blueprint,
     Job,
     RowChunk,

@@ -13,9 +13,9 @@ from typing import Any, Union
 
 import numpy as np
 
-from .errors import ExpressionError
+from ..core.errors import ExpressionError
+from ..core.types import PortType
 from .expr import Compiled, compile_expression
-from .types import PortType
 
 
 @dataclass(frozen=True)

@@ -18,11 +18,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from ..core.errors import Problem, Where
+from ..core.registry import REQUIRED, NodeSpec, Port, node_types
+from ..core.types import Kind, PortType, Range
 from .check import Outline, check_graph, output_type, param_kind
-from .errors import Problem, Where
 from .model import NodeDef, ParamDef, Wire, parse_input
-from .registry import REQUIRED, NodeSpec, Port, node_types
-from .types import Kind, PortType, Range
 from .yamlio import MAX_BYTES, Document, parse
 
 __all__ = ["Includes", "SubgraphSpec", "is_graph_type"]

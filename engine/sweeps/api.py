@@ -7,10 +7,10 @@
 ('ok', 24)
 
 A variant is one set of param values: a grid of every combination, or seeded random or
-Latin hypercube samples (:mod:`formgraph.sampling`), all checked before anything runs.
+Latin hypercube samples (:mod:`formgraph.sweeps.sampling`), all checked before anything runs.
 
 Every variant runs on Dask as part of one graph whose tasks are the nodes' cache keys
-(:mod:`formgraph.sweep_dask`), so work that variants share is done once. With ``out``, the
+(:mod:`formgraph.sweeps.cluster`), so work that variants share is done once. With ``out``, the
 table ``sweep.csv`` grows as variants finish; running the same sweep again keeps the rows
 already done and runs the rest.
 """
@@ -28,12 +28,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from .check import suggest
-from .errors import ParamError, Problem, Where
-from .graph import Graph
+from ..core.errors import ParamError, Problem, Where
+from ..core.terminal import StatusLine
+from ..evaluation.graph import Graph
+from ..language.check import suggest
+from .cluster import SweepError, Targets, Totals
 from .sampling import Domain, domain, parse_spec, sample
-from .sweep_dask import SweepError, Targets, Totals
-from .terminal import StatusLine
 
 __all__ = [
     "EACH_WORKER",
@@ -343,9 +343,9 @@ def sweep(
     SweepError
         When the cluster cannot be reached or the graph cannot be sent to it.
     """
-    from . import safety
-    from . import sweep_dask as run_dask
-    from .graph import load
+    from ..core import safety
+    from ..evaluation.graph import load
+    from . import cluster as run_dask
 
     g = load(graph) if isinstance(graph, (str, os.PathLike)) else graph
     problems: list[Problem] = []

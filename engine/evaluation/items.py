@@ -10,24 +10,24 @@ list of its items' keys) is what its users' keys see.
 A subgraph node runs its file's graph (sharing the caches) with the node's inputs as params;
 a wired input enters the subgraph's keys as the wire's identity.
 
-:class:`LanguageRun` is a mixin of the evaluation run in :mod:`formgraph.graph`.
+:class:`LanguageRun` is a mixin of the evaluation run (:mod:`formgraph.evaluation.run`).
 """
 
 from __future__ import annotations
 
 import os
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from ..core.errors import BudgetError, ExpressionError, GraphError, NodeError, Problem
+from ..core.registry import NodeSpec
+from ..core.types import loop_item_problem
+from ..geometry import Points
+from ..language.model import Expr, Input, Items, Literal, NodeDef, Wire, wires_of
+from ..language.subgraph import SubgraphSpec
 from . import cache as _cache
-from .errors import BudgetError, ExpressionError, GraphError, NodeError, Problem
-from .geometry import Points
-from .model import Expr, Input, Items, Literal, NodeDef, Wire, wires_of
-from .registry import NodeSpec
-from .subgraph import Includes, SubgraphSpec
-from .types import loop_item_problem
+from .stats import NodeStat
 
 # What one item of a repeated node costs against the element budget. An item is a whole
 # node run (some 0.2 ms of bookkeeping even for a tiny node), so a count the budget would
@@ -38,10 +38,8 @@ ITEM_ELEMENTS = 1000
 __all__ = [
     "ITEM_ELEMENTS",
     "LanguageRun",
-    "child_graph",
     "file_stamp",
     "input_names",
-    "node_spec_of",
     "reads_loop",
 ]
 
@@ -58,7 +56,7 @@ def input_names(value: Input, pt: Any) -> set[str]:
         and pt.is_expression
         and isinstance(value.value, str)
     ):
-        from .expr import compile_expression
+        from ..language.expr import compile_expression
 
         try:
             return set(compile_expression(value.value).names)
@@ -79,43 +77,6 @@ def file_stamp(path: Any) -> tuple[int, int] | None:
     except (OSError, TypeError, ValueError):
         return None
     return st.st_size, st.st_mtime_ns
-
-
-def node_spec_of(self: Any) -> SubgraphSpec:
-    """This graph as a node type, as another graph using its file sees it (its params
-    as inputs, its ``outputs:`` as outputs): what ``formgraph nodes part.yaml`` prints."""
-    if not self.file:
-        raise GraphError("only a graph read from a file can be used as a node")
-    path = Path(self.file)
-    nd = NodeDef.make(path.name, path.name, {})
-    spec, problems = Includes(path.resolve().parent).load(
-        nd, str(path), path.resolve().parent, [], ()
-    )
-    if spec is None:
-        raise GraphError(problems)
-    return spec
-
-
-def child_graph(self: Any, spec: SubgraphSpec) -> Any:
-    """The graph of a subgraph file, sharing this graph's caches and settings."""
-    child = self._children.get(spec.path)
-    if child is None:
-        doc = spec.document
-        assert doc is not None
-        child = type(self)(file=spec.label, description=doc.description, out_dir=self.out_dir)
-        child.budget = self.budget
-        child.memory, child.disk = self.memory, self.disk
-        child._identity, child._digests, child._written = (
-            self._identity,
-            self._digests,
-            self._written,
-        )
-        child._params, child._nodes, child.outputs = doc.params, doc.nodes, doc.outputs
-        child._values = {n: p.default for n, p in doc.params.items()}
-        child._subgraphs = dict(spec.subgraphs)
-        child._checked = True  # checked with this graph
-        self._children[spec.path] = child
-    return child
 
 
 def _check_count(loop: str, where: Any, count: int, budget: int, scale: int = 1) -> None:
@@ -329,8 +290,6 @@ class LanguageRun:
                 self.g._written[keys[k]] = file_stamp(value)
             found[k] = value
             computed += 1
-        from .run import NodeStat
-
         key = self.keys[name]
         self.g._identity[key] = key
         self.g._last[name] = (key, key)

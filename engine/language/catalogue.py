@@ -11,8 +11,8 @@ import enum
 import typing
 from typing import Any
 
-from .registry import REQUIRED, NodeSpec, Port, node_types
-from .types import Faces, Kind, PortType, Vec3
+from ..core.registry import REQUIRED, NodeSpec, Port, node_types
+from ..core.types import Faces, Kind, PortType, Vec3
 
 WIRE = {
     "type": "string",
@@ -256,7 +256,7 @@ def markdown() -> str:
     return "\n".join(lines).rstrip() + "\n"
 
 
-BEGIN = "<!-- catalogue:begin (generated: python -m formgraph.catalogue README.md) -->"
+BEGIN = "<!-- catalogue:begin (generated: python -m formgraph.language.catalogue README.md) -->"
 END = "<!-- catalogue:end -->"
 
 

@@ -13,12 +13,10 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from . import safety
-from .errors import ExpressionError, Problem, Where
-from .expr import compile_expression
-from .model import Expr, Input, Items, Literal, NodeDef, ParamDef, Wire
-from .registry import NodeSpec, node_types
-from .types import (
+from ..core import safety
+from ..core.errors import ExpressionError, Problem, Where
+from ..core.registry import NodeSpec, node_types
+from ..core.types import (
     Kind,
     PortType,
     TypeMismatch,
@@ -28,6 +26,8 @@ from .types import (
     loop_item_problem,
     number_text,
 )
+from .expr import compile_expression
+from .model import Expr, Input, Items, Literal, NodeDef, ParamDef, Wire
 
 
 def suggest(name: str, options: Any) -> str:
@@ -268,7 +268,7 @@ def _input_type(
         if any(t is None for t in types):
             return None
         bases = [k.base for t in types for k in t.kinds if t is not None]
-        from .types import _common_base
+        from ..core.types import _common_base
 
         return PortType((Kind(_common_base(bases), True),))
     return None

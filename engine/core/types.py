@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from .geometry import (
+from ..geometry import (
     Curve,
     Geometry,
     Mesh,

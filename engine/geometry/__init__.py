@@ -1,0 +1,40 @@
+"""The immutable geometry values that flow along wires.
+
+Every type is a frozen dataclass over read-only float64/int64 arrays, so a node can never
+change what another node sees. Each has ``to_pyvista()`` (pyvista imported lazily),
+``nbytes`` (for the memory cache) and ``state()`` / :func:`from_state` (plain arrays and
+JSON-able scalars, for the on-disk cache; no pickle). The math lives in
+:mod:`formgraph.kernels`; these classes are thin, validated wrappers.
+
+- ``base``: the :class:`Geometry` base, frozen arrays, the table of storable types
+- ``points``: :class:`Points`
+- ``curves``: :class:`Curve`, :class:`NurbsCurve`, :class:`ParametricCurve`
+- ``surfaces``: :class:`Surface`, :class:`NurbsSurface`, :class:`ParametricSurface`
+- ``mesh``: :class:`Mesh`
+"""
+
+from __future__ import annotations
+
+from .base import STORABLE, Geometry, as_xyz, from_state, frozen_array, is_frozen, storable
+from .curves import Curve, NurbsCurve, ParametricCurve
+from .mesh import Mesh
+from .points import Points
+from .surfaces import NurbsSurface, ParametricSurface, Surface
+
+__all__ = [
+    "STORABLE",
+    "Curve",
+    "Geometry",
+    "Mesh",
+    "NurbsCurve",
+    "NurbsSurface",
+    "ParametricCurve",
+    "ParametricSurface",
+    "Points",
+    "Surface",
+    "as_xyz",
+    "from_state",
+    "frozen_array",
+    "is_frozen",
+    "storable",
+]

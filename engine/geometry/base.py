@@ -1,0 +1,149 @@
+"""What every geometry value shares: the :class:`Geometry` base, frozen arrays, and the
+registry of types the disk cache can store and rebuild (:func:`storable`, :func:`from_state`).
+"""
+
+from __future__ import annotations
+
+from typing import Any, TypeVar
+
+import numpy as np
+
+__all__ = [
+    "STORABLE",
+    "Geometry",
+    "as_xyz",
+    "from_state",
+    "frozen_array",
+    "is_frozen",
+    "storable",
+]
+
+
+def is_frozen(a: Any) -> bool:
+    """Whether nobody can ever write to array ``a``: read-only all the way to an immutable
+    ``bytes`` buffer (an array that owns its data could be made writable again)."""
+    if not isinstance(a, np.ndarray) or a.flags.writeable:
+        return False
+    base: Any = a
+    while isinstance(base, np.ndarray):
+        base = base.base
+    return isinstance(base, bytes)
+
+
+def frozen_array(values: Any, dtype: Any = np.float64) -> np.ndarray:
+    """A C-contiguous array of ``values`` that nobody can write to, or make writable.
+
+    The data are copied once into an immutable ``bytes`` buffer and viewed from there, so
+    ``a.flags.writeable = True`` raises (for ``a`` and for ``a.base``). An array that is
+    already frozen is shared as it is, never copied.
+    """
+    if is_frozen(values) and values.dtype == dtype and values.flags.c_contiguous:
+        return values
+    a = np.asarray(values, dtype=dtype)
+    return np.frombuffer(a.tobytes(order="C"), dtype=a.dtype).reshape(a.shape)
+
+
+def as_xyz(values: Any, what: str = "points") -> np.ndarray:
+    """``(n, 2)`` or ``(n, 3)`` coordinates as a read-only ``(n, 3)`` float64 array (z = 0)."""
+    frozen = is_frozen(values) and values.dtype == np.float64 and values.flags.c_contiguous
+    if frozen and values.ndim == 2 and values.shape[1] == 3 and np.isfinite(values).all():
+        return values  # immutable and valid already (another value's coordinates): shared
+    try:
+        raw = np.asarray(values)
+        if raw.dtype.kind not in "biuf":
+            raise TypeError  # strings, objects: not coordinates
+        a = raw.astype(np.float64, copy=False)
+    except (TypeError, ValueError, OverflowError):
+        raw = None
+        a = _pad_rows(values, what)
+    if raw is not None and raw.dtype.kind == "b":
+        raise ValueError(f"{what} must be numbers, not true/false")
+    if a.ndim == 1 and a.size in (2, 3):
+        a = a[None, :]
+    if a.size == 0 and a.shape in ((0,), (0, 2), (0, 3)):
+        a = a.reshape(0, 3)
+    if a.ndim != 2 or a.shape[1] not in (2, 3):
+        raise ValueError(
+            f"{what} must be a list of [x, y] or [x, y, z] coordinates, got an array of shape "
+            f"{a.shape}"
+        )
+    if a.shape[1] == 2:
+        a = np.column_stack([a, np.zeros(len(a))])
+    if not np.all(np.isfinite(a)):
+        bad = int(np.argwhere(~np.isfinite(a))[0, 0])
+        raise ValueError(f"{what}: coordinate {bad} is not finite ({a[bad].tolist()})")
+    return frozen_array(a)
+
+
+def _number(x: Any) -> float:
+    if isinstance(x, (str, bytes, bool)) or not isinstance(x, (int, float, np.number)):
+        raise TypeError(f"{x!r} is not a number")
+    return float(x)
+
+
+def _pad_rows(values: Any, what: str) -> np.ndarray:
+    """Mixed [x, y] and [x, y, z] rows (z = 0 where it is missing)."""
+    try:
+        rows = [[_number(x) for x in r] for r in values]
+    except (TypeError, ValueError, OverflowError):
+        raise ValueError(f"{what} must be a list of [x, y] or [x, y, z] numbers") from None
+    for i, r in enumerate(rows):
+        if len(r) not in (2, 3):
+            raise ValueError(
+                f"{what}: point {i} has {len(r)} coordinates; give [x, y] or [x, y, z]"
+            )
+    return np.array([r + [0.0] * (3 - len(r)) for r in rows], dtype=np.float64).reshape(-1, 3)
+
+
+def _expression_fingerprint(f: Any) -> Any:
+    """A bound expression is its text and the param values it reads; any other callable
+    cannot be hashed (its content is code), and says so."""
+    text, params = getattr(f, "text", None), getattr(f, "params", None)
+    if isinstance(text, str) and params is not None:
+        return {"text": text, "params": dict(params)}
+    raise TypeError("a curve or surface of plain Python callables has no content hash")
+
+
+class Geometry:
+    """Base of the geometry types."""
+
+    @property
+    def nbytes(self) -> int:
+        return sum(v.nbytes for v in vars(self).values() if isinstance(v, np.ndarray))
+
+    def to_pyvista(self) -> Any:  # pragma: no cover - overridden
+        raise NotImplementedError
+
+    def state(self) -> dict[str, Any]:
+        """Arrays and JSON-able scalars that rebuild this value with :func:`from_state`."""
+        raise NotImplementedError(f"{type(self).__name__} cannot be stored on disk")
+
+    def fingerprint(self) -> Any:
+        """What determines this value, for content hashes (its state, by default)."""
+        return self.state()
+
+    def __reduce_ex__(self, protocol: Any) -> Any:
+        # pickled (e.g. to a worker process) as its state and rebuilt through the
+        # constructor, so the copy is validated and as frozen as the original
+        name = type(self).__name__
+        if STORABLE.get(name) is type(self):
+            return from_state, (name, self.state())
+        return super().__reduce_ex__(protocol)
+
+
+# The types whose ``state()`` rebuilds them: name -> class (the disk cache's table of types).
+STORABLE: dict[str, type[Geometry]] = {}
+
+G = TypeVar("G", bound=type)
+
+
+def storable(cls: G) -> G:
+    """Register a geometry type whose :meth:`Geometry.state` rebuilds it (class decorator)."""
+    STORABLE[cls.__name__] = cls
+    return cls
+
+
+def from_state(type_name: str, state: dict[str, Any]) -> Geometry:
+    """Rebuild a geometry value from :meth:`Geometry.state` (validated like any input)."""
+    cls = STORABLE[type_name]
+    return cls(**state)
