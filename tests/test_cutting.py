@@ -294,3 +294,23 @@ def test_an_empty_result_warns():
     g.add("n", "curves.boolean", a=[square(1)], b=[square(2)], operation="difference")
     with pytest.warns(fg.FormgraphWarning, match="leave no area"):
         assert g.evaluate("n") == []
+
+
+def test_nameplate_graph_cuts_to_size_on_layers(tmp_path):
+    import xml.etree.ElementTree as ET
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    g = fg.load(root / "graphs" / "nameplate.yaml", out_dir=tmp_path)
+    cut = g.evaluate("cut")
+    assert len(cut) == 4 and all(c.closed for c in cut)
+    boxes = sorted(np.ptp(np.asarray(c.control_points)[:, :2], axis=0).tolist() for c in cut)
+    # half the kerf (0.05) outside the 80 x 30 plate, inside the three holes of radius 1.6
+    np.testing.assert_allclose(boxes[-1], [80.1, 30.1], atol=2e-3)
+    np.testing.assert_allclose(boxes[:3], [[3.1, 3.1]] * 3, atol=2e-3)
+    assert sum(signed_area(c) < 0 for c in cut) == 3
+    svg = ET.parse(g.evaluate("svg")).getroot()
+    ns = "{http://www.w3.org/2000/svg}"
+    groups = {e.get("id"): e for e in svg.iter(f"{ns}g") if e.get("id")}
+    assert groups["cut"].get("stroke") == "#ff0000" and len(groups["cut"]) == 4
+    assert groups["engrave"].get("stroke") == "#0000ff" and len(groups["engrave"]) == 14
