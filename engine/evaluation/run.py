@@ -34,7 +34,7 @@ from ..core.errors import (
     Where,
 )
 from ..core.registry import Context, NodeSpec, node_types
-from ..core.types import TypeMismatch
+from ..core.types import Entries, TypeMismatch
 from ..language.model import FRAMES, STEP, Expr, Input, Items, Literal, NodeDef, Wire, wires_of
 from ..language.subgraph import SubgraphSpec
 from . import cache as _cache
@@ -245,13 +245,16 @@ class _Run(LanguageRun, SimulationRun):
             except (ValueError, TypeError, ZeroDivisionError, ExpressionError) as exc:
                 raise GraphError([Problem(self.where(name, port), str(exc))]) from None
         out: list[Any] = []
-        for item in value.items:
+        entries: list[int] = []
+        for k, item in enumerate(value.items):
             v = self.resolve(name, port, item, env)
             if isinstance(item, Wire) and isinstance(v, list):
                 out.extend(v)  # a list from a wire joins the list (checked at load)
+                entries.extend([k] * len(v))
             else:
                 out.append(v)
-        return out
+                entries.append(k)
+        return Entries(out, entries)  # which entry each item came on (types.entries_of)
 
     def fetch(self, target: str) -> Any:
         """The value of ``target``: from a cache, or computed after its inputs (no recursion)."""
@@ -341,6 +344,8 @@ class _Run(LanguageRun, SimulationRun):
                     kwargs[port] = p.type.coerce(p.default)
                 continue
             raw = self.resolve(name, port, nd.inputs[port], env)
+            if isinstance(nd.inputs[port], Wire) and isinstance(raw, list):
+                raw = Entries(raw, [0] * len(raw))  # one wire: one entry, however many items
             if p.type.is_expression:
                 kwargs[port] = self.bind_expression(name, port, p.type, raw, env)
                 continue
