@@ -164,6 +164,11 @@ class SegmentTree:
         bounds = np.cumsum([0] + [lv[0].shape[0] for lv in levels]).tolist()
         ax, ay, bx, by, rad = (np.concatenate([lv[k] for lv in levels]) for k in range(5))
         rad = np.where(np.isneginf(rad), np.nan, rad * (1 + 1e-12))
+        # Absolute slack of the pruning test: a point ON the segments (distance 0, as a grid
+        # sample on an input vertex is) has a bound of 0 and a flat capsule of radius 0, so
+        # a relative slack alone loses its node to the rounding of the axis distance, of
+        # the order of the machine epsilon times the coordinates.
+        self._scale = float(max(np.abs(a).max(), np.abs(b).max()))
         fields = _fields(ax, ay, bx, by) + (rad,)
         self._levels = [
             tuple(f[lo:hi] for f in fields) for lo, hi in zip(bounds[:-1], bounds[1:], strict=True)
@@ -202,6 +207,7 @@ class SegmentTree:
         lo = np.full(q, lo) if lo.ndim == 0 else np.broadcast_to(lo, (q,))
         hi = np.full(q, hi) if hi.ndim == 0 else np.broadcast_to(hi, (q,))
         px, py = np.ascontiguousarray(p[:, 0]), np.ascontiguousarray(p[:, 1])
+        slack = 1e-12 * max(self._scale, float(np.abs(px).max()), float(np.abs(py).max()))
         hi2 = np.square(np.maximum(hi, 0.0))
         lo2 = np.where(lo > 0, np.square(lo), -1.0)
         # Squared distance to the nearest curve point seen.
@@ -242,6 +248,7 @@ class SegmentTree:
             cut[best2 < lo2] = np.nan
             thr = cut.take(qi)
             thr += rad.take(node)
+            thr += slack
             thr *= thr
             keep = (dx <= thr).nonzero()[0]
             qi, node = qi.take(keep), node.take(keep)
