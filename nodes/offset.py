@@ -11,6 +11,7 @@ from formgraph.core.registry import Context, Range, node
 from formgraph.geometry import Curve, NurbsCurve
 from formgraph.kernels.offset import (
     OffsetTraceError,
+    WorkLimit,
     default_cell,
     grid_cells,
     offset_polylines,
@@ -111,7 +112,7 @@ def marching_squares(
         loops = offset_polylines(
             polylines, closed, distance, cell, smooth, simplify, max_cells=ctx.budget
         )
-    except OffsetTraceError as exc:
+    except (OffsetTraceError, WorkLimit) as exc:
         raise InputError("curves", str(exc)) from None
     except ValueError as exc:
         raise InputError(

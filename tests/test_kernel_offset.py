@@ -542,3 +542,47 @@ def test_a_trace_failure_says_where_and_what_to_do(monkeypatch):
     square = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], dtype=float)
     with pytest.raises(OffsetTraceError, match=r"near \(.*\).*shifted grids.*different cell"):
         offset_polylines([square], [True], 0.1)
+
+
+def test_segment_tree_of_a_messy_input_matches_brute_force(monkeypatch):
+    # Random points joined up: long segments criss-crossing, cut into pieces in Z-order for
+    # the tree; results still name the whole segment and its parameter. Small chunks force
+    # the chunked path.
+    from formgraph.kernels.offset import distance
+
+    monkeypatch.setattr(distance, "_FIRST_CHUNK", 64)
+    monkeypatch.setattr(distance, "_MAX_PAIRS", 2000)
+    rng = np.random.default_rng(5)
+    a = rng.uniform(0, 1, (60, 2))
+    b = np.roll(a, -1, axis=0)
+    tree = SegmentTree(a, b)
+    assert tree._n_pieces > a.shape[0]
+    p = rng.uniform(-0.2, 1.2, (700, 2))
+    brute, t = point_segment(p[:, None], a[None], b[None])
+    near = tree.query(p)
+    assert np.allclose(near.dist, brute.min(axis=1), rtol=0, atol=1e-12)
+    rows = np.arange(700)
+    assert np.allclose(brute[rows, near.segment], near.dist, atol=1e-12)
+    foot = a[near.segment] + near.t[:, None] * (b[near.segment] - a[near.segment])
+    assert np.allclose(np.hypot(*(p - foot).T), near.dist, atol=1e-12)
+    band = tree.query(p, 0.01, 0.02, upper=np.full(700, np.inf))
+    true = brute.min(axis=1)
+    inside = (true >= 0.01) & (true <= 0.02)
+    assert np.allclose(band.dist[inside], true[inside], atol=1e-12)
+    assert ((band.dist < 0.01) == (true < 0.01)).all()
+    assert ((band.dist > 0.02) == (true > 0.02)).all()
+
+
+def test_messy_input_is_charged_against_the_budget():
+    # 300 random points as one closed polyline, offset by 0.001: every sample near the
+    # (very long) result tests many segments. The work is counted and refused early,
+    # instead of gigabytes of (point, node) pairs.
+    from formgraph.kernels.offset import WorkLimit
+
+    pts = np.random.default_rng(0).uniform(0, 1, (300, 2))
+    with pytest.raises(WorkLimit, match=r"more than 20,000,000 \(point, segment\) pairs"):
+        offset_polylines([pts], [True], 0.001, max_cells=20_000_000)
+    # A clean input of as many segments does the same offset in far fewer pairs.
+    th = np.linspace(0, 2 * np.pi, 300, endpoint=False)
+    (loop,) = offset_polylines([np.c_[np.cos(th), np.sin(th)] / 2 + 0.5], [True], 0.001)
+    assert np.allclose(np.hypot(*(loop - 0.5).T).max(), 0.501, atol=1e-3)

@@ -33,12 +33,12 @@ from collections.abc import Sequence
 import numpy as np
 
 from .contour import InconsistentField, split_loops, trace_crossings, unique_ids
-from .distance import RowParity, SegmentTree
+from .distance import RowParity, SegmentTree, WorkLimit
 from .loops import simplify as simplify_loops
 from .refine import exact_loops
 from .refine import smooth as smooth_loops
 
-__all__ = ["OffsetTraceError", "default_cell", "grid_cells", "offset_polylines"]
+__all__ = ["OffsetTraceError", "WorkLimit", "default_cell", "grid_cells", "offset_polylines"]
 
 
 class OffsetTraceError(ValueError):
@@ -515,7 +515,9 @@ def offset_polylines(
     simplify : float
         Douglas-Peucker tolerance (0: none).
     max_cells : int
-        Largest grid (in cells) accepted.
+        Largest grid (in cells) accepted; also the most (point, segment) pairs the
+        distance queries may test together (their work: a messy input, many long segments
+        criss-crossing, makes each sample near the result test many).
 
     Returns
     -------
@@ -528,6 +530,8 @@ def offset_polylines(
     ValueError
         If there are no polylines, a polyline is not a finite (n, 2) array, distance is 0 or
         not finite, cell is not positive, or the grid would exceed ``max_cells``.
+        `WorkLimit` (a ValueError) if the distance queries pass ``max_cells`` pairs;
+        `OffsetTraceError` (a ValueError) if the outline cannot be traced.
 
     Example
     -------
@@ -554,7 +558,8 @@ def offset_polylines(
     if not (np.isfinite(cell) and cell > 0):
         raise ValueError(f"cell must be a positive finite number, got {cell}")
 
-    tree = SegmentTree(a, b)
+    # Every (point, segment) pair the distance queries test counts against the budget too.
+    tree = SegmentTree(a, b, max_pairs=max_cells)
     if seg_closed.all():  # (a boolean row selection of every row costs a copy's time)
         closed_a, closed_b = a, b
     else:
