@@ -403,7 +403,11 @@ def boolean(
     """
     ma = _solid("a", _clipping, ctx, kb.to_manifold, *_arrays(a), "the mesh")
     mb = _solid("b", _clipping, ctx, kb.to_manifold, *_arrays(b), "the mesh")
-    out = Mesh(*kb.from_manifold(kb.combine(ma, mb, operation)))
+    try:
+        both = kb.combine(ma, mb, operation, whats=("the mesh", "the mesh"))
+    except kb.NotSolidError as exc:
+        raise InputError("ab"[exc.operand or 0], str(exc)) from None
+    out = Mesh(*kb.from_manifold(both))
     if out.n_faces == 0:
         ctx.warn(f"the {kb.Operation(operation).value} is empty")
     return out
