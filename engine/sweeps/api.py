@@ -298,6 +298,7 @@ def sweep(
     workers: int | None = None,
     cache_dir: Any = _GRAPH_CACHE,
     size: tuple[int, int] = (256, 192),
+    camera: tuple[Any, Any, Any] | None = None,
     per_sheet: int = 100,
     on_row: Callable[[dict[str, Any]], None] | None = None,
     progress: Callable[[int, int, int, float], None] | None = None,
@@ -322,6 +323,9 @@ def sweep(
     render : str, optional
         A node drawn for each variant, tiled into ``out/sheet.png`` (``per_sheet`` cells of
         ``size`` pixels each, then ``sheet-2.png``, ...).
+    camera : (view, azimuth, elevation), optional
+        Where the cells look from, as ``formgraph.viewer.Camera`` takes them
+        (``("top", None, None)``, ``(None, 30, 20)``); default: each cell fits its value.
     out : path, optional
         Where ``sweep.csv`` grows as variants finish; rerunning the same sweep there keeps
         the rows already done (needed for export and render).
@@ -365,7 +369,12 @@ def sweep(
         raise ValueError("vary at least one param")
     if (export or render) and out is None:
         raise ValueError("export and render write files: give out=")
-    targets = Targets(targets.measures, targets.exports, render, size, targets.build)
+    if camera is not None:
+        from formgraph.viewer.frame import Camera
+
+        camera = tuple(camera)
+        Camera(*camera)  # a ValueError for a bad view or angle, before anything runs
+    targets = Targets(targets.measures, targets.exports, render, size, targets.build, camera)
     variants = sample(domains, method, samples, seed)
     base = g.params
     columns = ["variant"]

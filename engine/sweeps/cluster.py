@@ -73,6 +73,7 @@ class Targets:
     render: str | None = None
     size: tuple[int, int] = (256, 192)
     build: tuple[str, ...] = ()  # nodes only built (nothing measured, exported or drawn)
+    camera: tuple[Any, Any, Any] | None = None  # (view, azimuth, elevation) of the cells
 
     @property
     def nodes(self) -> list[str]:
@@ -172,7 +173,9 @@ def build(
         steps = g.plan(names, **params)
         totals.naive += len(steps)
         by_name = {s.name: s for s in steps}
-        row_key = "row-" + key_of([by_name[n].key for n in names] + [list(targets.size)])
+        row_key = "row-" + key_of(
+            [by_name[n].key for n in names] + [list(targets.size), list(targets.camera or ())]
+        )
         if row_key in rows:
             rows[row_key].append(index)
             continue
@@ -192,7 +195,7 @@ def build(
             users[s.key] = users.get(s.key, 0) + 1
         plans.append((row_key, kept, params))
     dsk: dict[str, Any] = {}
-    job = RowJob(targets.measures, targets.exports, targets.render, targets.size)
+    job = RowJob(targets.measures, targets.exports, targets.render, targets.size, targets.camera)
     row_plans = []
     for row_key, steps, params in plans:
         by_name = {s.name: s for s in steps}
