@@ -32,9 +32,11 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from ..core import safety
 from ..core.errors import FormgraphError
 from ..evaluation.cache import DiskCache, default_cache_dir, key_of
 from ..evaluation.graph import Graph, Step
+from ..language.yamlio import MAX_BYTES
 from .tasks import (
     Blueprint,
     Job,
@@ -128,7 +130,7 @@ def blueprint(g: Graph, cache_dir: str | None, worker_cache: bool) -> Blueprint:
         for path in g.files[1:]:
             try:
                 rel = Path(path).resolve().relative_to(root).as_posix()
-                files[rel] = Path(path).read_text(encoding="utf-8")
+                files[rel] = safety.read_regular(path, max_bytes=MAX_BYTES).decode("utf-8")
             except (OSError, ValueError, UnicodeDecodeError) as exc:
                 raise SweepError(
                     f"{g.file_label}: cannot send {path} to Dask workers: {exc}"

@@ -77,14 +77,18 @@ def test_two_coincident_copies_read_as_one_solid(operation, volume):
     assert _volume(_boolean(other, _double(), operation)) == pytest.approx(back)
 
 
-def test_a_collapsed_box_is_refused():
-    dot = fg.Mesh(np.full((8, 3), 0.5), _BOX_F)
-    with pytest.raises(fg.NodeError, match=r"input 'a'.*bounds no volume.*collapsed"):
-        _boolean(dot, _box(), "intersection")
-    g = fg.Graph()
-    g.add("u", "mesh.union", meshes=[_box(), dot])
-    with pytest.raises(fg.NodeError, match=r"mesh 1 bounds no volume"):
-        g.evaluate("u")
+def test_a_collapsed_box_is_the_empty_solid_with_a_warning():
+    for point in (0.0, 0.5, 5.0):  # at the origin manifold3d keeps its degenerate triangles
+        dot = fg.Mesh(np.full((8, 3), point), _BOX_F)
+        for operation, expected in (("intersection", 0.0), ("union", 1.0), ("difference", 0.0)):
+            with pytest.warns(fg.FormgraphWarning, match=r"input a bounds no volume"):
+                got = _boolean(dot, _box(), operation)
+            assert (got.n_faces == 0) if expected == 0 else _volume(got) == pytest.approx(1.0)
+        with pytest.warns(fg.FormgraphWarning, match=r"input b bounds no volume"):
+            assert _volume(_boolean(_box(), dot, "difference")) == pytest.approx(1.0)
+        g = fg.Graph()
+        g.add("u", "mesh.union", meshes=[_box(), dot])
+        assert _volume(g.evaluate("u")) == pytest.approx(1.0)
 
 
 def test_overlapping_parts_around_a_cavity_are_refused():

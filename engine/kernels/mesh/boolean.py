@@ -15,7 +15,8 @@ coordinates past :data:`MAX_COORDINATE` overflow its volumes, a solid smaller th
 operand's tolerance is erased, a mesh whose faces all collapsed bounds nothing, and parts that
 overlap (two coincident copies of a box) are read as a double shell. So unused vertices are
 dropped, overlapping parts of one mesh are fused first (their union, as ``mesh.union`` does),
-and the rest is refused with a sentence.
+a collapsed mesh is the empty solid (:func:`collapsed`), and the rest is refused with a
+sentence.
 """
 
 from __future__ import annotations
@@ -33,6 +34,7 @@ __all__ = [
     "NotSolidError",
     "Operation",
     "check_precision",
+    "collapsed",
     "boolean",
     "combine",
     "from_manifold",
@@ -121,8 +123,8 @@ def to_manifold(
     Raises
     ------
     NotSolidError
-        Open, non-manifold, misoriented, inside-out, collapsed, overlapping or out-of-range
-        input, as a sentence.
+        Open, non-manifold, misoriented, inside-out, overlapping or out-of-range input, as
+        a sentence (a collapsed one is the empty manifold).
     WorkLimitError
         Triangulating its faces would need more than ``max_tests`` corner tests.
     """
@@ -153,17 +155,26 @@ def to_manifold(
             f"{what} is not a valid solid for the boolean (manifold3d: {m.status().name}); it "
             "may be degenerate or intersect itself"
         )
-    if m.is_empty():
-        raise NotSolidError(
-            f"{what} bounds no volume: all of its {fo.size - 1} faces collapsed (zero area, "
-            "e.g. every vertex at one point)"
-        )
+    if collapsed(m):
+        import manifold3d
+
+        return manifold3d.Manifold()  # no volume: the empty solid, not a degenerate shell
     if m.volume() < 0:
         vol = float(signed_volume(v, fi, fo).sum())
         raise NotSolidError(
             f"{what} is inside out (its volume is {vol:.6g}); mesh.orient turns it outward"
         )
     return _fused(m, what) if fuse else m
+
+
+def collapsed(m: object) -> bool:
+    """Whether a manifold bounds no volume: no triangles left, or thinner (volume over
+    area) than its tolerance -- e.g. a box with every vertex at one point, which manifold3d
+    keeps as 12 degenerate triangles at the origin (tolerance 0) and then cuts wrongly."""
+    if m.is_empty():  # type: ignore[attr-defined]
+        return True
+    area = m.surface_area()  # type: ignore[attr-defined]
+    return area == 0 or abs(m.volume()) <= m.get_tolerance() * area  # type: ignore[attr-defined]
 
 
 def _drop_unused(v: np.ndarray, fi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -213,6 +224,8 @@ def check_precision(manifolds: Sequence[object], whats: Sequence[str]) -> None:
     """
     tol = max(m.get_tolerance() for m in manifolds)  # type: ignore[attr-defined]
     for i, (m, what) in enumerate(zip(manifolds, whats, strict=True)):
+        if m.is_empty():  # type: ignore[attr-defined]
+            continue  # the empty solid is exact at any scale
         box = np.asarray(m.bounding_box()).reshape(2, 3)  # type: ignore[attr-defined]
         size = float(np.linalg.norm(box[1] - box[0]))
         if size < _RESOLVED * tol:
