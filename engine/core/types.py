@@ -41,6 +41,35 @@ class Faces(list):
     port_name = "list[list[int]]"
 
 
+class Entries(list):
+    """The value of a list port that remembers which entry of the port each item came from.
+
+    A list port's YAML list (``curves: ["@cut", "@engrave"]``) joins the lists its wires
+    carry into one flat list; ``entries[i]`` is the index, in the port's list, of the entry
+    that item i came from (a single wire, ``curves: "@cut"``, is entry 0 for all its items).
+    Nodes that care where an item came from (the drawing exports give every wire its layer)
+    read it with :func:`entries_of`; every other node sees a plain list.
+    """
+
+    __slots__ = ("entries",)
+
+    def __init__(self, items: Any = (), entries: Any = ()):
+        super().__init__(items)
+        self.entries = tuple(int(e) for e in entries)
+        if len(self.entries) != len(self):
+            raise ValueError(f"{len(self)} items but {len(self.entries)} entry indices")
+
+
+def entries_of(values: list[Any]) -> list[int]:
+    """Per item of a list port, the index of the port's entry it came on.
+
+    Items given without that record (a list built in Python) are each their own entry.
+    """
+    if isinstance(values, Entries):
+        return list(values.entries)
+    return list(range(len(values)))
+
+
 class Expression(str):
     """An expression port (text in the node's variables and the graph params)."""
 
@@ -297,7 +326,8 @@ def _coerce_kind(k: Kind, value: Any) -> Any:
         if isinstance(value, (list, tuple)):
             if k.base is Vec3:
                 return _vec_list(value)
-            return [_coerce_kind(Kind(k.base), v) for v in value]
+            items = [_coerce_kind(Kind(k.base), v) for v in value]
+            return Entries(items, value.entries) if isinstance(value, Entries) else items
         if k.base is Vec3 and isinstance(value, np.ndarray) and value.ndim == 2:
             return _vec_list(value)
         # a single item is accepted where a list is asked

@@ -16,7 +16,6 @@ import sys
 import time
 import warnings as _warnings
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Protocol
 
@@ -35,13 +34,14 @@ from ..core.errors import (
     Where,
 )
 from ..core.registry import Context, NodeSpec, node_types
-from ..core.types import TypeMismatch
+from ..core.types import Entries, TypeMismatch
 from ..language.model import Expr, Input, Items, Literal, NodeDef, Wire, wires_of
 from ..language.subgraph import SubgraphSpec
 from . import cache as _cache
 from .items import LanguageRun, file_stamp, input_names, reads_loop
+from .stats import NodeStat, Step
 
-__all__ = ["GraphView", "NodeStat", "Step"]
+__all__ = ["GraphView", "NodeStat", "Step"]  # the records are in .stats
 
 
 class GraphView(Protocol):
@@ -65,31 +65,6 @@ class GraphView(Protocol):
     def _order(self, targets: Any) -> list[str]: ...
 
     def _child(self, spec: SubgraphSpec) -> GraphView: ...
-
-
-@dataclass
-class NodeStat:
-    """What happened to one node in the last evaluation."""
-
-    status: str  # 'computed' or 'cached'
-    seconds: float = 0.0
-    nbytes: int = 0
-    warnings: list[str] = field(default_factory=list)
-    source: str = ""  # where a cached value came from: 'memory' or 'disk'
-    items: int | None = None  # a repeated node: how many items it has
-    computed_items: int = 0  # ... and how many of them were computed (not cached)
-    inner: dict[str, NodeStat] | None = None  # a subgraph node: its own nodes' stats
-
-
-@dataclass(frozen=True)
-class Step:
-    """One node of an evaluation plan (see :meth:`formgraph.Graph.plan`)."""
-
-    name: str
-    key: str  # the node's cache key for the planned params
-    upstream: tuple[str, ...]  # the nodes whose outputs it reads, each once
-    export: bool  # an export node (writes a file into the output directory)
-    upstream_keys: tuple[str, ...] = ()  # their keys, in the same order
 
 
 class _Run(LanguageRun):
@@ -257,13 +232,16 @@ class _Run(LanguageRun):
             except (ValueError, TypeError, ZeroDivisionError, ExpressionError) as exc:
                 raise GraphError([Problem(self.where(name, port), str(exc))]) from None
         out: list[Any] = []
-        for item in value.items:
+        entries: list[int] = []
+        for k, item in enumerate(value.items):
             v = self.resolve(name, port, item, env)
             if isinstance(item, Wire) and isinstance(v, list):
                 out.extend(v)  # a list from a wire joins the list (checked at load)
+                entries.extend([k] * len(v))
             else:
                 out.append(v)
-        return out
+                entries.append(k)
+        return Entries(out, entries)  # which entry each item came on (types.entries_of)
 
     def fetch(self, target: str) -> Any:
         """The value of ``target``: from a cache, or computed after its inputs (no recursion)."""
@@ -348,6 +326,8 @@ class _Run(LanguageRun):
                     kwargs[port] = p.type.coerce(p.default)
                 continue
             raw = self.resolve(name, port, nd.inputs[port], env)
+            if isinstance(nd.inputs[port], Wire) and isinstance(raw, list):
+                raw = Entries(raw, [0] * len(raw))  # one wire: one entry, however many items
             if p.type.is_expression:
                 kwargs[port] = self.bind_expression(name, port, p.type, raw, env)
                 continue
