@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from ..core import safety
 from ..core.errors import (
     CycleError,
     ExpressionError,
@@ -61,17 +62,10 @@ def load(
     _check_budgets(budget, memory_bytes)
     path = Path(path)
     try:
-        with open(path, "rb") as fh:  # never read more than the format allows
-            data = fh.read(MAX_BYTES + 1)
-        if len(data) > MAX_BYTES:
-            raise GraphError(
-                Problem(
-                    Where(str(path)), f"the file is larger than {MAX_BYTES // (1024 * 1024)} MiB"
-                )
-            )
-        text = data.decode("utf-8")
+        text = safety.read_regular(path, max_bytes=MAX_BYTES).decode("utf-8")
     except (OSError, UnicodeDecodeError) as exc:
-        raise GraphError(Problem(Where(str(path)), f"cannot read the graph file: {exc}")) from None
+        why = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+        raise GraphError(Problem(Where(str(path)), f"cannot read the graph file: {why}")) from None
     return Graph.from_text(
         text,
         file=str(path),

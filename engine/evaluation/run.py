@@ -308,6 +308,8 @@ class _Run(LanguageRun, SimulationRun):
         if not hit and self.g.disk is not None:
             hit, value, identity = self.g.disk.get_entry(key)
             source = "disk"
+            if hit and not _holds(spec, value):
+                hit = False  # a well-formed entry of another type (a foreign or forged file)
             if hit:
                 self.g.memory.put(key, value)
         if hit and spec.is_export:
@@ -495,3 +497,12 @@ def _warn(message: str) -> None:
     while frame is not None and frame.f_code.co_filename.startswith(_PACKAGE):
         frame, level = frame.f_back, level + 1
     _warnings.warn(message, FormgraphWarning, stacklevel=level)
+
+
+def _holds(spec: NodeSpec, value: Any) -> bool:
+    """Whether a value read from the disk cache has the shape of ``spec``'s output(s)."""
+    if not spec.multi_output:
+        return spec.output_type(None).holds(value)
+    if not isinstance(value, (list, tuple)) or len(value) != len(spec.outputs):
+        return False
+    return all(t.holds(v) for t, v in zip(spec.outputs.values(), value, strict=True))
