@@ -26,7 +26,6 @@ from formgraph.geometry import (
     ParametricSurface,
     Points,
     Surface,
-    frozen_array,
 )
 from formgraph.kernels.geometry import affine, instancing
 from formgraph.kernels.mesh import meshops
@@ -236,17 +235,8 @@ def mesh_copy_to_points(
 
 def _valid_mesh(v: np.ndarray, fi: np.ndarray, fo: np.ndarray) -> Mesh:
     """A Mesh of fresh arrays that are valid by construction (copies of a valid mesh's
-    faces, shifted): frozen (one copy into an immutable buffer, so no one can make them
-    writable again) but not validated again, which for 10,000 copies would cost more than
-    building them."""
-    out = Mesh.__new__(Mesh)
-    for name, a, dtype in (
-        ("vertices", v, np.float64),
-        ("face_indices", fi, np.int64),
-        ("face_offsets", fo, np.int64),
-    ):
-        object.__setattr__(out, name, frozen_array(a, dtype))
-    return out
+    faces, shifted), not validated again (:meth:`Mesh.trusted`)."""
+    return Mesh.trusted(v, fi, fo)
 
 
 @node("curves.copy_to_points", version=1)
