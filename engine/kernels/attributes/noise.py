@@ -95,7 +95,7 @@ def raw_noise(x: Any, y: Any, z: Any) -> np.ndarray:
     return out.reshape(shape)
 
 
-def noise(x: Any, y: Any, z: Any = 0.0) -> np.ndarray:
+def noise(x: Any, y: Any = 0.0, z: Any = 0.0) -> np.ndarray:
     """Smooth gradient noise in [-1, 1] at the points ``(x, y, z)`` (broadcast together).
 
     Parameters
