@@ -27,6 +27,7 @@ from formgraph.geometry import (
     Points,
     Surface,
 )
+from formgraph.kernels.attributes import propagate as carry
 from formgraph.kernels.geometry import affine, instancing
 from formgraph.kernels.mesh import meshops
 
@@ -94,7 +95,7 @@ def transform_one(g: Geometry, linear: np.ndarray, offset: np.ndarray) -> Geomet
         For a geometry type it does not know.
     """
     if isinstance(g, Points):
-        return Points(affine.apply(g.xyz, linear, offset))
+        return Points(affine.apply(g.xyz, linear, offset), carry.turn(g.point_data, linear))
     if isinstance(g, NurbsCurve):
         w = g.weights if g.rational else None
         return NurbsCurve(affine.apply(g.control_points, linear, offset), g.degree, g.knots, w)
@@ -112,7 +113,13 @@ def transform_one(g: Geometry, linear: np.ndarray, offset: np.ndarray) -> Geomet
         fi = g.face_indices
         if np.linalg.det(linear) < 0:
             fi = meshops.reverse_faces(fi, g.face_offsets)
-        return Mesh(affine.apply(g.vertices, linear, offset), fi, g.face_offsets)
+        return Mesh(
+            affine.apply(g.vertices, linear, offset),
+            fi,
+            g.face_offsets,
+            carry.turn(g.point_data, linear),
+            carry.turn(g.face_data, linear),
+        )
     raise ValueError(f"cannot transform a {type(g).__name__}")
 
 

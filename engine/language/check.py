@@ -26,6 +26,7 @@ from ..core.types import (
     loop_item_problem,
     number_text,
 )
+from .elements import reads_elements
 from .expr import compile_expression
 from .model import Expr, Input, Items, Literal, NodeDef, ParamDef, Wire
 
@@ -397,6 +398,8 @@ def _check_input(
 ) -> list[str]:
     if isinstance(value, Wire):
         return _check_wire(g, pt, value, registry)
+    if pt.per_element and reads_elements(value, set(g.params) | ({loop.name} if loop else set())):
+        return []  # evaluated per element: its names are known when the geometry is
     if isinstance(value, Literal):
         return _check_literal(g, pt, value.value, loop)
     if isinstance(value, Expr):
