@@ -89,9 +89,9 @@ class ElementValue:
                 attrs = sorted(set(env) - set(VARIABLES))
                 have = ", ".join(attrs) if attrs else "none"
                 raise ValueError(
-                    f"'{p.text}' names '{missing[0]}', which is no param, no variable "
-                    f"({', '.join(n for n in VARIABLES if n in env)}) and no attribute of the "
-                    f"{what} (attributes: {have})"
+                    f"expression '={p.text}' names '{missing[0]}', which is not a param, a "
+                    f"variable ({', '.join(n for n in VARIABLES if n in env)}) or an "
+                    f"attribute of the {what} (attributes: {have})"
                 )
         cols = []
         for p in self.parts:

@@ -1,0 +1,77 @@
+"""Booleans that carry attributes, through manifold3d's vertex properties and face ids.
+
+manifold3d keeps any number of properties per vertex beside x, y, z and interpolates them
+linearly (barycentrically) at the vertices a boolean creates, so a point attribute that
+is linear in space stays exactly linear. Each input triangle carries the id of the face it
+was cut from (``face_id``); the ids of the second and later inputs are offset by the faces
+before them, so every output triangle names its source face among all inputs.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from ..mesh import boolean as kb
+from ..mesh.meshops import triangulate
+
+__all__ = ["from_manifold", "to_manifold"]
+
+
+def to_manifold(
+    vertices: np.ndarray,
+    face_indices: np.ndarray,
+    face_offsets: np.ndarray,
+    properties: np.ndarray,
+    first_face: int,
+    what: str = "the mesh",
+    max_tests: int | None = None,
+) -> object:
+    """A ``manifold3d.Manifold`` with ``properties`` (n, k) per vertex and each triangle's
+    face id ``first_face + its face``; checked as :func:`..mesh.boolean.to_manifold`."""
+    import manifold3d
+
+    kb.to_manifold(vertices, face_indices, face_offsets, what, max_tests)  # the checks
+    fo = np.asarray(face_offsets, dtype=np.int64)
+    _, tris, _ = triangulate(vertices, face_indices, fo, max_tests=max_tests)
+    parent = first_face + np.repeat(np.arange(fo.size - 1, dtype=np.int64), np.diff(fo) - 2)
+    props = np.ascontiguousarray(np.column_stack([vertices, properties]), dtype=np.float64)
+    mesh = manifold3d.Mesh64(
+        vert_properties=props,
+        tri_verts=np.ascontiguousarray(tris, dtype=np.int64).view(np.uint64).reshape(-1, 3),
+        face_id=parent.view(np.uint64),
+    )
+    return manifold3d.Manifold(mesh)
+
+
+def from_manifold(
+    m: object, n_properties: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Flat arrays, the interpolated properties (n, k) and each triangle's face id."""
+    mesh = m.to_mesh64()  # type: ignore[attr-defined]
+    vp = np.asarray(mesh.vert_properties, dtype=np.float64).reshape(-1, 3 + n_properties)
+    tri = np.ascontiguousarray(mesh.tri_verts).view(np.int64).reshape(-1)
+    face = np.asarray(mesh.face_id).view(np.int64).reshape(-1)
+    fo = np.arange(0, tri.size + 1, 3, dtype=np.int64)
+    return np.ascontiguousarray(vp[:, :3]), tri, fo, vp[:, 3:], face
+
+
+def union(
+    meshes: Sequence[tuple[np.ndarray, np.ndarray, np.ndarray]],
+    properties: Sequence[np.ndarray],
+    max_tests: int | None = None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Union of several solids (and of the parts within each), carrying properties."""
+    import manifold3d
+
+    parts, first = [], 0
+    for i, (m, props) in enumerate(zip(meshes, properties, strict=True)):
+        solid = to_manifold(*m, props, first, f"mesh {i}", max_tests)
+        parts.extend(solid.decompose())
+        first += len(m[2]) - 1
+    k = properties[0].shape[1] if properties else 0
+    if not parts:
+        empty = np.zeros((0, 3)), np.zeros(0, np.int64), np.zeros(1, np.int64)
+        return (*empty, np.zeros((0, k)), np.zeros(0, np.int64))
+    return from_manifold(manifold3d.Manifold.batch_boolean(parts, manifold3d.OpType.Add), k)
