@@ -54,7 +54,19 @@ def from_manifold(
     tri = np.ascontiguousarray(mesh.tri_verts).view(np.int64).reshape(-1)
     face = np.asarray(mesh.face_id).view(np.int64).reshape(-1)
     fo = np.arange(0, tri.size + 1, 3, dtype=np.int64)
-    return np.ascontiguousarray(vp[:, :3]), tri, fo, vp[:, 3:], face
+    # manifold3d keeps a vertex once per set of properties it has (a seam between the
+    # inputs, where each side interpolated its own); its merge lists say which are one
+    # point: join them, so the result is one closed surface again
+    to = np.arange(len(vp), dtype=np.int64)
+    src = np.asarray(mesh.merge_from_vert).view(np.int64).reshape(-1)
+    dst = np.asarray(mesh.merge_to_vert).view(np.int64).reshape(-1)
+    to[src] = dst
+    tri = to[tri]
+    used = np.zeros(len(vp), dtype=bool)
+    used[tri] = True
+    renumber = np.cumsum(used) - 1
+    vp = vp[used]
+    return np.ascontiguousarray(vp[:, :3]), renumber[tri], fo, vp[:, 3:], face
 
 
 def union(
