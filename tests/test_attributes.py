@@ -266,3 +266,56 @@ def test_tessellation_and_grid_carry_u_v():
     np.testing.assert_allclose(grid.point_data["u"], grid.vertices[:, 0] / 2)
     np.testing.assert_allclose(grid.point_data["v"], grid.vertices[:, 1] / 3)
     assert grid.point_data["r"].tolist() == grid.vertices[:, 0].tolist()
+
+
+# --------------------------------------------------------------------------------- export
+
+
+def test_ply_writes_colours_and_attributes_that_trimesh_and_meshio_read(tmp_path):
+    import io
+    import struct
+
+    import meshio
+
+    from formgraph.kernels.io.exporters import ply_binary
+
+    sphere = trimesh.creation.icosphere(2)
+    m = Mesh(sphere.vertices, sphere.faces.reshape(-1), np.arange(0, sphere.faces.size + 1, 3))
+    z = m.vertices[:, 2]
+    colour = np.column_stack([(z + 1) / 2, np.full_like(z, 0.25), 1 - (z + 1) / 2])
+    face_colour = np.tile([0.0, 1.0, 0.5], (m.n_faces, 1))
+    m = m.with_data({"color": colour, "h": z}, {"color": face_colour, "id": np.arange(m.n_faces)})
+    g = fg.Graph()
+    g.add_param("m", type="Mesh")
+    g.add("w", "export.ply", mesh="=m", path="colours.ply")
+    g.out_dir = tmp_path
+    path = g.evaluate("w", m=m)
+    back = trimesh.load(path, process=False)
+    np.testing.assert_array_equal(back.vertices, m.vertices)
+    np.testing.assert_array_equal(back.visual.vertex_colors[:, :3], np.rint(colour * 255))
+    faces = back.metadata["_ply_raw"]["face"]["data"]
+    np.testing.assert_array_equal(faces["id"], np.arange(m.n_faces))
+    assert (faces["green"] == 255).all() and (faces["blue"] == 128).all()
+    # meshio reads the vertex properties (it refuses face lists with more properties)
+    only_points = tmp_path / "points.ply"
+    only_points.write_bytes(ply_binary(*m.arrays, m.point_data))
+    raw = meshio.read(only_points)
+    np.testing.assert_array_equal(raw.point_data["h"], z)
+    red = raw.point_data["red"].view(np.uint8)  # meshio reads uchar as int8
+    np.testing.assert_array_equal(red, np.rint(colour[:, 0] * 255))
+    # mixed face sizes with a face attribute: records of different lengths, parsed by hand
+    v, fi, fo = meshops.box(1.0)
+    fi, fo = np.r_[fi, [0, 1, 2]], np.r_[fo, fo[-1] + 3]
+    data = ply_binary(v, fi, fo, None, {"k": np.arange(7.0)})
+    body = data[data.index(b"end_header\n") + 11 + 8 * 3 * 8 :]
+    pos, faces = 0, []
+    for _ in range(7):
+        c = body[pos]
+        idx = struct.unpack(f"<{c}i", body[pos + 1 : pos + 1 + 4 * c])
+        (k,) = struct.unpack("<d", body[pos + 1 + 4 * c : pos + 9 + 4 * c])
+        faces.append((list(idx), k))
+        pos += 9 + 4 * c
+    assert pos == len(body) and [k for _, k in faces] == list(range(7))
+    assert [f for f, _ in faces] == [list(f) for f in Mesh(v, fi, fo).faces]
+    plain = trimesh.load(io.BytesIO(ply_binary(*box().arrays)), file_type="ply", process=False)
+    assert len(plain.vertices) == 8
