@@ -432,12 +432,26 @@ def boolean(
     operation : Operation
         union, difference or intersection.
     """
-    if a.point_data or b.point_data or a.face_data or b.face_data:
-        out = _boolean_with_attributes(a, b, operation, ctx)
+    attributed = bool(a.point_data or b.point_data or a.face_data or b.face_data)
+    if attributed:
+        points, faces = _joined([a, b], ctx)
+        pa, pb = _split_props(points, [a.n_vertices, b.n_vertices])
+        ma = _solid("a", _clipping, ctx, kab.to_manifold, *_arrays(a), pa, 0, "the mesh")
+        mb = _solid("b", _clipping, ctx, kab.to_manifold, *_arrays(b), pb, a.n_faces, "the mesh")
     else:
         ma = _solid("a", _clipping, ctx, kb.to_manifold, *_arrays(a), "the mesh")
         mb = _solid("b", _clipping, ctx, kb.to_manifold, *_arrays(b), "the mesh")
-        out = Mesh(*kb.from_manifold(kb.combine(ma, mb, operation)))
+    for port, mesh, m in (("a", a, ma), ("b", b, mb)):
+        if m.is_empty() and mesh.n_faces:
+            ctx.warn(f"input {port} bounds no volume (its faces collapsed): an empty solid")
+    try:
+        both = kb.combine(ma, mb, operation, whats=("the mesh", "the mesh"))
+    except kb.NotSolidError as exc:
+        raise InputError("ab"[exc.operand or 0], str(exc)) from None
+    if attributed:
+        out = _attributed(*kab.from_manifold(both, pa.shape[1]), points, faces)
+    else:
+        out = Mesh(*kb.from_manifold(both))
     if out.n_faces == 0:
         ctx.warn(f"the {kb.Operation(operation).value} is empty")
     return out
@@ -454,13 +468,17 @@ def union(meshes: list[Mesh], *, ctx: Context) -> Mesh:
     """
     ctx.guard(sum(m.n_faces for m in meshes), "faces")
     if not any(m.point_data or m.face_data for m in meshes):
-        return Mesh(*_solid("meshes", _clipping, ctx, kb.union, [_arrays(m) for m in meshes]))
-    points, faces = _joined(meshes, ctx)
-    props = _split_props(points, [m.n_vertices for m in meshes])
-    v, fi, fo, p, face = _solid(
-        "meshes", _clipping, ctx, kab.union, [_arrays(m) for m in meshes], props
-    )
-    return _attributed(v, fi, fo, p, face, points, faces)
+        out = Mesh(*_solid("meshes", _clipping, ctx, kb.union, [_arrays(m) for m in meshes]))
+    else:
+        points, faces = _joined(meshes, ctx)
+        props = _split_props(points, [m.n_vertices for m in meshes])
+        v, fi, fo, p, face = _solid(
+            "meshes", _clipping, ctx, kab.union, [_arrays(m) for m in meshes], props
+        )
+        out = _attributed(v, fi, fo, p, face, points, faces)
+    if out.n_faces == 0 and any(m.n_faces for m in meshes):
+        ctx.warn("the union is empty: every mesh bounds no volume (their faces collapsed)")
+    return out
 
 
 def _joined(meshes: list[Mesh], ctx: Context) -> tuple[dict, dict]:
@@ -490,15 +508,6 @@ def _attributed(
     _, point_data = carry.split_columns(np.column_stack([v, props]), points)
     face_data = {k: a[face] for k, a in faces.items()}
     return Mesh(v, fi, fo, point_data, face_data)
-
-
-def _boolean_with_attributes(a: Mesh, b: Mesh, operation: Any, ctx: Context) -> Mesh:
-    points, faces = _joined([a, b], ctx)
-    pa, pb = _split_props(points, [a.n_vertices, b.n_vertices])
-    ma = _solid("a", _clipping, ctx, kab.to_manifold, *_arrays(a), pa, 0, "the mesh")
-    mb = _solid("b", _clipping, ctx, kab.to_manifold, *_arrays(b), pb, a.n_faces, "the mesh")
-    out = kab.from_manifold(kb.combine(ma, mb, operation), pa.shape[1])
-    return _attributed(*out, points, faces)
 
 
 # -------------------------------------------------------------------------------- measures

@@ -27,22 +27,31 @@ def to_manifold(
     first_face: int,
     what: str = "the mesh",
     max_tests: int | None = None,
+    fuse: bool = True,
 ) -> object:
     """A ``manifold3d.Manifold`` with ``properties`` (n, k) per vertex and each triangle's
     face id ``first_face + its face``; checked as :func:`..mesh.boolean.to_manifold`."""
     import manifold3d
 
-    kb.to_manifold(vertices, face_indices, face_offsets, what, max_tests)  # the checks
+    checked = kb.to_manifold(vertices, face_indices, face_offsets, what, max_tests, fuse=False)
+    if checked.is_empty():  # type: ignore[attr-defined]
+        return checked  # collapsed: the empty solid, as without attributes
     fo = np.asarray(face_offsets, dtype=np.int64)
-    _, tris, _ = triangulate(vertices, face_indices, fo, max_tests=max_tests)
+    fi = np.asarray(face_indices, dtype=np.int64)
+    used = np.zeros(len(vertices), bool)
+    used[fi] = True  # as kb.to_manifold: an unused vertex would still set the tolerance
+    renumber = np.cumsum(used) - 1
+    v = np.asarray(vertices, dtype=np.float64)[used]
+    _, tris, _ = triangulate(v, renumber[fi], fo, max_tests=max_tests)
     parent = first_face + np.repeat(np.arange(fo.size - 1, dtype=np.int64), np.diff(fo) - 2)
-    props = np.ascontiguousarray(np.column_stack([vertices, properties]), dtype=np.float64)
+    props = np.ascontiguousarray(np.column_stack([v, properties[used]]), dtype=np.float64)
     mesh = manifold3d.Mesh64(
         vert_properties=props,
         tri_verts=np.ascontiguousarray(tris, dtype=np.int64).view(np.uint64).reshape(-1, 3),
         face_id=parent.view(np.uint64),
     )
-    return manifold3d.Manifold(mesh)
+    m = manifold3d.Manifold(mesh)
+    return kb._fused(m, what) if fuse else m  # overlapping parts fused, as kb does
 
 
 def from_manifold(
@@ -77,11 +86,13 @@ def union(
     """Union of several solids (and of the parts within each), carrying properties."""
     import manifold3d
 
-    parts, first = [], 0
+    solids, first = [], 0
     for i, (m, props) in enumerate(zip(meshes, properties, strict=True)):
-        solid = to_manifold(*m, props, first, f"mesh {i}", max_tests)
-        parts.extend(solid.decompose())
+        solids.append(to_manifold(*m, props, first, f"mesh {i}", max_tests, fuse=False))
         first += len(m[2]) - 1
+    if solids:
+        kb.check_precision(solids, [f"mesh {i}" for i in range(len(solids))])
+    parts = [p for s in solids for p in s.decompose()]
     k = properties[0].shape[1] if properties else 0
     if not parts:
         empty = np.zeros((0, 3)), np.zeros(0, np.int64), np.zeros(1, np.int64)
