@@ -335,7 +335,8 @@ def sample_surface(
     """Points at the centres of a u x v grid of cells over a surface, with unit normals.
 
     Cell (i, j) is centred at parameters ``u0 + (i + 1/2) (u1 - u0) / u`` and likewise in
-    v; points run along v first (row i holds v points). Normals are ``S_u x S_v``
+    v; points run along v first (row i holds v points). The points carry ``normal``,
+    ``u`` and ``v`` point attributes (so ``align: "=normal"`` works). Normals are ``S_u x S_v``
     normalized: exact derivatives on a NURBS surface (The NURBS Book A3.6), central
     differences on a parametric one.
 
@@ -365,4 +366,5 @@ def sample_surface(
     if (length <= 1e-300).any():
         ctx.warn("the surface is degenerate at some samples; their normal is +z")
     normals = np.where(length > 1e-300, normals / np.where(length > 0, length, 1), [0, 0, 1.0])
-    return Samples(Points(xyz), normals)
+    # the points carry their normal and their surface parameters as attributes too
+    return Samples(Points(xyz, {"normal": normals, "u": gu, "v": gv}), normals)
