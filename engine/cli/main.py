@@ -68,6 +68,12 @@ def _parser() -> argparse.ArgumentParser:
             "--edges", action="store_true", help="draw every mesh face's edges (default: coarse)"
         )
         p.add_argument("--size", default="1024x768", metavar="WxH")
+        p.add_argument(
+            "--color",
+            metavar="NAME",
+            default=None,
+            help="colour points and meshes by an attribute, with a colour bar",
+        )
         camera_options(p)
         p.add_argument("--out", default="out", metavar="DIR", help=argparse.SUPPRESS)
 
@@ -252,11 +258,21 @@ def cmd_view(args: argparse.Namespace) -> int:
             layout=args.layout,
             edges=edges,
             camera=camera,
+            color=args.color,
             **params,
         )
         print(f"wrote {path}")
         return 0
-    viewer.show(g, node=nodes, size=size, layout=args.layout, edges=edges, camera=camera, **params)
+    viewer.show(
+        g,
+        node=nodes,
+        size=size,
+        layout=args.layout,
+        edges=edges,
+        camera=camera,
+        color=args.color,
+        **params,
+    )
     return 0
 
 

@@ -241,7 +241,7 @@ class Graph:
         self._values[name] = default
         self._checked = False
 
-    def add(self, name: str, type: str, **inputs: Any) -> None:
+    def add(self, name: str, type: str, /, **inputs: Any) -> None:
         """Add (or replace) node ``name`` of node type ``type`` with its inputs."""
         if not isinstance(name, str) or not isinstance(type, str):
             what = "node name" if not isinstance(name, str) else "node type"

@@ -24,6 +24,7 @@ from ..core.types import (
     describe,
     loop_item_problem,
 )
+from .elements import reads_elements
 from .expr import compile_expression
 from .model import FRAMES, STEP, Expr, Input, Items, Literal, NodeDef, ParamDef, Wire
 from .order import cycle_problems, kahn_order
@@ -345,6 +346,8 @@ def _check_input(
 ) -> list[str]:
     if isinstance(value, Wire):
         return _check_wire(g, pt, value, registry)
+    if pt.per_element and reads_elements(value, set(g.params) | ({loop.name} if loop else set())):
+        return []  # evaluated per element: its names are known when the geometry is
     if isinstance(value, Literal):
         return _check_literal(g, pt, value.value, loop)
     if isinstance(value, Expr):
