@@ -39,6 +39,12 @@ def graph_options(p: argparse.ArgumentParser) -> None:
         help="override graph params (parsed by each param's type); several may follow one --set",
     )
     p.add_argument(
+        "--inputs",
+        default=None,
+        metavar="DIR",
+        help="the folder read nodes read from (default: the graph file's folder)",
+    )
+    p.add_argument(
         "--budget",
         type=_budget,
         default=DEFAULT_BUDGET,

@@ -1,0 +1,79 @@
+"""Read: meshes, curves and points from the files designers already have.
+
+A path is relative to the graph file's folder and may not leave it (no absolute path, no
+``..``, no symlink out), unless the run names an inputs folder (``--inputs DIR``,
+``fg.load(..., inputs_dir=)``). The engine reads the file once, regular files only and
+capped in size, and hashes its bytes into the node's cache key: editing the file recomputes
+what reads it, an unchanged file is not parsed again. The parsers are the kernels of
+:mod:`formgraph.kernels.io` (``mesh_read``, ``ply_read``, ``threemf``, ``gltf``, ...).
+"""
+
+from __future__ import annotations
+
+import struct
+import zlib
+
+from formgraph.core.errors import InputError
+from formgraph.core.registry import Context, node
+from formgraph.core.types import InputPath
+from formgraph.geometry import Mesh
+from formgraph.kernels.io import readers
+from formgraph.kernels.mesh import repair
+
+# what a parser may raise on a malformed file (its sentence is kept, the traceback dropped)
+PARSE_ERRORS = (
+    ValueError,
+    IndexError,
+    KeyError,
+    TypeError,
+    OverflowError,
+    struct.error,
+    zlib.error,
+)
+
+
+def parsed(path: str, what: str, fn, *args):
+    """Call a reader; a malformed file becomes an error naming the ``path`` input and file."""
+    try:
+        return fn(*args)
+    except RecursionError:
+        raise InputError("path", f"{path!r}: nested too deeply to read as {what}") from None
+    except PARSE_ERRORS as exc:
+        raise InputError("path", f"{path!r}: cannot read it as {what}: {exc}") from None
+
+
+@node("read.mesh", version=1)
+def mesh(path: InputPath, weld: bool = False, *, ctx: Context) -> Mesh:
+    """Read a mesh file: STL (binary and ASCII), OBJ, PLY, OFF, 3MF or glTF/GLB.
+
+    The format comes from the extension. OBJ, PLY and OFF polygons are kept as they are;
+    STL is a triangle soup (three vertices per facet) until welded; 3MF and glTF give every
+    mesh their build or scene places, with its transform applied, joined into one mesh.
+    Units: 3MF's unit and glTF's metres become millimetres; the other formats have none.
+
+    Parameters
+    ----------
+    path : InputPath
+        The file, relative to the graph's folder (or the inputs folder), e.g. ``scan.stl``.
+    weld : bool
+        Merge vertices at exactly the same position (an STL's shared corners) and drop the
+        faces that collapse; ``mesh.weld`` merges within a tolerance.
+
+    Raises
+    ------
+    NodeError
+        For an unknown extension, or a truncated or garbled file (naming it).
+
+    Example
+    -------
+    ``part: {type: read.mesh, path: scan.stl, weld: true}``
+    """
+    _, data = ctx.read(path)
+    v, fi, fo = parsed(path, "a mesh", readers.mesh_arrays, path, data)
+    ctx.guard(len(fo) - 1, "faces")
+    if weld:
+        v, fi, fo = repair.weld(v, fi, fo, 0.0)
+    try:
+        return Mesh(v, fi, fo)
+    except ValueError as exc:
+        raise InputError("path", f"{path!r}: {exc}") from None
