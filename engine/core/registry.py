@@ -91,7 +91,7 @@ def node(name: str, *, version: int = 1) -> Callable[[Callable[..., Any]], Calla
 
     ``version`` is part of every cache key: bump it when the node's results change.
     """
-    if not re.fullmatch(r"[a-z][a-z0-9_]*\.[a-z][a-z0-9_]*", name):
+    if not re.fullmatch(r"[a-z][a-z0-9_]*\.[a-z0-9][a-z0-9_]*", name):  # export.3mf
         raise ValueError(f"node type names are 'family.name' in lower case, got {name!r}")
 
     def register(func: Callable[..., Any]) -> Callable[..., Any]:
