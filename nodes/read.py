@@ -16,7 +16,7 @@ import zlib
 from formgraph.core.errors import InputError
 from formgraph.core.registry import Context, node
 from formgraph.core.types import InputPath
-from formgraph.geometry import Mesh
+from formgraph.geometry import Curve, Mesh, NurbsCurve
 from formgraph.kernels.io import readers
 from formgraph.kernels.mesh import repair
 
@@ -77,3 +77,49 @@ def mesh(path: InputPath, weld: bool = False, *, ctx: Context) -> Mesh:
         return Mesh(v, fi, fo)
     except ValueError as exc:
         raise InputError("path", f"{path!r}: {exc}") from None
+
+
+@node("read.curves", version=1)
+def curves(path: InputPath, layers: list[str] | None = None, *, ctx: Context) -> list[Curve]:
+    """Read the curves of an SVG or DXF drawing, exactly, in millimetres.
+
+    Lines come in as degree-1 curves, Béziers as Béziers, arcs, circles and ellipses as
+    rational quadratics, DXF SPLINEs with their own degree, knots and weights, DXF polyline
+    bulges as exact arcs; each SVG subpath and each DXF polyline is one curve. SVG: the
+    document's ``width``/``height`` and ``viewBox`` give millimetres (else one user unit is
+    one CSS pixel, 25.4/96 mm), transforms are applied, y points up with the page's
+    lower-left corner at the origin. DXF: blocks are expanded, ``$INSUNITS`` scales to mm,
+    text, hatches and points are passed over (counted in a warning).
+
+    Parameters
+    ----------
+    path : InputPath
+        The drawing, relative to the graph's folder, e.g. ``logo.svg`` or ``plate.dxf``.
+    layers : list[str] | None
+        Keep only these layers: DXF layer names, SVG top-level group ids or Inkscape layer
+        labels. None keeps everything.
+
+    Example
+    -------
+    ``logo: {type: read.curves, path: logo.svg}``
+    """
+    _, data = ctx.read(path)
+    ext = parsed(path, "a drawing", readers.extension, path, readers.CURVE_FORMATS)
+    found, skipped = parsed(path, "a drawing", readers.CURVE_FORMATS[ext], data, ctx.budget)
+    if skipped:
+        kinds = ", ".join(f"{n} {k}" for k, n in sorted(skipped.items()))
+        ctx.warn(f"{path}: passed over what is not a curve ({kinds})")
+    if layers is not None:
+        names = sorted({c.layer for c in found})
+        for name in layers:
+            if name not in names:
+                ctx.warn(f"{path}: no curves on layer {name!r} (layers: {', '.join(names)})")
+        found = [c for c in found if c.layer in set(layers)]
+    ctx.guard(sum(len(c.curve[0]) for c in found), "control points")
+    out = []
+    for c in found:
+        try:
+            out.append(NurbsCurve(*c.curve))
+        except ValueError as exc:
+            raise InputError("path", f"{path!r}: a curve is malformed: {exc}") from None
+    return out

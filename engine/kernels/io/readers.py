@@ -11,12 +11,14 @@ from pathlib import PurePath
 
 import numpy as np
 
+from .dxf_read import read_dxf
 from .gltf import read_gltf
 from .mesh_read import read_obj, read_off, read_stl
 from .ply_read import read_ply
+from .svg_read import MAX_ELEMENTS, read_svg
 from .threemf import read_3mf
 
-__all__ = ["MESH_FORMATS", "extension", "mesh_arrays"]
+__all__ = ["CURVE_FORMATS", "MESH_FORMATS", "extension", "mesh_arrays"]
 
 
 def _merged(parts: list[tuple[str, np.ndarray, np.ndarray]]) -> tuple[np.ndarray, ...]:
@@ -36,6 +38,12 @@ MESH_FORMATS = {
     ".3mf": lambda data: _merged(read_3mf(data)),
     ".glb": lambda data: _merged(read_gltf(data)),
     ".gltf": lambda data: _merged(read_gltf(data)),
+}
+
+
+CURVE_FORMATS = {  # (data, element budget) -> (curves with a .curve and a .layer, skipped)
+    ".svg": lambda data, budget: (read_svg(data, min(MAX_ELEMENTS, budget)), {}),
+    ".dxf": lambda data, budget: read_dxf(data, budget),
 }
 
 
