@@ -16,7 +16,7 @@ import zlib
 from formgraph.core.errors import InputError
 from formgraph.core.registry import Context, node
 from formgraph.core.types import InputPath
-from formgraph.geometry import Curve, Mesh, NurbsCurve
+from formgraph.geometry import Curve, Mesh, NurbsCurve, Points
 from formgraph.kernels.io import readers
 from formgraph.kernels.mesh import repair
 
@@ -123,3 +123,27 @@ def curves(path: InputPath, layers: list[str] | None = None, *, ctx: Context) ->
         except ValueError as exc:
             raise InputError("path", f"{path!r}: a curve is malformed: {exc}") from None
     return out
+
+
+@node("read.points", version=1)
+def points(path: InputPath, *, ctx: Context) -> Points:
+    """Read points: CSV (``.csv``), whitespace text (``.txt``, ``.xyz``) or PLY vertices.
+
+    One point a line, ``x, y[, z]`` (z = 0 when missing; further columns are passed over).
+    A first line that is not numbers is a header; when it names ``x``, ``y`` and ``z``
+    columns, those are read, in any order. ``#`` starts a comment.
+
+    Parameters
+    ----------
+    path : InputPath
+        The file, relative to the graph's folder, e.g. ``survey.csv``.
+
+    Example
+    -------
+    ``pts: {type: read.points, path: scan.xyz}``
+    """
+    _, data = ctx.read(path)
+    ext = parsed(path, "points", readers.extension, path, readers.POINT_FORMATS)
+    xyz = parsed(path, "points", readers.POINT_FORMATS[ext], data)
+    ctx.guard(len(xyz), "points")
+    return Points(xyz)

@@ -235,3 +235,104 @@ def test_a_3mf_zip_bomb_is_refused_by_its_budget(tmp_path):
         z.writestr("3D/3dmodel.model", b"<model>" + b" " * (1 << 24))
     with pytest.raises(ValueError, match="zip bomb"):
         read_3mf(buf.getvalue(), max_bytes=1 << 20)
+
+
+# ------------------------------------------------------------------------------- points
+
+
+def _points(folder: Path, name: str, data: bytes) -> np.ndarray:
+    (folder / name).write_bytes(data)
+    g = fg.load(_graph(folder, f"  p: {{type: read.points, path: {name}}}\n"))
+    return g.evaluate("p").xyz
+
+
+def test_points_csv_header_names_the_columns(tmp_path):
+    data = b"id,z,x,y\n0,3,1,2\n1,6,4,5\n# done\n"
+    assert _points(tmp_path, "p.csv", data).tolist() == [[1, 2, 3], [4, 5, 6]]
+
+
+def test_points_xyz_without_header_and_two_columns(tmp_path):
+    assert _points(tmp_path, "p.xyz", b"1 2 3 255 0 0\n4 5 6 0 255 0\n").tolist() == [
+        [1, 2, 3],
+        [4, 5, 6],
+    ]
+    assert _points(tmp_path, "p.txt", b"x y\n1.5 2\n\n3 4e1\n").tolist() == [
+        [1.5, 2, 0],
+        [3, 40, 0],
+    ]
+
+
+def test_points_from_a_ply_written_by_trimesh(tmp_path):
+    cloud = trimesh.PointCloud(np.random.default_rng(2).random((50, 3)))
+    (tmp_path / "c.ply").write_bytes(cloud.export(file_type="ply"))
+    np.testing.assert_allclose(_points(tmp_path, "c.ply", (tmp_path / "c.ply").read_bytes()),
+                               cloud.vertices, rtol=1e-6)  # fmt: skip
+
+
+def test_points_ragged_lines_are_refused(tmp_path):
+    with pytest.raises(fg.NodeError, match="line 2 has 2 values but line 1 has 3"):
+        _points(tmp_path, "p.xyz", b"1 2 3\n4 5\n")
+
+
+# ------------------------------------------------------------------------ --set FILE
+
+
+PARAMS = """\
+formgraph: 1
+params:
+  part: {type: Mesh}
+  outline: {type: "list[Curve]"}
+  cloud: {type: Points}
+nodes:
+  m: {type: mesh.triangulate, mesh: "=part"}
+"""
+
+
+def test_set_fills_geometry_params_from_files(tmp_path):
+    from formgraph.cli.options import parse_sets
+
+    trimesh.creation.box().export(tmp_path / "scan.stl")
+    (tmp_path / "o.svg").write_bytes(
+        b'<svg xmlns="http://www.w3.org/2000/svg" width="10mm" height="10mm" viewBox="0 0 10 10">'
+        b'<circle cx="5" cy="5" r="2"/><rect width="1" height="1"/></svg>'
+    )
+    (tmp_path / "c.csv").write_bytes(b"1,2,3\n")
+    (tmp_path / "g.yaml").write_text(PARAMS)
+    g = fg.load(tmp_path / "g.yaml")
+    got = parse_sets(
+        g,
+        [
+            f"part={tmp_path / 'scan.stl'}",
+            f"outline={tmp_path / 'o.svg'}",
+            f"cloud={tmp_path / 'c.csv'}",
+        ],
+    )
+    assert got["part"].n_faces == 12 and got["part"].n_vertices == 36  # as read.mesh reads it
+    assert len(got["outline"]) == 2 and got["outline"][0].rational
+    assert got["cloud"].xyz.tolist() == [[1, 2, 3]]
+    assert g.evaluate("m", **got).n_faces == 12
+
+
+def test_set_a_missing_or_bad_file_says_which_param(tmp_path):
+    from formgraph.cli.options import parse_sets
+
+    (tmp_path / "g.yaml").write_text(PARAMS)
+    g = fg.load(tmp_path / "g.yaml")
+    with pytest.raises(fg.GraphError, match="--set part: .*does not exist"):
+        parse_sets(g, [f"part={tmp_path / 'none.stl'}"])
+    (tmp_path / "bad.stl").write_bytes(b"nonsense" * 20)
+    with pytest.raises(fg.GraphError, match="--set part: cannot read .*claims"):
+        parse_sets(g, [f"part={tmp_path / 'bad.stl'}"])
+
+
+def test_run_with_set_file_from_the_command_line(tmp_path):
+    from tools import cli
+
+    trimesh.creation.icosphere(1).export(tmp_path / "scan.stl")
+    (tmp_path / "g.yaml").write_text(
+        "formgraph: 1\nparams:\n  part: {type: Mesh}\nnodes:\n"
+        '  w: {type: mesh.weld, mesh: "=part"}\n'
+    )
+    r = cli("run", str(tmp_path / "g.yaml"), "--set", "part=scan.stl", "--no-cache", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert "80" in r.stdout

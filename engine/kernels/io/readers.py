@@ -15,10 +15,11 @@ from .dxf_read import read_dxf
 from .gltf import read_gltf
 from .mesh_read import read_obj, read_off, read_stl
 from .ply_read import read_ply
+from .points_read import read_ply_points, read_text_points
 from .svg_read import MAX_ELEMENTS, read_svg
 from .threemf import read_3mf
 
-__all__ = ["CURVE_FORMATS", "MESH_FORMATS", "extension", "mesh_arrays"]
+__all__ = ["CURVE_FORMATS", "MESH_FORMATS", "POINT_FORMATS", "extension", "mesh_arrays"]
 
 
 def _merged(parts: list[tuple[str, np.ndarray, np.ndarray]]) -> tuple[np.ndarray, ...]:
@@ -44,6 +45,14 @@ MESH_FORMATS = {
 CURVE_FORMATS = {  # (data, element budget) -> (curves with a .curve and a .layer, skipped)
     ".svg": lambda data, budget: (read_svg(data, min(MAX_ELEMENTS, budget)), {}),
     ".dxf": lambda data, budget: read_dxf(data, budget),
+}
+
+
+POINT_FORMATS = {
+    ".csv": lambda data: read_text_points(data, comma=True),
+    ".txt": lambda data: read_text_points(data, comma=False),
+    ".xyz": lambda data: read_text_points(data, comma=False),
+    ".ply": read_ply_points,
 }
 
 
