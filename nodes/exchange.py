@@ -16,8 +16,9 @@ import numpy as np
 from formgraph.core.errors import InputError
 from formgraph.core.registry import Context, node
 from formgraph.core.types import OutputPath
-from formgraph.geometry import Mesh
-from formgraph.kernels.io import gltf, threemf
+from formgraph.geometry import Curve, Mesh, NurbsCurve, NurbsSurface, Surface
+from formgraph.kernels.io import gltf, rhino, step, threemf
+from formgraph.kernels.io.exporters import mesh_report
 from formgraph.kernels.mesh import meshops
 
 
@@ -148,3 +149,119 @@ def export_gltf(
     scale = threemf.UNITS[units.value] / 1000.0
     data = gltf.write_glb(_triangles(meshes, ctx), names=names, scale=scale)
     return str(ctx.write(path, data))
+
+
+def _nurbs_curves(curves: list[Curve], port: str) -> list[tuple]:
+    out = []
+    for k, c in enumerate(curves):
+        if not isinstance(c, NurbsCurve):
+            raise InputError(
+                port,
+                f"curve {k} is a {type(c).__name__}; STEP and .3dm hold NURBS exactly (make it "
+                f"one with nurbs.interpolate through its points)",
+            )
+        out.append((c.control_points, c.degree, c.knots, c.weights if c.rational else None))
+    return out
+
+
+def _nurbs_surfaces(surfaces: list[Surface], port: str) -> list[tuple]:
+    out = []
+    for k, s in enumerate(surfaces):
+        if not isinstance(s, NurbsSurface):
+            raise InputError(
+                port,
+                f"surface {k} is a {type(s).__name__}; STEP and .3dm hold NURBS exactly "
+                f"(tessellate it and pass it as a mesh)",
+            )
+        w = s.weights if s.rational else None
+        out.append((s.control_points, s.degree_u, s.degree_v, s.knots_u, s.knots_v, w))
+    return out
+
+
+@node("export.step", version=1)
+def export_step(
+    path: OutputPath,
+    curves: list[Curve] | None = None,
+    surfaces: list[Surface] | None = None,
+    meshes: list[Mesh] | None = None,
+    *,
+    ctx: Context,
+) -> str:
+    """Write exact NURBS geometry (and meshes) as STEP, ISO 10303-21 AP214, for CAD.
+
+    Surfaces become ``B_SPLINE_SURFACE_WITH_KNOTS`` (rational where weighted), each the face
+    of its own shell in a shell-based surface model, bounded by its parameter domain's edges
+    (a pole left out, a seam one edge used both ways): Fusion, SolidWorks and FreeCAD open
+    them as surface bodies. Curves become ``B_SPLINE_CURVE_WITH_KNOTS``. A closed mesh
+    becomes a faceted solid (a closed shell of planar faces), an open one an open shell.
+    Millimetres; every number its shortest round-trip decimal, so the file is exact.
+
+    Parameters
+    ----------
+    path : OutputPath
+        File path relative to the output directory, e.g. ``cad/vase.step``.
+    curves : list[Curve] | None
+        NURBS curves.
+    surfaces : list[Surface] | None
+        NURBS surfaces.
+    meshes : list[Mesh] | None
+        Meshes, as faceted solids when closed.
+    """
+    c = _nurbs_curves(curves or [], "curves")
+    s = _nurbs_surfaces(surfaces or [], "surfaces")
+    meshes = meshes or []
+    ctx.guard(
+        sum(len(x[0]) for x in c)
+        + sum(x[0].shape[0] * x[0].shape[1] for x in s)
+        + 8 * sum(m.n_faces for m in meshes),
+        "STEP entities",
+    )
+    m = [
+        (x.vertices, x.face_indices, x.face_offsets, mesh_report(*_arrays(x)).watertight)
+        for x in meshes
+    ]
+    return str(ctx.write(path, step.write_step(curves=c, surfaces=s, meshes=m)))
+
+
+@node("export.rhino", version=1)
+def export_rhino(
+    path: OutputPath,
+    curves: list[Curve] | None = None,
+    surfaces: list[Surface] | None = None,
+    meshes: list[Mesh] | None = None,
+    layers: list[str] | None = None,
+    *,
+    ctx: Context,
+) -> str:
+    """Write a Rhino ``.3dm`` file (through rhino3dm): NURBS exact, meshes as meshes.
+
+    Degree, knots and weights go across as they are (openNURBS's knot and homogeneous point
+    conventions are converted); model units are millimetres.
+
+    Parameters
+    ----------
+    path : OutputPath
+        File path relative to the output directory, e.g. ``vase.3dm``.
+    curves : list[Curve] | None
+        NURBS curves.
+    surfaces : list[Surface] | None
+        NURBS surfaces.
+    meshes : list[Mesh] | None
+        Meshes.
+    layers : list[str] | None
+        One layer name per object, curves first, then surfaces, then meshes (default: a
+        layer per kind, ``curves``, ``surfaces``, ``meshes``).
+    """
+    c = _nurbs_curves(curves or [], "curves")
+    s = _nurbs_surfaces(surfaces or [], "surfaces")
+    m = [_arrays(x) for x in meshes or []]
+    ctx.guard(sum(len(x[0]) for x in m) + sum(x[0].size for x in s), "3dm vertices")
+    try:
+        data = rhino.write_3dm(curves=c, surfaces=s, meshes=m, layers=layers)
+    except ValueError as exc:
+        raise InputError("layers" if "layers" in str(exc) else "path", str(exc)) from None
+    return str(ctx.write(path, data))
+
+
+def _arrays(m: Mesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    return m.vertices, m.face_indices, m.face_offsets

@@ -12,12 +12,15 @@ from __future__ import annotations
 
 import struct
 import zlib
+from typing import NamedTuple
+
+import numpy as np
 
 from formgraph.core.errors import InputError
 from formgraph.core.registry import Context, node
 from formgraph.core.types import InputPath
-from formgraph.geometry import Curve, Mesh, NurbsCurve, Points
-from formgraph.kernels.io import readers
+from formgraph.geometry import Curve, Mesh, NurbsCurve, NurbsSurface, Points, Surface
+from formgraph.kernels.io import readers, rhino
 from formgraph.kernels.mesh import repair
 
 # what a parser may raise on a malformed file (its sentence is kept, the traceback dropped)
@@ -147,3 +150,43 @@ def points(path: InputPath, *, ctx: Context) -> Points:
     xyz = parsed(path, "points", readers.POINT_FORMATS[ext], data)
     ctx.guard(len(xyz), "points")
     return Points(xyz)
+
+
+class RhinoContents(NamedTuple):
+    curves: list[Curve]
+    surfaces: list[Surface]
+    meshes: list[Mesh]
+    points: Points
+
+
+@node("read.rhino", version=1)
+def read_rhino(path: InputPath, *, ctx: Context) -> RhinoContents:
+    """Read a Rhino ``.3dm`` file through rhino3dm: NURBS exact.
+
+    Every curve (lines, arcs, polylines and poly-curves too) comes in as its NURBS form,
+    every surface as a NURBS surface (a polysurface's faces as their untrimmed surfaces,
+    with a warning), meshes as meshes, point objects and point clouds as one set of points;
+    coordinates in the file's model units.
+
+    Parameters
+    ----------
+    path : InputPath
+        The file, relative to the graph's folder, e.g. ``model.3dm``.
+
+    Example
+    -------
+    ``model: {type: read.rhino, path: model.3dm}``, then ``"@model.surfaces"``
+    """
+    _, data = ctx.read(path)
+    got = parsed(path, "a Rhino model", rhino.read_3dm, data)
+    if got.untrimmed:
+        ctx.warn(f"{path}: {got.untrimmed} polysurface faces read as their untrimmed surfaces")
+    ctx.guard(sum(len(m[0]) for m in got.meshes) + sum(s[0].size for s in got.surfaces), "vertices")
+    try:
+        curves = [NurbsCurve(*c) for c in got.curves]
+        surfaces = [NurbsSurface(*s) for s in got.surfaces]
+        meshes = [Mesh(*m) for m in got.meshes]
+    except ValueError as exc:
+        raise InputError("path", f"{path!r}: {exc}") from None
+    pts = np.concatenate(got.points) if got.points else np.zeros((0, 3))
+    return RhinoContents(curves, surfaces, meshes, Points(pts))

@@ -127,3 +127,164 @@ def test_glb_reads_back_through_read_mesh(tmp_path):
     box = g.evaluate("box")
     assert back.n_faces == int(np.sum(box.face_sizes - 2))
     np.testing.assert_allclose(back.vertices, box.vertices, rtol=1e-6, atol=1e-5)
+
+
+# --------------------------------------------------------------------------------- STEP
+
+VASE = """\
+  pts: {type: points.list, points: [[1.3, 0, 6], [0.8, 0, 4.5], [2.2, 0, 2.1], [0.7, 0, 0],
+    [0, 0, 0]]}
+  profile: {type: nurbs.interpolate, points: "@pts", degree: 3}
+  vase: {type: nurbs.revolve, curve: "@profile"}
+  sheet: {type: nurbs.surface, points: [[[0, 0, 0], [1, 0, 1], [2, 0, 0]],
+    [[0, 1, 1], [1, 1, 2], [2, 1, 1]], [[0, 2, 0], [1, 2, 1], [2, 2, 0]]], degree_u: 2,
+    degree_v: 2}
+  box: {type: mesh.box, size: [2, 3, 4]}
+  plane: {type: mesh.plane, size: [2, 2]}
+"""
+
+
+def _occ(path: str):
+    pytest.importorskip("OCP")
+    from OCP.IFSelect import IFSelect_RetDone
+    from OCP.STEPControl import STEPControl_Reader
+
+    reader = STEPControl_Reader()
+    assert reader.ReadFile(path) == IFSelect_RetDone
+    reader.TransferRoots()
+    return reader.OneShape()
+
+
+def _occ_items(shape, kind):
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopoDS import TopoDS
+
+    cast = {"FACE": TopoDS.Face, "EDGE": TopoDS.Edge, "SOLID": TopoDS.Solid, "SHELL": TopoDS.Shell}
+    from OCP import TopAbs
+
+    e = TopExp_Explorer(shape, getattr(TopAbs, f"TopAbs_{kind}"))
+    out = []
+    while e.More():
+        out.append(cast[kind](e.Current()))
+        e.Next()
+    return out
+
+
+def test_step_surfaces_read_by_opencascade_evaluate_the_same(tmp_path):
+    from OCP.BRep import BRep_Tool
+    from OCP.BRepCheck import BRepCheck_Analyzer
+
+    g, out = _run(
+        tmp_path,
+        VASE + "  x: {type: export.step, surfaces: ['@vase', '@sheet'], path: s.step}\n",
+        "x",
+    )
+    shape = _occ(out)
+    assert BRepCheck_Analyzer(shape).IsValid()
+    faces = _occ_items(shape, "FACE")
+    assert len(faces) == 2
+    for face, name in zip(faces, ("vase", "sheet"), strict=True):
+        ours = g.evaluate(name)
+        surf = BRep_Tool.Surface_s(face)
+        assert surf.DynamicType().Name() == "Geom_BSplineSurface"
+        assert surf.UDegree() == ours.degree_u and surf.VDegree() == ours.degree_v
+        assert surf.IsURational() or surf.IsVRational() or not ours.rational
+        u = np.linspace(ours.knots_u[0], ours.knots_u[-1], 9)
+        v = np.linspace(ours.knots_v[0], ours.knots_v[-1], 7)
+        uu, vv = np.meshgrid(u, v, indexing="ij")
+        want = ours.evaluate(uu.ravel(), vv.ravel()).reshape(9, 7, 3)
+        for i in range(9):
+            for j in range(7):
+                p = surf.Value(float(u[i]), float(v[j]))
+                np.testing.assert_allclose([p.X(), p.Y(), p.Z()], want[i, j], atol=1e-12)
+
+
+def test_step_curves_and_a_faceted_solid(tmp_path):
+    from OCP.BRep import BRep_Tool
+    from OCP.BRepGProp import BRepGProp
+    from OCP.GProp import GProp_GProps
+
+    g, out = _run(
+        tmp_path,
+        VASE + "  x: {type: export.step, curves: ['@profile'], meshes: ['@box', '@plane'],"
+        " path: m.step}\n",
+        "x",
+    )
+    shape = _occ(out)
+    (solid,) = _occ_items(shape, "SOLID")
+    props = GProp_GProps()
+    BRepGProp.VolumeProperties_s(solid, props)
+    assert props.Mass() == pytest.approx(2 * 3 * 4, rel=1e-9)
+    assert len(_occ_items(shape, "SHELL")) == 2  # the box's closed shell and the plane's
+    profile = g.evaluate("profile")
+    curves = [BRep_Tool.Curve_s(e, 0, 1) for e in _occ_items(shape, "EDGE")]
+    splines = [c for c in curves if c is not None and c.DynamicType().Name() == "Geom_BSplineCurve"]
+    assert splines, "the profile curve is not in the file"
+    t = np.linspace(profile.knots[0], profile.knots[-1], 11)
+    want = profile.evaluate(t)
+    got = np.array([[p.X(), p.Y(), p.Z()] for p in (splines[0].Value(float(x)) for x in t)])
+    np.testing.assert_allclose(got, want, atol=1e-12)
+
+
+def test_step_refuses_a_parametric_surface(tmp_path):
+    with pytest.raises(fg.NodeError, match="surface 0 is a ParametricSurface"):
+        _run(
+            tmp_path,
+            "  s: {type: surfaces.parametric, x: u, y: v, z: u * v}\n"
+            "  x: {type: export.step, surfaces: ['@s'], path: s.step}\n",
+            "x",
+        )
+
+
+# --------------------------------------------------------------------------------- .3dm
+
+
+def test_rhino_file_evaluates_the_same_in_rhino3dm(tmp_path):
+    rhino3dm = pytest.importorskip("rhino3dm")
+    g, out = _run(
+        tmp_path,
+        VASE + "  x: {type: export.rhino, curves: ['@profile'], surfaces: ['@vase'],"
+        " meshes: ['@box'], layers: [profile, body, block], path: v.3dm}\n",
+        "x",
+    )
+    model = rhino3dm.File3dm.Read(out)
+    layers = [model.Layers[k].Name for k in range(len(model.Layers))]
+    assert layers == ["profile", "body", "block"]
+    kinds = [type(o.Geometry).__name__ for o in model.Objects]
+    assert kinds == ["NurbsCurve", "NurbsSurface", "Mesh"]
+    curve, surface, mesh = (o.Geometry for o in model.Objects)
+    ours_c, ours_s = g.evaluate("profile"), g.evaluate("vase")
+    for t in np.linspace(ours_c.knots[0], ours_c.knots[-1], 9):
+        p = curve.PointAt(float(t))
+        np.testing.assert_allclose([p.X, p.Y, p.Z], ours_c.evaluate([t])[0], atol=1e-12)
+    for u in np.linspace(0, 1, 5):
+        for v in np.linspace(0, 1, 5):
+            p = surface.PointAt(float(u), float(v))
+            np.testing.assert_allclose([p.X, p.Y, p.Z], ours_s.evaluate([u], [v])[0], atol=1e-12)
+    assert surface.IsRational and len(mesh.Vertices) == g.evaluate("box").n_vertices
+
+
+def test_rhino_round_trips_through_read_rhino_exactly(tmp_path):
+    g, out = _run(
+        tmp_path,
+        VASE + "  x: {type: export.rhino, curves: ['@profile'], surfaces: ['@vase', '@sheet'],"
+        " meshes: ['@box'], path: v.3dm}\n",
+        "x",
+    )
+    (tmp_path / "in.yaml").write_text(HEAD + "  m: {type: read.rhino, path: out/v.3dm}\n")
+    back = fg.load(tmp_path / "in.yaml").evaluate("m")
+    (c,), (s1, s2), (m,) = back.curves, back.surfaces, back.meshes
+    for got, want in ((c, g.evaluate("profile")),):
+        assert np.array_equal(got.control_points, want.control_points)
+        assert np.array_equal(got.knots, want.knots) and got.degree == want.degree
+    for got, want in ((s1, g.evaluate("vase")), (s2, g.evaluate("sheet"))):
+        np.testing.assert_allclose(got.control_points, want.control_points, rtol=0, atol=1e-14)
+        assert np.array_equal(got.knots_u, want.knots_u) and np.array_equal(
+            got.knots_v, want.knots_v
+        )
+        np.testing.assert_allclose(got.weights, want.weights, rtol=0, atol=1e-15)
+    box = g.evaluate("box")
+    assert np.array_equal(m.vertices, box.vertices) and np.array_equal(
+        m.face_indices, box.face_indices
+    )
+    assert len(back.points) == 0

@@ -1,0 +1,346 @@
+"""STEP (ISO 10303-21) files of exact NURBS geometry and faceted meshes, AP214.
+
+What goes in (ISO 10303-42 resources, as CAD programs exchange them):
+
+- each NURBS surface as a ``B_SPLINE_SURFACE_WITH_KNOTS`` (the complex rational entity with
+  ``RATIONAL_B_SPLINE_SURFACE`` when weighted), made the face of its own open shell: an
+  ``ADVANCED_FACE`` bounded by the four edges of its parameter domain, each edge the exact
+  boundary curve (the control net's first or last row or column, after clamping). A side
+  that collapses to a point (a pole) is left out of the loop; two sides that coincide (the
+  seam of a closed surface) are one edge used twice, once each way. The open shells make
+  one ``SHELL_BASED_SURFACE_MODEL``, which CAD programs show as surface bodies;
+- each curve a ``B_SPLINE_CURVE_WITH_KNOTS`` (rational where weighted) in a
+  ``GEOMETRIC_CURVE_SET``;
+- each closed mesh a ``MANIFOLD_SOLID_BREP`` of a ``CLOSED_SHELL``, an open one an
+  ``OPEN_SHELL`` of the surface model, each polygon a planar face bounded by a
+  ``POLY_LOOP`` (a faceted solid).
+
+All hang off one product, in millimetres. Numbers are written as their shortest round-trip
+decimals, in bulk (:mod:`formgraph.kernels.io.numfmt`), so the file holds the geometry to the
+last bit; control points and mesh vertices are ``CARTESIAN_POINT`` rows built as arrays.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..nurbs import homogeneous, is_clamped, project, respace
+from .numfmt import float_words, format_int, join_rows, squeeze
+
+__all__ = ["write_step"]
+
+Curve = tuple[np.ndarray, int, np.ndarray, "np.ndarray | None"]
+Surface = tuple[np.ndarray, int, int, np.ndarray, np.ndarray, "np.ndarray | None"]
+
+
+class _File:
+    """Entity lines, numbered as they are added."""
+
+    def __init__(self) -> None:
+        self.parts: list[bytes] = []
+        self.next = 1
+
+    def add(self, text: str) -> int:
+        k = self.next
+        self.parts.append(f"#{k}={text};\n".encode())
+        self.next += 1
+        return k
+
+    def points(self, xyz: np.ndarray) -> np.ndarray:
+        """``CARTESIAN_POINT`` rows for every point of ``xyz`` (n, 3); their ids."""
+        xyz = np.asarray(xyz, dtype=np.float64).reshape(-1, 3)
+        ids = np.arange(self.next, self.next + len(xyz), dtype=np.int64)
+        block = 1 << 15
+        for s in range(0, len(xyz), block):
+            b = xyz[s : s + block]
+            cols = [_reals(b[:, c]) for c in range(3)]
+            self.parts.append(
+                join_rows(
+                    [
+                        b"#",
+                        format_int(ids[s : s + block]),
+                        b"=CARTESIAN_POINT('',(",
+                        cols[0],
+                        b",",
+                        cols[1],
+                        b",",
+                        cols[2],
+                    ],
+                    b"));\n",
+                )  # fmt: skip
+            )
+        self.next += len(xyz)
+        return ids
+
+    def data(self) -> bytes:
+        return b"".join(self.parts)
+
+
+def _reals(x: np.ndarray) -> np.ndarray:
+    """STEP reals: the shortest round-trip text with a decimal point always (``1.``,
+    ``1.5E-05``), as a NUL-padded canvas (n, w)."""
+    x = np.asarray(x, dtype=np.float64) + 0.0  # -0.0 -> 0.0
+    canvas = float_words(x).view(np.uint8).copy()
+    # repr writes 1e-05 / 1.5e+16: STEP wants an upper-case E and a '.' in the mantissa
+    has_e = (canvas == ord("e")).any(axis=1)
+    canvas[canvas == ord("e")] = ord("E")
+    if has_e.any():
+        for i in np.flatnonzero(has_e):  # rare: exponents outside 1e-4 .. 1e16
+            text = squeeze(canvas[i : i + 1]).decode()
+            mant, exp = text.split("E")
+            text = (mant if "." in mant else mant + ".") + "E" + exp
+            row = np.zeros(canvas.shape[1], np.uint8)
+            row[: len(text)] = np.frombuffer(text.encode(), np.uint8)
+            canvas[i] = row
+    return canvas
+
+
+def _real(x: float) -> str:
+    return squeeze(_reals(np.array([x]))).decode()
+
+
+def _refs(ids) -> str:
+    return "(" + ",".join(f"#{int(i)}" for i in ids) + ")"
+
+
+def _reals_text(values) -> str:
+    return "(" + ",".join(_real(v) for v in np.ravel(values)) + ")"
+
+
+def _knot_lists(knots: np.ndarray) -> tuple[str, str]:
+    values, counts = np.unique(np.asarray(knots, dtype=np.float64), return_counts=True)
+    return "(" + ",".join(str(int(c)) for c in counts) + ")", _reals_text(values)
+
+
+def _clamp_surface(s: Surface) -> Surface:
+    cp, du, dv, ku, kv, w = s
+    pw = homogeneous(cp, w)
+    for axis, (d, k) in enumerate(((du, ku), (dv, kv))):
+        if is_clamped(d, k):
+            continue
+        n = len(k) - d - 1
+        a, b = k[d], k[n]
+        tau = np.concatenate([[a] * (d + 1), k[(k > a) & (k < b)], [b] * (d + 1)])
+        moved = np.moveaxis(pw, axis, 0)
+        pw = np.moveaxis(respace(d, k, moved, tau), 0, axis)
+        if axis == 0:
+            ku = tau
+        else:
+            kv = tau
+    cp2, w2 = project(pw, w is not None)
+    return cp2, du, dv, ku, kv, w2
+
+
+def _clamp_curve(c: Curve) -> Curve:
+    cp, p, k, w = c
+    if is_clamped(p, k):
+        return c
+    n = len(k) - p - 1
+    a, b = k[p], k[n]
+    tau = np.concatenate([[a] * (p + 1), k[(k > a) & (k < b)], [b] * (p + 1)])
+    cp2, w2 = project(respace(p, k, homogeneous(cp, w), tau), w is not None)
+    return cp2, p, tau, w2
+
+
+def _curve_entity(f: _File, c: Curve, closed: bool = False) -> int:
+    cp, p, k, w = _clamp_curve(c)
+    ids = f.points(cp)
+    mults, values = _knot_lists(k)
+    flag = ".T." if closed else ".F."
+    if w is None or np.all(w == w[0]):
+        return f.add(
+            f"B_SPLINE_CURVE_WITH_KNOTS('',{p},{_refs(ids)},.UNSPECIFIED.,{flag},.F.,"
+            f"{mults},{values},.UNSPECIFIED.)"
+        )
+    return f.add(
+        f"(BOUNDED_CURVE()B_SPLINE_CURVE({p},{_refs(ids)},.UNSPECIFIED.,{flag},.F.)"
+        f"B_SPLINE_CURVE_WITH_KNOTS({mults},{values},.UNSPECIFIED.)CURVE()"
+        f"GEOMETRIC_REPRESENTATION_ITEM()RATIONAL_B_SPLINE_CURVE({_reals_text(w)})"
+        f"REPRESENTATION_ITEM(''))"
+    )
+
+
+def _surface_face(f: _File, s: Surface) -> int:
+    cp, du, dv, ku, kv, w = _clamp_surface(s)
+    nu, nv = cp.shape[:2]
+    ids = f.points(cp.reshape(-1, 3)).reshape(nu, nv)
+    rows = "(" + ",".join(_refs(r) for r in ids) + ")"
+    mu, vu = _knot_lists(ku)
+    mv, vv = _knot_lists(kv)
+    if w is None or np.all(w == w.flat[0]):
+        surf = f.add(
+            f"B_SPLINE_SURFACE_WITH_KNOTS('',{du},{dv},{rows},.UNSPECIFIED.,.F.,.F.,.F.,"
+            f"{mu},{mv},{vu},{vv},.UNSPECIFIED.)"
+        )
+    else:
+        weights = "(" + ",".join(_reals_text(r) for r in w) + ")"
+        surf = f.add(
+            f"(BOUNDED_SURFACE()B_SPLINE_SURFACE({du},{dv},{rows},.UNSPECIFIED.,.F.,.F.,.F.)"
+            f"B_SPLINE_SURFACE_WITH_KNOTS({mu},{mv},{vu},{vv},.UNSPECIFIED.)"
+            f"GEOMETRIC_REPRESENTATION_ITEM()RATIONAL_B_SPLINE_SURFACE({weights})"
+            f"REPRESENTATION_ITEM('')SURFACE())"
+        )
+    # the domain's four sides, counter-clockwise in (u, v): v = v0, u = u1, v = v1, u = u0
+    wu = None if w is None else w
+    sides = [
+        (cp[:, 0], du, ku, None if wu is None else wu[:, 0]),
+        (cp[-1, :], dv, kv, None if wu is None else wu[-1, :]),
+        (cp[:, -1], du, ku, None if wu is None else wu[:, -1]),
+        (cp[0, :], dv, kv, None if wu is None else wu[0, :]),
+    ]
+    forward = [True, True, False, False]
+    corners = [cp[0, 0], cp[-1, 0], cp[-1, -1], cp[0, -1]]
+    scale = float(np.abs(cp).max()) or 1.0
+    vertex_ids: list[int] = []
+    for c in corners:  # corners that coincide share a vertex
+        for j, prev in enumerate(corners[: len(vertex_ids)]):
+            if np.linalg.norm(c - prev) <= 1e-12 * scale:
+                vertex_ids.append(vertex_ids[j])
+                break
+        else:
+            (pid,) = f.points(c[None])
+            vertex_ids.append(f.add(f"VERTEX_POINT('',#{pid})"))
+    edges: list[int | None] = [None] * 4
+    oriented = []
+    for k, (pts, deg, kn, ww) in enumerate(sides):
+        if np.all(np.linalg.norm(pts - pts[0], axis=1) <= 1e-12 * scale):
+            continue  # a pole: no edge
+        start, end = vertex_ids[k], vertex_ids[(k + 1) % 4]
+        if not forward[k]:
+            start, end = end, start
+        twin = None
+        if k >= 2:  # the seam of a closed surface: this side is the opposite one
+            o = k - 2
+            if edges[o] is not None and np.allclose(pts, sides[o][0], rtol=0, atol=1e-12 * scale):
+                twin = edges[o]
+        if twin is None:
+            curve = _curve_entity(f, (pts, deg, kn, ww))
+            twin = f.add(f"EDGE_CURVE('',#{start},#{end},#{curve},.T.)")
+            edges[k] = twin
+            same = forward[k]  # sides 2 and 3 run against their curves' parameter
+        else:
+            same = False  # the seam's second use runs against the first
+        oriented.append(f.add(f"ORIENTED_EDGE('',*,*,#{twin},{'.T.' if same else '.F.'})"))
+    loop = f.add(f"EDGE_LOOP('',{_refs(oriented)})")
+    bound = f.add(f"FACE_OUTER_BOUND('',#{loop},.T.)")
+    return f.add(f"ADVANCED_FACE('',(#{bound}),#{surf},.T.)")
+
+
+def _mesh_faces(f: _File, v: np.ndarray, fi: np.ndarray, fo: np.ndarray) -> list[int]:
+    """One planar face per polygon: POLY_LOOP of shared vertex points, its plane."""
+    pid = f.points(v)
+    faces = []
+    sizes = np.diff(fo)
+    # Newell normals and centroids, all faces at once
+    nxt = np.arange(fi.size) + 1
+    nxt[fo[1:] - 1] = fo[:-1]
+    a, b = v[fi], v[fi[nxt]]
+    face_of = np.repeat(np.arange(sizes.size), sizes)
+    n = np.zeros((sizes.size, 3))
+    cross = np.stack(
+        [
+            (a[:, 1] - b[:, 1]) * (a[:, 2] + b[:, 2]),
+            (a[:, 2] - b[:, 2]) * (a[:, 0] + b[:, 0]),
+            (a[:, 0] - b[:, 0]) * (a[:, 1] + b[:, 1]),
+        ],
+        axis=1,
+    )
+    for c in range(3):
+        n[:, c] = np.bincount(face_of, weights=cross[:, c], minlength=sizes.size)
+    length = np.linalg.norm(n, axis=1)
+    n = np.where(length[:, None] > 0, n / np.where(length > 0, length, 1)[:, None], [0, 0, 1])
+    ref = v[fi[fo[1:] - 1]] - v[fi[fo[:-1]]]
+    ref = ref - (ref * n).sum(1)[:, None] * n
+    rl = np.linalg.norm(ref, axis=1)
+    alt = np.where(np.abs(n[:, 0:1]) < 0.9, [[1.0, 0, 0]], [[0, 1.0, 0]])
+    alt = alt - (alt * n).sum(1)[:, None] * n
+    ref = np.where(rl[:, None] > 0, ref, alt)
+    ref /= np.linalg.norm(ref, axis=1)[:, None]
+    origin = f.points(v[fi[fo[:-1]]])
+    for k in range(sizes.size):
+        loop = f.add(f"POLY_LOOP('',{_refs(pid[fi[fo[k] : fo[k + 1]]])})")
+        bound = f.add(f"FACE_OUTER_BOUND('',#{loop},.T.)")
+        axis = f.add(f"DIRECTION('',{_reals_text(n[k])})")
+        refd = f.add(f"DIRECTION('',{_reals_text(ref[k])})")
+        place = f.add(f"AXIS2_PLACEMENT_3D('',#{origin[k]},#{axis},#{refd})")
+        plane = f.add(f"PLANE('',#{place})")
+        faces.append(f.add(f"FACE_SURFACE('',(#{bound}),#{plane},.T.)"))
+    return faces
+
+
+def write_step(
+    *,
+    curves: list[Curve] = (),  # type: ignore[assignment]
+    surfaces: list[Surface] = (),  # type: ignore[assignment]
+    meshes: list[tuple[np.ndarray, np.ndarray, np.ndarray, bool]] = (),  # type: ignore[assignment]
+    name: str = "formgraph",
+) -> bytes:
+    """A STEP AP214 file (ISO 10303-21) of exact curves and surfaces and faceted meshes.
+
+    Parameters
+    ----------
+    curves : list of (control_points (n, 3), degree, knots, weights or None)
+    surfaces : list of (control_points (nu, nv, 3), degree_u, degree_v, knots_u, knots_v,
+        weights (nu, nv) or None)
+    meshes : list of (vertices, face_indices, face_offsets, closed)
+        A closed mesh becomes a faceted solid (closed shell), an open one an open shell.
+    name : str
+        The product's name.
+
+    Returns
+    -------
+    bytes
+    """
+    f = _File()
+    app = f.add("APPLICATION_CONTEXT('core data for automotive mechanical design processes')")
+    f.add(
+        f"APPLICATION_PROTOCOL_DEFINITION('international standard','automotive_design',2000,#{app})"
+    )
+    pctx = f.add(f"PRODUCT_CONTEXT('',#{app},'mechanical')")
+    dctx = f.add(f"PRODUCT_DEFINITION_CONTEXT('part definition',#{app},'design')")
+    safe = name.replace("'", "''")
+    prod = f.add(f"PRODUCT('{safe}','{safe}','',(#{pctx}))")
+    form = f.add(f"PRODUCT_DEFINITION_FORMATION('','',#{prod})")
+    pdef = f.add(f"PRODUCT_DEFINITION('design','',#{form},#{dctx})")
+    pds = f.add(f"PRODUCT_DEFINITION_SHAPE('','',#{pdef})")
+    mm = f.add("(LENGTH_UNIT()NAMED_UNIT(*)SI_UNIT(.MILLI.,.METRE.))")
+    rad = f.add("(NAMED_UNIT(*)PLANE_ANGLE_UNIT()SI_UNIT($,.RADIAN.))")
+    sr = f.add("(NAMED_UNIT(*)SI_UNIT($,.STERADIAN.)SOLID_ANGLE_UNIT())")
+    unc = f.add(
+        f"UNCERTAINTY_MEASURE_WITH_UNIT(LENGTH_MEASURE(1.E-07),#{mm},'distance_accuracy_value','')"
+    )
+    ctx = f.add(
+        f"(GEOMETRIC_REPRESENTATION_CONTEXT(3)GLOBAL_UNCERTAINTY_ASSIGNED_CONTEXT((#{unc}))"
+        f"GLOBAL_UNIT_ASSIGNED_CONTEXT((#{mm},#{rad},#{sr}))REPRESENTATION_CONTEXT('',''))"
+    )
+    (o,) = f.points(np.zeros((1, 3)))
+    z = f.add("DIRECTION('',(0.,0.,1.))")
+    x = f.add("DIRECTION('',(1.,0.,0.))")
+    items = [f.add(f"AXIS2_PLACEMENT_3D('',#{o},#{z},#{x})")]
+    shells = []
+    for s in surfaces:
+        face = _surface_face(f, s)
+        shells.append(f.add(f"OPEN_SHELL('',(#{face}))"))
+    for v, fi, fo, closed in meshes:
+        faces = _mesh_faces(
+            f, np.asarray(v, float), np.asarray(fi, np.int64), np.asarray(fo, np.int64)
+        )
+        if closed:
+            shell = f.add(f"CLOSED_SHELL('',{_refs(faces)})")
+            items.append(f.add(f"MANIFOLD_SOLID_BREP('',#{shell})"))
+        else:
+            shells.append(f.add(f"OPEN_SHELL('',{_refs(faces)})"))
+    if shells:
+        items.append(f.add(f"SHELL_BASED_SURFACE_MODEL('',{_refs(shells)})"))
+    if len(curves):
+        ids = [_curve_entity(f, c) for c in curves]
+        items.append(f.add(f"GEOMETRIC_CURVE_SET('',{_refs(ids)})"))
+    rep = f.add(f"SHAPE_REPRESENTATION('{safe}',{_refs(items)},#{ctx})")
+    f.add(f"SHAPE_DEFINITION_REPRESENTATION(#{pds},#{rep})")
+    header = (
+        "ISO-10303-21;\nHEADER;\n"
+        "FILE_DESCRIPTION(('formgraph model'),'2;1');\n"
+        f"FILE_NAME('{safe}.stp','1970-01-01T00:00:00',(''),(''),'formgraph','formgraph','');\n"
+        "FILE_SCHEMA(('AUTOMOTIVE_DESIGN { 1 0 10303 214 1 1 1 1 }'));\nENDSEC;\nDATA;\n"
+    ).encode()
+    return header + f.data() + b"ENDSEC;\nEND-ISO-10303-21;\n"
