@@ -149,7 +149,7 @@ def file_value(name: str, declared: Any, text: str) -> Any:
     kind = declared.kinds[0]
     base, many = kind.base, kind.is_list
     try:
-        data = safety.read_regular(Path(text).expanduser())
+        data = safety.read_input(Path(text).expanduser())
     except PathError as exc:
         raise GraphError(f"--set {name}: {exc}") from None
     try:

@@ -1,13 +1,9 @@
-<<<<<<< HEAD
-"""Reading and writing files safely: only inside their folder, writes atomic.
-=======
-"""Reading and writing files safely: regular files only, atomically, inside the output directory.
+"""Reading and writing files safely: regular files only, atomically, inside their folder.
 
 Every file formgraph reads (graphs, subgraph parts, the inputs of read nodes) goes through
 :func:`read_regular`: a FIFO, a device or a socket named as a graph would block ``open`` or
 ``read`` forever, so the file is opened without blocking and refused unless it is a regular
 file, and never read past its size limit.
->>>>>>> main
 
 A graph downloaded from someone else must not write anywhere but the output directory, so
 every export path is relative, free of ``..``, and still inside the directory after symlinks
@@ -16,9 +12,9 @@ are followed. Files appear whole or not at all (temp file in the same folder, fs
 file names the process that writes it, so one left behind by a killed run is removed by the
 next write into its folder.
 
-Inputs (the files ``read.*`` nodes read) follow the same path rules inside the inputs root
-(the graph's folder unless the run names one), and are opened by :func:`read_regular`:
-regular files only (a FIFO or a device never blocks a run), and never more than a cap.
+Inputs (the files ``read.*`` nodes read) follow the export paths' rules inside the inputs
+folder (the graph's folder unless the run names one): :func:`resolve_input`, then
+:func:`read_input`, under :data:`MAX_INPUT_BYTES`.
 """
 
 from __future__ import annotations
@@ -333,47 +329,16 @@ def _running(pid: int) -> bool:
     return True
 
 
-def read_regular(path: str | os.PathLike[str], *, max_bytes: int = MAX_INPUT_BYTES) -> bytes:
-    """The bytes of the regular file ``path``, refusing anything else and anything larger
-    than ``max_bytes``.
 
-    Opened without blocking (``O_NONBLOCK``) and checked with ``fstat`` on the open file, so
-    a FIFO, a socket or a device is refused at once instead of hanging the run, and a file
-    swapped after the check is not the one read.
-
-    Raises
-    ------
-    PathError
-        A missing file, something other than a regular file, or one over the cap.
-    """
-    name = os.fspath(path)
-    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_BINARY", 0)
+def read_input(path: str | os.PathLike[str], max_bytes: int = MAX_INPUT_BYTES) -> bytes:
+    """The bytes of an input file (:func:`read_regular`), its refusal a :class:`PathError`
+    saying why in a sentence ("does not exist", "is a FIFO (named pipe), not a regular file",
+    "is larger than 1024 MiB")."""
     try:
-        fd = os.open(name, flags)
+        return read_regular(path, max_bytes=max_bytes)
     except FileNotFoundError:
-        raise PathError(f"{name!r} does not exist") from None
+        raise PathError(f"{os.fspath(path)!r} does not exist") from None
     except OSError as exc:
-        raise PathError(f"cannot open {name!r}: {exc.strerror or exc}") from None
-    try:
-        info = os.fstat(fd)
-        if not stat.S_ISREG(info.st_mode):
-            kind = "a folder" if stat.S_ISDIR(info.st_mode) else "not a regular file"
-            raise PathError(f"{name!r} is {kind}; only regular files are read")
-        if info.st_size > max_bytes:
-            raise PathError(
-                f"{name!r} is {info.st_size:,} bytes, over the cap of {max_bytes:,} bytes"
-            )
-        chunks, total = [], 0
-        while total <= max_bytes:  # a file growing while read is still capped
-            chunk = os.read(fd, min(1 << 24, max_bytes + 1 - total))
-            if not chunk:
-                break
-            chunks.append(chunk)
-            total += len(chunk)
-        if total > max_bytes:
-            raise PathError(f"{name!r} grew past the cap of {max_bytes:,} bytes while read")
-        return chunks[0] if len(chunks) == 1 else b"".join(chunks)
-    except OSError as exc:
-        raise PathError(f"cannot read {name!r}: {exc.strerror or exc}") from None
-    finally:
-        os.close(fd)
+        why = exc.strerror or str(exc)
+        why = why[3:] if why.startswith("it ") else why
+        raise PathError(f"{os.fspath(path)!r} {why}") from None

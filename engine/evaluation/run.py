@@ -206,7 +206,7 @@ class _Run(LanguageRun, SimulationRun):
         except PathError as exc:
             raise PathError([Problem(here, p.message) for p in exc.problems]) from None
         try:
-            data = safety.read_regular(path, max_bytes=safety.MAX_INPUT_BYTES)
+            data = safety.read_input(path)
         except PathError as exc:
             raise PathError(
                 [Problem(here, f"cannot read input {relpath!r}: {p.message}") for p in exc.problems]
@@ -221,7 +221,7 @@ class _Run(LanguageRun, SimulationRun):
         if held is not None:
             return held
         path = safety.resolve_input(self.g.input_root, relpath, self.g.input_base)
-        return path, safety.read_regular(path, max_bytes=safety.MAX_INPUT_BYTES)
+        return path, safety.read_input(path)
 
     def key_part(self, name: str, port: str, spec: NodeSpec, value: Input) -> Any:
         if isinstance(value, Wire):

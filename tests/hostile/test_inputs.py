@@ -76,11 +76,11 @@ def test_a_folder_is_not_a_file(tmp_path):
         fg.load(_graph(tmp_path, "d.stl")).evaluate("m")
 
 
-def test_read_regular_caps_the_size(tmp_path):
+def test_read_input_caps_the_size(tmp_path):
     (tmp_path / "big.bin").write_bytes(b"x" * 1000)
-    assert safety.read_regular(tmp_path / "big.bin", max_bytes=1000) == b"x" * 1000
-    with pytest.raises(fg.PathError, match="over the cap of 999 bytes"):
-        safety.read_regular(tmp_path / "big.bin", max_bytes=999)
+    assert safety.read_input(tmp_path / "big.bin", max_bytes=1000) == b"x" * 1000
+    with pytest.raises(fg.PathError, match="is larger than 999 bytes"):
+        safety.read_input(tmp_path / "big.bin", max_bytes=999)
 
 
 def test_a_huge_claimed_triangle_count_allocates_nothing(tmp_path):
