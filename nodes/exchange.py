@@ -8,7 +8,6 @@ returns the written file's path.
 
 from __future__ import annotations
 
-import re
 from enum import Enum
 
 import numpy as np
@@ -17,7 +16,7 @@ from formgraph.core.errors import InputError
 from formgraph.core.registry import Context, node
 from formgraph.core.types import OutputPath
 from formgraph.geometry import Curve, Mesh, NurbsCurve, NurbsSurface, Surface
-from formgraph.kernels.io import gltf, rhino, step, threemf
+from formgraph.kernels.io import colors, gltf, rhino, step, threemf
 from formgraph.kernels.io.exporters import mesh_report
 from formgraph.kernels.mesh import meshops
 
@@ -31,35 +30,10 @@ class Unit(str, Enum):
     meter = "meter"
 
 
-# the CSS basic colour keywords (CSS Color Module Level 4, section 6.1)
-_NAMED = {
-    "black": "000000", "silver": "c0c0c0", "gray": "808080", "grey": "808080",
-    "white": "ffffff", "maroon": "800000", "red": "ff0000", "purple": "800080",
-    "fuchsia": "ff00ff", "magenta": "ff00ff", "green": "008000", "lime": "00ff00",
-    "olive": "808000", "yellow": "ffff00", "navy": "000080", "blue": "0000ff",
-    "teal": "008080", "aqua": "00ffff", "cyan": "00ffff", "orange": "ffa500",
-}  # fmt: skip
-
-
 def css_rgba(text: str) -> tuple[float, float, float, float]:
-    """A CSS colour (``#rgb``, ``#rrggbb``, ``#rrggbbaa`` or a basic keyword) as 0..1 RGBA.
-
-    Raises
-    ------
-    ValueError
-        For anything else.
-    """
-    t = str(text).strip().lower()
-    t = "#" + _NAMED[t] if t in _NAMED else t
-    if re.fullmatch(r"#[0-9a-f]{3}", t):
-        t = "#" + "".join(c * 2 for c in t[1:])
-    if not re.fullmatch(r"#[0-9a-f]{6}([0-9a-f]{2})?", t):
-        raise ValueError(
-            f"{text!r} is not a colour: write #rrggbb, #rgb or a name such as red or navy"
-        )
-    t = t + "ff" if len(t) == 7 else t
-    r, g, b, a = (int(t[k : k + 2], 16) / 255 for k in (1, 3, 5, 7))
-    return (r, g, b, a)
+    """A CSS colour (:func:`formgraph.kernels.io.colors.css_color`) as opaque 0..1 RGBA."""
+    r, g, b = colors.rgb(text)
+    return (r / 255, g / 255, b / 255, 1.0)
 
 
 def _triangles(meshes: list[Mesh], ctx: Context) -> list[tuple[np.ndarray, np.ndarray]]:

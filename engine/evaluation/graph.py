@@ -200,7 +200,7 @@ class Graph:
 
     def _input_files(self) -> list[Path]:
         from ..core import safety
-        from ..language.model import Literal
+        from ..language.model import Expr, Literal
 
         found: list[Path] = []
         types = node_types()
@@ -208,13 +208,17 @@ class Graph:
             spec = types.get(nd.type)
             for port in spec.input_paths if spec is not None else ():
                 value = nd.inputs.get(port)
-                if isinstance(value, Literal) and isinstance(value.value, str):
-                    try:
-                        found.append(
-                            safety.resolve_input(self.input_root, value.value, self.input_base)
-                        )
-                    except GraphError:
-                        continue  # the check says why
+                try:
+                    if isinstance(value, Literal):
+                        text = value.value
+                    elif isinstance(value, Expr):  # a path from a param: its current value
+                        text = value.value(self._values)
+                    else:
+                        continue
+                    if isinstance(text, str):
+                        found.append(safety.resolve_input(self.input_root, text, self.input_base))
+                except (GraphError, ValueError, TypeError, ZeroDivisionError):
+                    continue  # the check or the run says why
         return list(dict.fromkeys(found))
 
     def as_node_spec(self) -> SubgraphSpec:

@@ -33,14 +33,20 @@ _WIDTH = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT4": 16}
 
 def vertex_normals(v: np.ndarray, tris: np.ndarray) -> np.ndarray:
     """Unit vertex normals: the sum of the (area-weighted) normals of the triangles around
-    each vertex; a vertex on no triangle gets +z."""
-    n = np.cross(v[tris[:, 1]] - v[tris[:, 0]], v[tris[:, 2]] - v[tris[:, 0]])
-    acc = np.zeros_like(v)
-    for k in range(3):
-        for c in range(3):
-            acc[:, c] += np.bincount(tris[:, k], weights=n[:, c], minlength=len(v))
-    length = np.linalg.norm(acc, axis=1)
-    out = np.zeros_like(v)
+    each vertex, in float32 (what glTF stores); a vertex on no triangle gets +z."""
+    p = np.asarray(v, dtype=np.float32)
+    a = p[tris[:, 1]] - p[tris[:, 0]]
+    b = p[tris[:, 2]] - p[tris[:, 0]]
+    n = np.empty_like(a)
+    n[:, 0] = a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]
+    n[:, 1] = a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]
+    n[:, 2] = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+    corners = tris.ravel()
+    acc = np.empty((len(p), 3), dtype=np.float64)
+    for c in range(3):  # each corner of each triangle adds its triangle's normal
+        acc[:, c] = np.bincount(corners, weights=np.repeat(n[:, c], 3), minlength=len(p))
+    length = np.sqrt(np.einsum("ij,ij->i", acc, acc))
+    out = np.zeros((len(p), 3), dtype=np.float32)
     out[:, 2] = 1.0
     ok = length > 0
     out[ok] = acc[ok] / length[ok, None]

@@ -82,16 +82,16 @@ def _reals(x: np.ndarray) -> np.ndarray:
     x = np.asarray(x, dtype=np.float64) + 0.0  # -0.0 -> 0.0
     canvas = float_words(x).view(np.uint8).copy()
     # repr writes 1e-05 / 1.5e+16: STEP wants an upper-case E and a '.' in the mantissa
-    has_e = (canvas == ord("e")).any(axis=1)
-    canvas[canvas == ord("e")] = ord("E")
-    if has_e.any():
-        for i in np.flatnonzero(has_e):  # rare: exponents outside 1e-4 .. 1e16
-            text = squeeze(canvas[i : i + 1]).decode()
-            mant, exp = text.split("E")
-            text = (mant if "." in mant else mant + ".") + "E" + exp
-            row = np.zeros(canvas.shape[1], np.uint8)
-            row[: len(text)] = np.frombuffer(text.encode(), np.uint8)
-            canvas[i] = row
+    is_e = canvas == ord("e")
+    canvas[is_e] = ord("E")
+    bare = np.flatnonzero(is_e.any(axis=1) & ~(canvas == ord(".")).any(axis=1))
+    if bare.size:  # a one-digit mantissa ('1e-05'): the point goes before the E
+        at = np.argmax(is_e[bare], axis=1)[:, None]
+        cols = np.arange(canvas.shape[1])[None, :]
+        rows = canvas[bare]
+        moved = np.take_along_axis(rows, np.where(cols > at, cols - 1, cols), axis=1)
+        moved[cols == at] = ord(".")
+        canvas[bare] = moved
     return canvas
 
 
@@ -100,11 +100,19 @@ def _real(x: float) -> str:
 
 
 def _refs(ids) -> str:
-    return "(" + ",".join(f"#{int(i)}" for i in ids) + ")"
+    """``(#1,#2,...)``, laid out in one array operation."""
+    ids = np.asarray(ids, dtype=np.int64).ravel()
+    if ids.size == 0:
+        return "()"
+    return "(" + join_rows([b"#", format_int(ids)], b",").decode()[:-1] + ")"
 
 
 def _reals_text(values) -> str:
-    return "(" + ",".join(_real(v) for v in np.ravel(values)) + ")"
+    """``(a,b,c)`` of the values' STEP reals, formatted in one array operation."""
+    x = np.ravel(np.asarray(values, dtype=np.float64))
+    if x.size == 0:
+        return "()"
+    return "(" + join_rows([_reals(x)], b",").decode()[:-1] + ")"
 
 
 def _knot_lists(knots: np.ndarray) -> tuple[str, str]:
@@ -226,17 +234,28 @@ def _surface_face(f: _File, s: Surface) -> int:
     return f.add(f"ADVANCED_FACE('',(#{bound}),#{surf},.T.)")
 
 
-def _mesh_faces(f: _File, v: np.ndarray, fi: np.ndarray, fo: np.ndarray) -> list[int]:
-    """One planar face per polygon: POLY_LOOP of shared vertex points, its plane."""
+def _rows(f: _File, parts: list, end: bytes = b");\n") -> None:
+    """Entity lines laid out in bulk: ``parts`` as for :func:`join_rows`."""
+    f.parts.append(join_rows(parts, end))
+
+
+def _ids(f: _File, n: int) -> np.ndarray:
+    out = np.arange(f.next, f.next + n, dtype=np.int64)
+    f.next += n
+    return out
+
+
+def _mesh_faces(f: _File, v: np.ndarray, fi: np.ndarray, fo: np.ndarray) -> np.ndarray:
+    """One planar face per polygon (a ``POLY_LOOP`` of the shared vertex points on its
+    ``PLANE``), every entity kind laid out for all faces at once; the faces' ids."""
     pid = f.points(v)
-    faces = []
     sizes = np.diff(fo)
-    # Newell normals and centroids, all faces at once
+    nf = sizes.size
+    # Newell normals (exact for planar polygons, a best fit otherwise), all faces at once
     nxt = np.arange(fi.size) + 1
     nxt[fo[1:] - 1] = fo[:-1]
     a, b = v[fi], v[fi[nxt]]
-    face_of = np.repeat(np.arange(sizes.size), sizes)
-    n = np.zeros((sizes.size, 3))
+    face_of = np.repeat(np.arange(nf), sizes)
     cross = np.stack(
         [
             (a[:, 1] - b[:, 1]) * (a[:, 2] + b[:, 2]),
@@ -245,26 +264,44 @@ def _mesh_faces(f: _File, v: np.ndarray, fi: np.ndarray, fo: np.ndarray) -> list
         ],
         axis=1,
     )
-    for c in range(3):
-        n[:, c] = np.bincount(face_of, weights=cross[:, c], minlength=sizes.size)
+    n = np.stack([np.bincount(face_of, weights=cross[:, c], minlength=nf) for c in range(3)], 1)
     length = np.linalg.norm(n, axis=1)
     n = np.where(length[:, None] > 0, n / np.where(length > 0, length, 1)[:, None], [0, 0, 1])
-    ref = v[fi[fo[1:] - 1]] - v[fi[fo[:-1]]]
+    ref = v[fi[fo[:-1] + 1]] - v[fi[fo[:-1]]]
     ref = ref - (ref * n).sum(1)[:, None] * n
-    rl = np.linalg.norm(ref, axis=1)
-    alt = np.where(np.abs(n[:, 0:1]) < 0.9, [[1.0, 0, 0]], [[0, 1.0, 0]])
+    alt = np.where(np.abs(n[:, :1]) < 0.9, [[1.0, 0, 0]], [[0, 1.0, 0]])
     alt = alt - (alt * n).sum(1)[:, None] * n
-    ref = np.where(rl[:, None] > 0, ref, alt)
+    ref = np.where(np.linalg.norm(ref, axis=1)[:, None] > 1e-300, ref, alt)
     ref /= np.linalg.norm(ref, axis=1)[:, None]
-    origin = f.points(v[fi[fo[:-1]]])
-    for k in range(sizes.size):
-        loop = f.add(f"POLY_LOOP('',{_refs(pid[fi[fo[k] : fo[k + 1]]])})")
-        bound = f.add(f"FACE_OUTER_BOUND('',#{loop},.T.)")
-        axis = f.add(f"DIRECTION('',{_reals_text(n[k])})")
-        refd = f.add(f"DIRECTION('',{_reals_text(ref[k])})")
-        place = f.add(f"AXIS2_PLACEMENT_3D('',#{origin[k]},#{axis},#{refd})")
-        plane = f.add(f"PLANE('',#{place})")
-        faces.append(f.add(f"FACE_SURFACE('',(#{bound}),#{plane},.T.)"))
+    loops, bounds, axes, refs, places, planes, faces = (_ids(f, nf) for _ in range(7))
+    for size in np.unique(sizes):  # POLY_LOOPs, one layout per polygon size
+        k = np.flatnonzero(sizes == size)
+        corner = fi[fo[k][:, None] + np.arange(size)]
+        parts: list = [b"#", format_int(loops[k]), b"=POLY_LOOP('',("]
+        for j in range(size):
+            parts += [b"#" if j == 0 else b",#", format_int(pid[corner[:, j]])]
+        _rows(f, parts, b"));\n")
+    _rows(f, [b"#", format_int(bounds), b"=FACE_OUTER_BOUND('',#", format_int(loops)], b",.T.);\n")
+    for ids, d in ((axes, n), (refs, ref)):
+        cols = [_reals(d[:, c]) for c in range(3)]
+        _rows(
+            f,
+            [b"#", format_int(ids), b"=DIRECTION('',(", cols[0], b",", cols[1], b",", cols[2]],
+            b"));\n",
+        )
+    _rows(
+        f,
+        [b"#", format_int(places), b"=AXIS2_PLACEMENT_3D('',#", format_int(pid[fi[fo[:-1]]]),
+         b",#", format_int(axes), b",#", format_int(refs)],
+        b");\n",
+    )  # fmt: skip
+    _rows(f, [b"#", format_int(planes), b"=PLANE('',#", format_int(places)], b");\n")
+    _rows(
+        f,
+        [b"#", format_int(faces), b"=FACE_SURFACE('',(#", format_int(bounds), b"),#",
+         format_int(planes)],
+        b",.T.);\n",
+    )  # fmt: skip
     return faces
 
 

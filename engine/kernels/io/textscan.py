@@ -52,18 +52,18 @@ class Lines:
     def text(self, which: np.ndarray, skip: int = 0) -> tuple[np.ndarray, np.ndarray]:
         """The bytes of the chosen lines joined by newlines, the first ``skip`` bytes of each
         blanked, and each chosen line's start in that text."""
-        starts, ends = self.starts[which], self.ends[which]
-        lengths = ends - starts + 1  # with the newline (or a stand-in for the last line)
-        buf = self.buf
-        if ends.size and ends[-1] >= buf.size:  # the last line has no newline
-            buf = np.concatenate([buf, np.array([10], np.uint8)])
-        keep = np.zeros(buf.size + 1, dtype=np.int8)
-        keep[starts] += 1  # neither array repeats an offset; one may meet the other
-        keep[ends + 1] -= 1
-        out = buf[np.cumsum(keep[:-1]) > 0]
+        which = np.asarray(which, dtype=bool)
+        # every line with its newline covers the buffer exactly: repeat the choice per byte
+        spans = np.diff(np.concatenate([self.starts, [self.buf.size]]))
+        out = self.buf[np.repeat(which, spans)]
+        lengths = spans[which]
+        if which.size and which[-1] and (out.size == 0 or out[-1] != 10):
+            out = np.concatenate([out, np.array([10], np.uint8)])  # the last line's newline
+            lengths = lengths.copy()
+            lengths[-1] += 1
         new_starts = np.concatenate([[0], np.cumsum(lengths)[:-1]]).astype(np.int64)
         if skip:
-            out = out.copy()
+            out = out.copy() if not out.flags.writeable or out.base is not None else out
             out[(new_starts[:, None] + np.arange(skip)).ravel()] = 32
         return out, new_starts
 
@@ -125,23 +125,25 @@ def ints_at(buf: np.ndarray, starts: np.ndarray) -> tuple[np.ndarray, np.ndarray
     starts = np.asarray(starts, dtype=np.int64)
     if starts.size == 0:
         return np.zeros(0, np.int64), starts
+    n = buf.size
     negative = buf[starts] == 45
-    first = starts + negative
-    nondigit = np.flatnonzero(~_DIGIT[buf])
-    ends = nondigit[np.minimum(np.searchsorted(nondigit, first), nondigit.size - 1)]
-    ends = (
-        np.where(ends < first, buf.size, ends) if nondigit.size else np.full_like(first, buf.size)
-    )
-    length = ends - first
-    if length.min() < 1:
-        at = int(starts[np.argmin(length)])
-        word = bytes(buf[at : at + 20]).split()[0][:20] if buf[at:].strip().size else b""
-        raise ValueError(f"{word.decode('latin-1')!r} is not an index")
-    if length.max() > 18:
-        raise ValueError("an index has more than 18 digits")
-    digits = buf.astype(np.int64) - 48
+    at = starts + negative
     value = np.zeros(starts.size, np.int64)
-    for k in range(int(length.max())):
-        on = length > k
-        value[on] = value[on] * 10 + digits[first[on] + k]
-    return np.where(negative, -value, value), ends
+    length = np.zeros(starts.size, np.int64)
+    alive = np.ones(starts.size, dtype=bool)
+    for _ in range(19):  # digit by digit, all numbers at once; a run ends at its first non-digit
+        inside = at < n
+        b = buf[np.minimum(at, n - 1)]
+        alive &= inside & _DIGIT[b]
+        if not alive.any():
+            break
+        value = np.where(alive, value * 10 + (b.astype(np.int64) - 48), value)
+        length += alive
+        at += alive
+    if alive.any():
+        raise ValueError("an index has more than 18 digits")
+    if length.min() < 1:
+        k = int(starts[np.argmin(length)])
+        word = bytes(buf[k : k + 20]).split()
+        raise ValueError(f"{(word[0] if word else b'').decode('latin-1')!r} is not an index")
+    return np.where(negative, -value, value), at
