@@ -152,8 +152,14 @@ def _clamp_curve(c: Curve) -> Curve:
 
 def _curve_entity(f: _File, c: Curve, closed: bool = False) -> int:
     cp, p, k, w = _clamp_curve(c)
-    ids = f.points(cp)
-    mults, values = _knot_lists(k)
+    return _curve_on(f, f.points(cp), p, _knot_lists(k), w, closed)
+
+
+def _curve_on(
+    f: _File, ids: np.ndarray, p: int, knots: tuple[str, str], w, closed: bool = False
+) -> int:
+    """A B-spline curve entity on existing points (``ids``) and knot lists."""
+    mults, values = knots
     flag = ".T." if closed else ".F."
     if w is None or np.all(w == w[0]):
         return f.add(
@@ -168,11 +174,28 @@ def _curve_entity(f: _File, c: Curve, closed: bool = False) -> int:
     )
 
 
+def _ref_rows(ids: np.ndarray) -> str:
+    """``((#1,#2),(#3,#4))`` of a grid of ids, laid out as one canvas."""
+    nu, nv = ids.shape
+    digits = format_int(ids.ravel())
+    w = digits.shape[1]
+    cells = np.zeros((nu, nv, w + 2), dtype=np.uint8)
+    cells[:, :, 0] = ord("#")
+    cells[:, :, 1 : w + 1] = digits.reshape(nu, nv, w)
+    cells[:, :, w + 1] = ord(",")
+    rows = np.zeros((nu, nv * (w + 2) + 2), dtype=np.uint8)
+    rows[:, 0] = ord("(")
+    rows[:, 1:-1] = cells.reshape(nu, -1)
+    rows[:, -2] = ord(")")  # the last cell's comma closes the row
+    rows[:, -1] = ord(",")
+    return "(" + squeeze(rows).decode()[:-1] + ")"
+
+
 def _surface_face(f: _File, s: Surface) -> int:
     cp, du, dv, ku, kv, w = _clamp_surface(s)
     nu, nv = cp.shape[:2]
     ids = f.points(cp.reshape(-1, 3)).reshape(nu, nv)
-    rows = "(" + ",".join(_refs(r) for r in ids) + ")"
+    rows = _ref_rows(ids)
     mu, vu = _knot_lists(ku)
     mv, vv = _knot_lists(kv)
     if w is None or np.all(w == w.flat[0]):
@@ -189,13 +212,16 @@ def _surface_face(f: _File, s: Surface) -> int:
             f"REPRESENTATION_ITEM('')SURFACE())"
         )
     # the domain's four sides, counter-clockwise in (u, v): v = v0, u = u1, v = v1, u = u0
+    # each side's curve stands on the net's own boundary points and the surface's knots
     wu = None if w is None else w
+    side_ids = [ids[:, 0], ids[-1, :], ids[:, -1], ids[0, :]]
     sides = [
-        (cp[:, 0], du, ku, None if wu is None else wu[:, 0]),
-        (cp[-1, :], dv, kv, None if wu is None else wu[-1, :]),
-        (cp[:, -1], du, ku, None if wu is None else wu[:, -1]),
-        (cp[0, :], dv, kv, None if wu is None else wu[0, :]),
+        (cp[:, 0], du, (mu, vu), None if wu is None else wu[:, 0]),
+        (cp[-1, :], dv, (mv, vv), None if wu is None else wu[-1, :]),
+        (cp[:, -1], du, (mu, vu), None if wu is None else wu[:, -1]),
+        (cp[0, :], dv, (mv, vv), None if wu is None else wu[0, :]),
     ]
+    corner_ids = [ids[0, 0], ids[-1, 0], ids[-1, -1], ids[0, -1]]
     forward = [True, True, False, False]
     corners = [cp[0, 0], cp[-1, 0], cp[-1, -1], cp[0, -1]]
     scale = float(np.abs(cp).max()) or 1.0
@@ -206,8 +232,7 @@ def _surface_face(f: _File, s: Surface) -> int:
                 vertex_ids.append(vertex_ids[j])
                 break
         else:
-            (pid,) = f.points(c[None])
-            vertex_ids.append(f.add(f"VERTEX_POINT('',#{pid})"))
+            vertex_ids.append(f.add(f"VERTEX_POINT('',#{corner_ids[len(vertex_ids)]})"))
     edges: list[int | None] = [None] * 4
     oriented = []
     for k, (pts, deg, kn, ww) in enumerate(sides):
@@ -222,7 +247,7 @@ def _surface_face(f: _File, s: Surface) -> int:
             if edges[o] is not None and np.allclose(pts, sides[o][0], rtol=0, atol=1e-12 * scale):
                 twin = edges[o]
         if twin is None:
-            curve = _curve_entity(f, (pts, deg, kn, ww))
+            curve = _curve_on(f, side_ids[k], deg, kn, ww)
             twin = f.add(f"EDGE_CURVE('',#{start},#{end},#{curve},.T.)")
             edges[k] = twin
             same = forward[k]  # sides 2 and 3 run against their curves' parameter
