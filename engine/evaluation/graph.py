@@ -217,8 +217,8 @@ class Graph:
                         continue
                     if isinstance(text, str):
                         found.append(safety.resolve_input(self.input_root, text, self.input_base))
-                except (GraphError, ValueError, TypeError, ZeroDivisionError):
-                    continue  # the check or the run says why
+                except (GraphError, KeyError, ValueError, TypeError, ZeroDivisionError):
+                    continue  # a loop's or a missing param's: the check or the run says why
         return list(dict.fromkeys(found))
 
     def as_node_spec(self) -> SubgraphSpec:

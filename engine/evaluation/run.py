@@ -177,10 +177,18 @@ class _Run(LanguageRun, SimulationRun):
                     "params": {n: self.tokens.get(n, self.values[n]) for n in names},
                     "wires": [self.key_part(name, port, spec, w) for w in wires_of(value)],
                 }
+                if port in spec.input_paths:  # a file per item, read when the item runs:
+                    parts["inputs"][port]["unkeyed"] = os.urandom(8).hex()  # never trusted
                 continue
             parts["inputs"][port] = self.key_part(name, port, spec, value)
-            if port in spec.input_paths and not wires_of(value):
-                parts["inputs"][port] = self.input_file(name, port, parts["inputs"][port])
+            if port in spec.input_paths:
+                if wires_of(value):  # a path known only when its wire runs: never trusted
+                    parts["inputs"][port] = {
+                        "wired": parts["inputs"][port],
+                        "unkeyed": os.urandom(8).hex(),
+                    }
+                else:
+                    parts["inputs"][port] = self.input_file(name, port, parts["inputs"][port])
         if spec.is_export:
             parts["out_dir"] = self.out_dir
         if sim is not None:
