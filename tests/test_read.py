@@ -336,3 +336,27 @@ def test_run_with_set_file_from_the_command_line(tmp_path):
     r = cli("run", str(tmp_path / "g.yaml"), "--set", "part=scan.stl", "--no-cache", cwd=tmp_path)
     assert r.returncode == 0, r.stderr
     assert "80" in r.stdout
+
+
+def test_headless_watch_redraws_when_an_input_file_changes(tmp_path):
+    pytest.importorskip("pyvista")
+    import os
+    import time
+
+    from formgraph import viewer
+
+    (tmp_path / "data").mkdir()
+    trimesh.creation.box().export(tmp_path / "data" / "part.stl")
+    graph = _graph(tmp_path, "  m: {type: read.mesh, path: part.stl, weld: true}\n")
+    png, out, err = tmp_path / "m.png", io.StringIO(), io.StringIO()
+    w = viewer.ScreenshotWatcher(
+        graph, png, "m", size=(160, 120), out=out, err=err, out_dir=tmp_path / "o",
+        inputs_dir=tmp_path / "data",
+    )  # fmt: skip
+    assert w.reload() is True and (tmp_path / "data" / "part.stl").resolve() in w.files
+    assert w.poll() is None
+    trimesh.creation.icosphere(1).export(tmp_path / "data" / "part.stl")
+    later = time.time() + 5
+    os.utime(tmp_path / "data" / "part.stl", (later, later))  # a new stamp, even on coarse clocks
+    assert w.poll() is True, err.getvalue()
+    assert "80 faces" in out.getvalue() or len(out.getvalue().splitlines()) == 2

@@ -278,6 +278,7 @@ def cmd_watch(args: argparse.Namespace) -> int:
     options = dict(
         sets=args.set,
         out_dir=args.out,
+        inputs_dir=args.inputs,
         budget=args.budget,
         size=size,
         layout=args.layout,
