@@ -78,6 +78,11 @@ class OutputPath(str):
     """A relative output path, checked not to leave the output directory."""
 
 
+class InputPath(str):
+    """A relative path of a file a node reads, checked not to leave the inputs folder; the
+    file's bytes are part of the node's cache key."""
+
+
 def number_text(x: float) -> str:
     """A number for a message: ``%g`` style, and an int too large for a float by its size."""
     if isinstance(x, int) and not -(10**15) < x < 10**15:
@@ -193,6 +198,10 @@ class PortType:
     @functools.cached_property
     def is_output_path(self) -> bool:
         return any(k.base is OutputPath for k in self.kinds)
+
+    @functools.cached_property
+    def is_input_path(self) -> bool:
+        return any(k.base is InputPath for k in self.kinds)
 
     @functools.cached_property
     def is_geometry(self) -> bool:
@@ -378,7 +387,7 @@ def _coerce_kind(k: Kind, value: Any) -> Any:
         if not math.isfinite(f):
             raise TypeMismatch(f"expected a finite float, got {f}")
         return f
-    if base in (str, Expression, OutputPath):
+    if base in (str, Expression, OutputPath, InputPath):
         if isinstance(value, str):
             return value
         raise TypeMismatch(f"expected {base.__name__}, got {describe(value)}")
