@@ -11,12 +11,14 @@ JSON-able scalars, for the on-disk cache; no pickle). The math lives in
 - ``curves``: :class:`Curve`, :class:`NurbsCurve`, :class:`ParametricCurve`
 - ``surfaces``: :class:`Surface`, :class:`NurbsSurface`, :class:`ParametricSurface`
 - ``mesh``: :class:`Mesh`
+- ``field``: :class:`Field`, a signed distance function kept as its recipe
 """
 
 from __future__ import annotations
 
 from .base import STORABLE, Geometry, as_xyz, from_state, frozen_array, is_frozen, storable
 from .curves import Curve, NurbsCurve, ParametricCurve
+from .field import Field
 from .mesh import Mesh
 from .points import Points
 from .surfaces import NurbsSurface, ParametricSurface, Surface
@@ -24,6 +26,7 @@ from .surfaces import NurbsSurface, ParametricSurface, Surface
 __all__ = [
     "STORABLE",
     "Curve",
+    "Field",
     "Geometry",
     "Mesh",
     "NurbsCurve",
