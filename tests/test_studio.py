@@ -271,6 +271,7 @@ class Studio:
 
     def __init__(self, graph: Path, out: Path):
         self.graph = graph
+        self.out = out
         self.proc = subprocess.Popen(
             [
                 sys.executable,
@@ -485,6 +486,35 @@ def test_save_writes_the_file(page, studio):
     assert sorted(p.name for p in studio.graph.parent.iterdir() if p.is_file()) == [
         "spiral_tube.yaml"
     ]
+
+
+def test_click_a_node_shows_it(page):
+    before = _canvas(page)
+    page.locator("#graph [data-node='spiral']").click()
+    page.wait_for_function("document.querySelector('#graph').innerText.includes('showing spiral')")
+    curve = _wait_picture(page, before)
+    assert _shows_model(curve) < _shows_model(before) / 2  # a thin curve, not the tube
+    page.get_by_text("show results").click()
+    page.wait_for_function("document.querySelector('#graph').innerText.includes('results')")
+    _wait_picture(page, curve)
+
+
+def test_an_edit_on_disk_reloads(page, studio):
+    text = studio.graph.read_text()
+    studio.graph.write_text(text.replace("default: 3, min: 1", "default: 2, min: 1"))
+    page.wait_for_function(
+        "document.querySelector('#editor').innerText.includes('default:\u00a02,')"
+    )
+    page.wait_for_function("document.querySelector('#status').innerText.includes('computed')")
+    assert "turns = 4" in page.inner_text("#controls")  # the control's value is kept
+
+
+def test_run_writes_the_exports(page, studio):
+    page.click("#run")
+    page.wait_for_function("document.querySelector('#status').innerText.includes('wrote')")
+    assert "tube.stl" in _status(page)
+    stl = studio.out / "tube.stl"
+    assert stl.read_bytes()[:5] != b"solid" and stl.stat().st_size > 100_000  # binary STL
 
 
 def test_page_without_the_token_is_refused(page, studio):

@@ -114,7 +114,7 @@ class Page:
         self.controls: list[Control] = []
         self._wanted: dict[str, Any] = {}  # the controls' values, as the page last set them
         self._edit_timer: Any = None
-        self._fitted = False
+        self._framed: tuple[float, ...] | None = None  # the bounds the camera was fit to
         self.updates = 0  # view updates sent (for the bench)
         self.timings: list[dict[str, float]] = []
         from formgraph.viewer.watch import _Watched
@@ -465,17 +465,24 @@ class Page:
         self.state.graph_svg = clickable_svg(drawing)
 
     def _picture(self, cooked: Cooked) -> None:
+        from formgraph.viewer.app import _camera_lost
+
         from .scene import send_back_faces
 
         added = self.scene.update(cooked.shown)
         send_back_faces()
-        if not self._fitted or added:
+        bounds = self.scene.bounds()
+        first = self._framed is None
+        if first:
             self.plotter.reset_camera()
-            self.plotter.renderer.ResetCameraClippingRange()
         self.view.update()
-        if not self._fitted or added:
+        if first:
             self.view.push_camera()
-            self._fitted = True
+        elif added or _camera_lost(self._framed, bounds):
+            # framed again in the browser, keeping the direction the user turned it to
+            self.view.reset_camera()
+        if first or added or _camera_lost(self._framed, bounds):
+            self._framed = bounds
         self.updates += 1
 
 
