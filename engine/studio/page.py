@@ -115,8 +115,7 @@ class Page:
         self._wanted: dict[str, Any] = {}  # the controls' values, as the page last set them
         self._edit_timer: Any = None
         self._framed: tuple[float, ...] | None = None  # the bounds the camera was fit to
-        self.updates = 0  # view updates sent (for the bench)
-        self.timings: list[dict[str, float]] = []
+        self.updates = 0  # view updates sent
         from formgraph.viewer.watch import _Watched
 
         page = self
@@ -130,6 +129,7 @@ class Page:
                 return True
 
         self.watch = DiskWatch(session.path, None, (), session.out_dir, session.budget, "", None)
+        self.watch.stamp = self.watch._stamp()  # the first load reads this version
         self._init_state()
         self._build()
         self.ctrl.on_server_bind.add(self._bind)
@@ -151,6 +151,7 @@ class Page:
         s.shown = "the graph's results"
         s.busy = False
         s.cook_id = 0  # bumped after each picture sent (the bench waits on it)
+        s.timing = {}  # where the last request's time went (read by bench/bench_studio.py)
 
         @s.change("text")
         def _edited(text: str, **_: Any) -> None:
@@ -192,6 +193,7 @@ class Page:
                     id="status",
                 )
                 v.VSpacer()
+                html.Div("{{ JSON.stringify(timing) }}", id="timing", style="display: none")
                 v.VProgressCircular(
                     v_show=("busy",), indeterminate=True, size=18, width=2, classes="mr-3"
                 )
@@ -378,8 +380,17 @@ class Page:
     # ---------------------------------------------------------------- engine -> page
 
     def _deliver(self, kind: str, result: Any, seconds: float) -> None:
-        if self.loop is not None:
-            self.loop.call_soon_threadsafe(self._apply, kind, result, seconds)
+        """In the worker thread: what can be made away from the page's loop (the datasets
+        of the picture, the graph's drawing), then the rest on the loop."""
+        if self.loop is None:
+            return
+        t0 = time.perf_counter()
+        prepared = None
+        if isinstance(result, Cooked):
+            datasets = self.scene.prepare(result.shown) if result.ok and kind != "run" else None
+            prepared = (datasets, self._drawing(result))
+        seconds += time.perf_counter() - t0
+        self.loop.call_soon_threadsafe(self._apply, kind, result, seconds, prepared)
 
     def _worker_error(self, kind: str, exc: BaseException) -> None:
         message = f"internal error ({kind}): {type(exc).__name__}: {exc}"
@@ -392,7 +403,7 @@ class Page:
             self.state.status = text
             self.state.status_bad = bad
 
-    def _apply(self, kind: str, result: Any, seconds: float) -> None:
+    def _apply(self, kind: str, result: Any, seconds: float, prepared: Any = None) -> None:
         t0 = time.perf_counter()
         name = self.session.path.name
         if kind == "save":
@@ -401,7 +412,11 @@ class Page:
             self._say(f"{name}: {text}", status != "ok")
             return
         cooked: Cooked = result
+        datasets, svg = prepared if prepared is not None else (None, None)
         s = self.state
+        if datasets is not None:  # the picture first: its arrays are what takes longest
+            self._picture(datasets)
+        t1 = time.perf_counter()
         with s:
             if kind == "text":
                 if self.session.text != s.text:
@@ -413,7 +428,8 @@ class Page:
                 s.status = f"{name}: ran in {_ms(cooked.seconds)}, wrote {written} into "
                 s.status += f"{self.session.out_dir}"
                 s.status_bad = False
-                self._drawing(cooked)
+                if svg is not None:
+                    s.graph_svg = svg
                 return
             s.problems = _problem_lines(cooked.problems)
             if cooked.new_graph or not cooked.ok or kind == "text":
@@ -426,7 +442,8 @@ class Page:
                 self._wanted = dict(self.session.values)
                 s.controls = [c.as_dict() for c in self.controls]
                 s.params = {c.name: _shown_value(c.value) for c in self.controls}
-            self._drawing(cooked)
+            if svg is not None:
+                s.graph_svg = svg
             shown = self.session.shown_names
             s.shown = ", ".join(shown) if shown else "the graph's results"
             if cooked.ok:
@@ -442,34 +459,38 @@ class Page:
                 s.status = f"{name}: {lines[0]}{more}{kept}"
                 s.status_bad = True
             s.busy = not self.worker.idle()
-        t1 = time.perf_counter()
-        if cooked.ok:
-            self._picture(cooked)
         t2 = time.perf_counter()
-        self.timings.append({"cook": cooked.seconds, "queue": seconds, "state": t1 - t0})
-        self.timings[-1]["picture"] = t2 - t1
+        timing = {
+            "cook_ms": round(cooked.seconds * 1000, 2),
+            # in the worker: queue, recook, datasets and drawing prepared
+            "asked_to_done_ms": round(seconds * 1000, 2),
+            "scene_ms": round((t1 - t0) * 1000, 2),  # arrays in place + serialization
+            "state_ms": round((t2 - t1) * 1000, 2),  # status, controls, problems, drawing
+        }
         with s:
             s.cook_id = s.cook_id + 1
+            s.timing = timing
 
-    def _drawing(self, cooked: Cooked) -> None:
+    def _drawing(self, cooked: Cooked) -> str | None:
+        """The graph's drawing, coloured by the last evaluation (None: nothing to draw)."""
         from formgraph.core.errors import FormgraphError
         from formgraph.drawgraph.layout import draw_graph
 
         graph = self.session.graph
         if graph is None:
-            return
+            return None
         try:
             drawing = draw_graph(graph, stats=cooked.stats, failed=cooked.failed)
         except FormgraphError:
-            return
-        self.state.graph_svg = clickable_svg(drawing)
+            return None
+        return clickable_svg(drawing)
 
-    def _picture(self, cooked: Cooked) -> None:
+    def _picture(self, datasets: dict[tuple[str, str], Any]) -> None:
         from formgraph.viewer.app import _camera_lost
 
         from .scene import send_back_faces
 
-        added = self.scene.update(cooked.shown)
+        added = self.scene.apply(datasets)
         send_back_faces()
         bounds = self.scene.bounds()
         first = self._framed is None

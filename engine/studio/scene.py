@@ -95,25 +95,37 @@ class StudioScene:
             self.colors[label] = PALETTE[len(self.colors) % len(PALETTE)]
         return self.colors[label]
 
+    @staticmethod
+    def prepare(shown: Iterable[tuple[str, Any]]) -> dict[tuple[str, str], Any]:
+        """The datasets to draw for ``(label, value)`` pairs, by ``(label, kind)``.
+
+        The costly half of an update (tessellating surfaces, normals, feature edges) and
+        touching no actor, so the worker thread does it while the page stays responsive.
+        """
+        out = {}
+        for label, value in (p for lv in shown for p in expand(*lv)):
+            data = datasets_of(geometry_items(value))
+            for kind in DRAWN:
+                if kind in data:
+                    out[(label, kind)] = _lean(data[kind])
+        return out
+
     def update(self, shown: Iterable[tuple[str, Any]]) -> bool:
         """Draw ``(label, value)`` pairs; True when actors were added or removed."""
+        return self.apply(self.prepare(shown))
+
+    def apply(self, prepared: dict[tuple[str, str], Any]) -> bool:
+        """Put prepared datasets in place (see :meth:`prepare`); True when actors were
+        added or removed (a step that only changes geometry adds none)."""
         changed = False
-        seen = set()
-        for label, value in (p for lv in shown for p in expand(*lv)):
-            data = {k: _lean(d) for k, d in datasets_of(geometry_items(value)).items()}
-            for kind in DRAWN:
-                new = data.get(kind)
-                if new is None:
-                    continue
-                key = (label, kind)
-                seen.add(key)
-                part = self.parts.get(key)
-                if part is None:
-                    self.parts[key] = self._add(label, kind, new)
-                    changed = True
-                else:
-                    _copy_into(part.data, new)
-        for key in [k for k in self.parts if k not in seen]:
+        for key, new in prepared.items():
+            part = self.parts.get(key)
+            if part is None:
+                self.parts[key] = self._add(*key, new)
+                changed = True
+            else:
+                _copy_into(part.data, new)
+        for key in [k for k in self.parts if k not in prepared]:
             for actor in self.parts.pop(key).actors:
                 self.plotter.remove_actor(actor, render=False)
             changed = True
