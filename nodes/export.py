@@ -15,7 +15,7 @@ import numpy as np
 
 from formgraph.core.errors import InputError
 from formgraph.core.registry import Context, Range, node
-from formgraph.core.types import OutputPath
+from formgraph.core.types import OutputPath, entries_of
 from formgraph.geometry import Curve, Mesh, NurbsCurve
 from formgraph.kernels import nurbs
 from formgraph.kernels.io import (
@@ -26,10 +26,11 @@ from formgraph.kernels.io import (
     obj_bytes,
     pdf_bytes,
     ply_binary,
-    stl_ascii,
+    stl_ascii_chunks,
     stl_binary,
     svg_bytes,
 )
+from formgraph.kernels.io.colors import css_color
 
 _CIRCLE_TOL = 1e-9  # relative: a rational quadratic piece closer than this to a circle is one
 
@@ -55,7 +56,8 @@ def stl(mesh: Mesh, path: OutputPath, ascii: bool = False, *, ctx: Context) -> s
     ctx.guard(int(np.sum(mesh.face_sizes - 2)), "triangles")
     for warning in mesh_report(v, fi, fo).warnings():
         ctx.warn(warning)
-    data = stl_ascii(v, fi, fo) if ascii else stl_binary(v, fi, fo)
+    # ASCII: written a block of facets at a time (the text is five times the binary)
+    data = stl_ascii_chunks(v, fi, fo) if ascii else stl_binary(v, fi, fo)
     return str(ctx.write(path, data))
 
 
@@ -96,13 +98,15 @@ def ply(mesh: Mesh, path: OutputPath, *, ctx: Context) -> str:
     return str(ctx.write(path, data))
 
 
-@node("export.svg", version=1)
+@node("export.svg", version=2)
 def svg(
     curves: list[Curve],
     path: OutputPath,
     margin: Annotated[float, Range(min=0)] = 1.0,
     stroke_width: Annotated[float, Range(min=1e-6)] = 0.1,
     samples: Annotated[int, Range(min=2)] = 1024,
+    layers: list[str] | None = None,
+    colors: list[str] | None = None,
     *,
     ctx: Context,
 ) -> str:
@@ -113,6 +117,13 @@ def svg(
     Bezier chains) become exact ``C`` commands, circles and arcs exact ``A`` commands,
     polylines ``L``; anything else a fine polyline.
 
+    With ``layers``, each entry of ``curves`` goes on a layer — a ``<g id=NAME>`` group
+    (an Inkscape layer too) stroked in the layer's colour, which is how laser software
+    tells cut from engrave: ``curves: ["@cut", "@engrave"]`` with ``layers: [cut,
+    engrave]`` puts every loop of ``@cut`` on ``cut``, however many it holds (the last
+    name takes any further entries). Colours are CSS colours, ``red`` or ``#ff0000``;
+    layers without one take red, blue, green, magenta, cyan, yellow in turn.
+
     Parameters
     ----------
     curves : list[Curve]
@@ -125,19 +136,30 @@ def svg(
         Line width, in mm.
     samples : int
         Points per curve for curves that can only be drawn as polylines.
+    layers : list[str] | None
+        Layer of each entry of ``curves`` (the last repeats for the rest): names start
+        with a letter and hold letters, digits, ``_ . -``.
+    colors : list[str] | None
+        Stroke colour (CSS) of each entry of ``layers``.
     """
     _guard_samples(curves, samples, ctx)
     paths = [curve_path(c, samples) for c in curves]
-    return str(ctx.write(path, svg_bytes(paths, margin=margin, stroke_width=stroke_width)))
+    names, styles = _drawing_layers(curves, layers, colors)
+    data = _drawing(
+        svg_bytes, paths, margin=margin, stroke_width=stroke_width, layers=names, colors=styles
+    )
+    return str(ctx.write(path, data))
 
 
-@node("export.pdf", version=1)
+@node("export.pdf", version=2)
 def pdf(
     curves: list[Curve],
     path: OutputPath,
     margin: Annotated[float, Range(min=0)] = 1.0,
     stroke_width: Annotated[float, Range(min=1e-6)] = 0.1,
     samples: Annotated[int, Range(min=2)] = 1024,
+    layers: list[str] | None = None,
+    colors: list[str] | None = None,
     *,
     ctx: Context,
 ) -> str:
@@ -146,6 +168,10 @@ def pdf(
     The page fits the drawing plus ``margin``. Beziers are exact; arcs become cubic Beziers
     within 1e-7 of the radius (PDF has no arc operator); anything else a fine polyline.
 
+    ``layers`` and ``colors`` as in ``export.svg``: each entry of ``curves`` on its layer
+    (a PDF optional content group, listed in a viewer's layers panel), stroked in the
+    layer's CSS colour.
+
     Parameters
     ----------
     curves : list[Curve]
@@ -158,23 +184,71 @@ def pdf(
         Line width, in mm.
     samples : int
         Points per curve for curves that can only be drawn as polylines.
+    layers : list[str] | None
+        Layer of each entry of ``curves`` (the last repeats for the rest).
+    colors : list[str] | None
+        Stroke colour (CSS) of each entry of ``layers``.
     """
     _guard_samples(curves, samples, ctx)
     paths = [curve_path(c, samples) for c in curves]
-    return str(ctx.write(path, pdf_bytes(paths, margin=margin, stroke_width=stroke_width)))
+    names, styles = _drawing_layers(curves, layers, colors)
+    data = _drawing(
+        pdf_bytes, paths, margin=margin, stroke_width=stroke_width, layers=names, colors=styles
+    )
+    return str(ctx.write(path, data))
+
+
+def _drawing_layers(
+    curves: list[Curve], layers: list[str] | None, colors: list[str] | None
+) -> tuple[list[str] | None, dict[str, str] | None]:
+    """Each curve's layer (by the entry of ``curves`` it came on) and each layer's colour."""
+    if layers is None:
+        if colors is not None:
+            raise InputError("colors", "colours are given per layer: give layers too")
+        return None, None
+    names = _curve_layers(layers, entries_of(curves))
+    if colors is None:
+        return names, None
+    if len(colors) != len(layers):
+        raise InputError(
+            "colors",
+            f"one colour per entry of layers is needed: {len(layers)} layers, "
+            f"{len(colors)} colours",
+        )
+    styles: dict[str, str] = {}
+    for name, color in zip(layers, colors, strict=True):
+        try:
+            value = css_color(color)
+        except ValueError as exc:
+            raise InputError("colors", str(exc)) from None
+        if styles.setdefault(name, value) != value:
+            raise InputError(
+                "colors", f"layer {name!r} is given two colours, {styles[name]} and {value}"
+            )
+    return names, styles
+
+
+def _drawing(write, paths, **kwargs) -> bytes:  # type: ignore[no-untyped-def]
+    """SVG or PDF bytes; a bad layer name is the ``layers`` input's error."""
+    try:
+        return write(paths, **kwargs)
+    except ValueError as exc:
+        if str(exc).startswith("layer"):
+            raise InputError("layers", str(exc)) from None
+        raise
 
 
 _PALETTE = (1, 5, 3, 6, 4, 2)  # ACI red, blue, green, magenta, cyan, yellow: default layers
 
 
-@node("export.dxf", version=2)
+@node("export.dxf", version=3)
 def dxf(
     path: OutputPath,
     curves: list[Curve] | None = None,
     mesh: Mesh | None = None,
     samples: Annotated[int, Range(min=2)] = 1024,
     layers: list[str] | None = None,
-    colors: list[int] | None = None,
+    colors: list[int] | list[str] | None = None,
     mesh_layer: str = "mesh",
     *,
     ctx: Context,
@@ -188,10 +262,13 @@ def dxf(
 
     Each curve goes on a layer, so that cut, engrave and each tool path can be told apart:
     by default all curves on ``curves`` and the mesh on ``mesh_layer``; with ``layers``,
-    curve i on ``layers[i]``, the last name also taking any curves after it (``[outline,
-    toolpath]`` puts the first curve on outline, every other on toolpath). Each layer gets
-    a colour (AutoCAD Color Index): ``colors[i]`` for ``layers[i]``, else red, blue, green,
-    magenta, cyan, yellow in turn.
+    the curves of entry i of ``curves`` on ``layers[i]`` — the layer follows the wire, so
+    ``curves: ["@cut", "@engrave"]`` puts every loop of ``@cut`` on the first layer however
+    many it holds — the last name also taking any entries after it. Each layer gets a
+    colour: ``colors[i]`` for ``layers[i]``, an AutoCAD Color Index (1 to 255) or a CSS
+    colour (``red``, ``#ff8000``: written as the layer's true colour, with the nearest
+    index beside it for older programs); else red, blue, green, magenta, cyan, yellow in
+    turn.
 
     Parameters
     ----------
@@ -204,15 +281,16 @@ def dxf(
     samples : int
         Points per curve for curves that are not NURBS.
     layers : list[str] | None
-        Layer name of each curve, in order (the last repeats for the rest).
-    colors : list[int] | None
-        Colour (ACI, 1 to 255) of each entry of ``layers``.
+        Layer name of each entry of ``curves``, in order (the last repeats for the rest).
+    colors : list[int] | list[str] | None
+        Colour of each entry of ``layers``: all ACI numbers (1 to 255) or all CSS colours.
     mesh_layer : str
         Layer of the mesh.
     """
     curves = curves or []
     _guard_samples(curves, samples, ctx, drawing=False)
-    names = _curve_layers(layers, len(curves))
+    names = _curve_layers(layers, entries_of(curves)) if layers is not None else None
+    names = names or ["curves"] * len(curves)
     layer_colors = _layer_colors(layers, colors, names, mesh_layer if mesh is not None else None)
     splines, polylines = [], []
     for c, layer in zip(curves, names, strict=True):  # one iteration per curve
@@ -241,19 +319,22 @@ def dxf(
     return str(ctx.write(path, data))
 
 
-def _curve_layers(layers: list[str] | None, count: int) -> list[str]:
-    if layers is None:
-        return ["curves"] * count
+def _curve_layers(layers: list[str], entries: list[int]) -> list[str]:
+    """The layer of each curve: that of the entry of the port it came on (the last layer
+    takes the entries past the end)."""
     if not layers:
         raise InputError("layers", "give at least one layer name, or leave layers out")
-    return [layers[min(i, len(layers) - 1)] for i in range(count)]
+    return [layers[min(e, len(layers) - 1)] for e in entries]
 
 
 def _layer_colors(
-    layers: list[str] | None, colors: list[int] | None, names: list[str], mesh_layer: str | None
-) -> dict[str, int]:
+    layers: list[str] | None,
+    colors: list[int] | list[str] | None,
+    names: list[str],
+    mesh_layer: str | None,
+) -> dict[str, int | str]:
     order = list(dict.fromkeys([*(layers or names), *([mesh_layer] if mesh_layer else [])]))
-    given: dict[str, int] = {}
+    given: dict[str, int | str] = {}
     if colors is not None:
         if layers is None or len(colors) != len(layers):
             raise InputError(
@@ -262,7 +343,12 @@ def _layer_colors(
                 f"{len(colors)} colours",
             )
         for name, aci in zip(layers, colors, strict=True):
-            if not 1 <= aci <= 255:
+            if isinstance(aci, str):
+                try:
+                    aci = css_color(aci)
+                except ValueError as exc:
+                    raise InputError("colors", str(exc)) from None
+            elif not 1 <= aci <= 255:
                 raise InputError(
                     "colors", f"a colour is an AutoCAD Color Index 1 to 255, got {aci}"
                 )
@@ -349,11 +435,13 @@ def _circular_pieces(cp: np.ndarray, knots: np.ndarray, w: np.ndarray) -> np.nda
     half_chord = 0.5 * np.linalg.norm(p[:, 2] - p[:, 0], axis=1)
     scale = np.maximum(np.maximum(t0, t1), 1e-300)
     cos_half = half_chord / scale
+    # a straight piece (weight 1, middle point halfway: a rounded rectangle's side) is a
+    # collinear piece of the chain, which the drawings write as a line
     circular = (
         (np.abs(t0 - t1) <= _CIRCLE_TOL * scale)
         & (np.abs(wm - cos_half) <= _CIRCLE_TOL)
         & (wm > 0)
-        & (wm < 1)
+        & ((wm < 1) | (np.abs(1 - cos_half) <= _CIRCLE_TOL))
     )
     if not np.all(circular):
         return None

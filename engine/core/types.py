@@ -41,6 +41,35 @@ class Faces(list):
     port_name = "list[list[int]]"
 
 
+class Entries(list):
+    """The value of a list port that remembers which entry of the port each item came from.
+
+    A list port's YAML list (``curves: ["@cut", "@engrave"]``) joins the lists its wires
+    carry into one flat list; ``entries[i]`` is the index, in the port's list, of the entry
+    that item i came from (a single wire, ``curves: "@cut"``, is entry 0 for all its items).
+    Nodes that care where an item came from (the drawing exports give every wire its layer)
+    read it with :func:`entries_of`; every other node sees a plain list.
+    """
+
+    __slots__ = ("entries",)
+
+    def __init__(self, items: Any = (), entries: Any = ()):
+        super().__init__(items)
+        self.entries = tuple(int(e) for e in entries)
+        if len(self.entries) != len(self):
+            raise ValueError(f"{len(self)} items but {len(self.entries)} entry indices")
+
+
+def entries_of(values: list[Any]) -> list[int]:
+    """Per item of a list port, the index of the port's entry it came on.
+
+    Items given without that record (a list built in Python) are each their own entry.
+    """
+    if isinstance(values, Entries):
+        return list(values.entries)
+    return list(range(len(values)))
+
+
 class Expression(str):
     """An expression port (text in the node's variables and the graph params)."""
 
@@ -171,6 +200,17 @@ class PortType:
             return True
         return all(any(_kind_accepts(k, o) for k in self.kinds) for o in other.kinds)
 
+    def holds(self, value: Any) -> bool:
+        """Whether ``value`` could be this port's output: geometry of the port's class (or a
+        list of it), anything but geometry for a number, text or other plain port.
+
+        For values read back from the disk cache, where an entry can be well formed and
+        still of another node (a Points where a measure belongs): a mismatch is a miss.
+        """
+        if self.same_as is not None or (value is None and self.optional):
+            return True
+        return any(_kind_holds(k, value) for k in self.kinds)
+
     def coerce(self, value: Any) -> Any:
         """The value a node function receives for the literal ``value``.
 
@@ -205,6 +245,19 @@ class PortType:
 
 def _is_geometry(base: Any) -> bool:
     return isinstance(base, type) and issubclass(base, Geometry)
+
+
+def _kind_holds(k: Kind, value: Any) -> bool:
+    if k.base is Any:
+        return True
+    if k.is_list and isinstance(value, np.ndarray):  # numbers stored as one array
+        return not _is_geometry(k.base)
+    if k.is_list and not isinstance(value, (list, tuple)):
+        return False
+    items = value if k.is_list else [value]
+    if _is_geometry(k.base):
+        return all(isinstance(v, k.base) for v in items)
+    return not any(isinstance(v, Geometry) for v in items)
 
 
 def _kind_accepts(k: Kind, o: Kind) -> bool:
@@ -273,7 +326,8 @@ def _coerce_kind(k: Kind, value: Any) -> Any:
         if isinstance(value, (list, tuple)):
             if k.base is Vec3:
                 return _vec_list(value)
-            return [_coerce_kind(Kind(k.base), v) for v in value]
+            items = [_coerce_kind(Kind(k.base), v) for v in value]
+            return Entries(items, value.entries) if isinstance(value, Entries) else items
         if k.base is Vec3 and isinstance(value, np.ndarray) and value.ndim == 2:
             return _vec_list(value)
         # a single item is accepted where a list is asked

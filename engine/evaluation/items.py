@@ -27,6 +27,7 @@ from ..geometry import Points
 from ..language.model import Expr, Input, Items, Literal, NodeDef, Wire, wires_of
 from ..language.subgraph import SubgraphSpec
 from . import cache as _cache
+from .stats import NodeStat
 
 # What one item of a repeated node costs against the element budget. An item is a whole
 # node run (some 0.2 ms of bookkeeping even for a tiny node), so a count the budget would
@@ -289,8 +290,6 @@ class LanguageRun:
                 self.g._written[keys[k]] = file_stamp(value)
             found[k] = value
             computed += 1
-        from .run import NodeStat
-
         key = self.keys[name]
         self.g._identity[key] = key
         self.g._last[name] = (key, key)

@@ -11,19 +11,45 @@ drawing of strokes needs nothing more and no PDF library is then a dependency.
 
 from __future__ import annotations
 
+import re
 import zlib
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
+from .colors import PALETTE, css_color, rgb
 from .numfmt import float_words, squeeze
 
-__all__ = ["Path2D", "drawing_bounds", "pdf_bytes", "svg_bytes"]
+__all__ = ["Path2D", "drawing_bounds", "layer_styles", "pdf_bytes", "svg_bytes"]
 
 KINDS = ("polyline", "cubic", "arc")
 UNITS_MM = {"mm": 1.0, "cm": 10.0, "in": 25.4, "pt": 25.4 / 72.0, "px": 25.4 / 96.0}
 _ARC_TOL = 1e-9
+_LAYER_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_.-]*")  # an XML name: an SVG id, a PDF name
+
+
+def layer_styles(layers: Sequence[str], colors: Mapping[str, str] | None = None) -> dict[str, str]:
+    """Each layer's stroke colour (``#rrggbb``), in order of first use.
+
+    ``colors`` gives some or all of them (CSS colours); the others take red, blue, green,
+    magenta, cyan, yellow in turn by their position.
+
+    Raises
+    ------
+    ValueError
+        A layer name that is not an XML name (a letter or ``_``, then letters, digits,
+        ``_ . -``: it becomes an SVG id), or a colour CSS does not know.
+    """
+    order = list(dict.fromkeys(layers))
+    for name in order:
+        if not isinstance(name, str) or not _LAYER_NAME.fullmatch(name):
+            raise ValueError(
+                f"layer {name!r}: a drawing layer's name starts with a letter or _ and has only "
+                "letters, digits, _ . and - (it becomes the SVG group's id)"
+            )
+    given = {k: css_color(v) for k, v in (colors or {}).items()}
+    return {n: given.get(n, PALETTE[i % len(PALETTE)]) for i, n in enumerate(order)}
 
 
 @dataclass(frozen=True)
@@ -188,12 +214,16 @@ def svg_bytes(
     margin: float = 1.0,
     stroke_width: float = 0.1,
     decimals: int = 6,
+    layers: Sequence[str] | None = None,
+    colors: Mapping[str, str] | None = None,
 ) -> bytes:
     """An SVG drawing of the paths: one ``<path>`` each, exact Beziers and arcs.
 
     Coordinates are in ``units`` (one SVG user unit is one ``units``), the ``viewBox`` fits
     the drawing's tight bounds plus ``margin``, and y is flipped so +y points up as in the
-    model. Strokes are black, unfilled, ``stroke_width`` wide.
+    model. Strokes are unfilled, ``stroke_width`` wide, black — or, with ``layers``, one
+    ``<g id=NAME>`` group per layer (also an Inkscape layer) stroked in its colour, the
+    paths of each layer in their order, the layers in order of first use.
 
     Parameters
     ----------
@@ -205,6 +235,10 @@ def svg_bytes(
         Line width in ``units``; > 0.
     decimals : int
         Decimal places of every coordinate (6 in mm is a nanometre).
+    layers : sequence of str, optional
+        The layer of each path (see :func:`layer_styles` for the names).
+    colors : mapping of layer -> CSS colour, optional
+        Stroke colours; layers not named take the default palette.
 
     Returns
     -------
@@ -224,35 +258,62 @@ def svg_bytes(
     def fmt(values: Sequence[float]) -> str:
         return squeeze(_numbers(np.array(values), decimals, b" ").view(np.uint8)).decode()[1:]
 
+    if layers is not None and len(layers) != len(paths):
+        raise ValueError(f"{len(paths)} paths but {len(layers)} layer names")
+    styles = layer_styles(layers, colors) if layers is not None else None
+    inkscape = ' xmlns:inkscape="http://www.inkscape.org/namespaces/inkscape"' if styles else ""
     head = (
         '<?xml version="1.0" encoding="UTF-8" standalone="no"?>\n'
-        '<svg xmlns="http://www.w3.org/2000/svg" version="1.1" '
+        f'<svg xmlns="http://www.w3.org/2000/svg"{inkscape} version="1.1" '
         f'width="{fmt([size[0]])}{units}" height="{fmt([size[1]])}{units}" '
         f'viewBox="{fmt([x0, y0, size[0], size[1]])}">\n'
         f'<g fill="none" stroke="#000000" stroke-width="{fmt([stroke_width])}" '
         'stroke-linecap="round" stroke-linejoin="round">\n'
     ).encode()
+    body = [_svg_path(path, decimals) for path in paths]
     lines = [head]
-    for path in paths:  # one iteration per curve; its points are formatted in bulk
-        q = path.points * np.array([1.0, -1.0])
-        if path.kind == "polyline":
-            items = [(b" M", _numbers(q[:1], decimals)), (b" L", _numbers(q[1:], decimals))]
-        elif path.kind == "cubic":
-            items = [(b" M", _numbers(q[:1], decimals)), (b" C", _numbers(q[1:], decimals))]
-        else:
-            _, radius, _, sweep, _ = _arc_geometry(path.points)
-            # Flipping y mirrors every arc, so a counter-clockwise arc of the model runs the
-            # negative-angle way in the page's coordinates: sweep-flag 0 (SVG 1.1, F.6.5, where
-            # flag 1 means increasing angle in user space). Every piece is under 180 degrees.
-            k = len(radius)
-            cols = [radius, radius, np.zeros(k), np.zeros(k), (sweep < 0) * 1.0]
-            args = np.column_stack(cols + [q[2::2, 0], q[2::2, 1]])
-            items = [(b" M", _numbers(q[:1], decimals)), (b" A", _numbers(args, decimals))]
-        if path.closed:
-            items.append((b" Z", np.zeros((0, 3), dtype=np.uint64)))
-        lines += [b'<path d="', _path_text(items)[1:], b'"/>\n']
+    if styles is None:
+        lines += body
+    else:
+        assert layers is not None
+        for name, color in styles.items():  # one group per layer
+            lines.append(
+                f'<g id="{name}" inkscape:groupmode="layer" inkscape:label="{name}" '
+                f'stroke="{color}">\n'.encode()
+            )
+            lines += [b for b, layer in zip(body, layers, strict=True) if layer == name]
+            lines.append(b"</g>\n")
     lines.append(b"</g>\n</svg>\n")
     return b"".join(lines)
+
+
+def _svg_path(path: Path2D, decimals: int) -> bytes:
+    """One ``<path d=...>`` element (its points formatted in bulk)."""
+    q = path.points * np.array([1.0, -1.0])
+    if path.kind == "polyline":
+        items = [(b" M", _numbers(q[:1], decimals)), (b" L", _numbers(q[1:], decimals))]
+    elif path.kind == "cubic":
+        items = [(b" M", _numbers(q[:1], decimals)), (b" C", _numbers(q[1:], decimals))]
+    else:
+        _, radius, _, sweep, straight = _arc_geometry(path.points)
+        # Flipping y mirrors every arc, so a counter-clockwise arc of the model runs the
+        # negative-angle way in the page's coordinates: sweep-flag 0 (SVG 1.1, F.6.5, where
+        # flag 1 means increasing angle in user space). Every piece is under 180 degrees.
+        k = len(radius)
+        cols = [radius, radius, np.zeros(k), np.zeros(k), (sweep < 0) * 1.0]
+        args = np.column_stack(cols + [q[2::2, 0], q[2::2, 1]])
+        items = [(b" M", _numbers(q[:1], decimals))]
+        # straight pieces (a rounded rectangle's sides) as L: an arc of radius 0 is a line in
+        # the SVG spec (F.6.2) but not in every reader; runs of each kind share a command
+        cuts = np.flatnonzero(np.diff(straight.astype(np.int8))) + 1
+        for run in np.split(np.arange(k), cuts):  # alternating runs: a handful
+            if straight[run[0]]:
+                items.append((b" L", _numbers(args[run, 5:], decimals)))
+            else:
+                items.append((b" A", _numbers(args[run], decimals)))
+    if path.closed:
+        items.append((b" Z", np.zeros((0, 3), dtype=np.uint64)))
+    return b'<path d="' + _path_text(items)[1:] + b'"/>\n'
 
 
 # --------------------------------------------------------------------------------------------
@@ -290,6 +351,8 @@ def pdf_bytes(
     margin: float = 1.0,
     stroke_width: float = 0.1,
     compress: bool = True,
+    layers: Sequence[str] | None = None,
+    colors: Mapping[str, str] | None = None,
 ) -> bytes:
     """A one-page PDF drawing of the paths, at true scale.
 
@@ -297,6 +360,9 @@ def pdf_bytes(
     drawing unit is ``units`` on paper (1 mm = 72 / 25.4 pt). Polylines become ``m``/``l``,
     cubic chains ``c``, arcs cubic Beziers (PDF has no arc operator), closed paths ``h``, and
     each path is stroked with ``S``. Coordinates are written in points with 4 decimals.
+    With ``layers``, each layer is an optional content group (PDF 1.5, section 8.11: the
+    layers panel of a PDF viewer or Illustrator) whose paths are stroked in its colour
+    (``RG``), the layers in order of first use.
 
     Parameters
     ----------
@@ -308,6 +374,10 @@ def pdf_bytes(
         Line width in ``units``; > 0.
     compress : bool
         Deflate the content stream (zlib, deterministic).
+    layers : sequence of str, optional
+        The layer of each path (names as :func:`layer_styles` takes them).
+    colors : mapping of layer -> CSS colour, optional
+        Stroke colours; layers not named take the default palette.
 
     Returns
     -------
@@ -327,7 +397,10 @@ def pdf_bytes(
     def pts(q: np.ndarray) -> np.ndarray:
         return _numbers((q - origin) * scale, 4)
 
-    ops = [f"{_fmt1(stroke_width * scale)} w 1 J 1 j\n".encode()]
+    if layers is not None and len(layers) != len(paths):
+        raise ValueError(f"{len(paths)} paths but {len(layers)} layer names")
+    styles = layer_styles(layers, colors) if layers is not None else None
+    strokes = []
     for path in paths:  # one iteration per curve; its points are formatted in bulk
         p = path.points
         if path.kind == "arc":
@@ -342,23 +415,43 @@ def pdf_bytes(
         body = np.concatenate([rest, np.repeat(_word_row(op), len(rest), axis=0)], axis=1)
         start = np.concatenate([first.reshape(1, -1), _word_row(b" m\n")], axis=1)
         text = squeeze(start.view(np.uint8)) + squeeze(body.view(np.uint8))
-        ops.append(text.replace(b"\n ", b"\n").lstrip(b" "))
-        ops.append(b"h S\n" if path.closed else b"S\n")
+        strokes.append(
+            text.replace(b"\n ", b"\n").lstrip(b" ") + (b"h S\n" if path.closed else b"S\n")
+        )
+    ops = [f"{_fmt1(stroke_width * scale)} w 1 J 1 j\n".encode()]
+    if styles is None:
+        ops += strokes
+    else:
+        assert layers is not None
+        for k, (name, color) in enumerate(styles.items()):  # one marked section per layer
+            r, g, b = (_fmt1(c / 255) for c in rgb(color))
+            ops.append(f"/OC /L{k} BDC\n{r} {g} {b} RG\n".encode())
+            ops += [t for t, layer in zip(strokes, layers, strict=True) if layer == name]
+            ops.append(b"EMC\n")
     content = b"".join(ops)
     stream_dict = f"<< /Length {{}}{' /Filter /FlateDecode' if compress else ''} >>"
     if compress:
         content = zlib.compress(content, 6)
+    catalog, resources, groups = "", "", []
+    if styles is not None:  # objects 6, 7, ...: one optional content group per layer
+        refs = " ".join(f"{6 + k} 0 R" for k in range(len(styles)))
+        catalog = f" /OCProperties << /OCGs [{refs}] /D << /Order [{refs}] /ON [{refs}] >> >>"
+        props = " ".join(f"/L{k} {6 + k} 0 R" for k in range(len(styles)))
+        resources = f"/Properties << {props} >> "
+        groups = [f"<< /Type /OCG /Name ({name}) >>".encode() for name in styles]
     objects = [
-        b"<< /Type /Catalog /Pages 2 0 R >>",
+        f"<< /Type /Catalog /Pages 2 0 R{catalog} >>".encode(),
         b"<< /Type /Pages /Kids [3 0 R] /Count 1 >>",
         (
             f"<< /Type /Page /Parent 2 0 R /MediaBox [0 0 {_fmt1(size[0])} {_fmt1(size[1])}] "
-            "/Contents 4 0 R /Resources << >> >>"
+            f"/Contents 4 0 R /Resources << {resources}>> >>"
         ).encode(),
         stream_dict.format(len(content)).encode() + b"\nstream\n" + content + b"\nendstream",
         b"<< /Producer (formgraph) >>",
+        *groups,
     ]
-    out = [b"%PDF-1.4\n%\xe2\xe3\xcf\xd3\n"]
+    version = b"1.4" if styles is None else b"1.5"  # optional content is PDF 1.5
+    out = [b"%PDF-" + version + b"\n%\xe2\xe3\xcf\xd3\n"]
     offsets = []
     pos = len(out[0])
     for i, body in enumerate(objects, start=1):
@@ -369,7 +462,7 @@ def pdf_bytes(
     xref = [f"xref\n0 {len(objects) + 1}\n".encode(), b"0000000000 65535 f\r\n"]
     xref += [f"{o:010d} 00000 n\r\n".encode() for o in offsets]
     trailer = (
-        f"trailer\n<< /Size {len(objects) + 1} /Root 1 0 R /Info {len(objects)} 0 R >>\n"
+        f"trailer\n<< /Size {len(objects) + 1} /Root 1 0 R /Info 5 0 R >>\n"
         f"startxref\n{pos}\n%%EOF\n"
     ).encode()
     return b"".join(out + xref + [trailer])

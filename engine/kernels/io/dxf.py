@@ -18,6 +18,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from .colors import rgb
 from .exporters import check_mesh
 
 __all__ = ["dxf_bytes"]
@@ -108,9 +109,11 @@ def dxf_bytes(
     meshes : sequence of (vertices (n, 3), face_indices, face_offsets [, layer])
     units : {"mm", "cm", "m", "in", "ft", "unitless"}
         Drawing units ($INSUNITS).
-    layer_colors : dict of layer name -> AutoCAD Color Index (1 .. 255), optional
+    layer_colors : dict of layer name -> AutoCAD Color Index (1 .. 255) or CSS colour
         Layers are created in the order of this mapping, then in the order the entities
-        name them (colour 7, white/black, unless given). Layer "0" always exists.
+        name them (colour 7, white/black, unless given). Layer "0" always exists. A CSS
+        colour (``"red"``, ``"#ff8000"``) becomes the layer's true colour (group code 420),
+        with the nearest index of the standard palette as its colour number.
 
     Returns
     -------
@@ -138,12 +141,16 @@ def dxf_bytes(
         (*check_mesh(*m[:3]), _layer_name(m[3] if len(m) > 3 else DEFAULT_LAYER, f"mesh {i}"))
         for i, m in enumerate(meshes)
     ]
-    colors: dict[str, int] = {}
+    colors: dict[str, int | tuple[int, int, int]] = {}
     for name, aci in (layer_colors or {}).items():
         _layer_name(name, "layer_colors")
+        if isinstance(aci, str):
+            colors[name] = rgb(aci)
+            continue
         if isinstance(aci, bool) or not isinstance(aci, (int, np.integer)) or not 1 <= aci <= 255:
             raise ValueError(
-                f"layer {name!r}: a colour is an AutoCAD Color Index 1 .. 255, got {aci!r}"
+                f"layer {name!r}: a colour is an AutoCAD Color Index 1 .. 255 or a CSS colour, "
+                f"got {aci!r}"
             )
         colors[name] = int(aci)
     for item in (*checked_splines, *checked_polylines, *checked_meshes):
@@ -179,13 +186,26 @@ def _register_classes_in_order(doc) -> None:
         doc.classes.add_class(name)
 
 
+def _nearest_aci(color: tuple[int, int, int]) -> int:
+    """The AutoCAD Color Index (1 .. 255) nearest to an RGB colour."""
+    from ezdxf.colors import DXF_DEFAULT_COLORS, int2rgb
+
+    table = np.array([int2rgb(c) for c in DXF_DEFAULT_COLORS[1:256]], dtype=np.float64)
+    return 1 + int(np.argmin(((table - np.asarray(color, dtype=np.float64)) ** 2).sum(axis=1)))
+
+
 def _document(ezdxf, splines, polylines, meshes, colors):
     doc = ezdxf.new("R2010", setup=False)
-    for name, aci in colors.items():
+    for name, color in colors.items():
+        true = isinstance(color, tuple)
+        aci = _nearest_aci(color) if true else color
         if name in doc.layers:  # "0", or a name differing only in case (DXF ignores case)
-            doc.layers.get(name).dxf.color = aci
+            layer = doc.layers.get(name)
+            layer.dxf.color = aci
         else:
-            doc.layers.add(name, color=aci)
+            layer = doc.layers.add(name, color=aci)
+        if true:
+            layer.rgb = color
     msp = doc.modelspace()
     for cp, degree, knots, w, closed, layer in splines:  # one iteration per curve
         spline = msp.add_spline(degree=degree, dxfattribs={"layer": layer})
