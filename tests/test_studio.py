@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import pyvista as pv
 
 from formgraph.core.errors import Problem, Where
 from formgraph.studio.guard import Guard, _split_host, cookie_name
@@ -535,3 +536,85 @@ def test_problem_lines_locate():
     problems = [Problem(Where("g.yaml", 4, "n", "x"), "bad"), Problem(Where(), "whole graph")]
     assert _markers(problems) == [{"line": 4, "message": "bad", "severity": "error"}]
     assert _problem_lines(problems) == ["line 4: node 'n': bad", "whole graph"]
+
+
+# ----------------------------------------------------------------------------- scene
+
+
+def _serialized_actor(actor):
+    from trame_vtk.modules.vtk.serializers import (
+        SynchronizationContext,
+        initialize_serializers,
+        serialize,
+    )
+    from trame_vtk.modules.vtk.serializers.utils import reference_id
+
+    from formgraph.studio.scene import send_back_faces
+
+    initialize_serializers()  # as trame-vtk's protocol does when it starts
+    send_back_faces()
+    return serialize(None, actor, reference_id(actor), SynchronizationContext(), 0)
+
+
+def test_back_faces_reach_the_browser(tube, tmp_path):
+    from formgraph.studio.scene import StudioScene, make_plotter
+    from formgraph.viewer.style import BACK_FACE
+
+    s = StudioSession(tube, out_dir=tmp_path / "out")
+    plotter = make_plotter()
+    try:
+        scene = StudioScene(plotter)
+        assert scene.update(s.open().shown)  # actors added
+        mesh = scene.parts[("solid", "meshes")].actors[0]
+        out = _serialized_actor(mesh)
+        calls = {name: args for name, args in out["calls"]}
+        assert "setBackfaceProperty" in calls
+        back_id = re.fullmatch(r"instance:\$\{(.+)\}", calls["setBackfaceProperty"][0])[1]
+        back = next(d for d in out["dependencies"] if d["id"] == back_id)
+        red = pv.Color(BACK_FACE).float_rgb
+        assert np.allclose(back["properties"]["diffuseColor"], red)
+        lines = scene.parts[("solid", "features")].actors[0]
+        assert "setBackfaceProperty" not in dict(_serialized_actor(lines)["calls"])
+    finally:
+        plotter.close()
+
+
+def test_a_step_changes_arrays_in_place(tube, tmp_path):
+    from formgraph.studio.scene import StudioScene, make_plotter
+
+    s = StudioSession(tube, out_dir=tmp_path / "out")
+    plotter = make_plotter()
+    try:
+        scene = StudioScene(plotter)
+        scene.update(s.open().shown)
+        part = scene.parts[("solid", "meshes")]
+        data, actors, added = part.data, list(part.actors), scene.added
+        faces = data.GetPolys().GetMTime()
+        points = data.GetPoints().GetData()
+        assert points.GetDataType() == 10  # VTK_FLOAT: half the bytes of float64
+        assert not scene.update(s.set_params(thickness=0.4).shown)  # nothing added
+        assert scene.parts[("solid", "meshes")].data is data and part.actors == actors
+        assert scene.added == added
+        # the faces did not change and were not touched: the same hash, not sent again
+        assert data.GetPolys().GetMTime() == faces
+        assert data.GetPoints().GetData() is not points  # the points did
+        assert data.bounds[5] == pytest.approx(3.4, abs=0.02)  # 3 turns up, 0.4 tube radius
+    finally:
+        plotter.close()
+
+
+def test_choice_control_for_an_enum_param():
+    import enum
+    from types import SimpleNamespace
+
+    from formgraph.core.types import Kind, PortType
+    from formgraph.language.model import ParamDef
+
+    class Ends(str, enum.Enum):
+        FLAT = "flat"
+        ROUND = "round"
+
+    p = ParamDef("ends", Ends.FLAT, PortType((Kind(Ends),)), "Ends")
+    graph = SimpleNamespace(params={"ends": Ends.FLAT}, param_defs={"ends": p})
+    (c,) = controls_of(graph, {})
+    assert (c.kind, c.value, c.choices) == ("choice", "flat", ("flat", "round"))
