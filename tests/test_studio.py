@@ -258,6 +258,28 @@ def test_superseded_is_not_a_formgraph_error():
     assert not issubclass(Superseded, FormgraphError)
 
 
+@pytest.mark.parametrize(
+    "args, code, message",
+    [
+        (["missing.yaml"], 1, "no such graph file"),
+        (["g.yaml", "--port", "70000"], 2, "a port is 0 to 65535"),
+        (["g.yaml", "--set", "turns"], 2, "--set takes NAME=VALUE"),
+    ],
+)
+def test_serve_command_line_errors(tmp_path, capsys, args, code, message):
+    from formgraph.cli.main import main
+
+    shutil.copy(TUBE, tmp_path / "g.yaml")
+    argv = ["serve", *(str(tmp_path / a) if a.endswith(".yaml") else a for a in args)]
+    if "port" in message:  # argparse's own check of the option: exits 2
+        with pytest.raises(SystemExit) as exc:
+            main([*argv, "--no-browser"])
+        assert exc.value.code == code
+    else:
+        assert main([*argv, "--no-browser"]) == code
+    assert message in capsys.readouterr().err
+
+
 def test_import_formgraph_does_not_import_trame():
     code = "import sys, formgraph, formgraph.studio; print(any('trame' in m for m in sys.modules))"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
@@ -508,6 +530,19 @@ def test_an_edit_on_disk_reloads(page, studio):
     )
     page.wait_for_function("document.querySelector('#status').innerText.includes('computed')")
     assert "turns = 4" in page.inner_text("#controls")  # the control's value is kept
+    # with unsaved edits in the editor, a change on disk does not overwrite them
+    page.click("#editor .view-lines")
+    page.keyboard.press("Control+End")
+    page.keyboard.type("# not saved")
+    time.sleep(0.6)  # past the edit delay
+    studio.graph.write_text(text)
+    page.wait_for_function("document.querySelector('#status').innerText.includes('on disk')")
+    assert "# not saved" in page.inner_text("#editor").replace("\xa0", " ")
+    page.click("#reload")  # takes the file's text
+    page.wait_for_function("!document.querySelector('#editor').innerText.includes('not saved')")
+    page.wait_for_function(
+        "document.querySelector('#editor').innerText.includes('default:\u00a03,')"
+    )
 
 
 def test_run_writes_the_exports(page, studio):

@@ -38,6 +38,15 @@ def url_host(host: str) -> str:
     return host
 
 
+def _loopback(host: str) -> bool:
+    if host == "localhost":
+        return True
+    try:
+        return ipaddress.ip_address(host).is_loopback
+    except ValueError:
+        return False
+
+
 @contextlib.contextmanager
 def _own_argv() -> Iterator[None]:
     """trame reads sys.argv for options of its own (--port, --host, ...): hide ours."""
@@ -103,6 +112,13 @@ def serve(
             file=sys.stderr,
             flush=True,
         )
+        if not _loopback(host):
+            print(
+                f"formgraph studio: listening on {host}, not only on this machine: whoever "
+                "can reach it and has the URL can run graphs here and save this file",
+                file=sys.stderr,
+                flush=True,
+            )
         if open_browser:
             import webbrowser
 

@@ -125,7 +125,14 @@ class Page:
 
             def reload(self) -> bool:
                 self.stamp = self._stamp()
-                page.worker.submit("text", page._open_disk)
+                if page.state.text != page.session.disk_text:  # unsaved edits: keep them
+                    page._say(
+                        f"{page.session.path.name} changed on disk; the editor keeps your "
+                        "edits (Reload takes the file's text, Save overwrites the file)",
+                        True,
+                    )
+                    return False
+                page.worker.submit("disk", page._open_disk)
                 return True
 
         self.watch = DiskWatch(session.path, None, (), session.out_dir, session.budget, "", None)
@@ -170,6 +177,7 @@ class Page:
         ctrl.trigger("show_node")(self._show_node)
         ctrl.add("save")(self._save)
         ctrl.add("run")(self._run)
+        ctrl.add("reload")(lambda: self.worker.submit("disk", self._open_disk))
         ctrl.add("reset_all")(lambda: self.worker.submit("params", self.session.reset_params))
         ctrl.add("show_results")(lambda: self.worker.submit("show", self.session.show, None))
 
@@ -187,6 +195,14 @@ class Page:
                 )
                 v.VBtn("Save", click=self.ctrl.save, variant="tonal", classes="ml-2", id="save")
                 v.VBtn("Run", click=self.ctrl.run, variant="tonal", classes="ml-2", id="run")
+                v.VBtn(
+                    "Reload",
+                    click=self.ctrl.reload,
+                    variant="text",
+                    classes="ml-1",
+                    id="reload",
+                    title="read the graph file again (the editor's unsaved edits are lost)",
+                )
                 html.Div(
                     "{{ status }}",
                     classes=("status_bad ? 'fg-status bad' : 'fg-status'",),
@@ -317,7 +333,7 @@ class Page:
 
     def _ready(self, **_: Any) -> None:
         self.loop = asyncio.get_event_loop()
-        self.worker.submit("text", self._open_disk)
+        self.worker.submit("disk", self._open_disk)
         self.loop.create_task(self._poll())
 
     async def _poll(self) -> None:
@@ -418,11 +434,13 @@ class Page:
             self._picture(datasets)
         t1 = time.perf_counter()
         with s:
-            if kind == "text":
-                if self.session.text != s.text:
-                    s.text = self.session.text
-                self.watch.files = [self.session.path, *self.session.files()[1:]]
-                self.watch.stamp = self.watch._stamp()
+            if kind == "disk" and self.session.text != s.text:
+                s.text = self.session.text  # the file's text into the editor
+            if kind in ("text", "disk"):
+                files = [self.session.path, *self.session.files()[1:]]
+                if files != self.watch.files:  # a subgraph file more or less to watch
+                    self.watch.files = files
+                    self.watch.stamp = self.watch._stamp()
             if kind == "run" and cooked.ok:
                 written = ", ".join(self.session.exports()) or "nothing to export"
                 s.status = f"{name}: ran in {_ms(cooked.seconds)}, wrote {written} into "
@@ -432,7 +450,7 @@ class Page:
                     s.graph_svg = svg
                 return
             s.problems = _problem_lines(cooked.problems)
-            if cooked.new_graph or not cooked.ok or kind == "text":
+            if cooked.new_graph or not cooked.ok or kind in ("text", "disk"):
                 s.markers = _markers(cooked.problems)
             if cooked.ok:
                 s.markers = []

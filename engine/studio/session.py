@@ -164,7 +164,8 @@ class StudioSession:
         self.out_dir = Path(out_dir)
         self.sets = list(sets)
         self.budget = budget
-        self.text = ""
+        self.text = ""  # the text of the version opened last (the editor's or the file's)
+        self.disk_text: str | None = None  # the file's text as last read or saved
         self.graph: Graph | None = None  # the last version that checked
         self.values: dict[str, Any] = {}  # params set by the controls (and --set)
         self.shown_names: list[str] | None = None  # None: the graph's results
@@ -198,6 +199,7 @@ class StudioSession:
                 problem = exc.problems[0] if isinstance(exc, GraphError) else None
                 problem = problem or Problem(Where(str(self.path)), f"cannot read it: {exc}")
                 return self._failed([problem], str(problem))
+            self.disk_text = text
         self.text = text
         try:
             graph = Graph.from_text(
@@ -332,7 +334,7 @@ class StudioSession:
         the studio writes)."""
         path = self.path.resolve()
         target = write_atomic(path.parent, path.name, text.encode("utf-8"))
-        self.text = text
+        self.disk_text = text
         return target
 
     def run(self) -> Cooked:
