@@ -113,6 +113,8 @@ class Page:
         self.loop: asyncio.AbstractEventLoop | None = None
         self.controls: list[Control] = []
         self._wanted: dict[str, Any] = {}  # the controls' values, as the page last set them
+        self._editor_text = ""  # the editor's text as the loop last knew it
+        self._disk_text: str | None = None  # the file's text as last read or saved
         self._edit_timer: Any = None
         self._framed: tuple[float, ...] | None = None  # the bounds the camera was fit to
         self.updates = 0  # view updates sent
@@ -125,7 +127,7 @@ class Page:
 
             def reload(self) -> bool:
                 self.stamp = self._stamp()
-                if page.state.text != page.session.disk_text:  # unsaved edits: keep them
+                if page.state.text != page._disk_text:  # unsaved edits: keep them
                     page._say(
                         f"{page.session.path.name} changed on disk; the editor keeps your "
                         "edits (Reload takes the file's text, Save overwrites the file)",
@@ -162,8 +164,9 @@ class Page:
 
         @s.change("text")
         def _edited(text: str, **_: Any) -> None:
-            if text == self.session.text:
+            if text == self._editor_text:
                 return  # the text the server itself put in the editor
+            self._editor_text = text
             if self._edit_timer is not None:
                 self._edit_timer.cancel()
             loop = asyncio.get_event_loop()
@@ -383,12 +386,12 @@ class Page:
         text = self.state.text
         self.worker.submit("save", self._save_text, text)
 
-    def _save_text(self, text: str) -> tuple[str, Any]:
+    def _save_text(self, text: str) -> tuple[str, str, str | None]:
         try:
             path = self.session.save(text)
         except Exception as exc:  # a PathError or an OSError: said on the page
-            return ("error", f"not saved: {exc}")
-        return ("ok", f"saved {path.name}")
+            return ("error", f"not saved: {exc}", None)
+        return ("ok", f"saved {path.name}", text)
 
     def _run(self) -> None:
         self.worker.submit("run", self.session.run)
@@ -404,9 +407,23 @@ class Page:
         prepared = None
         if isinstance(result, Cooked):
             datasets = self.scene.prepare(result.shown) if result.ok and kind != "run" else None
-            prepared = (datasets, self._drawing(result))
+            prepared = (datasets, self._drawing(result), self._snapshot())
         seconds += time.perf_counter() - t0
         self.loop.call_soon_threadsafe(self._apply, kind, result, seconds, prepared)
+
+    def _snapshot(self) -> dict[str, Any]:
+        """What the page shows of the session, read in the worker thread, between two of
+        its requests (the loop must not read a session the next request is changing)."""
+        session = self.session
+        graph = session.graph
+        return {
+            "text": session.text,
+            "files": [session.path, *session.files()[1:]],
+            "controls": controls_of(graph, session.values) if graph is not None else None,
+            "values": dict(session.values),
+            "shown": session.shown_names,
+            "exports": session.exports(),
+        }
 
     def _worker_error(self, kind: str, exc: BaseException) -> None:
         message = f"internal error ({kind}): {type(exc).__name__}: {exc}"
@@ -423,26 +440,30 @@ class Page:
         t0 = time.perf_counter()
         name = self.session.path.name
         if kind == "save":
-            status, text = result
+            status, text, saved = result
             self.watch.stamp = self.watch._stamp()  # our own write: no reload
+            if saved is not None:
+                self._disk_text = saved
             self._say(f"{name}: {text}", status != "ok")
             return
         cooked: Cooked = result
-        datasets, svg = prepared if prepared is not None else (None, None)
+        datasets, svg, snap = prepared if prepared is not None else (None, None, None)
+        if snap is None:
+            snap = self._snapshot()  # (a request with no Cooked result: not reached)
         s = self.state
         if datasets is not None:  # the picture first: its arrays are what takes longest
             self._picture(datasets)
         t1 = time.perf_counter()
         with s:
-            if kind == "disk" and self.session.text != s.text:
-                s.text = self.session.text  # the file's text into the editor
-            if kind in ("text", "disk"):
-                files = [self.session.path, *self.session.files()[1:]]
-                if files != self.watch.files:  # a subgraph file more or less to watch
-                    self.watch.files = files
-                    self.watch.stamp = self.watch._stamp()
+            if kind == "disk":
+                self._disk_text = snap["text"]
+                if snap["text"] != s.text:
+                    self._editor_text = s.text = snap["text"]  # the file's text, in the editor
+            if kind in ("text", "disk") and snap["files"] != self.watch.files:
+                self.watch.files = snap["files"]  # a subgraph file more or less to watch
+                self.watch.stamp = self.watch._stamp()
             if kind == "run" and cooked.ok:
-                written = ", ".join(self.session.exports()) or "nothing to export"
+                written = ", ".join(snap["exports"]) or "nothing to export"
                 s.status = f"{name}: ran in {_ms(cooked.seconds)}, wrote {written} into "
                 s.status += f"{self.session.out_dir}"
                 s.status_bad = False
@@ -455,14 +476,20 @@ class Page:
             if cooked.ok:
                 s.markers = []
                 s.problems = []
-            if self.session.graph is not None and (cooked.new_graph or kind == "params"):
-                self.controls = controls_of(self.session.graph, self.session.values)
-                self._wanted = dict(self.session.values)
+            newer = kind == "params" and self.worker.waiting("params")
+            if (
+                snap["controls"] is not None
+                and (cooked.new_graph or kind == "params")
+                and not newer
+            ):
+                # (with a newer step waiting, the sliders keep the values the user set)
+                self.controls = snap["controls"]
+                self._wanted = dict(snap["values"])
                 s.controls = [c.as_dict() for c in self.controls]
                 s.params = {c.name: _shown_value(c.value) for c in self.controls}
             if svg is not None:
                 s.graph_svg = svg
-            shown = self.session.shown_names
+            shown = snap["shown"]
             s.shown = ", ".join(shown) if shown else "the graph's results"
             if cooked.ok:
                 s.status = (

@@ -63,6 +63,11 @@ class Worker:
         if self._running is not None and self._running in self._pending:
             raise Superseded(self._running)
 
+    def waiting(self, kind: str) -> bool:
+        """Whether a request of ``kind`` waits to run."""
+        with self._cv:
+            return kind in self._pending
+
     def idle(self) -> bool:
         with self._cv:
             return self._running is None and not self._pending
