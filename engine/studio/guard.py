@@ -58,6 +58,11 @@ def _split_host(host: str) -> tuple[str, int | None] | None:
         name, rest = host[1:end], host[end + 1 :]
         if rest and not rest.startswith(":"):
             return None
+        try:  # brackets hold an IPv6 address, nothing else
+            if ipaddress.ip_address(name).version != 6:
+                return None
+        except ValueError:
+            return None
         port_text = rest[1:]
     else:
         name, sep, port_text = host.rpartition(":")
