@@ -319,3 +319,49 @@ def test_ply_writes_colours_and_attributes_that_trimesh_and_meshio_read(tmp_path
     assert [f for f, _ in faces] == [list(f) for f in Mesh(v, fi, fo).faces]
     plain = trimesh.load(io.BytesIO(ply_binary(*box().arrays)), file_type="ply", process=False)
     assert len(plain.vertices) == 8
+
+
+def test_curves_copy_to_points_per_point_and_sample_surface_attributes():
+    g = fg.Graph()
+    g.add("wall", "surfaces.parametric", x="v", y="0.5 * sin(v)", z="u", u=[0, 2], v=[0, 6])
+    g.add("spots", "geometry.sample_surface", surface="@wall", u=2, v=5)
+    g.add("ring", "nurbs.circle", radius=0.2)
+    g.add(
+        "rings",
+        "curves.copy_to_points",
+        curve="@ring",
+        points="@spots.points",
+        align="=normal",
+        scale="=1 + i",
+    )
+    spots = g.evaluate("spots")
+    pts = spots.points
+    np.testing.assert_array_equal(pts.point_data["normal"], np.asarray(spots.normals))
+    assert pts.point_data["u"].shape == (10,) and pts.point_data["v"].max() < 6
+    rings = g.evaluate("rings")
+    for k, ring in enumerate(rings):
+        p = ring.sample(64)
+        r = np.linalg.norm(p - pts.xyz[k], axis=1)
+        np.testing.assert_allclose(r, 0.2 * (1 + k), rtol=1e-9)
+        # the ring's plane is normal to the surface normal there
+        np.testing.assert_allclose((p - pts.xyz[k]) @ pts.point_data["normal"][k], 0, atol=1e-9)
+
+
+def test_per_element_values_are_checked(tmp_path):
+    g = load_text(
+        tmp_path,
+        """
+formgraph: 1
+nodes:
+  p: {type: points.grid, nx: 2, ny: 2}
+  inf: {type: attr.set, geometry: "@p", name: h, value: "=1 / (x * 0)"}
+  deep: {type: mesh.copy_to_points, mesh: "@b", points: "@p", rotate: "=x"}
+  b: {type: mesh.box}
+""",
+    )
+    with pytest.raises(fg.NodeError, match="not finite at element 0"):
+        g.evaluate("inf")
+    with pytest.raises(fg.NodeError, match="input 'rotate'"):
+        g.evaluate("deep")  # one number per point where a vector per point is needed
+    with pytest.raises(fg.NodeError, match=r"rotate needs \[rx, ry, rz\] per point"):
+        g.evaluate("deep")
