@@ -18,8 +18,8 @@ from typing import Any
 
 from formgraph.core.errors import FormgraphError, GraphError, Problem, Where
 from formgraph.evaluation.graph import Graph, load
-from formgraph.language.check import param_kind
 from formgraph.language.model import Items, Wire, parse_input
+from formgraph.language.params import param_kind
 
 from .frame import Camera
 from .scene import PALETTE, TEXT_COLOR, Scene, fit_scenes
@@ -58,7 +58,7 @@ def shown_nodes(graph: Graph, node: str | Iterable[str] | None = None) -> list[s
 
 
 def _check_target(graph: Graph, registry: dict[str, Any], target: str) -> None:
-    from formgraph.language.check import suggest
+    from formgraph.language.params import suggest
 
     where = Where(graph.file)
     if target in graph.nodes:

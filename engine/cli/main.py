@@ -201,7 +201,7 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 def cmd_check(args: argparse.Namespace) -> int:
     from ..evaluation.graph import load
-    from ..language.check import param_warnings
+    from ..language.params import param_warnings
 
     g = load(args.graph)
     for p in param_warnings(g.param_defs, g.file_label):
@@ -346,7 +346,7 @@ def cmd_graph(args: argparse.Namespace) -> int:
 def cmd_nodes(args: argparse.Namespace) -> int:
     from ..core.registry import node_types
     from ..language.catalogue import catalogue_text, markdown, node_text
-    from ..language.check import suggest
+    from ..language.params import suggest
 
     if args.markdown:
         sys.stdout.write(markdown())
