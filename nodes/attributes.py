@@ -17,7 +17,7 @@ from formgraph.core.errors import InputError
 from formgraph.core.registry import Context, node
 from formgraph.core.types import PerElement, SameAs
 from formgraph.geometry import Mesh, Points
-from formgraph.language.elements import ElementValue, element_env
+from formgraph.language.elements import VARIABLES, ElementValue, element_env
 
 
 class Domain(str, Enum):
@@ -64,6 +64,10 @@ def set_attribute(
     """
     if not isinstance(name, str) or not name.isidentifier() or name.startswith("_"):
         raise InputError("name", f"{name!r} is not a name: letters, digits and _, not first _")
+    if name in VARIABLES:
+        raise InputError(
+            "name", f"{name!r} is a variable of per-element expressions; choose another name"
+        )
     domain = Domain(domain)
     if domain is Domain.face and not isinstance(geometry, Mesh):
         raise InputError("domain", "a point set has no faces; use domain: point")
@@ -74,7 +78,7 @@ def set_attribute(
     ctx.guard(count, "elements")
     what = "faces" if domain is Domain.face else "points"
     if isinstance(value, ElementValue):
-        env = element_env(geometry, domain.value)
+        env = element_env(geometry, domain.value, value.names)
         try:
             values: Any = value.evaluate(env, count, what)
         except ValueError as exc:

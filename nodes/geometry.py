@@ -179,7 +179,7 @@ def _per_point(points: Points, **inputs: Any) -> dict[str, Any]:
     env = None
     for port, value in inputs.items():
         if isinstance(value, ElementValue):
-            env = element_env(points) if env is None else env
+            env = element_env(points, "point", value.names) if env is None else env
             try:
                 out[port] = value.evaluate(env, len(points), "points")
             except ValueError as exc:
