@@ -119,8 +119,10 @@ class Watcher(_Watched):
         layout: str = "overlay",
         edges: bool | None = None,
         camera: Camera | None = None,
+        color: str | None = None,
     ):
         super().__init__(path, node, sets, out_dir, budget, layout, edges, camera)
+        self.color = color
         self.plotter = plotter
         self.session: Session | None = None
         self.reloads = 0
@@ -152,6 +154,7 @@ class Watcher(_Watched):
                     layout=self.layout,
                     edges=self.edges,
                     camera=self.camera,
+                    color=self.color,
                 )
                 self.session.add_keys()
                 self.session.scene.set_error(None)  # an error left by a broken start
@@ -196,6 +199,7 @@ def watch(
     layout: str = "overlay",
     edges: bool | None = None,
     camera: Camera | None = None,
+    color: str | None = None,
 ) -> Watcher:
     """Open a window on ``graph_path`` that redraws whenever the file is saved.
 
@@ -228,6 +232,7 @@ def watch(
         layout=layout,
         edges=edges,
         camera=camera,
+        color=color,
     )
     watcher.reload()
     plotter.add_timer_event(
@@ -301,8 +306,10 @@ class ScreenshotWatcher(_Watched):
         camera: Camera | None = None,
         out: Any = None,
         err: Any = None,
+        color: str | None = None,
     ):
         super().__init__(path, node, sets, out_dir, budget, layout, edges, camera)
+        self.color = color
         self.screenshot = Path(screenshot)
         self.size = size
         self.out = out if out is not None else sys.stdout
@@ -336,6 +343,7 @@ class ScreenshotWatcher(_Watched):
                     layout=self.layout,
                     edges=self.edges,
                     camera=self.camera,
+                    color=self.color,
                 )
                 self.screenshot.parent.mkdir(parents=True, exist_ok=True)
                 tmp = self.screenshot.with_name(f".{self.screenshot.name}.{os.getpid()}.tmp.png")
