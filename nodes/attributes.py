@@ -53,7 +53,9 @@ def set_attribute(
     name : str
         The attribute's name (letters, digits and _), e.g. ``color``, ``height``.
     value : float | list[float]
-        A number, a vector, an expression or a list of them (see above).
+        A number, a vector, or per-element expressions: one ("=z / 10"), or a list with
+        one per component (["=x", 0, "=rand(i)"]), over x y z, nx ny nz, i, count, the
+        element's attributes and the params.
     domain : Domain
         ``point`` (points, or a mesh's vertices) or ``face`` (a mesh's faces).
 
