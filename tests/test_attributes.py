@@ -365,3 +365,9 @@ nodes:
         g.evaluate("deep")  # one number per point where a vector per point is needed
     with pytest.raises(fg.NodeError, match=r"rotate needs \[rx, ry, rz\] per point"):
         g.evaluate("deep")
+
+
+def test_from_faces_takes_the_points_attributes():
+    pts = Points([[0, 0], [1, 0], [1, 1], [0, 1]], {"w": [1.0, 2.0, 3.0, 4.0]})
+    out = run("mesh.from_faces", pts, "vertices", faces=[[0, 1, 2, 3]])
+    assert out.point_data["w"].tolist() == [1, 2, 3, 4]
