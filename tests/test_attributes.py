@@ -371,3 +371,16 @@ def test_from_faces_takes_the_points_attributes():
     pts = Points([[0, 0], [1, 0], [1, 1], [0, 1]], {"w": [1.0, 2.0, 3.0, 4.0]})
     out = run("mesh.from_faces", pts, "vertices", faces=[[0, 1, 2, 3]])
     assert out.point_data["w"].tolist() == [1, 2, 3, 4]
+
+
+def test_per_element_expressions_in_a_repeat_read_the_loop_name(tmp_path):
+    text = """
+formgraph: 1
+nodes:
+  p: {type: points.grid, nx: 3, ny: 1}
+  s: {type: attr.set, repeat: {k: 3}, geometry: "@p", name: h, value: "=x * k + rand(i, k)"}
+"""
+    out = load_text(tmp_path, text).evaluate("s")
+    x, i = np.asarray(out[0].xyz)[:, 0], np.arange(3.0)
+    for k, value in enumerate(out):
+        np.testing.assert_array_equal(value.point_data["h"], x * k + rand(i, k))
