@@ -94,7 +94,7 @@ class ElementValue:
                     f"attribute of the {what} (attributes: {have})"
                 )
         cols = []
-        for p in self.parts:
+        for j, p in enumerate(self.parts):
             if isinstance(p, Bound):
                 with np.errstate(all="ignore"):
                     v = np.asarray(p.compiled(p.params, **env), dtype=np.float64)
@@ -104,6 +104,11 @@ class ElementValue:
                 if v.ndim > 1 or (v.ndim == 1 and self.vector):
                     raise ValueError(f"{self.text} gives an array of shape {v.shape}")
                 v = np.broadcast_to(v, (count,) + v.shape)
+            if self.vector and v.ndim != 1:
+                raise ValueError(
+                    f"component {j} of {self.text} gives {v.shape[1:]} values per element; "
+                    f"each component must be one number per element"
+                )
             cols.append(v)
         out = np.stack(cols, axis=1) if self.vector else cols[0]
         if out.ndim > 2:

@@ -16,7 +16,10 @@ def _graph(text: str) -> fg.Graph:
     return fg.Graph.from_text("formgraph: 1\nnodes:\n" + text, file="h.yaml")
 
 
-GRID = "  p: {type: points.grid, nx: 3, ny: 2}\n"
+GRID = (
+    "  q: {type: points.grid, nx: 3, ny: 2}\n"
+    '  p: {type: attr.set, geometry: "@q", name: normal, value: [0, 0, 1]}\n'
+)
 
 
 @pytest.mark.parametrize(
@@ -27,6 +30,7 @@ GRID = "  p: {type: points.grid, nx: 3, ny: 2}\n"
         ('"=rand(i) ** 1e308 + 1e308 * 10"', "not finite"),
         ('["=x", "=nothing"]', "names 'nothing'"),
         ('"=_x"', "starting with '_'"),
+        ('["=normal", 0]', "component 0 of .* gives \\(3,\\) values per element"),
     ],
 )
 def test_bad_per_element_values_are_located_errors(value, why):
