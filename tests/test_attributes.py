@@ -384,3 +384,19 @@ nodes:
     x, i = np.asarray(out[0].xyz)[:, 0], np.arange(3.0)
     for k, value in enumerate(out):
         np.testing.assert_array_equal(value.point_data["h"], x * k + rand(i, k))
+
+
+def test_glb_writes_the_color_attribute_as_color_0(tmp_path):
+    sphere = trimesh.creation.icosphere(2)
+    m = Mesh(sphere.vertices, sphere.faces.reshape(-1), np.arange(0, sphere.faces.size + 1, 3))
+    z = m.vertices[:, 2]
+    colour = np.column_stack([(z + 1) / 2, np.full_like(z, 0.25), 1 - (z + 1) / 2])
+    g = fg.Graph()
+    g.add_param("m", type="Mesh")
+    g.add("w", "export.gltf", meshes=["=m"], path="colours.glb")
+    g.out_dir = tmp_path
+    path = g.evaluate("w", m=m.with_data({"color": colour}))
+    scene = trimesh.load(path, process=False)
+    back = next(iter(scene.geometry.values()))
+    assert len(back.vertices) == m.n_vertices
+    np.testing.assert_allclose(back.visual.vertex_colors[:, :3] / 255.0, colour, atol=1 / 255)
