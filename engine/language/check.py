@@ -43,7 +43,9 @@ def param_kind(p: ParamDef) -> type | None:
     """The scalar type of a param without a declared ``type:``, read from how it is written.
 
     A number is an ``int`` only when its default, min and max are all written as whole
-    numbers (``{default: 3, min: 0.5, max: 10}`` is a float); None for anything else.
+    numbers (``{default: 3, min: 0.5, max: 10}`` is a float) and it feeds no port that
+    asks for a float only (``r: 2`` feeding a radius is a float, see :func:`infer_fed`);
+    None for anything else.
     """
     if p.type is not None:
         return None
@@ -51,10 +53,53 @@ def param_kind(p: ParamDef) -> type | None:
     if isinstance(d, (bool, str)):
         return type(d)
     if _whole(d):
-        return int if all(_whole(b) for b in (p.min, p.max) if b is not None) else float
+        whole = all(_whole(b) for b in (p.min, p.max) if b is not None)
+        return int if whole and p.fed is not float else float
     if isinstance(d, float):
         return float
     return None
+
+
+def _expression_ports_take_text(g: Outline, nd: NodeDef, spec: NodeSpec) -> None:
+    """Read ``z: "=wall/2"`` on an expression port as the expression ``wall/2``.
+
+    An expression port takes the text of an expression; written with the ``=`` of a
+    param expression it is still one expression (over the port's variables and the
+    params), so the ``=`` is dropped rather than the text evaluated once with the param
+    defaults. ``"=shape"`` naming a text param still passes that param's text.
+    """
+    for port, value in nd.inputs.items():
+        if not isinstance(value, Expr) or port not in spec.inputs:
+            continue
+        if not spec.inputs[port].type.is_expression:
+            continue
+        if value.compiled.is_bare_name:
+            p = g.params.get(value.text.strip())
+            if p is not None and (isinstance(p.default, str) or p.type is not None):
+                continue
+        nd.inputs[port] = Literal(value.text)
+
+
+def infer_fed(g: Outline, registry: Mapping[str, NodeSpec]) -> None:
+    """Set each param's ``fed``: float when the expressions that read it feed float ports
+    only (``radius: "=r"``), None when any feeds an int port (``count: "=r"``) or none does.
+    """
+    votes: dict[str, set[type]] = {name: set() for name in g.params}
+    for nd in g.nodes.values():
+        spec = registry.get(nd.type)
+        if spec is None:
+            continue
+        for port, value in nd.inputs.items():
+            if not isinstance(value, Expr) or port not in spec.inputs:
+                continue
+            bases = {k.base for k in spec.inputs[port].type.kinds if not k.is_list}
+            kind = float if float in bases and int not in bases else int if int in bases else None
+            if kind is None:
+                continue
+            for name in value.compiled.names & votes.keys():
+                votes[name].add(kind)
+    for name, p in g.params.items():
+        p.fed = float if votes[name] == {float} else None
 
 
 def check_param_value(p: ParamDef, value: Any) -> Any:
@@ -130,6 +175,7 @@ def check_graph(g: Outline, extra: list[Problem] | None = None) -> list[Problem]
 
     from .expr import CONSTANTS, FUNCTIONS
 
+    infer_fed(g, registry)
     for p in g.params.values():
         if not p.name.isidentifier() or p.name.startswith("_"):
             problems.append(
@@ -161,6 +207,8 @@ def check_graph(g: Outline, extra: list[Problem] | None = None) -> list[Problem]
 
     for nd in g.nodes.values():
         spec = registry.get(nd.type)
+        if spec is not None:
+            _expression_ports_take_text(g, nd, spec)
         if spec is None:
             if nd.type.endswith((".yaml", ".yml")):
                 continue  # a graph file: its problems come from reading it
@@ -369,7 +417,13 @@ def _check_node(
     for message in repeat_problems:
         add(message, "repeat")
     for port in nd.raw:
-        if port not in spec.inputs:
+        if port not in spec.inputs and nd.raw[port] is None and " " in str(port):
+            add(
+                f"the text {port!r} became an input of its own, because inside {{...}} a "
+                "', ' ends a value: put text that holds ', ' in quotes",
+                port,
+            )
+        elif port not in spec.inputs:
             add(
                 f"'{nd.type}' has no input '{port}'{suggest(port, spec.inputs)}; its inputs are "
                 f"{', '.join(spec.inputs) or 'none'}",
