@@ -26,7 +26,7 @@ from formgraph.kernels.io import (
     obj_bytes,
     pdf_bytes,
     ply_binary,
-    stl_ascii,
+    stl_ascii_chunks,
     stl_binary,
     svg_bytes,
 )
@@ -56,7 +56,8 @@ def stl(mesh: Mesh, path: OutputPath, ascii: bool = False, *, ctx: Context) -> s
     ctx.guard(int(np.sum(mesh.face_sizes - 2)), "triangles")
     for warning in mesh_report(v, fi, fo).warnings():
         ctx.warn(warning)
-    data = stl_ascii(v, fi, fo) if ascii else stl_binary(v, fi, fo)
+    # ASCII: written a block of facets at a time (the text is five times the binary)
+    data = stl_ascii_chunks(v, fi, fo) if ascii else stl_binary(v, fi, fo)
     return str(ctx.write(path, data))
 
 

@@ -141,7 +141,8 @@ def _profile_table(stats: dict[str, Any], nodes: dict[str, str]) -> str:
         items = getattr(st, "items", None)
         notes = list(st.warnings)
         if items is not None:  # a repeated node: one row, with how many of its items ran
-            notes.insert(0, f"{items} items, {st.computed_items}/{items} computed")
+            unit = getattr(st, "unit", "items")  # a simulated node's items are its steps
+            notes.insert(0, f"{items} {unit}, {st.computed_items}/{items} computed")
         rows.append(
             f"{name:<24} {nodes.get(name, ''):<24} {st.status:<9} {st.seconds:>9.4f} "
             f"{size:>10}  {'; '.join(notes)}"

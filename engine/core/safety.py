@@ -21,6 +21,7 @@ import re
 import stat
 import tempfile
 import time
+from collections.abc import Iterable
 from pathlib import Path, PurePosixPath, PureWindowsPath
 
 from .errors import PathError
@@ -108,34 +109,53 @@ def resolve_output(out_dir: str | os.PathLike[str], relpath: str) -> Path:
     return real
 
 
-def write_atomic(out_dir: str | os.PathLike[str], relpath: str, data: bytes | memoryview) -> Path:
+def write_atomic(
+    out_dir: str | os.PathLike[str],
+    relpath: str,
+    data: bytes | memoryview | Iterable[bytes | memoryview],
+) -> Path:
     """Write ``data`` to ``relpath`` inside ``out_dir``, atomically; returns the path.
 
     Creates sub-folders; leaves an existing file untouched when it already holds ``data``.
     On any failure the previous file (if any) is intact and no temp file is left behind.
-    ``data`` is any bytes-like object; it is written as it is, never copied.
+    ``data`` is any bytes-like object, written as it is, never copied; or an iterable of
+    them (pieces of a big file made one after another, each written before the next is
+    made: the whole file is never in memory), compared with an existing file only once
+    written to the temp file.
     """
-    data = memoryview(data).cast("B")
+    pieces = None
+    try:
+        data = memoryview(data).cast("B")
+    except TypeError:  # not bytes-like: an iterable of pieces
+        pieces = iter(data)
     target = resolve_output(out_dir, relpath)
     try:
         target.parent.mkdir(parents=True, exist_ok=True)
     except FileExistsError:
         raise PathError(f"output path {relpath!r} runs through a file, not a folder") from None
     target = resolve_output(out_dir, relpath)  # a folder made meanwhile could be a symlink
-    try:
-        if target.is_file() and target.stat().st_size == data.nbytes and _holds(target, data):
-            return target
-    except OSError:
-        pass
+    if pieces is None:
+        try:
+            if target.is_file() and target.stat().st_size == data.nbytes and _holds(target, data):
+                return target
+        except OSError:
+            pass
     remove_stale_temps(target.parent)
     fd, tmp = tempfile.mkstemp(
         prefix=f".{target.name}{TMP_TAG}{os.getpid()}-", suffix=".tmp", dir=target.parent
     )
     try:
         with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
+            if pieces is None:
+                fh.write(data)
+            else:
+                for piece in pieces:
+                    fh.write(piece)
             fh.flush()
             os.fsync(fh.fileno())
+        if pieces is not None and _same_file(target, Path(tmp)):
+            os.unlink(tmp)
+            return target
         os.chmod(tmp, 0o644)
         os.replace(tmp, target)
     except BaseException:
@@ -145,6 +165,23 @@ def write_atomic(out_dir: str | os.PathLike[str], relpath: str, data: bytes | me
             pass
         raise
     return target
+
+
+def _same_file(target: Path, tmp: Path, chunk: int = 1 << 20) -> bool:
+    """Whether ``target`` is a regular file with exactly the bytes of ``tmp`` (read a chunk
+    at a time)."""
+    try:
+        if not target.is_file() or target.stat().st_size != tmp.stat().st_size:
+            return False
+        with open(target, "rb") as a, open(tmp, "rb") as b:
+            while True:
+                x, y = a.read(chunk), b.read(chunk)
+                if x != y:
+                    return False
+                if not x:
+                    return True
+    except OSError:
+        return False
 
 
 _KINDS = {

@@ -14,6 +14,7 @@ any mix of face sizes.
 from __future__ import annotations
 
 import struct
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 import numpy as np
@@ -28,6 +29,7 @@ __all__ = [
     "obj_bytes",
     "ply_binary",
     "stl_ascii",
+    "stl_ascii_chunks",
     "stl_binary",
     "triangle_normals",
 ]
@@ -233,13 +235,9 @@ def stl_ascii(
     face_offsets: np.ndarray,
     name: str = "formgraph",
 ) -> bytes:
-    """ASCII STL in the classic ``facet normal ... endfacet`` layout.
-
-    Numbers are written in sign-mantissa-e-sign-exponent form with nine significant digits —
-    exactly the float32 values a binary STL of the same mesh holds. Every facet is a
-    fixed-width record: the constant words are laid down once in a block-sized template, each
-    distinct vertex is formatted once and its 48 bytes of text copied (as one item) into every
-    facet that uses it.
+    """ASCII STL in the classic ``facet normal ... endfacet`` layout, as one ``bytes``
+    (the pieces of `stl_ascii_chunks` joined; write those to a file instead to keep the
+    memory at a block's worth).
 
     Parameters
     ----------
@@ -253,9 +251,44 @@ def stl_ascii(
     -------
     bytes
     """
+    return b"".join(stl_ascii_chunks(vertices, face_indices, face_offsets, name))
+
+
+def stl_ascii_chunks(
+    vertices: np.ndarray,
+    face_indices: np.ndarray,
+    face_offsets: np.ndarray,
+    name: str = "formgraph",
+) -> Iterator[bytes]:
+    """ASCII STL in pieces: the ``solid`` line, blocks of facets, the ``endsolid`` line.
+
+    Numbers are written in sign-mantissa-e-sign-exponent form with nine significant digits —
+    exactly the float32 values a binary STL of the same mesh holds. Every facet is a
+    fixed-width record: the constant words are laid down once in a block-sized template, each
+    distinct vertex is formatted once and its 48 bytes of text copied (as one item) into every
+    facet that uses it. One block of facets (``_BLOCK``, about 4 MiB of text) is built per
+    piece, so a writer that passes the pieces on holds that and the vertices' text, not the
+    whole file (1M triangles: 260 MiB of text). The input is checked before the first piece.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float64
+    face_indices : (m,) int
+    face_offsets : (n_faces + 1,) int
+    name : str
+        The solid's name, written after ``solid`` and ``endsolid`` (ASCII, no line breaks).
+
+    Returns
+    -------
+    iterator of bytes
+    """
     if not name.isascii() or not name.isprintable():
         raise ValueError(f"the solid name must be printable ASCII, got {name!r}")
     v, tris = _stl_input(vertices, face_indices, face_offsets)
+    return _stl_ascii_pieces(v, tris, name)
+
+
+def _stl_ascii_pieces(v: np.ndarray, tris: np.ndarray, name: str) -> Iterator[bytes]:
     field = 3 * E9_WIDTH
     item = np.dtype(f"V{field}")
     vertex_text = (
@@ -273,16 +306,11 @@ def stl_ascii(
     template = np.empty((min(len(tris), _BLOCK), width), dtype=np.uint8)
     for w, at in zip(words, starts, strict=True):
         template[:, at : at + len(w)] = np.frombuffer(w, dtype=np.uint8)
-    head = f"solid {name}\n".encode()
-    tail = f"endsolid {name}\n".encode()
-    out = np.empty(len(head) + len(tris) * width + len(tail), dtype=np.uint8)
-    out[: len(head)] = np.frombuffer(head, dtype=np.uint8)
-    out[len(out) - len(tail) :] = np.frombuffer(tail, dtype=np.uint8)
-    facets = out[len(head) : len(out) - len(tail)].reshape(len(tris), width)
     fields = [int(at) + len(w) for w, at in zip(words[:-1], starts[:-1], strict=True)]
     v32 = v.astype(np.float32)
     columns = [np.ascontiguousarray(v32[:, k]) for k in range(3)]
-    for s in _blocks(len(tris)):
+    yield f"solid {name}\n".encode()
+    for s in _blocks(len(tris), _BLOCK):
         t = tris[s]
         rec = template[: len(t)]
         normals = _facet_normals(columns, t)
@@ -291,8 +319,8 @@ def stl_ascii(
         for corner in range(3):
             at = fields[corner + 1]
             rec[:, at : at + field].view(item)[:, 0] = np.take(vertex_text, t[:, corner])
-        facets[s] = rec
-    return out.tobytes()
+        yield rec.tobytes()
+    yield f"endsolid {name}\n".encode()
 
 
 def _stl_input(
