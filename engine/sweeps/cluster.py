@@ -226,6 +226,29 @@ def build(
     return dsk, rows, chunks, totals
 
 
+@contextlib.contextmanager
+def _workers_ignore_interrupts() -> Iterator[None]:
+    """Start worker processes with Ctrl-C ignored (an ignored signal stays ignored across
+    their exec, where a handler or a blocked mask would not).
+
+    A terminal sends Ctrl-C to the whole process group: the workers would each die with a
+    ``KeyboardInterrupt`` traceback, mid-import or mid-task, while the client is already
+    stopping the sweep and closing the cluster, which ends them in order. Only the client
+    hears Ctrl-C; while the workers start (a second or two) it is ignored there too.
+    """
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
 HANDSHAKE_SECONDS = 10.0
 _HANDSHAKE_BYTES = 1 << 16  # a scheduler's greeting is some 60 bytes
 
@@ -238,8 +261,8 @@ def probe_scheduler(address: str, timeout: float | None = None) -> None:
     ``distributed`` itself waits for it without a time limit and allocates whatever length
     the peer announces, so a port that accepts and stays silent would hang the sweep and
     one that sends junk could ask for exabytes. Here the greeting must come within
-    ``timeout`` seconds (:data:`HANDSHAKE_SECONDS`), be under 64 KiB and read as Dask's. Addresses other than TCP
-    (``tls://``, ``inproc://``) are left to ``distributed``.
+    ``timeout`` seconds (:data:`HANDSHAKE_SECONDS`), be under 64 KiB and read as Dask's.
+    Addresses other than TCP (``tls://``, ``inproc://``) are left to ``distributed``.
 
     Raises
     ------
@@ -330,7 +353,10 @@ def connect(client: Any, workers: int | None) -> Iterator[Any]:
     # distributed sets MALLOC_TRIM_THRESHOLD_ in workers to hand memory back early; for
     # numpy kernels whose temporaries are megabytes that costs a page-fault storm (the spiral
     # tube builds 1.4x slower), and a sweep's workers end with the sweep anyway
-    with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}):
+    with (
+        dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}),
+        _workers_ignore_interrupts(),
+    ):
         cluster = LocalCluster(
             n_workers=n,
             threads_per_worker=1,
