@@ -324,8 +324,9 @@ class LanguageRun:
                     f"repeat '{loop}' would run about {_count(est)} items, one per element "
                     f"'{source}' makes: each item is a node run and counts as "
                     f"{ITEM_ELEMENTS:,} elements, so {_count(est * ITEM_ELEMENTS * self.scale)}"
-                    f" in all, over the budget of {self.g.budget:,} (at most "
-                    f"{self.g.budget // ITEM_ELEMENTS:,} items; refused before '{source}' runs)",
+                    f" in all, over the budget of {self.g.budget:,}, and at most "
+                    f"{self.g.budget // ITEM_ELEMENTS:,} items fit (refused before '{source}' "
+                    "runs)",
                 )
             ]
         )
