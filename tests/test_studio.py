@@ -191,6 +191,30 @@ def test_session_a_failing_node_names_itself(tmp_path):
     assert s.graph is not None  # a version that checks is current: a param may fix it
 
 
+def test_session_watches_its_subgraph_files(tmp_path):
+    (tmp_path / "part.yaml").write_text(
+        "formgraph: 1\n"
+        "params:\n"
+        "  r: {default: 1.0}\n"
+        "outputs:\n"
+        "  pts: '@pts'\n"
+        "nodes:\n"
+        "  pts:\n"
+        "    type: points.circle\n"
+        "    count: 6\n"
+        "    radius: =r\n"
+    )
+    main = tmp_path / "main.yaml"
+    main.write_text("formgraph: 1\nnodes:\n  ring:\n    type: part.yaml\n    r: 2.0\n")
+    s = StudioSession(main, out_dir=tmp_path / "out")
+    assert s.open().ok
+    assert [p.name for p in s.files()] == ["main.yaml", "part.yaml"]
+    # a broken part is still watched, so that fixing it reloads
+    (tmp_path / "part.yaml").write_text("formgraph: 1\nnodes:\n  pts:\n    type: nope\n")
+    assert not s.open().ok
+    assert [p.name for p in s.files()] == ["main.yaml", "part.yaml"]
+
+
 def test_controls_from_param_types(tmp_path):
     path = tmp_path / "g.yaml"
     path.write_text(
