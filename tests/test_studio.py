@@ -215,6 +215,19 @@ def test_session_watches_its_subgraph_files(tmp_path):
     assert [p.name for p in s.files()] == ["main.yaml", "part.yaml"]
 
 
+def test_session_watches_and_rereads_its_input_files(tmp_path):
+    (tmp_path / "pts.csv").write_text("x,y,z\n0,0,0\n1,0,0\n")
+    main = tmp_path / "main.yaml"
+    main.write_text("formgraph: 1\nnodes:\n  pts:\n    type: read.points\n    path: pts.csv\n")
+    s = StudioSession(main, out_dir=tmp_path / "out")
+    first = s.open()
+    assert first.ok and len(first.shown[0][1]) == 2
+    assert [p.name for p in s.files()] == ["main.yaml", "pts.csv"]
+    (tmp_path / "pts.csv").write_text("x,y,z\n0,0,0\n1,0,0\n2,0,0\n")
+    again = s.cook()  # the input's bytes are in its key: a recook reads it again
+    assert again.ok and len(again.shown[0][1]) == 3 and again.computed == 1
+
+
 def test_controls_from_param_types(tmp_path):
     path = tmp_path / "g.yaml"
     path.write_text(
@@ -677,3 +690,35 @@ def test_choice_control_for_an_enum_param():
     graph = SimpleNamespace(params={"ends": Ends.FLAT}, param_defs={"ends": p})
     (c,) = controls_of(graph, {})
     assert (c.kind, c.value, c.choices) == ("choice", "flat", ("flat", "round"))
+
+
+def test_colour_by_an_attribute(tmp_path):
+    from formgraph.studio.scene import StudioScene, make_plotter
+
+    path = tmp_path / "g.yaml"
+    path.write_text(
+        "formgraph: 1\n"
+        "params:\n"
+        "  k: {default: 1.0, min: 0.5, max: 4.0}\n"
+        "nodes:\n"
+        "  box: {type: mesh.box, size: [1, 1, 2]}\n"
+        "  tall: {type: attr.set, geometry: '@box', name: tall, value: '=k * z'}\n"
+    )
+    s = StudioSession(path, out_dir=tmp_path / "out")
+    shown = s.open().shown
+    plotter = make_plotter()
+    try:
+        scene = StudioScene(plotter)
+        plain = scene.prepare(shown)
+        assert plain.attributes == ["tall"] and plain.color_by is None
+        assert "tall" not in plain.parts[("tall", "meshes")].point_data  # not sent undrawn
+        scene.apply(plain)
+        assert scene.apply(scene.prepare(shown, "tall"))  # coloured: actors made again
+        mapper = scene.parts[("tall", "meshes")].actors[0].GetMapper()
+        assert mapper.GetScalarVisibility() and mapper.GetArrayName() == "tall"
+        assert mapper.GetScalarRange() == pytest.approx((-1.0, 1.0))
+        assert not scene.apply(scene.prepare(s.set_params(k=3.0).shown, "tall"))
+        assert mapper.GetScalarRange() == pytest.approx((-3.0, 3.0))  # follows the values
+        assert scene.prepare(shown, "nope").color_by is None  # no such attribute: by node
+    finally:
+        plotter.close()

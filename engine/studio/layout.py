@@ -143,6 +143,18 @@ def build(page: Any) -> tuple[Any, Any]:
                         block=True,
                         classes="mb-2",
                     )
+                    v.VSelect(
+                        v_show=("attributes.length",),
+                        label="colour by",
+                        items=("['none', ...attributes]",),
+                        model_value=("color_by",),
+                        update_modelValue="color_by = $event; trigger('colour_by', [$event])",
+                        density="compact",
+                        hide_details=True,
+                        variant="outlined",
+                        classes="mb-3",
+                        id="colour-by",
+                    )
                     _control_widgets(v, html)
     return layout, view
 

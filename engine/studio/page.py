@@ -70,6 +70,7 @@ class Page:
         self._wanted: dict[str, Any] = {}  # the controls' values, as the page last set them
         self._editor_text = ""  # the editor's text as the loop last knew it
         self._disk_text: str | None = None  # the file's text as last read or saved
+        self._color_by: str | None = None  # the attribute the page colours by
         self._edit_timer: Any = None
         self._framed: tuple[float, ...] | None = None  # the bounds the camera was fit to
         self.updates = 0  # view updates sent
@@ -81,16 +82,20 @@ class Page:
             """The viewer's watching of a graph's files, asking the worker to reload."""
 
             def reload(self) -> bool:
-                self.stamp = self._stamp()
-                if page.state.text != page._disk_text:  # unsaved edits: keep them
-                    page._say(
-                        f"{page.session.path.name} changed on disk; the editor keeps your "
-                        "edits (Reload takes the file's text, Save overwrites the file)",
-                        True,
-                    )
-                    return False
-                page.worker.submit("disk", page._open_disk)
-                return True
+                old, self.stamp = self.stamp, self._stamp()
+                own = old is None or self.stamp is None or old[0] != self.stamp[0]
+                if page.state.text == page._disk_text:
+                    page.worker.submit("disk", page._open_disk)
+                    return True
+                if not own:  # a part or an input changed: the editor's version again
+                    page.worker.submit("text", page.session.open, page.state.text)
+                    return True
+                page._say(  # the graph file itself, under unsaved edits: keep them
+                    f"{page.session.path.name} changed on disk; the editor keeps your "
+                    "edits (Reload takes the file's text, Save overwrites the file)",
+                    True,
+                )
+                return False
 
         self.watch = DiskWatch(session.path, None, (), session.out_dir, session.budget, "", None)
         self.watch.stamp = self.watch._stamp()  # the first load reads this version
@@ -116,6 +121,8 @@ class Page:
         s.busy = False
         s.cook_id = 0  # bumped after each picture sent (the bench waits on it)
         s.timing = {}  # where the last request's time went (read by bench/bench_studio.py)
+        s.attributes = []  # the attributes of what is shown, to colour by
+        s.color_by = "none"
 
         @s.change("text")
         def _edited(text: str, **_: Any) -> None:
@@ -133,6 +140,7 @@ class Page:
         ctrl.trigger("set_param")(self._set_param)
         ctrl.trigger("reset_param")(self._reset_param)
         ctrl.trigger("show_node")(self._show_node)
+        ctrl.trigger("colour_by")(self._colour_by)
         ctrl.add("save")(self._save)
         ctrl.add("run")(self._run)
         ctrl.add("reload")(lambda: self.worker.submit("disk", self._open_disk))
@@ -184,6 +192,11 @@ class Page:
     def _reset(self, name: str) -> Cooked:
         return self.session.reset_params(name)
 
+    def _colour_by(self, name: str | None) -> None:
+        """Colour by an attribute (``"none"``: by node), drawn again from the last result."""
+        self._color_by = None if name in (None, "", "none") else str(name)
+        self.worker.submit("show", lambda: self.session.last)
+
     def _show_node(self, name: str) -> None:
         self.worker.submit("show", self.session.show, [name])
 
@@ -216,7 +229,9 @@ class Page:
         t0 = time.perf_counter()
         prepared = None
         if isinstance(result, Cooked):
-            datasets = self.scene.prepare(result.shown) if result.ok and kind != "run" else None
+            datasets = None
+            if result.ok and kind != "run":
+                datasets = self.scene.prepare(result.shown, self._color_by)
             prepared = (datasets, self._drawing(result), self._snapshot())
         seconds += time.perf_counter() - t0
         self.loop.call_soon_threadsafe(self._apply, kind, result, seconds, prepared)
@@ -263,6 +278,9 @@ class Page:
         s = self.state
         if datasets is not None:  # the picture first: its arrays are what takes longest
             self._picture(datasets)
+            with s:
+                s.attributes = datasets.attributes
+                s.color_by = datasets.color_by or "none"
         t1 = time.perf_counter()
         with s:
             if kind == "disk":
@@ -342,7 +360,7 @@ class Page:
             return None
         return clickable_svg(drawing)
 
-    def _picture(self, datasets: dict[tuple[str, str], Any]) -> None:
+    def _picture(self, datasets: Any) -> None:
         from formgraph.viewer.app import _camera_lost
 
         from .scene import send_back_faces

@@ -68,7 +68,7 @@ def controls_of(graph: Graph, values: dict[str, Any]) -> list[Control]:
     type) a list of its options; anything else (a vector, a list, a string) a text field
     holding its YAML.
     """
-    from formgraph.language.check import param_kind
+    from formgraph.language.params import param_kind
 
     out = []
     current = {**graph.params, **values}
@@ -150,6 +150,8 @@ class StudioSession:
         ``NAME=VALUE`` params from the command line, the controls' starting values.
     budget : int
         The element budget per node, as for :func:`formgraph.load`.
+    inputs_dir : str or path, optional
+        The folder the read nodes read from (default: the graph file's), as ``--inputs``.
     """
 
     def __init__(
@@ -159,8 +161,10 @@ class StudioSession:
         out_dir: str | os.PathLike[str] = "out",
         sets: Sequence[str] = (),
         budget: int = DEFAULT_BUDGET,
+        inputs_dir: str | os.PathLike[str] | None = None,
     ):
         self.path = Path(path)
+        self.inputs_dir = inputs_dir
         self.out_dir = Path(out_dir)
         self.sets = list(sets)
         self.budget = budget
@@ -203,7 +207,11 @@ class StudioSession:
         self.text = text
         try:
             graph = Graph.from_text(
-                text, file=str(self.path), out_dir=self.out_dir, budget=self.budget
+                text,
+                file=str(self.path),
+                out_dir=self.out_dir,
+                budget=self.budget,
+                inputs_dir=self.inputs_dir,
             )
         except GraphError as exc:
             self._files = list(getattr(exc, "files", None) or [self.path])
@@ -233,7 +241,7 @@ class StudioSession:
 
     def _kept_values(self, graph: Graph) -> dict[str, Any]:
         from formgraph.core.types import TypeMismatch
-        from formgraph.language.check import check_param_value
+        from formgraph.language.params import check_param_value
 
         kept = {}
         for name, value in self.values.items():
@@ -248,7 +256,8 @@ class StudioSession:
         return kept
 
     def files(self) -> list[Path]:
-        """The files the last version read: its own and its subgraph files (to watch)."""
+        """The files the last version read: its own, its subgraph files and the files its
+        read nodes name (what to watch)."""
         return list(self._files)
 
     # ------------------------------------------------------------------------ cook
