@@ -495,20 +495,24 @@ def test_page_shows_the_model(page):
     assert blue.mean() > 0.01
     assert "type: nurbs.sweep" in page.inner_text("#editor").replace("\xa0", " ")
     assert page.locator("#graph [data-node='tube']").count() == 1
-    assert re.search(r"6 computed, 0 cached", _status(page))
+    assert re.search(r"\d+ computed, \d+ cached in", _status(page))
+
+
+def _turns(pg) -> int:
+    return int(re.search(r"turns = (\d+)", pg.inner_text("#controls")).group(1))
 
 
 def test_slider_recooks_and_redraws(page):
-    before = _canvas(page)
+    before, turns = _canvas(page), _turns(page)
     thumb = page.locator(".fg-slider-turns .v-slider-thumb")
     thumb.focus()
-    page.keyboard.press("ArrowRight")
+    page.keyboard.press("ArrowRight" if turns < 12 else "ArrowLeft")
     page.wait_for_function("document.querySelector('#status').innerText.includes('1 cached')")
     after = _wait_picture(page, before)
     assert _shows_model(after) > 0.02
     m = re.search(r"(\d+) computed, (\d+) cached", _status(page))
     assert m and (int(m.group(1)), int(m.group(2))) == (5, 1)  # the section circle stays
-    assert "turns = 4" in page.inner_text("#controls")
+    assert _turns(page) == (turns + 1 if turns < 12 else turns - 1)
 
 
 def test_typo_shows_its_line_and_fixing_recovers(page, studio):
@@ -560,13 +564,21 @@ def test_click_a_node_shows_it(page):
 
 
 def test_an_edit_on_disk_reloads(page, studio):
-    text = studio.graph.read_text()
+    # turns set by its control (whatever ran before on this page): a reload keeps it
+    before, turns = _status(page), _turns(page)
+    page.locator(".fg-slider-turns .v-slider-thumb").focus()
+    page.keyboard.press("ArrowRight" if turns < 12 else "ArrowLeft")
+    page.wait_for_function(f"document.querySelector('#status').innerText != {before!r}")
+    page.wait_for_function(
+        f"!document.querySelector('#controls').innerText.includes('turns = {turns}\\n')"
+    )
+    text, turns = studio.graph.read_text(), _turns(page)
     studio.graph.write_text(text.replace("default: 3, min: 1", "default: 2, min: 1"))
     page.wait_for_function(
         "document.querySelector('#editor').innerText.includes('default:\u00a02,')"
     )
     page.wait_for_function("document.querySelector('#status').innerText.includes('computed')")
-    assert "turns = 4" in page.inner_text("#controls")  # the control's value is kept
+    assert _turns(page) == turns  # the control's value is kept
     # with unsaved edits in the editor, a change on disk does not overwrite them
     page.click("#editor .view-lines")
     page.keyboard.press("Control+End")
