@@ -370,7 +370,7 @@ class Page:
         bounds = self.scene.bounds()
         first = self._framed is None
         if first:
-            self.plotter.reset_camera()
+            self.plotter.reset_camera(render=False)  # a render would send the scene
         self.view.update()
         if first:
             self.view.push_camera()

@@ -171,7 +171,7 @@ class StudioScene:
             if kind in COLOURED:
                 kw.update(colour_by(data, self.color_by))
         part = _Part(data)
-        actor = self.plotter.add_mesh(data, reset_camera=False, **kw)
+        actor = self.plotter.add_mesh(data, reset_camera=False, render=False, **kw)
         apply_material(actor, kind)  # Phong, and the back faces in BACK_FACE
         part.actors.append(actor)
         self.added += len(part.actors)
