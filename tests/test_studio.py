@@ -702,6 +702,7 @@ def test_choice_control_for_an_enum_param():
     graph = SimpleNamespace(params={"ends": Ends.FLAT}, param_defs={"ends": p})
     (c,) = controls_of(graph, {})
     assert (c.kind, c.value, c.choices) == ("choice", "flat", ("flat", "round"))
+    assert c.as_dict()["default"] == "flat" and type(c.as_dict()["default"]) is str
 
 
 def test_colour_by_an_attribute(tmp_path):

@@ -22,7 +22,7 @@ from typing import Any
 from formgraph.core.errors import Problem
 
 from .layout import build
-from .session import Control, Cooked, StudioSession, controls_of
+from .session import Control, Cooked, StudioSession, controls_of, plain
 from .worker import Worker
 
 __all__ = ["Page"]
@@ -201,9 +201,7 @@ class Page:
         self.worker.submit("show", self.session.show, [name])
 
     def _open_disk(self) -> Cooked:
-        cooked = self.session.open()
-        cooked.message = cooked.message or ""
-        return cooked
+        return self.session.open()  # the file's text
 
     def _save(self) -> None:
         text = self.state.text
@@ -314,7 +312,7 @@ class Page:
                 self.controls = snap["controls"]
                 self._wanted = dict(snap["values"])
                 s.controls = [c.as_dict() for c in self.controls]
-                s.params = {c.name: _shown_value(c.value) for c in self.controls}
+                s.params = {c.name: plain(c.value) for c in self.controls}
             if svg is not None:
                 s.graph_svg = svg
             shown = snap["shown"]
@@ -402,14 +400,6 @@ def _as_param(c: Control, value: Any) -> Any:
         except Exception:  # not YAML: handed on as text, the param's check speaks
             return value
     return value
-
-
-def _shown_value(value: Any) -> Any:
-    if hasattr(value, "value") and not isinstance(value, (int, float, str)):
-        return value.value  # an Enum
-    if isinstance(value, (int, float, str, bool)) or value is None:
-        return value
-    return repr(value)
 
 
 def _ms(seconds: float) -> str:

@@ -26,7 +26,7 @@ from formgraph.core.safety import write_atomic
 from formgraph.evaluation.graph import Graph
 from formgraph.language.yamlio import MAX_BYTES
 
-__all__ = ["Control", "Cooked", "StudioSession", "Superseded", "controls_of"]
+__all__ = ["Control", "Cooked", "StudioSession", "Superseded", "controls_of", "plain"]
 
 
 class Superseded(Exception):
@@ -48,16 +48,31 @@ class Control:
     doc: str = ""
 
     def as_dict(self) -> dict[str, Any]:
+        """The control as the page's state holds it (JSON: an Enum as its value)."""
         return {
             "name": self.name,
             "kind": self.kind,
-            "default": self.default,
+            "default": plain(self.default),
             "min": self.min,
             "max": self.max,
             "step": self.step,
             "choices": list(self.choices),
             "doc": self.doc,
         }
+
+
+def plain(value: Any) -> Any:
+    """``value`` as JSON can carry it: an Enum as its value, a tuple as a list, anything
+    else that is not a number, string, bool, list or None as its repr."""
+    import enum
+
+    if isinstance(value, enum.Enum):
+        return value.value
+    if isinstance(value, (list, tuple)):
+        return [plain(v) for v in value]
+    if value is None or isinstance(value, (bool, int, float, str)):
+        return value
+    return repr(value)
 
 
 def controls_of(graph: Graph, values: dict[str, Any]) -> list[Control]:
