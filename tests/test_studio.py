@@ -228,6 +228,24 @@ def test_session_watches_and_rereads_its_input_files(tmp_path):
     assert again.ok and len(again.shown[0][1]) == 3 and again.computed == 1
 
 
+def test_node_warnings_are_located(tmp_path):
+    path = tmp_path / "g.yaml"
+    path.write_text(
+        "formgraph: 1\n"
+        "nodes:\n"
+        "  box: {type: mesh.box}\n"
+        "  smooth:\n"
+        "    type: mesh.catmull_clark\n"
+        "    mesh: '@box'\n"
+        "    sharpness: 2\n"
+    )
+    cooked = StudioSession(path, out_dir=tmp_path / "out").open()
+    assert cooked.ok
+    (w,) = cooked.warnings
+    assert (w.where.node, w.where.line) == ("smooth", 4)
+    assert "sharpness has no effect without crease_angle" in w.message
+
+
 def test_controls_from_param_types(tmp_path):
     path = tmp_path / "g.yaml"
     path.write_text(

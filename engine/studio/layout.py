@@ -106,7 +106,11 @@ def build(page: Any) -> tuple[Any, Any]:
                             ),
                         )
                     with html.Div(classes="fg-problems", id="problems", v_show="problems.length"):
-                        html.Div("{{ p }}", v_for="p in problems")
+                        html.Div(
+                            "{{ p }}",
+                            v_for="p in problems",
+                            style=("p.startsWith('warning') ? 'color: #8a5a00' : ''",),
+                        )
                 with html.Div(classes="fg-center"):
                     with html.Div(classes="fg-view", id="view"):
                         view = PyVistaLocalView(page.plotter)

@@ -32,9 +32,9 @@ POLL_SECONDS = 0.5  # how often the graph's files are looked at
 _names = itertools.count()
 
 
-def _markers(problems: list[Problem]) -> list[dict[str, Any]]:
+def _markers(problems: list[Problem], severity: str = "error") -> list[dict[str, Any]]:
     return [
-        {"line": p.where.line, "message": p.message, "severity": "error"}
+        {"line": p.where.line, "message": p.message, "severity": severity}
         for p in problems
         if p.where.line is not None
     ]
@@ -299,9 +299,9 @@ class Page:
             s.problems = _problem_lines(cooked.problems)
             if cooked.new_graph or not cooked.ok or kind in ("text", "disk"):
                 s.markers = _markers(cooked.problems)
-            if cooked.ok:
-                s.markers = []
-                s.problems = []
+            if cooked.ok:  # what is left to say: the nodes' warnings
+                s.markers = _markers(cooked.warnings, "warning")
+                s.problems = [f"warning: {p}" for p in _problem_lines(cooked.warnings)]
             newer = kind == "params" and self.worker.waiting("params")
             if (
                 snap["controls"] is not None
@@ -318,9 +318,11 @@ class Page:
             shown = snap["shown"]
             s.shown = ", ".join(shown) if shown else "the graph's results"
             if cooked.ok:
+                n = len(cooked.warnings)
+                warned = f", {n} warning{'s' if n != 1 else ''}" if n else ""
                 s.status = (
                     f"{name}: {cooked.computed} computed, {cooked.cached} cached in "
-                    f"{_ms(cooked.seconds)}"
+                    f"{_ms(cooked.seconds)}{warned}"
                 )
                 s.status_bad = False
             else:

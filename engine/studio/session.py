@@ -142,6 +142,7 @@ class Cooked:
     failed: list[str] = field(default_factory=list)
     message: str = ""
     new_graph: bool = False  # a new version of the graph (controls and drawing may change)
+    warnings: list[Problem] = field(default_factory=list)  # the nodes' warnings, located
 
     @property
     def computed(self) -> int:
@@ -343,7 +344,7 @@ class StudioSession:
             if t != base:
                 value = getattr(value, t[len(base) + 1 :])
             shown.append((t, value))
-        self.last = Cooked(True, shown, dict(graph.stats), seconds)
+        self.last = Cooked(True, shown, dict(graph.stats), seconds, warnings=_warnings(graph))
         return self.last
 
     def _failed(self, problems: Sequence[Problem], message: str, failed=()) -> Cooked:
@@ -392,6 +393,17 @@ class StudioSession:
                 if isinstance(path, str):
                     out.append(path)
         return out
+
+
+def _warnings(graph: Graph) -> list[Problem]:
+    """The last evaluation's node warnings (an open mesh, a value clamped), each at its
+    node's line."""
+    out = []
+    for name, st in graph.stats.items():
+        node = graph._nodes.get(name)  # the authored node: its line
+        where = Where(graph.file, getattr(node, "line", None), name)
+        out.extend(Problem(where, w) for w in st.warnings)
+    return out
 
 
 def _base(graph: Graph, target: str) -> str:
