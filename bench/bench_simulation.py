@@ -76,6 +76,19 @@ def run(table) -> None:
         )
         if n == 10_000:
             table.time(case, "numpy all pairs", lambda p=p: all_pairs_step(p), repeat=1)
+            case = "neighbour pairs within 2, 10,000-vertex curve"
+            table.time(case, "formgraph", lambda p=p: growth.pairs_within(p, RADIUS))
+            try:
+                from scipy.spatial import cKDTree
+
+                table.time(
+                    case,
+                    "scipy cKDTree",
+                    lambda p=p: cKDTree(p).query_pairs(RADIUS, output_type="ndarray"),
+                    note="tree built each step, as a step would",
+                )
+            except ImportError as exc:
+                table.add(case, "scipy cKDTree", None, f"not installed ({exc.name})")
 
     x, edges, corners = square_net(100)
     rest = 0.95 * np.linalg.norm(x[edges[:, 1]] - x[edges[:, 0]], axis=1)
