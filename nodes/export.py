@@ -26,7 +26,7 @@ from formgraph.kernels.io import (
     obj_bytes,
     pdf_bytes,
     ply_binary,
-    stl_ascii,
+    stl_ascii_chunks,
     stl_binary,
     svg_bytes,
 )
@@ -56,7 +56,8 @@ def stl(mesh: Mesh, path: OutputPath, ascii: bool = False, *, ctx: Context) -> s
     ctx.guard(int(np.sum(mesh.face_sizes - 2)), "triangles")
     for warning in mesh_report(v, fi, fo).warnings():
         ctx.warn(warning)
-    data = stl_ascii(v, fi, fo) if ascii else stl_binary(v, fi, fo)
+    # ASCII: written a block of facets at a time (the text is five times the binary)
+    data = stl_ascii_chunks(v, fi, fo) if ascii else stl_binary(v, fi, fo)
     return str(ctx.write(path, data))
 
 
@@ -86,6 +87,10 @@ def obj(mesh: Mesh, path: OutputPath, normals: bool = False, *, ctx: Context) ->
 def ply(mesh: Mesh, path: OutputPath, *, ctx: Context) -> str:
     """Write a mesh as binary little-endian PLY: double coordinates, polygon faces kept.
 
+    Every point and face attribute is written: a ``color`` (3 or 4 components in 0..1) as
+    ``uchar red green blue [alpha]``, which viewers show, a ``normal`` as ``nx ny nz``, any
+    other as ``double`` properties (``name``, or ``name_0, name_1, ...`` for a vector).
+
     Parameters
     ----------
     mesh : Mesh
@@ -93,7 +98,7 @@ def ply(mesh: Mesh, path: OutputPath, *, ctx: Context) -> str:
     path : OutputPath
         File path relative to the output directory.
     """
-    data = ply_binary(mesh.vertices, mesh.face_indices, mesh.face_offsets)
+    data = ply_binary(*mesh.arrays, mesh.point_data, mesh.face_data)
     return str(ctx.write(path, data))
 
 

@@ -67,9 +67,12 @@ def _as_nurbs(curve: Curve, port: str, ctx: Context) -> CurveTuple:
     if isinstance(curve, NurbsCurve):
         return _tuple(curve)
     samples = curve.samples if isinstance(curve, ParametricCurve) else 256
-    ctx.guard(4 * max(samples, 4), f"entries of the interpolation system of input '{port}'")
-    pts = np.asarray(curve.sample(max(samples, 4)))
     closed = bool(curve.closed)
+    # What the banded solve holds at once (kernels.nurbs.banded_entries), and the samples.
+    n = max(samples, 4)
+    entries = K.banded_entries(n, 4, 3, closed) + 8 * n
+    ctx.guard(entries, f"entries of the interpolation system of input '{port}'")
+    pts = np.asarray(curve.sample(n))
     return _call(port, K.interpolate, pts[:-1] if closed else pts, 3, closed)
 
 
@@ -252,8 +255,9 @@ def interpolate(
     count = len(pts) - (1 if closed and len(pts) > 1 and np.array_equal(pts[0], pts[-1]) else 0)
     if degree > count - 1 >= 1:
         ctx.warn(f"degree {degree} needs {degree + 1} points, got {count}: using {count - 1}")
-    # the banded system holds (degree + 1) entries per point, and as many blocks in its solve
-    ctx.guard(count * (min(degree, max(count - 1, 1)) + 1), "entries of the interpolation system")
+    # what the banded solve holds at once (kernels.nurbs.banded_entries)
+    width = min(degree, max(count - 1, 1)) + 1
+    ctx.guard(K.banded_entries(count, width, 3, closed), "entries of the interpolation system")
     return _curve(_call("points", K.interpolate, pts, degree, closed, parametrization.value))
 
 
@@ -584,7 +588,8 @@ def tessellate(
 
     A row of the grid that sits at one point (a pole: a revolve whose profile ends on the
     axis, a sphere's tip) becomes one vertex, its quads triangles: no zero-area faces, and
-    a revolve to the axis comes out closed there.
+    a revolve to the axis comes out closed there. Each vertex carries its surface
+    parameters as the ``u`` and ``v`` point attributes.
 
     Parameters
     ----------
@@ -596,4 +601,4 @@ def tessellate(
         Number of faces along v.
     """
     ctx.guard((u + 1) * (v + 1), "vertices")
-    return surface.tessellate(u, v)
+    return surface.tessellate(u, v, with_uv=True)

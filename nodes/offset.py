@@ -9,7 +9,13 @@ import numpy as np
 from formgraph.core.errors import InputError
 from formgraph.core.registry import Context, Range, node
 from formgraph.geometry import Curve, NurbsCurve
-from formgraph.kernels.offset import default_cell, grid_cells, offset_polylines
+from formgraph.kernels.offset import (
+    OffsetTraceError,
+    WorkLimit,
+    default_cell,
+    grid_cells,
+    offset_polylines,
+)
 
 _TOLERANCE = 1e-3  # the kernel's accuracy, as a fraction of the input's extent
 _SAMPLE_SHARE = 0.1  # sampling error allowed, as a share of that (and of the cell)
@@ -106,6 +112,8 @@ def marching_squares(
         loops = offset_polylines(
             polylines, closed, distance, cell, smooth, simplify, max_cells=ctx.budget
         )
+    except (OffsetTraceError, WorkLimit) as exc:
+        raise InputError("curves", str(exc)) from None
     except ValueError as exc:
         raise InputError(
             "smooth" if str(exc).startswith("smoothing") else "cell", str(exc)

@@ -9,7 +9,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from formgraph.kernels import nurbs as K
-from formgraph.kernels.nurbs.banded import solve_banded_rows
+from formgraph.kernels.nurbs import fit
+from formgraph.kernels.nurbs.banded import banded_entries, solve_banded_rows
 from formgraph.kernels.nurbs.fit import _collocation_rows, _periodic_knots
 
 
@@ -127,3 +128,53 @@ def test_wildly_uneven_spacing_is_accurate_or_refused(closed, degree):
     u = K.interpolation_parameters(pts, closed)
     miss = np.abs(K.curve_evaluate(cp, p, knots, None, u) - pts).max()
     assert miss <= 1e-7 * np.abs(pts).max()
+
+
+@pytest.mark.parametrize("closed", [False, True])
+def test_the_charge_covers_what_the_solve_holds(closed):
+    # What a node charges against its budget before asking for the fit (numpy's and
+    # LAPACK's arrays, traced), for a cubic through 200,000 points in 3 columns.
+    import tracemalloc
+
+    n = 200_000
+    t = np.linspace(0, 40 * np.pi, n, endpoint=not closed)
+    pts = np.column_stack([np.cos(t), np.sin(t), np.sin(0.37 * t)])
+    tracemalloc.start()
+    try:
+        K.interpolate(pts, 3, closed)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak / 8 <= banded_entries(n, 4, 3, closed)
+
+
+def test_open_fit_falls_back_to_the_rows_solve(monkeypatch):
+    # If scipy's solve refuses, the rows' own banded solve gives the same curve.
+    import scipy.interpolate
+
+    rng = np.random.default_rng(8)
+    pts = np.cumsum(rng.normal(size=(500, 3)), axis=0)
+    cp, p, knots, _ = K.interpolate(pts, 3)
+
+    def refuse(*args, **kwargs):
+        raise np.linalg.LinAlgError("refused")
+
+    monkeypatch.setattr(scipy.interpolate, "make_interp_spline", refuse)
+    cp2, _, knots2, _ = K.interpolate(pts, 3)
+    np.testing.assert_array_equal(knots, knots2)
+    np.testing.assert_allclose(cp2, cp, atol=1e-9 * np.abs(pts).max())
+    u = K.interpolation_parameters(pts)
+    cols, vals = fit._collocation_rows(3, knots, u)
+    np.testing.assert_allclose(_dense(cols, vals, 500) @ cp2, pts, atol=1e-9 * np.abs(pts).max())
+
+
+def test_averaged_knots_by_running_sums_match_the_definition():
+    # Eq. 9.8: knot j + p is the mean of parameters j .. j + p - 1 (running sums, kept in
+    # order against rounding).
+    rng = np.random.default_rng(2)
+    u = np.concatenate([[0.0], np.sort(rng.uniform(0, 1, 998)), [1.0]])
+    for p in (1, 2, 3, 5):
+        knots = fit._averaged_knots(u, p)
+        inner = [u[j : j + p].mean() for j in range(1, len(u) - p)]
+        np.testing.assert_allclose(knots[p + 1 : -p - 1], inner, atol=1e-14)
+        assert (np.diff(knots) >= 0).all()

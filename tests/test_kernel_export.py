@@ -24,6 +24,7 @@ from formgraph.kernels.io import (
     pdf_bytes,
     ply_binary,
     stl_ascii,
+    stl_ascii_chunks,
     stl_binary,
     svg_bytes,
 )
@@ -201,6 +202,24 @@ def test_ascii_stl_holds_the_binary_values(tmp_path):
     assert np.array_equal(a.normals, b.normals)
     t = trimesh.load(io.BytesIO(text), file_type="stl")
     assert len(t.faces) == 12 and t.is_watertight and t.volume > 0
+
+
+def test_ascii_stl_in_blocks_is_the_same_file(monkeypatch):
+    # Pieces of at most a block of facets each, joined: the whole text, byte for byte.
+    from formgraph.kernels.io import exporters
+
+    monkeypatch.setattr(exporters, "_BLOCK", 5)
+    rng = np.random.default_rng(2)
+    v = BOX_V + rng.normal(scale=0.01, size=BOX_V.shape)
+    pieces = list(stl_ascii_chunks(v, BOX_FI, BOX_FO, name="box"))
+    assert len(pieces) == 2 + 3  # solid, 12 facets in blocks of 5, endsolid
+    facet = len(pieces[1]) // 5
+    assert [len(p) for p in pieces[1:-1]] == [5 * facet, 5 * facet, 2 * facet]
+    whole = b"".join(pieces)
+    assert whole == stl_ascii(v, BOX_FI, BOX_FO, name="box")
+    assert whole.count(b"endfacet") == 12
+    with pytest.raises(ValueError, match="printable ASCII"):
+        stl_ascii_chunks(v, BOX_FI, BOX_FO, name="a\nb")  # refused before the first piece
 
 
 @needs_admesh

@@ -410,3 +410,179 @@ def test_row_parity_matches_shapely():
     inside = parity.inside(i, j)
     pts = shapely.points(origin[0] + j * cell, origin[1] + i * cell)
     assert (inside == shapely.contains(shapely.Polygon(star), pts)).all()
+
+
+def test_points_on_the_segments_are_at_distance_zero():
+    # A grid sample exactly on an input vertex (or on a flat run of segments) has an upper
+    # bound of 0 and flat capsules of radius 0: the pruning needs an absolute slack, or the
+    # rounding of the axis distance drops the very node the point lies on and the distance
+    # comes back as "above the band" (the cause of the offset-of-an-offset failure).
+    x = np.linspace(-5.0, 85.0, 901)
+    a = np.c_[x[:-1], np.full(900, -5.0)]
+    b = np.c_[x[1:], np.full(900, -5.0)]
+    tree = SegmentTree(a, b)
+    p = np.r_[a[::7], (a[::11] + b[::11]) / 2]
+    for upper in (None, np.zeros(p.shape[0])):
+        near = tree.query(p, 0.0, 0.3, upper=upper)
+        assert near.exact.all()
+        assert np.abs(near.dist).max() <= 1e-12
+
+
+# --- offsets of offsets, of our own outputs, of arbitrary polylines -------------------------
+
+
+def _rounded_rectangle(w: float, h: float, r: float) -> np.ndarray:
+    (loop,) = offset_polylines([np.array([[0, 0], [w, 0], [w, h], [0, h]], float)], [True], r)
+    return loop
+
+
+def _check_against_buffer(loops, polygon, d, closed=True, tolerance=1e-3):
+    """Our loops against shapely's buffer of the very polyline we offset."""
+    assert all(shapely.Polygon(loop).is_valid for loop in loops)
+    geom = shapely.Polygon(polygon) if closed else shapely.LineString(polygon)
+    reference = geom.buffer(d, quad_segs=64)
+    ours = as_shape(loops)
+    assert ours.is_valid
+    size = extent(polygon)
+    assert ours.symmetric_difference(reference).area <= tolerance * size * reference.length + 1e-9
+
+
+@pytest.mark.parametrize("cell", [None, 0.02])
+@pytest.mark.parametrize("d", [0.1, 0.5, 1.0, -0.1])
+def test_kerf_of_a_rounded_plate(d, cell):
+    # The nameplate: an 80 x 30 rectangle rounded by an offset of 5, then a kerf. The plate's
+    # straight sides run through samples of the kerf's grid, exactly on its input vertices.
+    plate = _rounded_rectangle(80.0, 30.0, 5.0)
+    loops = offset_polylines([plate], [True], d, cell=cell)
+    assert len(loops) == 1
+    _check_against_buffer(loops, plate, d)
+    # The kerf of the plate is the plate of the rectangle grown by 5 + d (to the tolerance).
+    reference = shapely.box(0, 0, 80, 30).buffer(5 + d, quad_segs=64)
+    assert as_shape(loops).symmetric_difference(reference).area <= 1e-3 * 90 * reference.length
+
+
+def test_kerf_traces_on_the_first_grid(monkeypatch):
+    # The exact distance, not the shifted grids of the fallback, is what makes it work.
+    from formgraph.kernels.offset import marching
+
+    monkeypatch.setattr(marching, "_SHIFTS", (0.0,))
+    plate = _rounded_rectangle(80.0, 30.0, 5.0)
+    for d in (0.1, -0.1, 0.5):
+        _check_against_buffer(offset_polylines([plate], [True], d), plate, d)
+
+
+_OFFSET_SETTINGS = settings(
+    max_examples=12, deadline=None, derandomize=True, suppress_health_check=list(HealthCheck)
+)
+
+
+@_OFFSET_SETTINGS
+@given(
+    st.integers(1, 40),
+    st.integers(1, 40),
+    st.sampled_from([0.5, 1.0, 2.0, 5.0]),
+    st.sampled_from([0.05, 0.1, 0.25, 0.5, 1.0, -0.05, -0.1, -0.25]),
+    st.sampled_from([None, 0.01, 0.02, 0.05]),
+)
+def test_offsets_of_grid_aligned_offsets(w, h, r, d, cell):
+    # Whole-number sizes and round distances put many samples exactly on the input and on
+    # the level: the degenerate cases.
+    plate = _rounded_rectangle(float(w), float(h), r)
+    if cell is not None and cell >= 0.9 * abs(d):
+        cell = abs(d) / 2
+    loops = offset_polylines([plate], [True], d, cell=cell)
+    _check_against_buffer(loops, plate, d)
+
+
+@_OFFSET_SETTINGS
+@given(
+    star_polygons(),
+    st.floats(-0.2, 0.3).filter(lambda d: abs(d) > 0.03),
+    st.floats(-0.1, 0.1).filter(lambda d: abs(d) > 0.005),
+    st.sampled_from([None, 0.5, 0.25]),
+)
+def test_offsets_of_our_own_outputs(polygon, d1, d2, cell_share):
+    # Each loop of an offset, offset again (inward, outward, at kerf-like distances).
+    first = offset_polylines([polygon], [True], d1)
+    if not first:
+        return
+    cell = None if cell_share is None else cell_share * abs(d2)
+    loops = offset_polylines(first, [True] * len(first), d2, cell=cell)
+    reference = as_shape(first).buffer(d2, quad_segs=64)
+    ours = as_shape(loops)
+    assert ours.is_valid
+    size = max(extent(*first), 1e-9)
+    assert ours.symmetric_difference(reference).area <= 1e-3 * size * reference.length + 1e-9
+
+
+@_OFFSET_SETTINGS
+@given(
+    st.lists(st.tuples(st.integers(-20, 20), st.integers(-20, 20)), min_size=2, max_size=30),
+    st.sampled_from([0.25, 0.5, 1.0, 2.0]),
+    st.sampled_from([None, 0.1, 0.2]),
+)
+def test_offsets_of_arbitrary_open_polylines(points, d, cell):
+    # Integer vertices (repeats, spikes, self-crossings and collinear runs included): a band.
+    pts = np.array(points, dtype=float) / 4
+    loops = offset_polylines([pts], [False], d, cell=cell)
+    if np.ptp(pts, axis=0).max() == 0:
+        reference = shapely.Point(pts[0]).buffer(d, quad_segs=64)
+        assert as_shape(loops).symmetric_difference(reference).area <= 1e-3 * 2 * d * 7
+        return
+    _check_against_buffer(loops, pts, d, closed=False)
+
+
+def test_a_trace_failure_says_where_and_what_to_do(monkeypatch):
+    from formgraph.kernels.offset import OffsetTraceError, contour, marching
+
+    def broken(*args, **kwargs):
+        raise contour.InconsistentField("inconsistent field samples: test", np.array([0]))
+
+    monkeypatch.setattr(marching, "trace_crossings", broken)
+    square = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], dtype=float)
+    with pytest.raises(OffsetTraceError, match=r"near \(.*\).*shifted grids.*different cell"):
+        offset_polylines([square], [True], 0.1)
+
+
+def test_segment_tree_of_a_messy_input_matches_brute_force(monkeypatch):
+    # Random points joined up: long segments criss-crossing, cut into pieces in Z-order for
+    # the tree; results still name the whole segment and its parameter. Small chunks force
+    # the chunked path.
+    from formgraph.kernels.offset import distance
+
+    monkeypatch.setattr(distance, "_FIRST_CHUNK", 64)
+    monkeypatch.setattr(distance, "_MAX_PAIRS", 2000)
+    rng = np.random.default_rng(5)
+    a = rng.uniform(0, 1, (60, 2))
+    b = np.roll(a, -1, axis=0)
+    tree = SegmentTree(a, b)
+    assert tree._n_pieces > a.shape[0]
+    p = rng.uniform(-0.2, 1.2, (700, 2))
+    brute, t = point_segment(p[:, None], a[None], b[None])
+    near = tree.query(p)
+    assert np.allclose(near.dist, brute.min(axis=1), rtol=0, atol=1e-12)
+    rows = np.arange(700)
+    assert np.allclose(brute[rows, near.segment], near.dist, atol=1e-12)
+    foot = a[near.segment] + near.t[:, None] * (b[near.segment] - a[near.segment])
+    assert np.allclose(np.hypot(*(p - foot).T), near.dist, atol=1e-12)
+    band = tree.query(p, 0.01, 0.02, upper=np.full(700, np.inf))
+    true = brute.min(axis=1)
+    inside = (true >= 0.01) & (true <= 0.02)
+    assert np.allclose(band.dist[inside], true[inside], atol=1e-12)
+    assert ((band.dist < 0.01) == (true < 0.01)).all()
+    assert ((band.dist > 0.02) == (true > 0.02)).all()
+
+
+def test_messy_input_is_charged_against_the_budget():
+    # 300 random points as one closed polyline, offset by 0.001: every sample near the
+    # (very long) result tests many segments. The work is counted and refused early,
+    # instead of gigabytes of (point, node) pairs.
+    from formgraph.kernels.offset import WorkLimit
+
+    pts = np.random.default_rng(0).uniform(0, 1, (300, 2))
+    with pytest.raises(WorkLimit, match=r"more than 20,000,000 \(point, segment\) pairs"):
+        offset_polylines([pts], [True], 0.001, max_cells=20_000_000)
+    # A clean input of as many segments does the same offset in far fewer pairs.
+    th = np.linspace(0, 2 * np.pi, 300, endpoint=False)
+    (loop,) = offset_polylines([np.c_[np.cos(th), np.sin(th)] / 2 + 0.5], [True], 0.001)
+    assert np.allclose(np.hypot(*(loop - 0.5).T).max(), 0.501, atol=1e-3)

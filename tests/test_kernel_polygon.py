@@ -142,3 +142,27 @@ def test_a_loop_of_no_area_is_fanned_without_error():
     xy = np.column_stack([np.arange(6.0), np.zeros(6)])
     assert triangulate_polygon(xy).shape == (4, 3)
     assert triangulate_polygon(np.zeros((5, 3))).shape == (3, 3)
+
+
+def test_earcut_answers_are_checked_before_they_are_used(monkeypatch):
+    # A wrong answer from the library (here: triangles dropped, then one flipped) is not
+    # used: the rounds of our own clipper tile the polygon instead.
+    import mapbox_earcut
+
+    from formgraph.kernels.mesh import polygon
+
+    xy = star(300)
+    good = mapbox_earcut.triangulate_float64(xy, np.array([300], dtype=np.uint32))
+    for bad in (good[:-3], np.r_[good[:-3], good[-3:][::-1]]):
+        monkeypatch.setattr(mapbox_earcut, "triangulate_float64", lambda *a, b=bad: b)
+        assert polygon._earcut(polygon.polygon_plane(xy)) is None
+        assert_tiles(xy, triangulate_polygon(xy))
+
+
+def test_a_self_crossing_loop_falls_back_to_the_rounds():
+    # A bow tie of many corners: earcut drops triangles there; the rounds still give k - 2.
+    t = np.linspace(0, 2 * np.pi, 400, endpoint=False)
+    xy = np.column_stack([np.sin(t), np.sin(t) * np.cos(t)])
+    tris = triangulate_polygon(xy)
+    assert tris.shape == (398, 3)
+    assert np.array_equal(np.unique(tris), np.arange(400))

@@ -386,5 +386,16 @@ def test_interpolation_of_too_many_points_is_refused_before_solving():
     g = fg.Graph(budget=4_000)
     g.add("pts", "points.random", count=1001, seed=1)
     g.add("c", "nurbs.interpolate", points="@pts")
-    with pytest.raises(fg.BudgetError, match=r"4,004 entries of the interpolation system"):
+    # 1,001 points, cubic: 40 numbers a point (kernels.nurbs.banded_entries), not 4
+    with pytest.raises(fg.BudgetError, match=r"40,040 entries of the interpolation system"):
         g.evaluate("c")
+
+
+def test_parametric_samples_into_extrude_are_charged_what_the_solve_holds():
+    # 10 million samples: 4 entries a sample would pass the default budget of 50 million;
+    # the solve holds ten times that.
+    g = fg.Graph()
+    g.add("c", "curves.parametric", x="cos(t)", y="sin(t)", samples=10_000_000)
+    g.add("e", "nurbs.extrude", curve="@c", direction=[0, 0, 1])
+    with pytest.raises(fg.BudgetError, match=r"480,000,000 entries of the interpolation system"):
+        g.evaluate("e")

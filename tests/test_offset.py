@@ -117,3 +117,16 @@ def test_errors_name_the_input():
         g.add("c", "curves.polyline", points=SQUARE, closed=True)
         g.add("off", "offset.marching_squares", curves=["@c"], distance=0.5, cell=0.001)
         g.evaluate("off")
+
+
+@pytest.mark.parametrize("kerf", [0.1, -0.1, 0.5])
+def test_offset_of_an_offset_node(kerf):
+    # The nameplate's chain: a rounded plate (an offset), then a kerf (an offset of it).
+    g = fg.Graph()
+    g.add("plate", "curves.polyline", points=[[0, 0], [80, 0], [80, 30], [0, 30]], closed=True)
+    g.add("round", "offset.marching_squares", curves=["@plate"], distance=5)
+    g.add("kerf", "offset.marching_squares", curves=["@round"], distance=kerf)
+    (loop,) = g.evaluate("kerf")
+    reference = shapely.box(0, 0, 80, 30).buffer(5 + kerf, quad_segs=64)
+    ours = shapely.Polygon(np.asarray(loop.control_points)[:-1, :2])
+    assert ours.symmetric_difference(reference).area <= 1e-3 * 90 * reference.length

@@ -96,3 +96,28 @@ def test_deleted_export_is_written_again(tmp_path):
     g.evaluate("w")
     assert os.path.exists(path)
     assert g.stats["w"].status == "computed"
+
+
+def test_write_atomic_takes_pieces_and_keeps_an_identical_file(tmp_path):
+    pieces = [b"solid x\n", memoryview(b"facet " * 1000), b"endsolid x\n"]
+    target = write_atomic(tmp_path, "a/b.stl", iter(pieces))
+    assert target.read_bytes() == b"".join(bytes(p) for p in pieces)
+    os.utime(target, (1, 1))
+    write_atomic(tmp_path, "a/b.stl", (p for p in pieces))  # the same bytes: untouched
+    assert target.stat().st_mtime == 1
+    write_atomic(tmp_path, "a/b.stl", (p for p in pieces[:2]))  # different: replaced
+    assert target.read_bytes() == b"".join(bytes(p) for p in pieces[:2])
+    assert sorted(p.name for p in target.parent.iterdir()) == ["b.stl"]
+
+
+def test_a_failing_piece_leaves_the_old_file_and_no_temp(tmp_path):
+    write_atomic(tmp_path, "c.txt", b"old")
+
+    def pieces():
+        yield b"new"
+        raise RuntimeError("the exporter failed mid-way")
+
+    with pytest.raises(RuntimeError, match="mid-way"):
+        write_atomic(tmp_path, "c.txt", pieces())
+    assert (tmp_path / "c.txt").read_bytes() == b"old"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["c.txt"]

@@ -18,9 +18,10 @@ from typing import Any
 
 from formgraph.core.errors import FormgraphError, GraphError, Problem, Where
 from formgraph.evaluation.graph import Graph, load
-from formgraph.language.check import param_kind
 from formgraph.language.model import Items, Wire, parse_input
+from formgraph.language.params import param_kind
 
+from .frame import Camera
 from .scene import PALETTE, TEXT_COLOR, Scene, fit_scenes
 
 __all__ = ["LAYOUTS", "Session", "Slider", "shown_nodes"]
@@ -57,7 +58,7 @@ def shown_nodes(graph: Graph, node: str | Iterable[str] | None = None) -> list[s
 
 
 def _check_target(graph: Graph, registry: dict[str, Any], target: str) -> None:
-    from formgraph.language.check import suggest
+    from formgraph.language.params import suggest
 
     where = Where(graph.file)
     if target in graph.nodes:
@@ -122,6 +123,11 @@ class Session:
         and size.
     edges : bool, optional
         Draw mesh face edges always (True), never (False), or on coarse meshes (None).
+    camera : Camera, optional
+        Where the views look from (:class:`~.frame.Camera`); automatic if None.
+    color : str, optional
+        Colour the points and meshes by this attribute (point or face), with a colour bar;
+        a 3-component ``color`` attribute is shown as the RGB colours it holds.
     """
 
     def __init__(
@@ -134,6 +140,8 @@ class Session:
         timing: bool = True,
         layout: str = "overlay",
         edges: bool | None = None,
+        camera: Camera | None = None,
+        color: str | None = None,
     ):
         if layout not in LAYOUTS:
             raise ValueError(f"layout must be one of {', '.join(LAYOUTS)}, got {layout!r}")
@@ -146,6 +154,7 @@ class Session:
         self.layout = layout
         self.params: dict[str, Any] = dict(params or {})
         self.timing = timing
+        self.color = color  # an attribute to colour by (with a colour bar), or None
         self.seconds: float | None = None
         self.targets = shown_nodes(self.graph, node) if self.graph is not None else []
         self.controls_x = 0.76  # where the column of sliders starts (fraction of the width)
@@ -153,13 +162,15 @@ class Session:
         self.widgets: dict[str, Any] = {}  # slider widgets by param name
         shown = self.evaluate()
         self.scenes = self._make_scenes(len(shown), edges)
+        for scene in self.scenes:
+            scene.camera = camera or Camera()
         self._draw(shown)
         self.fit_camera()
         self._status()
 
     def _make_scenes(self, n: int, edges: bool | None) -> list[Scene]:
         if self.layout == "overlay":
-            return [Scene(self.plotter, edges=edges)]
+            return [Scene(self.plotter, edges=edges, color_by=self.color)]
         rows, cols = self.plotter.shape
         if rows != 1 or cols < n:
             raise ValueError(
@@ -168,7 +179,10 @@ class Session:
             )
         colors: dict[str, str] = {}
         scenes = [
-            Scene(self.plotter, (0, i), titled=True, edges=edges, colors=colors) for i in range(n)
+            Scene(
+                self.plotter, (0, i), titled=True, edges=edges, colors=colors, color_by=self.color
+            )
+            for i in range(n)
         ]
         if n > 1:
             self.plotter.link_views(list(range(n)))

@@ -17,7 +17,14 @@ from typing import Any
 
 from ..core.errors import FormgraphError, FormgraphWarning, GraphError
 from ..core.terminal import StatusLine
-from .options import UsageError, graph_options, parse_sets, size_text
+from .options import (
+    UsageError,
+    camera_arg,
+    camera_options,
+    graph_options,
+    parse_sets,
+    size_text,
+)
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -61,6 +68,13 @@ def _parser() -> argparse.ArgumentParser:
             "--edges", action="store_true", help="draw every mesh face's edges (default: coarse)"
         )
         p.add_argument("--size", default="1024x768", metavar="WxH")
+        p.add_argument(
+            "--color",
+            metavar="NAME",
+            default=None,
+            help="colour points and meshes by an attribute, with a colour bar",
+        )
+        camera_options(p)
         p.add_argument("--out", default="out", metavar="DIR", help=argparse.SUPPRESS)
 
     view = sub.add_parser("view", help="show nodes' outputs (window, or PNG with --screenshot)")
@@ -187,7 +201,7 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 def cmd_check(args: argparse.Namespace) -> int:
     from ..evaluation.graph import load
-    from ..language.check import param_warnings
+    from ..language.params import param_warnings
 
     g = load(args.graph)
     for p in param_warnings(g.param_defs, g.file_label):
@@ -234,13 +248,31 @@ def cmd_view(args: argparse.Namespace) -> int:
     params = parse_sets(g, args.set)
     nodes = args.nodes or None
     edges = True if args.edges else None
+    camera = camera_arg(args)
     if args.screenshot:
         path = viewer.screenshot(
-            g, args.screenshot, node=nodes, size=size, layout=args.layout, edges=edges, **params
+            g,
+            args.screenshot,
+            node=nodes,
+            size=size,
+            layout=args.layout,
+            edges=edges,
+            camera=camera,
+            color=args.color,
+            **params,
         )
         print(f"wrote {path}")
         return 0
-    viewer.show(g, node=nodes, size=size, layout=args.layout, edges=edges, **params)
+    viewer.show(
+        g,
+        node=nodes,
+        size=size,
+        layout=args.layout,
+        edges=edges,
+        camera=camera,
+        color=args.color,
+        **params,
+    )
     return 0
 
 
@@ -260,6 +292,7 @@ def cmd_watch(args: argparse.Namespace) -> int:
         size=size,
         layout=args.layout,
         edges=edges,
+        camera=camera_arg(args),
     )
     if args.screenshot:
         viewer.ScreenshotWatcher(args.graph, args.screenshot, nodes, **options).run(
@@ -313,7 +346,7 @@ def cmd_graph(args: argparse.Namespace) -> int:
 def cmd_nodes(args: argparse.Namespace) -> int:
     from ..core.registry import node_types
     from ..language.catalogue import catalogue_text, markdown, node_text
-    from ..language.check import suggest
+    from ..language.params import suggest
 
     if args.markdown:
         sys.stdout.write(markdown())

@@ -13,7 +13,7 @@ import inspect
 import math
 import re
 import typing
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -204,8 +204,9 @@ class Context:
                 f"{self.budget:,} (raise it with budget= or --budget if you mean it)"
             )
 
-    def write(self, path: str, data: bytes) -> Path:
-        """Write ``data`` atomically to ``path`` inside the output directory."""
+    def write(self, path: str, data: bytes | Iterable[bytes]) -> Path:
+        """Write ``data`` (bytes-like, or an iterable of bytes-like pieces written as they
+        come) atomically to ``path`` inside the output directory."""
         target = safety.write_atomic(self.out_dir, path, data)
         self.written.append(target)
         return target

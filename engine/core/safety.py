@@ -1,4 +1,9 @@
-"""Writing files safely: atomically, and only inside the output directory.
+"""Reading and writing files safely: regular files only, atomically, inside the output directory.
+
+Every file formgraph reads (graphs, subgraph parts, the inputs of read nodes) goes through
+:func:`read_regular`: a FIFO, a device or a socket named as a graph would block ``open`` or
+``read`` forever, so the file is opened without blocking and refused unless it is a regular
+file, and never read past its size limit.
 
 A graph downloaded from someone else must not write anywhere but the output directory, so
 every export path is relative, free of ``..``, and still inside the directory after symlinks
@@ -10,10 +15,13 @@ next write into its folder.
 
 from __future__ import annotations
 
+import errno
 import os
 import re
+import stat
 import tempfile
 import time
+from collections.abc import Iterable
 from pathlib import Path, PurePosixPath, PureWindowsPath
 
 from .errors import PathError
@@ -101,34 +109,53 @@ def resolve_output(out_dir: str | os.PathLike[str], relpath: str) -> Path:
     return real
 
 
-def write_atomic(out_dir: str | os.PathLike[str], relpath: str, data: bytes | memoryview) -> Path:
+def write_atomic(
+    out_dir: str | os.PathLike[str],
+    relpath: str,
+    data: bytes | memoryview | Iterable[bytes | memoryview],
+) -> Path:
     """Write ``data`` to ``relpath`` inside ``out_dir``, atomically; returns the path.
 
     Creates sub-folders; leaves an existing file untouched when it already holds ``data``.
     On any failure the previous file (if any) is intact and no temp file is left behind.
-    ``data`` is any bytes-like object; it is written as it is, never copied.
+    ``data`` is any bytes-like object, written as it is, never copied; or an iterable of
+    them (pieces of a big file made one after another, each written before the next is
+    made: the whole file is never in memory), compared with an existing file only once
+    written to the temp file.
     """
-    data = memoryview(data).cast("B")
+    pieces = None
+    try:
+        data = memoryview(data).cast("B")
+    except TypeError:  # not bytes-like: an iterable of pieces
+        pieces = iter(data)
     target = resolve_output(out_dir, relpath)
     try:
         target.parent.mkdir(parents=True, exist_ok=True)
     except FileExistsError:
         raise PathError(f"output path {relpath!r} runs through a file, not a folder") from None
     target = resolve_output(out_dir, relpath)  # a folder made meanwhile could be a symlink
-    try:
-        if target.is_file() and target.stat().st_size == data.nbytes and _holds(target, data):
-            return target
-    except OSError:
-        pass
+    if pieces is None:
+        try:
+            if target.is_file() and target.stat().st_size == data.nbytes and _holds(target, data):
+                return target
+        except OSError:
+            pass
     remove_stale_temps(target.parent)
     fd, tmp = tempfile.mkstemp(
         prefix=f".{target.name}{TMP_TAG}{os.getpid()}-", suffix=".tmp", dir=target.parent
     )
     try:
         with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
+            if pieces is None:
+                fh.write(data)
+            else:
+                for piece in pieces:
+                    fh.write(piece)
             fh.flush()
             os.fsync(fh.fileno())
+        if pieces is not None and _same_file(target, Path(tmp)):
+            os.unlink(tmp)
+            return target
         os.chmod(tmp, 0o644)
         os.replace(tmp, target)
     except BaseException:
@@ -138,6 +165,72 @@ def write_atomic(out_dir: str | os.PathLike[str], relpath: str, data: bytes | me
             pass
         raise
     return target
+
+
+def _same_file(target: Path, tmp: Path, chunk: int = 1 << 20) -> bool:
+    """Whether ``target`` is a regular file with exactly the bytes of ``tmp`` (read a chunk
+    at a time)."""
+    try:
+        if not target.is_file() or target.stat().st_size != tmp.stat().st_size:
+            return False
+        with open(target, "rb") as a, open(tmp, "rb") as b:
+            while True:
+                x, y = a.read(chunk), b.read(chunk)
+                if x != y:
+                    return False
+                if not x:
+                    return True
+    except OSError:
+        return False
+
+
+_KINDS = {
+    stat.S_IFIFO: "a FIFO (named pipe)",
+    stat.S_IFCHR: "a character device",
+    stat.S_IFBLK: "a block device",
+    stat.S_IFSOCK: "a socket",
+    stat.S_IFDIR: "a folder",
+}
+
+
+def read_regular(path: str | os.PathLike[str], *, max_bytes: int) -> bytes:
+    """The bytes of a regular file, at most ``max_bytes`` of them.
+
+    Opened with ``O_NONBLOCK`` (a FIFO's ``open`` returns at once instead of waiting for a
+    writer) and checked with ``fstat`` on the open descriptor, so what is read is what was
+    checked.
+
+    Raises
+    ------
+    OSError
+        The file cannot be opened; it is not a regular file (``errno.EINVAL``, "is a FIFO
+        (named pipe), not a regular file"); it is larger than ``max_bytes``
+        (``errno.EFBIG``, "is larger than 16 MiB").
+    """
+    fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+    try:
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode):
+            kind = _KINDS.get(stat.S_IFMT(st.st_mode), "not a file")
+            raise OSError(errno.EINVAL, f"it is {kind}, not a regular file", str(path))
+        if st.st_size > max_bytes:
+            raise OSError(errno.EFBIG, f"it is larger than {_size(max_bytes)}", str(path))
+        chunks, total = [], 0
+        while total <= max_bytes:  # the file may grow while it is read
+            chunk = os.read(fd, min(1 << 20, max_bytes + 1 - total))
+            if not chunk:
+                break
+            chunks.append(chunk)
+            total += len(chunk)
+        if total > max_bytes:
+            raise OSError(errno.EFBIG, f"it is larger than {_size(max_bytes)}", str(path))
+        return b"".join(chunks)
+    finally:
+        os.close(fd)
+
+
+def _size(n: int) -> str:
+    return f"{n // (1 << 20)} MiB" if n >= 1 << 20 and n % (1 << 20) == 0 else f"{n:,} bytes"
 
 
 def _holds(path: Path, data: memoryview, chunk: int = 1 << 20) -> bool:

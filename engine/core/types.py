@@ -120,6 +120,16 @@ class Variables:
         object.__setattr__(self, "names", tuple(names))
 
 
+@dataclass(frozen=True)
+class PerElement:
+    """A port that also takes expressions evaluated once per element of the geometry on
+    input ``of`` (over the element's ``x y z``, ``i``, ``count``, its attributes and the
+    params): ``scale: "=0.5 + rand(i)"``. A plain value, or an expression of the params
+    alone, is an ordinary input."""
+
+    of: str
+
+
 class TypeMismatch(ValueError):
     """A literal or wire that does not fit a port."""
 
@@ -163,6 +173,7 @@ class PortType:
     range: Range | None = None
     variables: tuple[str, ...] = ()
     same_as: str | None = None  # an output typed like one of the node's inputs
+    per_element: str | None = None  # takes per-element expressions over this input
 
     @property
     def name(self) -> str:
@@ -200,6 +211,17 @@ class PortType:
             return True
         return all(any(_kind_accepts(k, o) for k in self.kinds) for o in other.kinds)
 
+    def holds(self, value: Any) -> bool:
+        """Whether ``value`` could be this port's output: geometry of the port's class (or a
+        list of it), anything but geometry for a number, text or other plain port.
+
+        For values read back from the disk cache, where an entry can be well formed and
+        still of another node (a Points where a measure belongs): a mismatch is a miss.
+        """
+        if self.same_as is not None or (value is None and self.optional):
+            return True
+        return any(_kind_holds(k, value) for k in self.kinds)
+
     def coerce(self, value: Any) -> Any:
         """The value a node function receives for the literal ``value``.
 
@@ -234,6 +256,19 @@ class PortType:
 
 def _is_geometry(base: Any) -> bool:
     return isinstance(base, type) and issubclass(base, Geometry)
+
+
+def _kind_holds(k: Kind, value: Any) -> bool:
+    if k.base is Any:
+        return True
+    if k.is_list and isinstance(value, np.ndarray):  # numbers stored as one array
+        return not _is_geometry(k.base)
+    if k.is_list and not isinstance(value, (list, tuple)):
+        return False
+    items = value if k.is_list else [value]
+    if _is_geometry(k.base):
+        return all(isinstance(v, k.base) for v in items)
+    return not any(isinstance(v, Geometry) for v in items)
 
 
 def _kind_accepts(k: Kind, o: Kind) -> bool:
@@ -431,6 +466,7 @@ def port_type(hint: Any) -> PortType:
     rng: Range | None = None
     variables: tuple[str, ...] = ()
     same_as: str | None = None
+    per_element: str | None = None
     if typing.get_origin(hint) is typing.Annotated:
         hint, *extras = typing.get_args(hint)
         for x in extras:
@@ -440,6 +476,8 @@ def port_type(hint: Any) -> PortType:
                 variables = x.names
             elif isinstance(x, SameAs):
                 same_as = x.port
+            elif isinstance(x, PerElement):
+                per_element = x.of
     optional = False
     alternatives = [hint]
     if typing.get_origin(hint) in (typing.Union, _pytypes.UnionType):
@@ -454,7 +492,7 @@ def port_type(hint: Any) -> PortType:
             kinds.append(Kind(item, True))
         else:
             kinds.append(Kind(alt, False))
-    return PortType(tuple(kinds), optional, rng, variables, same_as)
+    return PortType(tuple(kinds), optional, rng, variables, same_as, per_element)
 
 
 def type_by_name(name: str) -> PortType:

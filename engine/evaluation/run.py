@@ -35,6 +35,7 @@ from ..core.errors import (
 )
 from ..core.registry import Context, NodeSpec, node_types
 from ..core.types import Entries, TypeMismatch
+from ..language.elements import bind_elements, reads_elements
 from ..language.model import FRAMES, STEP, Expr, Input, Items, Literal, NodeDef, Wire, wires_of
 from ..language.subgraph import SubgraphSpec
 from . import cache as _cache
@@ -195,6 +196,13 @@ class _Run(LanguageRun, SimulationRun):
         if isinstance(value, Items):
             return [self.key_part(name, port, spec, i) for i in value.items]
         pt = spec.inputs[port].type
+        if pt.per_element and reads_elements(value, self.values):
+            element = bind_elements(value, self.values)  # per element: text and params
+            names = sorted(element.names & set(self.values))
+            return {
+                "per_element": element.text,
+                "params": {n: self.tokens.get(n, self.values[n]) for n in names},
+            }
         if pt.is_expression:  # the text, and the values of the params the text reads
             from ..language.expr import compile_expression
 
@@ -308,6 +316,8 @@ class _Run(LanguageRun, SimulationRun):
         if not hit and self.g.disk is not None:
             hit, value, identity = self.g.disk.get_entry(key)
             source = "disk"
+            if hit and not _holds(spec, value):
+                hit = False  # a well-formed entry of another type (a foreign or forged file)
             if hit:
                 self.g.memory.put(key, value)
         if hit and spec.is_export:
@@ -342,6 +352,10 @@ class _Run(LanguageRun, SimulationRun):
                     kwargs[port] = self.bind_expression(name, port, p.type, p.default, env)
                 else:
                     kwargs[port] = p.type.coerce(p.default)
+                continue
+            values = self.values if env is None else env
+            if p.type.per_element and reads_elements(nd.inputs[port], values):
+                kwargs[port] = bind_elements(nd.inputs[port], values)
                 continue
             raw = self.resolve(name, port, nd.inputs[port], env)
             if isinstance(nd.inputs[port], Wire) and isinstance(raw, list):
@@ -495,3 +509,12 @@ def _warn(message: str) -> None:
     while frame is not None and frame.f_code.co_filename.startswith(_PACKAGE):
         frame, level = frame.f_back, level + 1
     _warnings.warn(message, FormgraphWarning, stacklevel=level)
+
+
+def _holds(spec: NodeSpec, value: Any) -> bool:
+    """Whether a value read from the disk cache has the shape of ``spec``'s output(s)."""
+    if not spec.multi_output:
+        return spec.output_type(None).holds(value)
+    if not isinstance(value, (list, tuple)) or len(value) != len(spec.outputs):
+        return False
+    return all(t.holds(v) for t, v in zip(spec.outputs.values(), value, strict=True))

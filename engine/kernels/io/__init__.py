@@ -21,6 +21,7 @@ from .exporters import (
     obj_bytes,
     ply_binary,
     stl_ascii,
+    stl_ascii_chunks,
     stl_binary,
     triangle_normals,
 )
@@ -37,6 +38,7 @@ __all__ = [
     "pdf_bytes",
     "ply_binary",
     "stl_ascii",
+    "stl_ascii_chunks",
     "stl_binary",
     "svg_bytes",
     "triangle_normals",

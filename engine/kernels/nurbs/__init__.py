@@ -19,6 +19,7 @@ weights (nu, nv) | None)`` with u along the first axis. ``weights=None`` is non-
 
 from __future__ import annotations
 
+from .banded import banded_entries
 from .basis import (
     basis_function_derivatives,
     basis_functions,
@@ -71,6 +72,7 @@ from .surface import (
 
 __all__ = [
     "arc",
+    "banded_entries",
     "basis_function_derivatives",
     "basis_functions",
     "basis_matrix",

@@ -10,6 +10,13 @@
 from __future__ import annotations
 
 from .contour import marching_squares
-from .marching import default_cell, grid_cells, offset_polylines
+from .marching import OffsetTraceError, WorkLimit, default_cell, grid_cells, offset_polylines
 
-__all__ = ["default_cell", "grid_cells", "marching_squares", "offset_polylines"]
+__all__ = [
+    "OffsetTraceError",
+    "WorkLimit",
+    "default_cell",
+    "grid_cells",
+    "marching_squares",
+    "offset_polylines",
+]

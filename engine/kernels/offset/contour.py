@@ -21,7 +21,30 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Crossings", "marching_squares", "split_loops", "trace_crossings", "unique_ids"]
+__all__ = [
+    "Crossings",
+    "InconsistentField",
+    "marching_squares",
+    "split_loops",
+    "trace_crossings",
+    "unique_ids",
+]
+
+
+class InconsistentField(ValueError):
+    """Sampled values that no contour can follow: a contour enters a cell it cannot leave,
+    or leaves it through an edge whose samples are on one side of the level.
+
+    Attributes
+    ----------
+    edges : (k,) int64
+        Flat ids of the samples where it happened (the cell's or the edge's first sample).
+    """
+
+    def __init__(self, message: str, edges: np.ndarray) -> None:
+        super().__init__(message)
+        self.edges = np.asarray(edges, dtype=np.int64)
+
 
 # Cell corners counter-clockwise: 0 = (i, j) bottom-left, 1 = (i, j+1) bottom-right,
 # 2 = (i+1, j+1) top-right, 3 = (i+1, j) top-left. Side s joins corner s to corner s+1:
@@ -166,7 +189,10 @@ def trace_crossings(
     centre_in = (mid < level) if below else (mid > level)
     exit_side = _EXIT[case, entry, centre_in.astype(np.int8)].astype(np.int64)
     if (exit_side < 0).any():  # cannot happen with consistent values; never index with -1
-        raise ValueError("inconsistent field samples: a contour enters a cell it cannot leave")
+        raise InconsistentField(
+            "inconsistent field samples: a contour enters a cell it cannot leave",
+            corner[exit_side < 0],
+        )
 
     exit_edge = (ci + _SIDE_DI[exit_side]) * nx + cj + _SIDE_DJ[exit_side]
     exit_vertical = _SIDE_VERTICAL[exit_side]
@@ -228,7 +254,9 @@ def _lookup(sorted_ids: np.ndarray, ids: np.ndarray) -> np.ndarray:
     ok = pos < sorted_ids.size
     ok[ok] = sorted_ids[pos[ok]] == ids[ok]
     if not ok.all():
-        raise ValueError("inconsistent field samples: a contour leaves through an uncrossed edge")
+        raise InconsistentField(
+            "inconsistent field samples: a contour leaves through an uncrossed edge", ids[~ok]
+        )
     return pos
 
 

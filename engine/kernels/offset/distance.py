@@ -25,7 +25,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Nearest", "RowParity", "SegmentTree", "point_segment"]
+__all__ = ["Nearest", "RowParity", "SegmentTree", "WorkLimit", "point_segment"]
+
+
+class WorkLimit(ValueError):
+    """The queries of a `SegmentTree` tested more (point, node) pairs than its ``max_pairs``."""
+
 
 _PAIRS = 1024  # (point, node) pairs a query tests per visited level, about
 
@@ -85,23 +90,37 @@ class SegmentTree:
         tight capsules; any order is correct.
     leaf : int
         Segments per leaf, tested by brute force.
+    max_pairs : int, optional
+        A bound on the work of all queries together: the (point, node) pairs they test
+        (`WorkLimit` once passed). None: no bound.
     """
 
-    def __init__(self, a: np.ndarray, b: np.ndarray, leaf: int = 4) -> None:
+    def __init__(
+        self, a: np.ndarray, b: np.ndarray, leaf: int = 4, max_pairs: int | None = None
+    ) -> None:
         a = np.asarray(a, dtype=float)
         b = np.asarray(b, dtype=float)
         n = a.shape[0]
         if n == 0:
             raise ValueError("a segment tree needs at least one segment")
-        n_leaves = -(-n // leaf)
+        self.a, self.b, self.n, self.leaf = a, b, n, leaf
+        # Long segments are cut into pieces for the hierarchy (results still name the whole
+        # segment): a capsule over a few long segments that do not follow each other (a
+        # messy input, as random points joined up) is as fat as the input, so every query
+        # would test every leaf; capsules over pieces of at most 1/64 of the extent stay thin.
+        pa, pb, self._owner, self._start, self._scale_t = _pieces(a, b)
+        n_pieces = pa.shape[0]
+        n_leaves = -(-n_pieces // leaf)
         depth = max(0, int(np.ceil(np.log2(n_leaves))))
         width = 2**depth
-        pad = n_leaves * leaf - n
-        self.a = np.concatenate([a, np.repeat(a[-1:], pad, axis=0)])
-        self.b = np.concatenate([b, np.repeat(b[-1:], pad, axis=0)])
-        self.n = n
-        self.leaf = leaf
+        pad = n_leaves * leaf - n_pieces
+        pa = np.concatenate([pa, np.repeat(pa[-1:], pad, axis=0)])
+        pb = np.concatenate([pb, np.repeat(pb[-1:], pad, axis=0)])
+        self._n_pieces = n_pieces
         self.depth = depth
+        self.pairs = 0  # (point, node) pairs tested by every query so far: the work done
+        self.last_pairs = 0
+        self.max_pairs = max_pairs
 
         # Leaf capsules: axis from the first segment's start to the last one's end, radius
         # the farthest segment end from that axis (a capsule is convex, so it then holds
@@ -109,16 +128,16 @@ class SegmentTree:
         # where the one before ends, as a polyline's do) the other ends are the starts, so
         # only those are measured. Strided coordinate views, squared distances until the
         # one square root of the maximum.
-        axa = self.a[0::leaf]
-        axb = self.b[leaf - 1 :: leaf]
+        axa = pa[0::leaf]
+        axb = pb[leaf - 1 :: leaf]
         ax, ay, bx, by = axa[:, 0], axa[:, 1], axb[:, 0], axb[:, 1]
         ux, uy = bx - ax, by - ay
         len2 = ux * ux + uy * uy
         inv = np.divide(1.0, len2, out=np.zeros_like(len2), where=len2 > 0)
-        chain = np.array_equal(a[1:], b[:-1])
-        ends = [self.a[k::leaf] for k in range(1, leaf)]
+        chain = np.array_equal(pa[1:n_pieces], pb[: n_pieces - 1])
+        ends = [pa[k::leaf] for k in range(1, leaf)]
         if not chain:
-            ends += [self.b[k::leaf] for k in range(leaf - 1)]
+            ends += [pb[k::leaf] for k in range(leaf - 1)]
         d2 = np.zeros(n_leaves)
         for e in ends:
             dx, dy = e[:, 0] - ax, e[:, 1] - ay
@@ -164,11 +183,16 @@ class SegmentTree:
         bounds = np.cumsum([0] + [lv[0].shape[0] for lv in levels]).tolist()
         ax, ay, bx, by, rad = (np.concatenate([lv[k] for lv in levels]) for k in range(5))
         rad = np.where(np.isneginf(rad), np.nan, rad * (1 + 1e-12))
+        # Absolute slack of the pruning test: a point ON the segments (distance 0, as a grid
+        # sample on an input vertex is) has a bound of 0 and a flat capsule of radius 0, so
+        # a relative slack alone loses its node to the rounding of the axis distance, of
+        # the order of the machine epsilon times the coordinates.
+        self._scale = float(max(np.abs(a).max(), np.abs(b).max()))
         fields = _fields(ax, ay, bx, by) + (rad,)
         self._levels = [
             tuple(f[lo:hi] for f in fields) for lo, hi in zip(bounds[:-1], bounds[1:], strict=True)
         ]
-        self._segs = _fields(self.a[:, 0], self.a[:, 1], self.b[:, 0], self.b[:, 1])
+        self._segs = _fields(pa[:, 0], pa[:, 1], pb[:, 0], pb[:, 1])
 
     def query(
         self,
@@ -201,11 +225,54 @@ class SegmentTree:
         lo, hi = (np.asarray(v, dtype=float) for v in (lo, hi))
         lo = np.full(q, lo) if lo.ndim == 0 else np.broadcast_to(lo, (q,))
         hi = np.full(q, hi) if hi.ndim == 0 else np.broadcast_to(hi, (q,))
+        if upper is not None:
+            upper = np.asarray(upper, float)
+        # The (point, node) pairs of one pass are held at once: in chunks of points, sized
+        # from the pairs the chunk before needed per point, they stay near _MAX_PAIRS.
+        chunk = q if q <= _FIRST_CHUNK else _FIRST_CHUNK
+        if chunk == q:
+            return self._query(p, lo, hi, upper)
+        parts = []
+        start = 0
+        while start < q:
+            stop = min(q, start + chunk)
+            part = self._query(
+                p[start:stop],
+                lo[start:stop],
+                hi[start:stop],
+                None if upper is None else upper[start:stop],
+            )
+            parts.append(part)
+            per_point = max(self.last_pairs / (stop - start), 1.0)
+            chunk = int(min(max(_MAX_PAIRS / per_point, 256), 8 * chunk))
+            start = stop
+        return Nearest(*(np.concatenate([getattr(r, f) for r in parts]) for f in _NEAREST))
+
+    def _charge(self, pairs: int) -> None:
+        self.pairs += pairs
+        if self.max_pairs is not None and self.pairs > self.max_pairs:
+            raise WorkLimit(
+                f"the distance queries would test more than {self.max_pairs:,} (point, segment) "
+                f"pairs against the {self.n:,} input segments (each sample near the result "
+                "tests the segments within its reach: many when the input criss-crosses or "
+                "the distance is large next to it); use a larger cell, fewer or cleaner "
+                "curves, or a larger budget"
+            )
+
+    def _query(
+        self, p: np.ndarray, lo: np.ndarray, hi: np.ndarray, upper: np.ndarray | None
+    ) -> Nearest:
+        """`query` of one chunk of points (``lo``, ``hi``: one value a point). Sets
+        ``last_pairs``, the most (point, node) pairs one pass held, and adds every pair
+        tested to ``pairs``."""
+        q = p.shape[0]
         px, py = np.ascontiguousarray(p[:, 0]), np.ascontiguousarray(p[:, 1])
+        peak = 0
+        slack = 1e-12 * max(self._scale, float(np.abs(px).max()), float(np.abs(py).max()))
         hi2 = np.square(np.maximum(hi, 0.0))
         lo2 = np.where(lo > 0, np.square(lo), -1.0)
         # Squared distance to the nearest curve point seen.
-        best2 = np.full(q, np.inf) if upper is None else np.square(np.asarray(upper, float))
+        best2 = np.full(q, np.inf) if upper is None else np.square(upper)
         # Levels are visited in jumps that keep about _PAIRS (point, node) pairs per visit:
         # few points start deep and skip levels (numpy calls cost more than the few more
         # capsules tested), many go two levels a step.
@@ -214,6 +281,8 @@ class SegmentTree:
         node = _fan_out(np.zeros(q, dtype=np.int64), 2**level)
         while True:
             ax, ay, ux, uy, inv, rad = self._levels[level]
+            peak = max(peak, qi.size)
+            self._charge(qi.size)
             nux, nuy = ux.take(node), uy.take(node)
             dx = px.take(qi)
             dx -= ax.take(node)
@@ -242,6 +311,7 @@ class SegmentTree:
             cut[best2 < lo2] = np.nan
             thr = cut.take(qi)
             thr += rad.take(node)
+            thr += slack
             thr *= thr
             keep = (dx <= thr).nonzero()[0]
             qi, node = qi.take(keep), node.take(keep)
@@ -256,6 +326,8 @@ class SegmentTree:
 
         # Leaves: brute force over their segments.
         seg = _fan_out(node, self.leaf)
+        self.last_pairs = max(peak, seg.size)
+        self._charge(seg.size)
         qs = qi.repeat(self.leaf)
         ax, ay, ux, uy, inv = self._segs
         dx = px.take(qs)
@@ -282,8 +354,15 @@ class SegmentTree:
         param = np.zeros(q)
         # Ties give several hits per point; any one of them is a nearest segment.
         at = qs.take(hit)
-        segment[at] = np.minimum(seg.take(hit), self.n - 1)
-        param[at] = t.take(hit)
+        piece = np.minimum(seg.take(hit), self._n_pieces - 1)
+        if self._owner is None:
+            segment[at] = piece
+            param[at] = t.take(hit)
+        else:  # a piece's parameter on its whole segment
+            segment[at] = self._owner.take(piece)
+            param[at] = np.minimum(
+                self._start.take(piece) + t.take(hit) * self._scale_t.take(piece), 1.0
+            )
         dist = np.sqrt(dist2)
         found = dist2 < np.inf
         exact = found & (dist <= hi)
@@ -296,6 +375,65 @@ class SegmentTree:
             out[far] = np.maximum(best[far], np.nextafter(hi[far], np.inf))
         segment[~exact] = -1
         return Nearest(out, exact, segment, param)
+
+
+_FIRST_CHUNK = 8192  # points in a query's first chunk
+_MAX_PAIRS = 1 << 21  # (point, node) pairs a query's chunk should hold at once, about
+_NEAREST = ("dist", "exact", "segment", "t")
+_PIECES = 64  # a segment is cut into pieces of at most 1/_PIECES of the input's extent
+_MAX_PIECES = 1 << 20  # ... while the pieces stay fewer than this (or than 4 per segment)
+
+
+def _pieces(a: np.ndarray, b: np.ndarray):
+    """Segments ``a -> b`` cut into pieces of at most ``extent / _PIECES`` (fewer cuts if
+    there would be too many), in Morton order of their midpoints (the order of a messy input
+    says nothing about where its segments are; a tree over that order has fat capsules).
+
+    Returns the pieces' ends, and per piece its segment, and where on it the piece starts and
+    how much of it the piece spans (as segment parameters); the last three are ``None`` if
+    no segment is cut (the segments are then their own pieces, in their given order).
+    """
+    n = a.shape[0]
+    ux, uy = b[:, 0] - a[:, 0], b[:, 1] - a[:, 1]
+    length = np.sqrt(ux * ux + uy * uy)
+    extent = max(float(np.ptp(a[:, 0])), float(np.ptp(a[:, 1])), float(length.max()))
+    if extent == 0:
+        return a, b, None, None, None
+    longest = extent / _PIECES
+    total = float(length.sum())
+    budget = max(4 * n, _MAX_PIECES)
+    if total / longest > budget:
+        longest = total / budget
+    count = np.maximum(np.ceil(length / longest), 1).astype(np.int64)
+    if (count == 1).all():
+        return a, b, None, None, None
+    first = np.cumsum(count) - count
+    owner = np.repeat(np.arange(n), count)
+    k = np.arange(owner.size) - first[owner]
+    m = count[owner].astype(float)
+    start, span = k / m, 1.0 / m
+    ao, bo = a[owner], b[owner]
+    pa = ao + (bo - ao) * start[:, None]
+    pb = ao + (bo - ao) * (start + span)[:, None]
+    pa[first] = a  # whole segments' own ends, exactly
+    pb[first + count - 1] = b
+    order = np.argsort(_morton((pa + pb) / 2), kind="stable")
+    return pa[order], pb[order], owner[order], start[order], span[order]
+
+
+def _morton(p: np.ndarray) -> np.ndarray:
+    """Z-order keys of points: coordinates quantized to 16 bits, bits interleaved."""
+    lo = p.min(axis=0)
+    size = float((p.max(axis=0) - lo).max()) or 1.0
+    q = ((p - lo) * (65535.0 / size)).astype(np.uint64)
+
+    def spread(v: np.ndarray) -> np.ndarray:
+        v = (v | (v << np.uint64(8))) & np.uint64(0x00FF00FF)
+        v = (v | (v << np.uint64(4))) & np.uint64(0x0F0F0F0F)
+        v = (v | (v << np.uint64(2))) & np.uint64(0x33333333)
+        return (v | (v << np.uint64(1))) & np.uint64(0x55555555)
+
+    return spread(q[:, 0]) | (spread(q[:, 1]) << np.uint64(1))
 
 
 _PATTERNS: dict[int, np.ndarray] = {}  # 0, 1, ..., fan - 1 repeated, per fan (grown as needed)

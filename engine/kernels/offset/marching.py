@@ -32,19 +32,28 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from .contour import split_loops, trace_crossings, unique_ids
-from .distance import RowParity, SegmentTree
+from .contour import InconsistentField, split_loops, trace_crossings, unique_ids
+from .distance import RowParity, SegmentTree, WorkLimit
 from .loops import simplify as simplify_loops
 from .refine import exact_loops
 from .refine import smooth as smooth_loops
 
-__all__ = ["default_cell", "grid_cells", "offset_polylines"]
+__all__ = ["OffsetTraceError", "WorkLimit", "default_cell", "grid_cells", "offset_polylines"]
+
+
+class OffsetTraceError(ValueError):
+    """The sampled distance field could not be traced into closed loops (a defect of the
+    kernel on this input, not a bad argument): raised only after shifted grids failed too."""
+
 
 DEFAULT_MAX_CELLS = 2**27
 _COARSE_CELLS = 32  # cells per side of the first, full level of the quadtree
 _TOLERANCE = 1e-3  # default error, as a fraction of the input's extent
 _MAX_HALVINGS = 4  # finer grids tried when a part of the result is thinner than a cell
 _MIN_LOOP = 8  # a traced loop with fewer vertices asks for a finer grid
+# Grid shifts (fractions of a cell) tried when tracing meets inconsistent samples: a sample
+# a rounding error from the level on one grid is well clear of it on the next.
+_SHIFTS = (0.0, 0.381966, 0.618034 + 0.13)
 
 
 def default_cell(extent: float, distance: float, tolerance: float = 1e-3) -> float:
@@ -155,16 +164,30 @@ _DENSE = 32
 _DENSE_MIN = 1 << 16
 
 
-def _store_lookup(ids: np.ndarray, values: np.ndarray):
+def _store_lookup(ids: np.ndarray, values: np.ndarray, checked: bool = False):
     """``value(q)``: the ``values`` of sample ids ``q``, each one of the sorted ``ids``. A dense
     table of positions while the ids span a small grid or one the stored band fills well
-    (two gathers a call), else a binary search (only a band of a big grid is stored)."""
+    (two gathers a call), else a binary search (only a band of a big grid is stored).
+
+    ``checked``: an id that is not stored raises `InconsistentField` (the tracer asks for
+    the corners of every cell the contour enters; one the band left out means the samples
+    disagree). Unchecked, only stored ids may be asked."""
     size = int(ids[-1]) + 1 if ids.size else 1
     if size <= max(_DENSE_MIN, _DENSE * ids.size):
-        table = np.empty(size, dtype=np.int32)  # (only stored ids are ever asked)
+        table = np.full(size, -1, dtype=np.int32) if checked else np.empty(size, dtype=np.int32)
         table[ids] = np.arange(ids.size, dtype=np.int32)
 
         def dense(q: np.ndarray) -> np.ndarray:
+            if checked:
+                inside = q < size
+                pos = table[np.where(inside, q, 0)]
+                missing = ~inside | (pos < 0)
+                if missing.any():
+                    raise InconsistentField(
+                        "inconsistent field samples: a contour enters a cell outside the band",
+                        q[missing],
+                    )
+                return values[pos]
             return values[table[q]]
 
         return dense
@@ -173,7 +196,15 @@ def _store_lookup(ids: np.ndarray, values: np.ndarray):
         perm = np.argsort(q)
         pos = np.empty(q.size, dtype=np.int64)
         pos[perm] = np.searchsorted(ids, q[perm])
-        return values[np.minimum(pos, ids.size - 1)]
+        pos = np.minimum(pos, ids.size - 1)
+        if checked:
+            missing = ids[pos] != q
+            if missing.any():
+                raise InconsistentField(
+                    "inconsistent field samples: a contour enters a cell outside the band",
+                    q[missing],
+                )
+        return values[pos]
 
     return value
 
@@ -299,7 +330,7 @@ def _trace(field: _Field, ids, values, cells, ncx: int):
     nx = ncx + 1
     distance = field.level
     radius = abs(distance)
-    value = _store_lookup(ids, values)
+    value = _store_lookup(ids, values, checked=True)
     c00, c01, c10 = value(cells), value(cells + 1), value(cells + nx)
     in00, in01, in10 = c00 < distance, c01 < distance, c10 < distance
     h_edges = np.sort(cells[in00 != in01])
@@ -317,8 +348,9 @@ def _trace(field: _Field, ids, values, cells, ncx: int):
     return trace_crossings(h_edges, v_edges, nx, value, distance, True, exact_centre)
 
 
-def _grid(lo: np.ndarray, hi: np.ndarray, distance: float, cell: float, max_cells: int):
-    """Origin, cells per side and quadtree depth of the grid covering the offset."""
+def _grid(lo: np.ndarray, hi: np.ndarray, distance: float, cell: float, max_cells: int, shift=0.0):
+    """Origin, cells per side and quadtree depth of the grid covering the offset (its
+    samples moved by ``shift`` cells along both axes; the margin covers that)."""
     margin = abs(distance) + 2 * cell
     size = (hi - lo + 2 * margin) / cell
     levels = max(0, int(np.ceil(np.log2(max(size.max() / _COARSE_CELLS, 1.0)))))
@@ -329,7 +361,7 @@ def _grid(lo: np.ndarray, hi: np.ndarray, distance: float, cell: float, max_cell
             f"the offset grid would need {ncx} x {ncy} = {ncx * ncy} cells, more than the "
             f"limit of {max_cells}; use a larger cell than {cell:.6g}"
         )
-    origin = (lo + hi) / 2 - np.array([ncx, ncy]) * cell / 2
+    origin = (lo + hi) / 2 - (np.array([ncx, ncy]) / 2 - shift) * cell
     return origin, ncx, ncy, levels
 
 
@@ -483,7 +515,9 @@ def offset_polylines(
     simplify : float
         Douglas-Peucker tolerance (0: none).
     max_cells : int
-        Largest grid (in cells) accepted.
+        Largest grid (in cells) accepted; also the most (point, segment) pairs the
+        distance queries may test together (their work: a messy input, many long segments
+        criss-crossing, makes each sample near the result test many).
 
     Returns
     -------
@@ -496,6 +530,8 @@ def offset_polylines(
     ValueError
         If there are no polylines, a polyline is not a finite (n, 2) array, distance is 0 or
         not finite, cell is not positive, or the grid would exceed ``max_cells``.
+        `WorkLimit` (a ValueError) if the distance queries pass ``max_cells`` pairs;
+        `OffsetTraceError` (a ValueError) if the outline cannot be traced.
 
     Example
     -------
@@ -522,22 +558,37 @@ def offset_polylines(
     if not (np.isfinite(cell) and cell > 0):
         raise ValueError(f"cell must be a positive finite number, got {cell}")
 
-    tree = SegmentTree(a, b)
+    # Every (point, segment) pair the distance queries test counts against the budget too.
+    tree = SegmentTree(a, b, max_pairs=max_cells)
     if seg_closed.all():  # (a boolean row selection of every row costs a copy's time)
         closed_a, closed_b = a, b
     else:
         closed_a, closed_b = a[seg_closed], b[seg_closed]
     radius = abs(distance)
     for halvings in range(_MAX_HALVINGS + 1):
-        origin, ncx, ncy, levels = _grid(lo, hi, distance, cell, max_cells)
-        parity = (
-            RowParity(closed_a, closed_b, origin, cell, ncy + 1, ncx + 1)
-            if closed_a.shape[0]
-            else None
-        )
-        field = _Field(tree, parity, origin, cell, distance)
-        ids, values, feet, cells = _band_cells(field, ncx, ncy, levels)
-        cr = _trace(field, ids, values, cells, ncx)
+        for shift in _SHIFTS:
+            origin, ncx, ncy, levels = _grid(lo, hi, distance, cell, max_cells, shift)
+            parity = (
+                RowParity(closed_a, closed_b, origin, cell, ncy + 1, ncx + 1)
+                if closed_a.shape[0]
+                else None
+            )
+            field = _Field(tree, parity, origin, cell, distance)
+            ids, values, feet, cells = _band_cells(field, ncx, ncy, levels)
+            try:
+                cr = _trace(field, ids, values, cells, ncx)
+                break
+            except InconsistentField as exc:
+                failure = exc
+        else:
+            i, j = np.divmod(failure.edges[0], ncx + 1)
+            x, y = (origin + np.array([j, i]) * cell).tolist()
+            raise OffsetTraceError(
+                f"the offset could not trace its outline near ({x:.6g}, {y:.6g}): {failure} "
+                f"on {len(_SHIFTS)} shifted grids of cell {cell:.6g}. This is a defect of the "
+                "offset on this input (please report it with the curves); a slightly "
+                "different cell usually avoids it"
+            ) from None
         # A part of the result thinner than a cell can pass between samples and be cut or
         # missed, and a loop of a few vertices is too coarse to refine: then sample twice
         # as finely (as far as the budget allows).
