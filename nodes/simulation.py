@@ -19,6 +19,11 @@ from formgraph.geometry import Curve, Mesh, NurbsCurve
 from formgraph.kernels.curves import growth as kg
 from formgraph.kernels.mesh import relax as kr
 
+#: what one point of a growth step costs against the element budget: its neighbour pairs
+#: and the arrays over them (about 50 numbers a point); the default budget allows a step of
+#: a million points, a few seconds
+GROWTH_POINT_ELEMENTS = 50
+
 
 def _polygon(curve: Curve, spacing: float, port: str) -> tuple[np.ndarray, bool]:
     """A curve's vertices (the control polygon of a polyline, else points about
@@ -49,7 +54,7 @@ def grow(
     curve: Curve,
     split: Annotated[float, Range(min=1e-9)] = 1.0,
     repulsion: Annotated[float, Range(min=0)] = 0.5,
-    radius: Annotated[float, Range(min=1e-9)] | None = None,
+    radius: Annotated[float | None, Range(min=1e-9)] = None,
     bounds: Curve | None = None,
     jitter: Annotated[float, Range(min=0)] = 0.3,
     seed: int = 0,
@@ -99,7 +104,8 @@ def grow(
         fence, _ = _polygon(bounds, 0.5 * split, "bounds")
     edges = np.diff(np.vstack([p, p[:1]]) if closed else p, axis=0)
     pieces = np.ceil(np.linalg.norm(edges[:, :2], axis=1) / split).sum()
-    ctx.guard(2 * max(pieces, len(p)), "points")  # a step at most doubles a divided edge
+    # a step at most doubles a divided edge, and each point costs its neighbour pairs
+    ctx.guard(GROWTH_POINT_ELEMENTS * 2 * max(pieces, len(p)), "elements (growing points)")
     mixed = zlib.crc32(np.ascontiguousarray(p[:, :2]).tobytes())
     try:
         out = kg.grow_step(
@@ -113,7 +119,9 @@ def grow(
             seed=int(np.random.SeedSequence([abs(seed), mixed]).generate_state(1)[0]),
         )
     except ValueError as exc:
-        raise InputError("bounds" if "bounds" in str(exc) else "curve", str(exc)) from None
+        message = str(exc)
+        port = "radius" if "search radius" in message else "curve"
+        raise InputError("bounds" if "bounds" in message else port, message) from None
     xyz = np.c_[out, np.full(len(out), p[0, 2])]
     return NurbsCurve.polyline(xyz, closed=closed)
 
@@ -122,7 +130,7 @@ def grow(
 def relax(
     mesh: Mesh,
     anchors: list[int] | None = None,
-    rest_length: Annotated[float, Range(min=1e-12)] | None = None,
+    rest_length: Annotated[float | None, Range(min=1e-12)] = None,
     stiffness: Annotated[float, Range(min=0)] = 1.0,
     load: Vec3 = (0.0, 0.0, 0.0),
     pressure: float = 0.0,

@@ -266,3 +266,19 @@ def test_profile_and_drawing_show_steps(tmp_path, capsys):
     assert main(["graph", str(path), "-o", str(tmp_path / "g.svg")]) == 0
     svg = (tmp_path / "g.svg").read_text()
     assert "simulate a" in svg and "frames" in svg and "stack" in svg
+
+
+def test_plans_key_the_steps_and_compute_step_runs_only_the_new_ones():
+    # the sweep's path: keys before anything runs, then each node from its inputs
+    g = fg.Graph.from_text(COUNT)
+    done: dict[str, object] = {}
+    for steps, computed in ((7, 7), (9, 2)):
+        plan = g.plan("count", steps=steps)
+        assert [s.name for s in plan] == ["start", "count"]
+        for step in plan:
+            value, st = g.compute_step(step, {u: done[u] for u in step.upstream}, steps=steps)
+            done[step.name] = value
+        assert done["count"] == steps + 0.5
+        assert (st.items, st.computed_items) == (steps, computed)
+    assert g.plan("count", steps=9)[-1].key == g.plan("count", steps=9)[-1].key
+    assert g.plan("count", steps=9)[-1].key != g.plan("count", steps=8)[-1].key
