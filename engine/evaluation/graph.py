@@ -377,6 +377,27 @@ class Graph:
         outs = {n: run.results[n] for n in names}
         return outs[names[0]] if isinstance(nodes, str) else outs
 
+    def frames(self, node: str, **params: Any) -> list[Any]:
+        """Every step's output of simulated node ``node`` (``simulate:``), in step order:
+        what a wire ``@node.frames`` carries. Keyword arguments override params.
+
+        Raises
+        ------
+        GraphError
+            ``node`` is not a simulated node.
+        """
+        nd = self._nodes.get(node)
+        if nd is None or nd.simulate is None:
+            raise GraphError(f"{self.file_label}: '{node}' is not a simulated node (simulate:)")
+        if not self._checked:
+            self.check()
+        values = dict(self._values)
+        values.update(self._checked_params(params))
+        run = _Run(self, values)
+        self.stats = run.stats
+        run.run([node])
+        return run.frames_of(node)
+
     def sinks(self) -> list[str]:
         """Nodes nothing else reads from (exports, usually), in author order."""
         used = {up for nd in self._nodes.values() for up in nd.upstream()}
