@@ -282,3 +282,35 @@ def test_plans_key_the_steps_and_compute_step_runs_only_the_new_ones():
         assert (st.items, st.computed_items) == (steps, computed)
     assert g.plan("count", steps=9)[-1].key == g.plan("count", steps=9)[-1].key
     assert g.plan("count", steps=9)[-1].key != g.plan("count", steps=8)[-1].key
+
+
+def test_a_subgraph_node_can_simulate(tmp_path):
+    (tmp_path / "step.yaml").write_text(
+        """\
+formgraph: 1
+params:
+  curve: {type: Curve}
+  amount: 1.0
+nodes:
+  moved: {type: geometry.transform, geometry: "=curve", translate: ["=amount", 0, 0]}
+outputs:
+  curve: "@moved"
+"""
+    )
+    (tmp_path / "main.yaml").write_text(
+        """\
+formgraph: 1
+params:
+  steps: {default: 4, min: 0, max: 20}
+nodes:
+  c: {type: nurbs.circle}
+  walk:
+    type: step.yaml
+    simulate: {state: curve, from: "@c", steps: "=steps"}
+    amount: "=step"
+"""
+    )
+    g = fg.load(tmp_path / "main.yaml")
+    assert g.evaluate("walk").evaluate(0.0)[0] == pytest.approx(1 + (1 + 2 + 3 + 4))
+    assert g.evaluate("walk", steps=6).evaluate(0.0)[0] == pytest.approx(1 + 21)
+    assert g.stats["walk"].computed_items == 2
