@@ -5,7 +5,8 @@ One step (:func:`grow_step`) moves every vertex by the sum of
 - attraction: a spring along each edge toward half the split length;
 - alignment: a pull toward the midpoint of its two neighbours (Laplacian smoothing);
 - repulsion: a push away from every non-adjacent vertex nearer than ``radius``, falling off
-  linearly to zero at ``radius`` (and from the edges of ``bounds``, when given);
+  linearly to zero at ``radius`` (and from ``bounds``, when given, sampled at least every
+  ``split``);
 - jitter: an optional random push (seeded; the same on every run), which breaks the
   symmetry of a regular seed;
 
@@ -241,7 +242,7 @@ def grow_step(
     bounds : (k, 2) float, optional
         A closed simple polygon the curve starts and stays inside (its edges also repel).
     jitter : float
-        A random push of up to about ``jitter * split`` per vertex, from ``seed``.
+        A random push of up to ``jitter * split / 2`` along each axis, from ``seed``.
     seed : int
 
     Returns
