@@ -19,6 +19,9 @@ from formgraph.geometry import Curve, Mesh, NurbsCurve
 from formgraph.kernels.curves import growth as kg
 from formgraph.kernels.mesh import relax as kr
 
+#: the point attribute that carries a relaxation's velocities from one step to the next
+VELOCITY = "relax_velocity"
+
 #: what one point of a growth step costs against the element budget: its neighbour pairs
 #: and the arrays over them (about 50 numbers a point); the default budget allows a step of
 #: a million points, a few seconds
@@ -138,6 +141,7 @@ def relax(
     rest_scale: Annotated[float, Range(min=1e-6)] = 1.0,
     anchor_boundary: bool = False,
     iterations: Annotated[int, Range(min=1, max=10_000)] = 10,
+    momentum: bool = True,
     *,
     ctx: Context,
 ) -> Mesh:
@@ -146,10 +150,11 @@ def relax(
     Dynamic relaxation with kinetic damping (Barnes 1999): each vertex gets a fictitious
     mass from its springs' stiffness and a velocity that integrates the out-of-balance
     force; the velocities are zeroed at each peak of kinetic energy. A step runs
-    ``iterations`` of these from rest. Loads hang a net (turned upside down, a vault in
-    pure compression); pressure inflates a closed mesh along its area-weighted vertex
-    normals. Anchors do not move at all. Use with ``simulate:``; with the defaults a few
-    hundred steps bring a small net to rest.
+    ``iterations`` of these; with ``momentum`` the velocities ride along to the next step
+    as the point attribute ``relax_velocity``, so the steps are one motion. Loads hang a
+    net (turned upside down, a vault in pure compression); pressure inflates a closed mesh
+    along its area-weighted vertex normals. Anchors do not move at all. Use with
+    ``simulate:``; with the defaults a few hundred steps bring a small net to rest.
 
     Parameters
     ----------
@@ -176,6 +181,9 @@ def relax(
         Also hold every vertex of the mesh's boundary (a vault's springing line).
     iterations : int
         Relaxation iterations per step.
+    momentum : bool
+        Carry the velocities to the next step (the ``relax_velocity`` point attribute);
+        off, every step starts at rest.
     """
     v = np.asarray(mesh.vertices)
     n = len(v)
@@ -209,7 +217,11 @@ def relax(
         triangles=triangles,
         anchors=np.asarray(fixed, dtype=np.int64),
     )
-    x, _ = kr.relax(v, net, steps=iterations)
-    if not np.isfinite(x).all():
+    velocity = mesh.point_data.get(VELOCITY) if momentum else None
+    if velocity is not None and np.shape(velocity) != (n, 3):
+        velocity = None  # not ours: start at rest
+    x, velocity = kr.relax(v, net, steps=iterations, velocity=velocity)
+    if not (np.isfinite(x).all() and np.isfinite(velocity).all()):
         raise InputError("stiffness", "the relaxation diverged: the loads are too large")
-    return Mesh(x, mesh.face_indices, mesh.face_offsets)
+    point_data = mesh.point_data.with_(VELOCITY, velocity) if momentum else mesh.point_data
+    return Mesh.trusted(x, mesh.face_indices, mesh.face_offsets, point_data, mesh.face_data)

@@ -139,3 +139,16 @@ def test_relax_problems_are_located():
     g.set_input("hang", "reference", "@other")
     with pytest.raises(fg.NodeError, match="reference must have the mesh's faces"):
         g.evaluate("hang")
+
+
+def test_momentum_carries_the_velocities_so_the_steps_are_one_motion():
+    g = fg.Graph.from_text(RELAX)
+    hung = g.evaluate("hang", steps=60)
+    velocity = hung.point_data["relax_velocity"]
+    assert velocity.shape == (81, 3) and not velocity[[0, 8, 72, 80]].any()
+    # the same 600 iterations as one motion: at rest; from rest every step: still falling
+    moving = np.abs(g.evaluate("hang", steps=61).vertices - hung.vertices).max()
+    g.set_input("hang", "momentum", False)
+    slow = g.evaluate("hang", steps=60)
+    assert "relax_velocity" not in slow.point_data
+    assert np.abs(g.evaluate("hang", steps=61).vertices - slow.vertices).max() > 100 * moving
