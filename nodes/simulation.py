@@ -187,12 +187,23 @@ def relax(
     """
     v = np.asarray(mesh.vertices)
     n = len(v)
-    edges = mesh.edge_table.vertices
     ref = mesh if reference is None else reference
+    same = ref is mesh or (
+        ref.n_vertices == n
+        and ref.face_offsets.shape == mesh.face_offsets.shape
+        and (
+            ref.face_indices is mesh.face_indices
+            or np.array_equal(ref.face_indices, mesh.face_indices)
+        )
+        and np.array_equal(ref.face_offsets, mesh.face_offsets)
+    )
+    # the reference is the same object every step: its edge table is built once
+    table = ref.edge_table if same else mesh.edge_table
+    edges = table.vertices
     if rest_length is not None:
         rest = np.full(len(edges), float(rest_length))
     else:
-        if ref.n_vertices != n or not np.array_equal(ref.face_indices, mesh.face_indices):
+        if not same:
             raise InputError("reference", "reference must have the mesh's faces (the same net)")
         rv = np.asarray(ref.vertices)
         rest = rest_scale * np.linalg.norm(rv[edges[:, 1]] - rv[edges[:, 0]], axis=1)
@@ -203,7 +214,6 @@ def relax(
         bad = next(a for a in fixed if not -n <= a < n)
         raise InputError("anchors", f"anchor {bad} is not a vertex (the mesh has {n})")
     if anchor_boundary:
-        table = mesh.edge_table
         fixed += np.unique(table.vertices[table.counts == 1]).tolist()
     ctx.guard(iterations * (n + len(edges)), "spring updates")
     triangles = kr.fan_triangles(mesh.face_indices, mesh.face_offsets) if pressure else None
