@@ -15,7 +15,7 @@ from stubs import CALLS
 
 import formgraph as fg
 from formgraph.cli.main import main
-from formgraph.drawgraph.layout import node_marks
+from formgraph.drawgraph.layout import draw_graph, node_marks
 from formgraph.language.catalogue import json_schema
 
 COUNT = """\
@@ -315,3 +315,10 @@ nodes:
     assert g.evaluate("walk").evaluate(0.0)[0] == pytest.approx(1 + (1 + 2 + 3 + 4))
     assert g.evaluate("walk", steps=6).evaluate(0.0)[0] == pytest.approx(1 + 21)
     assert g.stats["walk"].computed_items == 2
+
+
+def test_the_drawing_after_a_run_says_how_many_steps_ran():
+    g = fg.Graph.from_text(COUNT)
+    g.evaluate("count")
+    g.evaluate("count", steps=25)
+    assert "computed 5/25 steps" in draw_graph(g).svg
