@@ -152,3 +152,14 @@ def test_momentum_carries_the_velocities_so_the_steps_are_one_motion():
     slow = g.evaluate("hang", steps=60)
     assert "relax_velocity" not in slow.point_data
     assert np.abs(g.evaluate("hang", steps=61).vertices - slow.vertices).max() > 100 * moving
+
+
+def test_steps_from_the_disk_cache_go_on_exactly_as_a_cold_run(tmp_path):
+    # the velocities ride in the cached mesh: a resumed motion is the same motion
+    g = fg.Graph.from_text(RELAX, cache_dir=tmp_path)
+    g.evaluate("hang", steps=40)
+    resumed = fg.Graph.from_text(RELAX, cache_dir=tmp_path)
+    out = resumed.evaluate("hang", steps=45)
+    assert resumed.stats["hang"].computed_items == 5
+    cold = fg.Graph.from_text(RELAX).evaluate("hang", steps=45)
+    assert out.vertices.tobytes() == cold.vertices.tobytes()
