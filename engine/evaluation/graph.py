@@ -430,22 +430,13 @@ class Graph:
         return outs[names[0]] if isinstance(nodes, str) else outs
 
     def frames(self, node: str, **params: Any) -> list[Any]:
-        """Every step's output of simulated node ``node`` (``simulate:``), in step order:
-        what a wire ``@node.frames`` carries. Keyword arguments override params.
-
-        Raises
-        ------
-        GraphError
-            ``node`` is not a simulated node.
-        """
+        """Every step's output of simulated node ``node``, in order (``@node.frames``)."""
         nd = self._nodes.get(node)
         if nd is None or nd.simulate is None:
             raise GraphError(f"{self.file_label}: '{node}' is not a simulated node (simulate:)")
         if not self._checked:
             self.check()
-        values = dict(self._values)
-        values.update(self._checked_params(params))
-        run = _Run(self, values)
+        run = _Run(self, {**self._values, **self._checked_params(params)})
         self.stats = run.stats
         run.run([node])
         return run.frames_of(node)
