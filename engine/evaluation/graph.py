@@ -448,6 +448,18 @@ class Graph:
                 )
         raise GraphError(f"{self.file_label}: no node '{name}'{suggest(name, self._nodes)}")
 
+    def frames(self, node: str, **params: Any) -> list[Any]:
+        """Every step's output of simulated node ``node``, in order (``@node.frames``)."""
+        nd = self._nodes.get(node)
+        if nd is None or nd.simulate is None:
+            raise GraphError(f"{self.file_label}: '{node}' is not a simulated node (simulate:)")
+        if not self._checked:
+            self.check()
+        run = _Run(self, {**self._values, **self._checked_params(params)})
+        self.stats = run.stats
+        run.run([node])
+        return run.frames_of(node)
+
     def sinks(self) -> list[str]:
         """Nodes nothing else reads from (exports, usually), in author order."""
         used = {up for nd in self._nodes.values() for up in nd.upstream()}
