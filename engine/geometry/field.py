@@ -305,13 +305,10 @@ def _from_mesh(field: Field, p: np.ndarray) -> np.ndarray:
     from ..kernels.field import meshdist
 
     cache = field._cache
-    if "nearest" not in cache:
+    if "signed" not in cache:
         mesh = field.args["mesh"]
-        tri = mesh.vertices[_triangles(mesh)]
-        cache["nearest"] = meshdist.Nearest(tri)
-        cache["winding"] = meshdist.WindingNumber(tri)
-    d = cache["nearest"].distance(p)
-    return np.where(cache["winding"](p) > 0.5, -d, d)
+        cache["signed"] = meshdist.SignedDistance(mesh.vertices, _triangles(mesh))
+    return cache["signed"](p)
 
 
 def _triangles(mesh: Any) -> np.ndarray:

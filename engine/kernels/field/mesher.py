@@ -104,6 +104,13 @@ TET_CORNERS, TRI_TABLE = _tables()  # (6, 4) cube corners; (6, 16, 2, 3, 2)
 # ---------------------------------------------------------------------------- the grid
 
 
+GRID_SHIFT = np.array([0.1234567, 0.2345678, 0.3456789]) * 0.5
+# a vertex stays this fraction of its edge off either end, so vertices never coincide, not
+# even as the float32 coordinates of an STL (at 2,000 cells from the origin an ulp of
+# float32 is 1e-4 of a cell)
+END_GAP = 5e-4
+
+
 def plan_grid(lo: np.ndarray, hi: np.ndarray, cell: float, coarse: int = 16):
     """The finest grid over ``[lo, hi]`` (padded by a cell) and its octree depth.
 
@@ -116,7 +123,9 @@ def plan_grid(lo: np.ndarray, hi: np.ndarray, cell: float, coarse: int = 16):
     levels = max(0, int(np.ceil(np.log2(max(n.max() / coarse, 1.0)))))
     blocks = -(-n // (1 << levels))
     size = blocks * (1 << levels)
-    origin = (lo + hi) / 2.0 - size * cell / 2.0  # centre the grid on the box
+    # centre the grid on the box, shifted by a generic fraction of a cell: the planes of
+    # boxes and cuts at round coordinates then never pass exactly through grid corners
+    origin = (lo + hi) / 2.0 - size * cell / 2.0 + cell * GRID_SHIFT
     return origin, levels, blocks
 
 
@@ -224,14 +233,14 @@ def mesh_field(
 def _roots(f: Fn, pa, pb, fa, fb, steps: int, cell: float) -> np.ndarray:
     """Points where ``f`` changes sign on segments ``pa -> pb`` (Illinois regula falsi).
 
-    ``fa`` and ``fb`` have opposite signs (one is < 0, the other >= 0). Points are kept a
-    hair off the ends so two edges meeting at a corner that is exactly zero give distinct
-    (if coincident-looking) vertices, never a NaN.
+    ``fa`` and ``fb`` have opposite signs (one is < 0, the other >= 0). Points are kept
+    ``END_GAP`` off the ends, so edges meeting at a corner on the surface give distinct
+    vertices (and no triangle collapses to a point in a file of float32 coordinates).
     """
     lo_t = np.zeros(len(pa))
     hi_t = np.ones(len(pa))
     flo, fhi = fa.copy(), fb.copy()
-    t = np.clip(flo / (flo - fhi), 1e-6, 1 - 1e-6)
+    t = np.clip(flo / (flo - fhi), END_GAP, 1 - END_GAP)
     tol = 1e-4 * cell
     idx = np.arange(len(pa))
     side = np.zeros(len(pa), dtype=np.int8)  # which end was kept last (Illinois)
@@ -256,7 +265,7 @@ def _roots(f: Fn, pa, pb, fa, fb, steps: int, cell: float) -> np.ndarray:
             break
         den = flo[idx] - fhi[idx]
         frac = np.divide(flo[idx], den, out=np.full(len(idx), 0.5), where=den != 0)
-        t[idx] = np.clip(lo_t[idx] + frac * (hi_t[idx] - lo_t[idx]), 1e-6, 1 - 1e-6)
+        t[idx] = np.clip(lo_t[idx] + frac * (hi_t[idx] - lo_t[idx]), END_GAP, 1 - END_GAP)
     return pa + t[:, None] * (pb - pa)
 
 
