@@ -205,12 +205,13 @@ def mesh_field(
     corner = corner[mixed]
     ins = ins[mixed]
     # per tetrahedron: its sign case and up to two triangles of (corner, direction) edges
-    tc = ins[:, TET_CORNERS]  # (m, 6, 4)
-    case = (tc * (1 << np.arange(4))).sum(axis=2)  # (m, 6)
-    table = TRI_TABLE[np.arange(6)[None, :], case]  # (m, 6, 2, 3, 2)
-    keep = table[:, :, :, 0, 0] >= 0  # (m, 6, 2)
-    cell_of = np.nonzero(keep)[0]
-    tri = table[keep]  # (t, 3, 2): local start corner, direction index
+    bits = ins.astype(np.int8)
+    case = sum(bits[:, TET_CORNERS[:, k]] << k for k in range(4))  # (m, 6)
+    cell_of, tet = np.nonzero((case != 0) & (case != 15))  # the tetrahedra the surface cuts
+    table = TRI_TABLE[tet, case[cell_of, tet]]  # (c, 2, 3, 2)
+    second = table[:, 1, 0, 0] >= 0  # a quad: two triangles
+    tri = np.concatenate([table[:, 0], table[second, 1]])  # (t, 3, 2): start corner, direction
+    cell_of = np.concatenate([cell_of, cell_of[second]])
     start = corner[cell_of[:, None], tri[..., 0]]  # (t, 3) corner numbers
     end = corner[cell_of[:, None], tri[..., 0] + tri[..., 1] + 1]  # bit codes add: s & d = 0
     # one vertex per (start corner, direction): a perfect hash, no sort
@@ -284,8 +285,9 @@ def _number_corners(cells: np.ndarray, n: np.ndarray, max_cells: int):
     """
     nb = n // BRICK + 1
     cc = (cells[:, None, :] + CORNERS[None, :, :]).reshape(-1, 3)
-    brick = (cc // BRICK) @ np.array([nb[1] * nb[2], nb[2], 1], dtype=np.int64)
-    place = (cc % BRICK) @ np.array([BRICK * BRICK, BRICK, 1], dtype=np.int64)
+    x, y, z = cc[:, 0], cc[:, 1], cc[:, 2]  # (integer matmul has no fast path in numpy)
+    brick = ((x >> 3) * nb[1] + (y >> 3)) * nb[2] + (z >> 3)
+    place = ((x & 7) << 6) | ((y & 7) << 3) | (z & 7)
     marked = np.zeros(int(np.prod(nb)), dtype=bool)
     marked[brick] = True
     n_slots = int(marked.sum())

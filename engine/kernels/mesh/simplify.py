@@ -29,10 +29,13 @@ def is_closed(triangles: np.ndarray) -> bool:
     t = np.asarray(triangles, dtype=np.int64)
     if not len(t):
         return False
-    e = np.sort(np.stack([t, np.roll(t, -1, axis=1)], axis=2).reshape(-1, 2), axis=1)
+    a, b = t.reshape(-1), t[:, [1, 2, 0]].reshape(-1)
     n = int(t.max()) + 1
-    _, counts = np.unique(e[:, 0] * n + e[:, 1], return_counts=True)
-    return bool((counts == 2).all())
+    k = np.sort(np.minimum(a, b) * n + np.maximum(a, b))
+    # every key exactly twice: equal in pairs, and each pair unlike the next
+    if k.size % 2 or not (k[0::2] == k[1::2]).all():
+        return False
+    return bool((k[2::2] != k[1:-1:2]).all())
 
 
 def _compact(v: np.ndarray, t: np.ndarray):
