@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import trimesh
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from formgraph.kernels.field import meshdist, mesher, sdf
@@ -175,6 +175,7 @@ def test_a_field_that_is_not_finite_is_refused():
     ),
     st.floats(0, 0.6),
 )
+@example(spheres=[(0.0, 0.0, 0.0, 0.5), (0.0, 0.0, 0.75, 0.5)], k=0.0)  # a kink on edges
 def test_random_smooth_blends_are_closed_outward_and_even_euler(spheres, k):
     def f(p):
         out = None

@@ -267,6 +267,17 @@ def _roots(f: Fn, pa, pb, fa, fb, steps: int, cell: float) -> np.ndarray:
         den = flo[idx] - fhi[idx]
         frac = np.divide(flo[idx], den, out=np.full(len(idx), 0.5), where=den != 0)
         t[idx] = np.clip(lo_t[idx] + frac * (hi_t[idx] - lo_t[idx]), END_GAP, 1 - END_GAP)
+    # what regula falsi left (a kink of a sharp union on the edge converges only linearly):
+    # bisection of the bracket, which halves it every step whatever the field's shape
+    for _ in range(16 if steps else 0):
+        if not len(idx):
+            break
+        t[idx] = np.clip((lo_t[idx] + hi_t[idx]) / 2.0, END_GAP, 1 - END_GAP)
+        fp = _check(f(pa[idx] + t[idx, None] * (pb[idx] - pa[idx])))
+        low = (fp < 0) == (flo[idx] < 0)
+        lo_t[idx[low]], flo[idx[low]] = t[idx[low]], fp[low]
+        hi_t[idx[~low]], fhi[idx[~low]] = t[idx[~low]], fp[~low]
+        idx = idx[np.abs(fp) > tol]
     return pa + t[:, None] * (pb - pa)
 
 
