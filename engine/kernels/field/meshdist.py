@@ -5,7 +5,7 @@
   nearest of the three edges), degenerate triangles included.
 * :class:`Nearest`: the distance from many points to the nearest of many primitives
   (triangles or segments), exact, by a bounding-box hierarchy over the primitives in
-  Morton order (a linear BVH: leaves of 8, nodes of 8), traversed for all points at once:
+  Morton order (a linear BVH: leaves of 2, nodes of 8), traversed for all points at once:
   the primitive with the nearest centre (scipy's cKDTree) gives each point an upper
   bound, then every (point, node) pair whose box is nearer than that bound is opened,
   level by level, down to the exact distances.
@@ -103,7 +103,7 @@ class _Hierarchy:
     (``lo``, ``hi``); ``order`` maps sorted positions to the caller's primitive indices.
     """
 
-    LEAF = 8
+    LEAF = 2  # small leaves: tight boxes prune far more pairs than they add (1.7x vs 8)
     FAN = 8
 
     def __init__(self, corners: np.ndarray):
