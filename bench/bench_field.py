@@ -125,7 +125,7 @@ def run(table) -> None:
     t = table.time(case, f"formgraph ({n_ours:,} points)", lambda: field.evaluate(p), repeat=1)
     table.time(
         case,
-        f"trimesh proximity ({n_ref:,} points, x{n_ours // n_ref})",
+        "trimesh proximity",
         lambda: [trimesh.proximity.signed_distance(tor, p[:n_ref]) for _ in range(1)],
         repeat=1,
     )
@@ -149,7 +149,7 @@ def run(table) -> None:
     case = f"decimate a {len(s.faces):,}-triangle sphere to 10 %"
     table.time(
         case,
-        "formgraph (mesh.decimate's kernel)",
+        "formgraph",
         lambda: ksimp.decimate(s.vertices, s.faces, len(s.faces) // 10),
         repeat=1,
     )
