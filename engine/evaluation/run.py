@@ -529,7 +529,8 @@ class _Run(LanguageRun, SimulationRun):
     def bind_expression(
         self, name: str, port: str, pt: Any, text: Any, env: dict[str, Any] | None = None
     ) -> Any:
-        from ..language.expr import Bound, compile_expression
+        from ..language.bound import Bound
+        from ..language.expr import compile_expression
 
         values = self.values if env is None else env
         allowed = set(values) | set(pt.variables)

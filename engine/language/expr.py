@@ -143,35 +143,6 @@ class Compiled:
         return self.text.strip().isidentifier() and self.text.strip() not in CONSTANTS
 
 
-@dataclass(frozen=True)
-class Bound:
-    """An expression with its graph params bound; nodes call it with their own variables.
-
-    Example
-    -------
-    >>> x = Bound(compile_expression("r * cos(t)"), {"r": 2.0})
-    >>> float(x(t=0.0))
-    2.0
-    """
-
-    compiled: Compiled
-    params: Mapping[str, Any]
-
-    @property
-    def text(self) -> str:
-        return self.compiled.text
-
-    def __call__(self, **variables: Any) -> Any:
-        return self.compiled(self.params, **variables)
-
-    def taylor(self, variable: str, **variables: Any) -> tuple[Any, Any, Any]:
-        """Value, first and second derivative in ``variable``, exact (see
-        :mod:`~formgraph.language.derivative`; raises ``NotDifferentiable`` for noise)."""
-        from .derivative import taylor
-
-        return taylor(self.compiled.text, variable, {**self.params, **variables})
-
-
 def compile_expression(text: str, allowed: set[str] | frozenset[str] | None = None) -> Compiled:
     """Compile ``text`` into a :class:`Compiled` closure tree.
 

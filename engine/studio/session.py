@@ -247,7 +247,8 @@ class StudioSession:
         return cooked
 
     def _start_values(self, graph: Graph) -> dict[str, Any] | Cooked:
-        from formgraph.cli.options import UsageError, parse_sets
+        from formgraph.core.errors import UsageError
+        from formgraph.language.params import parse_sets
 
         try:
             return parse_sets(graph, self.sets)
