@@ -71,7 +71,16 @@ window.__fg = {ws: [], draws: [], keys: []};
 def _start(graph: Path, out: Path) -> tuple[subprocess.Popen, str]:
     log = open(graph.parent / "studio.log", "w")  # noqa: SIM115  (closed with the folder)
     proc = subprocess.Popen(
-        [sys.executable, "-m", "formgraph.studio", str(graph), "--port", "0", "--no-browser"]
+        [
+            sys.executable,
+            "-m",
+            "formgraph.cli.main",
+            "serve",
+            str(graph),
+            "--port",
+            "0",
+            "--no-browser",
+        ]
         + ["--out", str(out)],
         stdout=subprocess.PIPE,
         stderr=log,

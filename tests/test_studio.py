@@ -354,7 +354,8 @@ class Studio:
             [
                 sys.executable,
                 "-m",
-                "formgraph.studio",
+                "formgraph.cli.main",
+                "serve",
                 str(graph),
                 "--port",
                 "0",
