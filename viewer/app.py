@@ -18,8 +18,8 @@ from typing import Any
 
 from formgraph.core.errors import FormgraphError, GraphError, Problem, Where
 from formgraph.evaluation.graph import Graph, load
-from formgraph.language.check import param_kind
 from formgraph.language.model import Items, Wire, parse_input
+from formgraph.language.params import param_kind
 
 from .frame import Camera
 from .scene import PALETTE, TEXT_COLOR, Scene, fit_scenes
@@ -58,7 +58,7 @@ def shown_nodes(graph: Graph, node: str | Iterable[str] | None = None) -> list[s
 
 
 def _check_target(graph: Graph, registry: dict[str, Any], target: str) -> None:
-    from formgraph.language.check import suggest
+    from formgraph.language.params import suggest
 
     where = Where(graph.file)
     if target in graph.nodes:
@@ -125,6 +125,9 @@ class Session:
         Draw mesh face edges always (True), never (False), or on coarse meshes (None).
     camera : Camera, optional
         Where the views look from (:class:`~.frame.Camera`); automatic if None.
+    color : str, optional
+        Colour the points and meshes by this attribute (point or face), with a colour bar;
+        a 3-component ``color`` attribute is shown as the RGB colours it holds.
     """
 
     def __init__(
@@ -138,6 +141,7 @@ class Session:
         layout: str = "overlay",
         edges: bool | None = None,
         camera: Camera | None = None,
+        color: str | None = None,
     ):
         if layout not in LAYOUTS:
             raise ValueError(f"layout must be one of {', '.join(LAYOUTS)}, got {layout!r}")
@@ -150,6 +154,7 @@ class Session:
         self.layout = layout
         self.params: dict[str, Any] = dict(params or {})
         self.timing = timing
+        self.color = color  # an attribute to colour by (with a colour bar), or None
         self.seconds: float | None = None
         self.targets = shown_nodes(self.graph, node) if self.graph is not None else []
         self.controls_x = 0.76  # where the column of sliders starts (fraction of the width)
@@ -165,7 +170,7 @@ class Session:
 
     def _make_scenes(self, n: int, edges: bool | None) -> list[Scene]:
         if self.layout == "overlay":
-            return [Scene(self.plotter, edges=edges)]
+            return [Scene(self.plotter, edges=edges, color_by=self.color)]
         rows, cols = self.plotter.shape
         if rows != 1 or cols < n:
             raise ValueError(
@@ -174,7 +179,10 @@ class Session:
             )
         colors: dict[str, str] = {}
         scenes = [
-            Scene(self.plotter, (0, i), titled=True, edges=edges, colors=colors) for i in range(n)
+            Scene(
+                self.plotter, (0, i), titled=True, edges=edges, colors=colors, color_by=self.color
+            )
+            for i in range(n)
         ]
         if n > 1:
             self.plotter.link_views(list(range(n)))

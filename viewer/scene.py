@@ -144,16 +144,15 @@ def datasets_of(items: Sequence[Geometry]) -> dict[str, Any]:
     Surfaces and meshes come with split point normals for smooth shading; ``features``
     holds their feature edges and open boundaries (see :func:`~.style.shaded`).
     """
-    import pyvista as pv
 
-    points = [np.asarray(g.xyz) for g in items if isinstance(g, Points) and len(g)]
+    points = [g.to_pyvista() for g in items if isinstance(g, Points) and len(g)]
     curves = [g for g in items if isinstance(g, Curve)]
     surfaces = [g for g in items if isinstance(g, Surface)]
     meshes = [g for g in items if isinstance(g, Mesh) and g.n_faces]
     surface_data = _merge([s.tessellate(*_surface_resolution(s)).to_pyvista() for s in surfaces])
     mesh_data = _merge([m.to_pyvista() for m in meshes])
     out: dict[str, Any] = {
-        "points": pv.PolyData(np.concatenate(points)) if points else None,
+        "points": _merge(points),
         "curves": _polylines([c.display_points() for c in curves]),
         "polygon": _polylines([c.control_points for c in curves if isinstance(c, NurbsCurve)]),
         "net": _merge(
@@ -215,6 +214,9 @@ class Scene:
         (None, at most :data:`~.style.COARSE_FACES` faces).
     colors : dict, optional
         Label -> colour, shared between scenes so that a node keeps its colour.
+    color_by : str, optional
+        An attribute to colour points, surfaces and meshes by, with a colour bar (a
+        ``color`` of 3 or 4 components in 0..1 is drawn as those colours).
     """
 
     def __init__(
@@ -225,8 +227,10 @@ class Scene:
         titled: bool = False,
         edges: bool | None = None,
         colors: dict[str, str] | None = None,
+        color_by: str | None = None,
     ):
         self.plotter = plotter
+        self.color_by = color_by
         self.subplot = subplot
         self.titled = titled
         self.edges = edges
@@ -327,7 +331,10 @@ class Scene:
         self._layer_edges(layer)
 
     def _add_part(self, layer: Layer, kind: str, data: Any) -> Part:
-        actor = self.plotter.add_mesh(data, reset_camera=False, **style(kind, layer.color))
+        options = style(kind, layer.color)
+        if kind in ("points", "surfaces", "meshes"):
+            options.update(colour_by(data, self.color_by))
+        actor = self.plotter.add_mesh(data, reset_camera=False, **options)
         apply_material(actor, kind)
         part = Part(data, actor)
         if kind in OVERLAYS:
@@ -606,6 +613,38 @@ class Scene:
             if actor is not None:
                 out[name] = _text_of(actor)
         return out
+
+
+def colour_by(data: Any, name: str | None) -> dict[str, Any]:
+    """add_mesh keywords that colour ``data`` by its attribute ``name`` (a point array, else
+    a cell array), with a colour bar titled by the name; nothing when it has no such
+    array. A ``color`` of 3 or 4 components in 0..1 is shown as RGB(A), without a bar."""
+    if not name:
+        return {}
+    where = "point" if name in data.point_data else "cell" if name in data.cell_data else None
+    if where is None:
+        return {}
+    values = np.asarray((data.point_data if where == "point" else data.cell_data)[name])
+    options: dict[str, Any] = {"scalars": name, "preference": where, "color": None}
+    if name == "color" and values.ndim == 2 and values.shape[1] in (3, 4):
+        return {**options, "rgb": True}
+    if values.ndim == 2 and values.shape[1] > 1:  # a vector: by its length
+        options["component"] = None
+    return {
+        **options,
+        "cmap": "viridis",
+        "show_scalar_bar": True,
+        "scalar_bar_args": {
+            "title": name,
+            "vertical": True,
+            "position_x": 0.88,
+            "position_y": 0.12,
+            "height": 0.6,
+            "width": 0.06,
+            "color": "black",
+            "fmt": "%.3g",
+        },
+    }
 
 
 def _vertices(data: Any) -> Any:

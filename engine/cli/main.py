@@ -68,6 +68,12 @@ def _parser() -> argparse.ArgumentParser:
             "--edges", action="store_true", help="draw every mesh face's edges (default: coarse)"
         )
         p.add_argument("--size", default="1024x768", metavar="WxH")
+        p.add_argument(
+            "--color",
+            metavar="NAME",
+            default=None,
+            help="colour points and meshes by an attribute, with a colour bar",
+        )
         camera_options(p)
         p.add_argument("--out", default="out", metavar="DIR", help=argparse.SUPPRESS)
 
@@ -195,7 +201,7 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 def cmd_check(args: argparse.Namespace) -> int:
     from ..evaluation.graph import load
-    from ..language.check import param_warnings
+    from ..language.params import param_warnings
 
     g = load(args.graph)
     for p in param_warnings(g.param_defs, g.file_label):
@@ -252,11 +258,21 @@ def cmd_view(args: argparse.Namespace) -> int:
             layout=args.layout,
             edges=edges,
             camera=camera,
+            color=args.color,
             **params,
         )
         print(f"wrote {path}")
         return 0
-    viewer.show(g, node=nodes, size=size, layout=args.layout, edges=edges, camera=camera, **params)
+    viewer.show(
+        g,
+        node=nodes,
+        size=size,
+        layout=args.layout,
+        edges=edges,
+        camera=camera,
+        color=args.color,
+        **params,
+    )
     return 0
 
 
@@ -330,7 +346,7 @@ def cmd_graph(args: argparse.Namespace) -> int:
 def cmd_nodes(args: argparse.Namespace) -> int:
     from ..core.registry import node_types
     from ..language.catalogue import catalogue_text, markdown, node_text
-    from ..language.check import suggest
+    from ..language.params import suggest
 
     if args.markdown:
         sys.stdout.write(markdown())

@@ -89,13 +89,13 @@ def parse_sets(graph: Any, items: Sequence[str]) -> dict[str, Any]:
         if not sep or not name:
             raise UsageError(f"--set takes NAME=VALUE, got {item!r} (node names go before --set)")
         if name not in defs:
-            from ..language.check import suggest
+            from ..language.params import suggest
 
             raise GraphError(
                 f"--set {name}: unknown param{suggest(name, defs)}; params are "
                 f"{', '.join(defs) or 'none'}"
             )
-        from ..language.check import param_kind
+        from ..language.params import param_kind
         from ..language.yamlread import load_value
 
         kind = param_kind(defs[name])

@@ -120,6 +120,16 @@ class Variables:
         object.__setattr__(self, "names", tuple(names))
 
 
+@dataclass(frozen=True)
+class PerElement:
+    """A port that also takes expressions evaluated once per element of the geometry on
+    input ``of`` (over the element's ``x y z``, ``i``, ``count``, its attributes and the
+    params): ``scale: "=0.5 + rand(i)"``. A plain value, or an expression of the params
+    alone, is an ordinary input."""
+
+    of: str
+
+
 class TypeMismatch(ValueError):
     """A literal or wire that does not fit a port."""
 
@@ -163,6 +173,7 @@ class PortType:
     range: Range | None = None
     variables: tuple[str, ...] = ()
     same_as: str | None = None  # an output typed like one of the node's inputs
+    per_element: str | None = None  # takes per-element expressions over this input
 
     @property
     def name(self) -> str:
@@ -455,6 +466,7 @@ def port_type(hint: Any) -> PortType:
     rng: Range | None = None
     variables: tuple[str, ...] = ()
     same_as: str | None = None
+    per_element: str | None = None
     if typing.get_origin(hint) is typing.Annotated:
         hint, *extras = typing.get_args(hint)
         for x in extras:
@@ -464,6 +476,8 @@ def port_type(hint: Any) -> PortType:
                 variables = x.names
             elif isinstance(x, SameAs):
                 same_as = x.port
+            elif isinstance(x, PerElement):
+                per_element = x.of
     optional = False
     alternatives = [hint]
     if typing.get_origin(hint) in (typing.Union, _pytypes.UnionType):
@@ -478,7 +492,7 @@ def port_type(hint: Any) -> PortType:
             kinds.append(Kind(item, True))
         else:
             kinds.append(Kind(alt, False))
-    return PortType(tuple(kinds), optional, rng, variables, same_as)
+    return PortType(tuple(kinds), optional, rng, variables, same_as, per_element)
 
 
 def type_by_name(name: str) -> PortType:

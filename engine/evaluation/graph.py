@@ -29,8 +29,9 @@ from ..core.errors import (
 )
 from ..core.registry import DEFAULT_BUDGET, NodeSpec, node_types
 from ..core.types import TypeMismatch, describe, type_by_name
-from ..language.check import Outline, check_graph, check_param_value
+from ..language.check import Outline, check_graph
 from ..language.model import NodeDef, ParamDef, parse_input
+from ..language.params import check_param_value
 from ..language.subgraph import Includes, SubgraphSpec, is_graph_type
 from ..language.yamlio import MAX_BYTES, MAX_DEPTH, dump, parse
 from . import cache as _cache
@@ -240,7 +241,7 @@ class Graph:
         self._values[name] = default
         self._checked = False
 
-    def add(self, name: str, type: str, **inputs: Any) -> None:
+    def add(self, name: str, type: str, /, **inputs: Any) -> None:
         """Add (or replace) node ``name`` of node type ``type`` with its inputs."""
         if not isinstance(name, str) or not isinstance(type, str):
             what = "node name" if not isinstance(name, str) else "node type"
@@ -311,7 +312,7 @@ class Graph:
         for name, value in params.items():
             p = self._params.get(name)
             if p is None:
-                from ..language.check import suggest
+                from ..language.params import suggest
 
                 problems.append(
                     Problem(
@@ -367,7 +368,7 @@ class Graph:
         names = _node_names(nodes)
         for n in names:
             if n not in self._nodes:
-                from ..language.check import suggest
+                from ..language.params import suggest
 
                 raise GraphError(f"{self.file_label}: no node '{n}'{suggest(n, self._nodes)}")
         run = _Run(self, values)

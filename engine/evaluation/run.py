@@ -35,6 +35,7 @@ from ..core.errors import (
 )
 from ..core.registry import Context, NodeSpec, node_types
 from ..core.types import Entries, TypeMismatch
+from ..language.elements import bind_elements, reads_elements
 from ..language.model import FRAMES, STEP, Expr, Input, Items, Literal, NodeDef, Wire, wires_of
 from ..language.subgraph import SubgraphSpec
 from . import cache as _cache
@@ -195,6 +196,13 @@ class _Run(LanguageRun, SimulationRun):
         if isinstance(value, Items):
             return [self.key_part(name, port, spec, i) for i in value.items]
         pt = spec.inputs[port].type
+        if pt.per_element and reads_elements(value, self.values):
+            element = bind_elements(value, self.values)  # per element: text and params
+            names = sorted(element.names & set(self.values))
+            return {
+                "per_element": element.text,
+                "params": {n: self.tokens.get(n, self.values[n]) for n in names},
+            }
         if pt.is_expression:  # the text, and the values of the params the text reads
             from ..language.expr import compile_expression
 
@@ -344,6 +352,10 @@ class _Run(LanguageRun, SimulationRun):
                     kwargs[port] = self.bind_expression(name, port, p.type, p.default, env)
                 else:
                     kwargs[port] = p.type.coerce(p.default)
+                continue
+            values = self.values if env is None else env
+            if p.type.per_element and reads_elements(nd.inputs[port], values):
+                kwargs[port] = bind_elements(nd.inputs[port], values)
                 continue
             raw = self.resolve(name, port, nd.inputs[port], env)
             if isinstance(nd.inputs[port], Wire) and isinstance(raw, list):

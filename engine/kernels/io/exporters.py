@@ -16,6 +16,7 @@ from __future__ import annotations
 import struct
 from collections.abc import Iterator
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -559,7 +560,47 @@ def _face_lines(fi: np.ndarray, fo: np.ndarray, with_normals: bool) -> bytes:
 # PLY
 
 
-def ply_binary(vertices: np.ndarray, face_indices: np.ndarray, face_offsets: np.ndarray) -> bytes:
+def _ply_properties(data: Any, n: int) -> tuple[list[str], np.ndarray | None]:
+    """Header lines and one packed record per element for a mapping of attributes.
+
+    A ``color`` of 3 or 4 components (0..1) is written as ``uchar red green blue [alpha]``
+    (what viewers and trimesh read as colours), a 3-component ``normal`` as ``nx ny nz``,
+    any other attribute as ``double`` properties, ``name`` or ``name_0, name_1, ...``.
+    """
+    if not data:
+        return [], None
+    fields: list[tuple[str, str]] = []
+    columns: list[np.ndarray] = []
+    for name, a in data.items():
+        a = np.asarray(a, dtype=np.float64).reshape(n, -1)
+        k = a.shape[1]
+        if name == "color" and k in (3, 4):
+            names = ["red", "green", "blue", "alpha"][:k]
+            rgb = np.rint(np.clip(a, 0.0, 1.0) * 255.0).astype(np.uint8)
+            fields += [(c, "u1") for c in names]
+            columns += [rgb[:, c] for c in range(k)]
+            continue
+        if name == "normal" and k == 3:
+            names = ["nx", "ny", "nz"]
+        else:
+            names = [name] if k == 1 else [f"{name}_{c}" for c in range(k)]
+        fields += [(c, "<f8") for c in names]
+        columns += [a[:, c] for c in range(k)]
+    record = np.dtype(fields)
+    out = np.empty(n, dtype=record)
+    for (c, _), col in zip(fields, columns, strict=True):
+        out[c] = col
+    ply_type = {"u1": "uchar", "<f8": "double"}
+    return [f"property {ply_type[t]} {c}\n" for c, t in fields], out
+
+
+def ply_binary(
+    vertices: np.ndarray,
+    face_indices: np.ndarray,
+    face_offsets: np.ndarray,
+    point_data: Any = None,
+    face_data: Any = None,
+) -> bytes:
     """Binary little-endian PLY: double x, y, z per vertex; faces as lists of int indices.
 
     Each face record is a count (``uchar``, or ``uint`` when some face has more than 255
@@ -567,11 +608,17 @@ def ply_binary(vertices: np.ndarray, face_indices: np.ndarray, face_offsets: np.
     records have different lengths, so they are laid out by computing every record's byte
     offset and placing counts and indices with one scatter each.
 
+    Attributes (``point_data``, ``face_data``: name -> (n,) or (n, k) arrays) become
+    properties of the vertex and face elements: a ``color`` in 0..1 as ``uchar red green
+    blue`` (and ``alpha`` for 4 components), a ``normal`` as ``nx ny nz``, anything else as
+    ``double`` (``name``, or ``name_0 ... name_{k-1}`` for a vector).
+
     Parameters
     ----------
     vertices : (n, 3) float64
     face_indices : (m,) int
     face_offsets : (n_faces + 1,) int
+    point_data, face_data : mapping name -> array, optional
 
     Returns
     -------
@@ -584,6 +631,8 @@ def ply_binary(vertices: np.ndarray, face_indices: np.ndarray, face_offsets: np.
     n_faces = sizes.size
     wide = bool(sizes.size and sizes.max() > 255)
     count_type, count_dtype = ("uint", np.dtype("<u4")) if wide else ("uchar", np.dtype("u1"))
+    v_props, v_extra = _ply_properties(point_data, len(v))
+    f_props, f_extra = _ply_properties(face_data, n_faces)
     header = (
         "ply\n"
         "format binary_little_endian 1.0\n"
@@ -591,26 +640,41 @@ def ply_binary(vertices: np.ndarray, face_indices: np.ndarray, face_offsets: np.
         f"element vertex {len(v)}\n"
         "property double x\n"
         "property double y\n"
-        "property double z\n"
-        f"element face {n_faces}\n"
-        f"property list {count_type} int vertex_indices\n"
-        "end_header\n"
+        "property double z\n" + "".join(v_props) + f"element face {n_faces}\n"
+        f"property list {count_type} int vertex_indices\n" + "".join(f_props) + "end_header\n"
     ).encode()
     cw = count_dtype.itemsize
+    ew = 0 if f_extra is None else f_extra.dtype.itemsize
     if n_faces and np.all(sizes == sizes[0]):  # one face size: a packed structured array
-        record = np.dtype([("count", count_dtype), ("indices", "<i4", (int(sizes[0]),))])
+        parts = [("count", count_dtype), ("indices", "<i4", (int(sizes[0]),))]
+        if f_extra is not None:
+            parts.append(("extra", f"V{ew}"))
+        record = np.dtype(parts)
         faces = np.empty(n_faces, dtype=record)
         faces["count"] = sizes[0]
         faces["indices"] = fi.reshape(n_faces, -1)
+        if f_extra is not None:
+            faces["extra"] = f_extra.view(f"V{ew}")
         face_bytes = faces.data
     else:
         face_of = np.repeat(np.arange(n_faces), sizes)
-        starts = fo[:-1] * 4 + np.arange(n_faces) * cw  # byte offset of each record
-        buf = np.empty(fi.size * 4 + n_faces * cw, dtype=np.uint8)
+        starts = fo[:-1] * 4 + np.arange(n_faces) * (cw + ew)  # byte offset of each record
+        buf = np.empty(fi.size * 4 + n_faces * (cw + ew), dtype=np.uint8)
         buf[starts[:, None] + np.arange(cw)] = (
             sizes.astype(count_dtype).view(np.uint8).reshape(-1, cw)
         )
-        pos = np.arange(fi.size) * 4 + (face_of + 1) * cw
+        pos = np.arange(fi.size) * 4 + face_of * ew + (face_of + 1) * cw
         buf[pos[:, None] + np.arange(4)] = fi.astype("<i4").view(np.uint8).reshape(-1, 4)
+        if f_extra is not None and n_faces:
+            tail = starts + cw + 4 * sizes
+            buf[tail[:, None] + np.arange(ew)] = f_extra.view(np.uint8).reshape(n_faces, ew)
         face_bytes = buf.data
-    return b"".join([header, v.astype("<f8").data, face_bytes])
+    if v_extra is None:
+        vertex_bytes = v.astype("<f8").data
+    else:
+        record = np.dtype([("xyz", "<f8", (3,)), ("extra", f"V{v_extra.dtype.itemsize}")])
+        rows = np.empty(len(v), dtype=record)
+        rows["xyz"] = v
+        rows["extra"] = v_extra.view(f"V{v_extra.dtype.itemsize}")
+        vertex_bytes = rows.data
+    return b"".join([header, vertex_bytes, face_bytes])
