@@ -17,7 +17,8 @@ import numpy as np
 from formgraph.core.errors import InputError
 from formgraph.core.registry import Context, Range, node
 from formgraph.core.types import Vec3
-from formgraph.geometry import Curve, NurbsCurve, frozen_array
+from formgraph.geometry import Curve, NurbsCurve, Points, frozen_array
+from formgraph.kernels import curves as kc
 from formgraph.kernels.curves import regions as kregions
 from formgraph.kernels.curves import sampling as ksampling
 from formgraph.kernels.curves import shapes as kshapes
@@ -428,3 +429,67 @@ def text(
             knots[pieces] = frozen_array(np.concatenate([ends[0], inner, ends[1]]))
         out.append(NurbsCurve(cp, degree, knots[pieces]))
     return out
+
+
+@node("curves.divide", version=1)
+def divide(
+    curve: Curve,
+    count: Annotated[int | None, Range(min=2)] = None,
+    spacing: Annotated[float | None, Range(min=0)] = None,
+    *,
+    ctx: Context,
+) -> Points:
+    """Points on a curve at equal arc length, with ``tangent`` and ``t`` point attributes.
+
+    Give ``count`` or ``spacing``. The arc length is integrated by Gauss-Legendre
+    quadrature on every knot span and inverted by safeguarded Newton steps, so the points
+    lie exactly on the curve (a polyline: along its straight segments); an open curve gets
+    both ends, a closed one its start and no repeat of it. ``tangent`` is the unit tangent
+    (the direction of travel) and ``t`` the curve parameter of each point: copy parts onto
+    the points aligned to the curve, or drive expressions by position along it.
+
+    Parameters
+    ----------
+    curve : Curve
+        Any curve.
+    count : int
+        Number of points (open: both ends included; closed: >= 3).
+    spacing : float
+        Distance along the curve between points; rounded so it divides the length evenly.
+
+    Example
+    -------
+    ``studs: {type: curves.divide, curve: "@rim", spacing: 5}``
+    """
+    if (count is None) == (spacing is None):
+        raise InputError("count", "give exactly one of count and spacing")
+    closed = _closed(curve)
+    if isinstance(curve, NurbsCurve):
+        k = np.asarray(curve.knots)
+        breaks = np.unique(k[curve.degree : len(curve.control_points) + 1])
+        pieces = 1 if curve.degree == 1 else 16
+    else:
+        breaks, pieces = np.array(curve.domain), max(64, getattr(curve, "samples", 256))
+
+    def speed(tt: np.ndarray) -> np.ndarray:
+        return np.linalg.norm(curve.derivative(tt), axis=-1)
+
+    edges, cum = kc.arc_length_table(speed, breaks, pieces)
+    length = float(cum[-1])
+    if not length > 0.0:
+        raise InputError("curve", "cannot divide a curve of zero length")
+    n = (
+        count
+        if count is not None
+        else _kernel("spacing", kc.resample_count, length, spacing, closed)
+    )
+    if closed and n < 3:
+        raise InputError("count", f"dividing a closed curve needs count >= 3, got {n}")
+    ctx.guard(n, "points")
+    s = np.arange(n) * (length / n) if closed else np.linspace(0.0, length, n)
+    t = kc.parameters_at_lengths(speed, edges, cum, s)
+    xyz = np.asarray(curve.evaluate(t))
+    d = np.asarray(curve.derivative(t))
+    norm = np.linalg.norm(d, axis=1)
+    tangent = np.divide(d, norm[:, None], out=np.zeros_like(d), where=norm[:, None] > 0)
+    return Points(xyz, point_data={"tangent": tangent, "t": t})
