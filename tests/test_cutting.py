@@ -389,6 +389,12 @@ def test_divide_by_spacing_rounds_to_divide_the_length():
     )
     np.testing.assert_allclose(pts.point_data["tangent"][1], [1, 0, 0], atol=1e-12)
     np.testing.assert_allclose(pts.point_data["tangent"][3], [0, 1, 0], atol=1e-12)
+    np.testing.assert_allclose(line.evaluate(pts.point_data["t"]), pts.xyz, atol=1e-12)
+    # knots that are not the chord lengths: t still gives the same points back
+    uneven = NurbsCurve(line.control_points, 1, [0, 0, 0.3, 1, 1])
+    again = run("curves.divide", curve=uneven, spacing=2.4)
+    np.testing.assert_allclose(again.xyz, pts.xyz, atol=1e-12)
+    np.testing.assert_allclose(uneven.evaluate(again.point_data["t"]), again.xyz, atol=1e-12)
 
 
 def test_divide_needs_one_of_count_and_spacing():

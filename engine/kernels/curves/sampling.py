@@ -20,7 +20,7 @@ import numpy as np
 
 from ..nurbs import decompose_bezier
 
-__all__ = ["bezier_pieces", "chord_gap", "refine_chords", "sample_nurbs"]
+__all__ = ["bezier_pieces", "chord_gap", "polyline_at_lengths", "refine_chords", "sample_nurbs"]
 
 _GRID = 32  # parameters per piece where |C''| is looked at
 _SAFETY = 1.5  # on the sampled maximum of |C''|
@@ -180,3 +180,47 @@ def sample_nurbs(
     elif closed and len(p) > 1 and np.abs(p[0] - p[-1]).max() <= 1e-12 * max(1.0, np.abs(p).max()):
         p = p[:-1]
     return np.ascontiguousarray(p)
+
+
+def polyline_at_lengths(
+    control_points: np.ndarray, knots: np.ndarray, lengths: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+    """Points, parameters and unit tangents of a degree-1 NURBS at arc lengths, exactly.
+
+    A clamped degree-1 curve runs straight from control point i to i + 1 while its
+    parameter runs linearly over ``[knots[i + 1], knots[i + 2]]``, so the point at a length
+    is found by a binary search in the running chord length and a linear step (a
+    zero-length segment is never the one chosen).
+
+    Parameters
+    ----------
+    control_points : (n, 3) float
+    knots : (n + 2,) float
+    lengths : (m,) float
+        Arc lengths from the start, in ``[0, length]``.
+
+    Returns
+    -------
+    t : (m,) float
+    points : (m, 3) float
+    tangents : (m, 3) float
+        The unit direction of the segment each point lies on.
+    length : float
+        The curve's length.
+    """
+    cp = np.asarray(control_points, dtype=np.float64)
+    seg = np.diff(cp, axis=0)
+    size = np.sqrt(np.einsum("ij,ij->i", seg, seg))
+    cum = np.concatenate([[0.0], np.cumsum(size)])
+    s = np.asarray(lengths, dtype=np.float64)
+    i = np.clip(np.searchsorted(cum, s, side="right") - 1, 0, len(seg) - 1)
+    # past a run of zero-length segments at the very end, step back to a real one
+    real = np.flatnonzero(size > 0)
+    if real.size:
+        i = np.minimum(i, real[-1])
+    f = np.divide(s - cum[i], size[i], out=np.zeros_like(s), where=size[i] > 0)
+    f = np.clip(f, 0.0, 1.0)
+    k = np.asarray(knots, dtype=np.float64)
+    t = k[i + 1] + f * (k[i + 2] - k[i + 1])
+    tangent = np.divide(seg[i], size[i, None], out=np.zeros_like(seg[i]), where=size[i, None] > 0)
+    return t, cp[i] + f[:, None] * seg[i], tangent, float(cum[-1])
