@@ -221,16 +221,25 @@ def _outlines(
     matches = kregions.match_rings(out_rings, sampled)
     # every outline's points in one frozen array, and its knots (the running chord length,
     # ends doubled) in another: each curve's arrays are views, shared rather than copied
-    xyz = frozen_array(np.c_[coords, np.zeros(len(coords))])
-    step = np.r_[0.0, np.hypot(*np.diff(coords, axis=0).T)]
+    m, rings = len(coords), len(offsets) - 1
+    flat = np.zeros((m, 3))
+    flat[:, :2] = coords
+    xyz = frozen_array(flat)
+    dx, dy = coords[1:, 0] - coords[:-1, 0], coords[1:, 1] - coords[:-1, 1]
+    step = np.empty(m)
+    step[0] = 0.0
+    np.sqrt(dx * dx + dy * dy, out=step[1:])
     step[offsets[:-1]] = 0.0  # each ring's length starts from 0
     chord = np.cumsum(step)
     chord -= np.repeat(chord[offsets[:-1]], np.diff(offsets))
-    slot = np.arange(len(coords)) + 2 * np.repeat(np.arange(len(offsets) - 1), np.diff(offsets))
-    knots = np.empty(len(coords) + 2 * (len(offsets) - 1))
-    knots[slot + 1] = chord
-    knots[slot[offsets[:-1]]] = 0.0
-    knots[slot[offsets[1:] - 1] + 2] = chord[offsets[1:] - 1]
+    # ring i's knots sit at [offsets[i] + 2 i, offsets[i + 1] + 2 i + 2): its chords with the
+    # first and last doubled
+    knots = np.empty(m + 2 * rings)
+    shift = 2 * np.repeat(np.arange(rings), np.diff(offsets))
+    knots[np.arange(m) + shift + 1] = chord
+    first = offsets[:-1] + 2 * np.arange(rings)
+    knots[first] = 0.0
+    knots[offsets[1:] + 2 * np.arange(rings) + 1] = chord[offsets[1:] - 1]
     knots = frozen_array(knots)
     result: list[Curve] = []
     for i, match in enumerate(matches):  # one step per outline
