@@ -23,8 +23,8 @@ import numpy as np
 import formgraph as fg
 from formgraph.geometry import Mesh
 from formgraph.kernels.attributes.noise import noise
-from formgraph.kernels.mesh import primitives
 from formgraph.kernels.attributes.random import rand
+from formgraph.kernels.mesh import primitives
 
 
 def run(table) -> None:

@@ -119,9 +119,11 @@ def _parser() -> argparse.ArgumentParser:
         "--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS
     )
 
+    from .serve import add_parser as add_serve
     from .sweep import add_parsers
 
     add_parsers(sub)
+    add_serve(sub)
     return ap
 
 
@@ -170,7 +172,13 @@ def cmd_run(args: argparse.Namespace) -> int:
     from ..evaluation.graph import load
 
     cache_dir = None if args.no_cache else (args.cache_dir or default_cache_dir())
-    g = load(args.graph, out_dir=args.out, cache_dir=cache_dir, budget=args.budget)
+    g = load(
+        args.graph,
+        out_dir=args.out,
+        cache_dir=cache_dir,
+        budget=args.budget,
+        inputs_dir=args.inputs,
+    )
     params = parse_sets(g, args.set)
     progress = _ProgressLine(sys.stderr)
     g.progress = progress
@@ -244,7 +252,7 @@ def cmd_view(args: argparse.Namespace) -> int:
     size = _size_arg(args.size)
     if not args.screenshot:
         _no_window("view", args)
-    g = _graph.load(args.graph, out_dir=args.out, budget=args.budget)
+    g = _graph.load(args.graph, out_dir=args.out, budget=args.budget, inputs_dir=args.inputs)
     params = parse_sets(g, args.set)
     nodes = args.nodes or None
     edges = True if args.edges else None
@@ -288,6 +296,7 @@ def cmd_watch(args: argparse.Namespace) -> int:
     options = dict(
         sets=args.set,
         out_dir=args.out,
+        inputs_dir=args.inputs,
         budget=args.budget,
         size=size,
         layout=args.layout,
@@ -315,7 +324,13 @@ def cmd_graph(args: argparse.Namespace) -> int:
     if output != "-" and Path(output).suffix.lower() not in (".svg", ".png"):
         raise UsageError(f"-o {output}: the drawing is written as .svg or .png")
     cache_dir = None if args.no_cache else (args.cache_dir or default_cache_dir())
-    g = load(args.graph, out_dir=args.out, cache_dir=cache_dir, budget=args.budget)
+    g = load(
+        args.graph,
+        out_dir=args.out,
+        cache_dir=cache_dir,
+        budget=args.budget,
+        inputs_dir=args.inputs,
+    )
     g.set(**parse_sets(g, args.set))  # the param boxes show the values used
     failure: FormgraphError | None = None
     if args.run:
@@ -385,7 +400,14 @@ COMMANDS = {
     "schema": cmd_schema,
     "sweep": lambda args: _sweep_command("cmd_sweep", args),
     "cache": lambda args: _sweep_command("cmd_cache", args),
+    "serve": lambda args: _serve_command(args),
 }
+
+
+def _serve_command(args: argparse.Namespace) -> int:
+    from .serve import cmd_serve
+
+    return cmd_serve(args)
 
 
 def _sweep_command(name: str, args: argparse.Namespace) -> int:

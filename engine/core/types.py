@@ -20,6 +20,7 @@ import numpy as np
 
 from ..geometry import (
     Curve,
+    Field,
     Geometry,
     Mesh,
     NurbsCurve,
@@ -76,6 +77,11 @@ class Expression(str):
 
 class OutputPath(str):
     """A relative output path, checked not to leave the output directory."""
+
+
+class InputPath(str):
+    """A relative path of a file a node reads, checked not to leave the inputs folder; the
+    file's bytes are part of the node's cache key."""
 
 
 def number_text(x: float) -> str:
@@ -142,6 +148,7 @@ GEOMETRY_TYPES: dict[str, type] = {
     "Surface": Surface,
     "NurbsSurface": NurbsSurface,
     "Mesh": Mesh,
+    "Field": Field,
 }
 SCALARS: dict[str, type] = {"int": int, "float": float, "bool": bool, "str": str}
 
@@ -193,6 +200,10 @@ class PortType:
     @functools.cached_property
     def is_output_path(self) -> bool:
         return any(k.base is OutputPath for k in self.kinds)
+
+    @functools.cached_property
+    def is_input_path(self) -> bool:
+        return any(k.base is InputPath for k in self.kinds)
 
     @functools.cached_property
     def is_geometry(self) -> bool:
@@ -378,7 +389,7 @@ def _coerce_kind(k: Kind, value: Any) -> Any:
         if not math.isfinite(f):
             raise TypeMismatch(f"expected a finite float, got {f}")
         return f
-    if base in (str, Expression, OutputPath):
+    if base in (str, Expression, OutputPath, InputPath):
         if isinstance(value, str):
             return value
         raise TypeMismatch(f"expected {base.__name__}, got {describe(value)}")

@@ -11,6 +11,7 @@ are evaluated by the :class:`formgraph.evaluation.items.LanguageRun` mixin.
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import os
 import sys
 import time
@@ -99,6 +100,8 @@ class _Run(LanguageRun, SimulationRun):
         self.total = 0
         self.started: set[str] = set()  # nodes that began computing, for the progress line
         self.quiet = False  # inside run(): numpy's warnings are silenced once, not per node
+        # node -> input path -> (file, bytes): read once when keyed, handed to the node
+        self.input_files: dict[str, dict[str, tuple[Path, bytes]]] = {}
 
     def where(self, name: str, port: str | None = None) -> Where:
         nd = self.g._nodes[name]
@@ -141,6 +144,7 @@ class _Run(LanguageRun, SimulationRun):
                 self.fetch(n)
         for t in targets:
             self.fetch(t)
+        self.input_files.clear()  # the bytes of inputs whose nodes came from a cache
 
     def identity(self, name: str) -> str:
         # identity of the value that flows out of a node: its key, or an earlier identical
@@ -174,8 +178,18 @@ class _Run(LanguageRun, SimulationRun):
                     "params": {n: self.tokens.get(n, self.values[n]) for n in names},
                     "wires": [self.key_part(name, port, spec, w) for w in wires_of(value)],
                 }
+                if port in spec.input_paths:  # a file per item, read when the item runs:
+                    parts["inputs"][port]["unkeyed"] = os.urandom(8).hex()  # never trusted
                 continue
             parts["inputs"][port] = self.key_part(name, port, spec, value)
+            if port in spec.input_paths:
+                if wires_of(value):  # a path known only when its wire runs: never trusted
+                    parts["inputs"][port] = {
+                        "wired": parts["inputs"][port],
+                        "unkeyed": os.urandom(8).hex(),
+                    }
+                else:
+                    parts["inputs"][port] = self.input_file(name, port, parts["inputs"][port])
         if spec.is_export:
             parts["out_dir"] = self.out_dir
         if sim is not None:
@@ -189,6 +203,34 @@ class _Run(LanguageRun, SimulationRun):
         self.item_keys[name] = items
         self.keys[name] = _cache.key_of({"repeat": items})
         return self.keys[name]
+
+    def input_file(self, name: str, port: str, relpath: Any) -> Any:
+        """The key part of an input file: its path and a hash of its bytes (kept for the
+        node, which parses exactly the bytes its key holds)."""
+        if not isinstance(relpath, str):
+            return relpath  # the check or the node says what is wrong with it
+        here = self.where(name, port)
+        try:
+            path = safety.resolve_input(self.g.input_root, relpath, self.g.input_base)
+        except PathError as exc:
+            raise PathError([Problem(here, p.message) for p in exc.problems]) from None
+        try:
+            data = safety.read_input(path)
+        except PathError as exc:
+            raise PathError(
+                [Problem(here, f"cannot read input {relpath!r}: {p.message}") for p in exc.problems]
+            ) from None
+        self.input_files.setdefault(name, {})[relpath] = (path, data)
+        return {"path": relpath, "bytes": hashlib.blake2b(data, digest_size=20).hexdigest()}
+
+    def read_input(self, name: str, relpath: str) -> tuple[Path, bytes]:
+        """What a node's ``ctx.read`` returns: the bytes keyed, else the file read now (a
+        path that came down a wire)."""
+        held = self.input_files.get(name, {}).get(relpath)
+        if held is not None:
+            return held
+        path = safety.resolve_input(self.g.input_root, relpath, self.g.input_base)
+        return path, safety.read_input(path)
 
     def key_part(self, name: str, port: str, spec: NodeSpec, value: Input) -> Any:
         if isinstance(value, Wire):
@@ -380,7 +422,13 @@ class _Run(LanguageRun, SimulationRun):
         """Run the node function (or the subgraph) on ``kwargs``: (value, seconds, warnings)."""
         warnings: list[str] = []
         if spec.wants_context:
-            kwargs["ctx"] = Context(name, self.out_path, self.g.budget, warnings)
+            kwargs["ctx"] = Context(
+                name,
+                self.out_path,
+                self.g.budget,
+                warnings,
+                inputs=lambda relpath: self.read_input(name, relpath),
+            )
         if self.g.progress is not None:  # counted as it goes: linear in the graph's size
             self.g.progress(name, len(self.started) - (name in self.started), self.total)
         self.started.add(name)
@@ -414,6 +462,8 @@ class _Run(LanguageRun, SimulationRun):
             raise NodeError(self.where(name), nd.type, str(exc)) from exc
         except Exception as exc:
             raise NodeError(self.where(name), nd.type, f"{type(exc).__name__}: {exc}") from exc
+        finally:
+            self.input_files.pop(name, None)
         for w in warnings:
             _warn(f"{self.where(name).prefix()}: {w}")
         return value, time.perf_counter() - t0, warnings

@@ -436,6 +436,10 @@ def _check_literal(g: Outline, pt: PortType, value: Any, loop: _Loop | None = No
         why = safety.path_problem(value)
         if why:
             problems.append(why)
+    if not problems and pt.is_input_path and isinstance(value, str):
+        why = safety.path_problem(value, "input path", "the inputs folder")
+        if why:
+            problems.append(why)
     return problems
 
 
