@@ -16,7 +16,7 @@ import numpy as np
 
 from formgraph.core.errors import InputError
 from formgraph.core.registry import Context, Range, node
-from formgraph.core.types import Vec3
+from formgraph.core.types import InputPath, Vec3
 from formgraph.geometry import Curve, NurbsCurve, Points, frozen_array
 from formgraph.kernels import curves as kc
 from formgraph.kernels.curves import regions as kregions
@@ -365,7 +365,17 @@ class Align(str, Enum):
     right = "right"  # ends there
 
 
-def _font(font: str) -> ktext.Font:
+def _font(font: str, font_file: str | None, ctx: Context) -> ktext.Font:
+    """The parsed font: the file the graph names (its bytes key the node), else a bundled
+    one."""
+    if font_file is not None:
+        if not font_file.lower().endswith((".ttf", ".otf")):
+            raise InputError("font_file", f"{font_file!r}: a font file is a .ttf or .otf")
+        _, data = ctx.read(font_file)
+        try:
+            return ktext.load_font(data)
+        except ValueError as exc:
+            raise InputError("font_file", f"{font_file!r}: {exc}") from None
     path = _kernel("font", ktext.bundled_font_path, font)
     try:
         data = path.read_bytes()
@@ -381,6 +391,7 @@ def text(
     font: str = "DejaVu Sans",
     align: Align = Align.left,
     position: Vec3 = (0.0, 0.0, 0.0),
+    font_file: InputPath | None = None,
     *,
     ctx: Context,
 ) -> list[Curve]:
@@ -408,6 +419,11 @@ def text(
         left, center or right: each line starts at, is centred on or ends at ``position``.
     position : Vec3
         Where the first line's baseline meets the alignment point.
+    font_file : InputPath | None
+        A TrueType or OpenType font (``.ttf``, ``.otf``) in the graph's folder (or the
+        inputs folder), e.g. ``fonts/Inter.otf``: used instead of ``font``. Confined as
+        every input path (no absolute path, no ``..``, no symlink out); its bytes are part
+        of the node's key, so editing the font recomputes the text.
 
     Example
     -------
@@ -416,11 +432,12 @@ def text(
     if not size > 0:
         raise InputError("size", f"size must be positive, got {size}")
     ctx.guard(len(text) * 64, "glyph control points")  # a glyph has tens of points
-    f = _font(font)
+    f = _font(font, font_file, ctx)
     degree, pts, offsets, missing = _kernel("text", ktext.layout, f, text, size, align.value)
     if missing:
+        chars = "".join(missing[:20])
         ctx.warn(
-            f"the font {font!r} has no glyph for {''.join(missing[:20])!r}: drawn as its "
+            f"the font {font_file or font!r} has no glyph for {chars!r}: drawn as its "
             "missing-glyph box"
         )
     ctx.guard(len(pts), "glyph control points")
