@@ -143,14 +143,34 @@ def _rings(
     def guard(n: int) -> None:
         ctx.guard(total + n, "curve samples")
 
-    for i, c in enumerate(curves):  # one step per curve; its samples are vectorized
+    # NURBS of degree >= 2 are sampled together, a batch per degree (one vectorized pass)
+    batched: dict[int, np.ndarray] = {}
+    by_degree: dict[int, list[int]] = {}
+    for i, c in enumerate(curves):
         if not _closed(c):
             raise InputError(
                 port,
                 f"curve {i} is open: a region is bounded by closed curves (close it, or "
                 "offset it with offset.marching_squares to get a band around it)",
             )
-        if isinstance(c, NurbsCurve):
+        if isinstance(c, NurbsCurve) and c.degree >= 2:
+            by_degree.setdefault(c.degree, []).append(i)
+    for members in by_degree.values():
+        batch = [
+            (
+                curves[i].control_points,
+                curves[i].degree,
+                curves[i].knots,
+                curves[i].weights if curves[i].rational else None,
+            )
+            for i in members
+        ]
+        sampled_batch = _kernel(port, ksampling.sample_closed_batch, batch, tol, guard)
+        batched.update(zip(members, sampled_batch, strict=True))
+    for i, c in enumerate(curves):  # one step per curve; its samples are vectorized
+        if i in batched:
+            ring = batched[i]
+        elif isinstance(c, NurbsCurve):
             w = np.asarray(c.weights) if c.rational else None
             ring = _kernel(
                 port,
