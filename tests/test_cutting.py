@@ -402,3 +402,20 @@ def test_divide_needs_one_of_count_and_spacing():
         run("curves.divide", curve=circle(1.0))
     with pytest.raises(fg.NodeError, match=r"input 'count'.*count >= 3"):
         run("curves.divide", curve=circle(1.0), count=2)
+
+
+def test_batch_sampling_is_the_sampling_of_each_curve():
+    glyphs = run("curves.text", text="Sg", size=7)
+    rect = run("curves.rectangle", size=[5, 3], radius=1, center=[9, 0])
+    curves = [circle(1.5, -3, 0), rect, *glyphs]
+    for degree in (2,):  # DejaVu's quadratics, the circle's and the rectangle's arcs
+        batch = [
+            (c.control_points, c.degree, c.knots, c.weights if c.rational else None)
+            for c in curves
+            if c.degree == degree
+        ]
+        together = sampling.sample_closed_batch(batch, 1e-4)
+        for args, got in zip(batch, together, strict=True):
+            alone = sampling.sample_nurbs(*args, 1e-4, closed=True)
+            assert got.shape == alone.shape  # the same samples, up to the parameter's rounding
+            np.testing.assert_allclose(got, alone, rtol=0, atol=1e-12)
