@@ -274,6 +274,11 @@ def _outlines(
 
 
 def _tolerance(tolerance: float | None, curves: list[Curve]) -> float:
+    """The sampling tolerance: given (and checked), else 1e-5 of the curves' extent. Polylines
+    are taken at their vertices, so when every curve is one no extent is needed."""
+    polylines = all(isinstance(c, NurbsCurve) and c.degree == 1 for c in curves)
+    if tolerance is None and polylines:
+        return 1.0  # unused: nothing is sampled
     extent = _extent(curves)
     if tolerance is None:
         return _TOLERANCE * (extent if extent > 0 else 1.0)
