@@ -63,8 +63,11 @@ def rectangle(
     -------
     ``plate: {type: curves.rectangle, size: [80, 30], radius: 4}``
     """
-    port = "size" if len(size) != 2 or not all(s > 0 for s in size) else "radius"
-    cp, degree, knots, w = _kernel(port, kshapes.rounded_rectangle, size, center, radius)
+    try:
+        cp, degree, knots, w = kshapes.rounded_rectangle(size, center, radius)
+    except ValueError as exc:
+        port = next((q for q in ("size", "center") if str(exc).startswith(q)), "radius")
+        raise InputError(port, str(exc)) from None
     return NurbsCurve(cp, degree, knots, w)
 
 
@@ -74,6 +77,8 @@ def polygon(
     radius: Annotated[float, Range(min=0)],
     center: Vec3 = (0.0, 0.0, 0.0),
     angle: float = 0.0,
+    *,
+    ctx: Context,
 ) -> NurbsCurve:
     """A regular polygon, closed, counter-clockwise, its corners on a circle of ``radius``.
 
@@ -92,6 +97,7 @@ def polygon(
     -------
     ``hex: {type: curves.polygon, sides: 6, radius: 5}``
     """
+    ctx.guard(sides, "polygon corners")
     port = "sides" if sides < 3 else "radius"
     corners = _kernel(port, kshapes.regular_polygon, sides, radius, center, angle)
     return NurbsCurve.polyline(corners, closed=True)

@@ -81,3 +81,17 @@ def test_degenerate_regions():
     g.add("x", "curves.boolean", a=[c, c], b=[])
     with pytest.warns(fg.FormgraphWarning, match="no area"):
         assert g.evaluate("x") == []
+
+
+def test_a_billion_sided_polygon_is_refused_before_it_is_built():
+    g = fg.Graph(budget=1_000_000)
+    g.add("p", "curves.polygon", sides=10**9, radius=1)
+    with pytest.raises(fg.BudgetError, match="polygon corners"):
+        g.evaluate("p")
+
+
+def test_a_rectangle_too_large_for_doubles_is_a_located_error():
+    g = fg.Graph()
+    g.add("r", "curves.rectangle", size=[1e308, 1e308], radius=1e307)
+    with pytest.raises(fg.NodeError, match=r"input 'size'.*too large"):
+        g.evaluate("r")
