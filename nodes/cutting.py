@@ -152,6 +152,7 @@ def _rings(
     # NURBS of degree >= 2 are sampled together, a batch per degree (one vectorized pass)
     batched: dict[int, np.ndarray] = {}
     by_degree: dict[int, list[int]] = {}
+    tilted: list[int] = []
     for i, c in enumerate(curves):
         if not _closed(c):
             raise InputError(
@@ -161,6 +162,15 @@ def _rings(
             )
         if isinstance(c, NurbsCurve) and c.degree >= 2:
             by_degree.setdefault(c.degree, []).append(i)
+        z = np.asarray(c.control_points)[:, 2] if isinstance(c, NurbsCurve) else c.sample(65)[:, 2]
+        if z.max() - z.min() > 1e-9 * max(1.0, float(np.abs(z).max())):
+            tilted.append(i)
+    if tilted:
+        shown = ", ".join(str(i) for i in tilted[:10]) + (", ..." if len(tilted) > 10 else "")
+        ctx.warn(
+            f"{port}: curve(s) {shown} are not parallel to the XY plane: their projection "
+            "onto it (z dropped) bounds the region"
+        )
     for members in by_degree.values():
         batch = [
             (

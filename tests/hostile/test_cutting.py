@@ -95,3 +95,12 @@ def test_a_rectangle_too_large_for_doubles_is_a_located_error():
     g.add("r", "curves.rectangle", size=[1e308, 1e308], radius=1e307)
     with pytest.raises(fg.NodeError, match=r"input 'size'.*too large"):
         g.evaluate("r")
+
+
+def test_curves_out_of_the_xy_plane_are_projected_with_a_warning():
+    tilted = NurbsCurve.polyline([[0, 0, 0], [1, 0, 1], [1, 1, 2], [0, 1, 1]], closed=True)
+    g = fg.Graph()
+    g.add("u", "curves.union", curves=[tilted])
+    with pytest.warns(fg.FormgraphWarning, match=r"curves: curve\(s\) 0 are not parallel"):
+        (loop,) = g.evaluate("u")
+    assert np.allclose(np.asarray(loop.control_points)[:, 2], 0)
