@@ -277,3 +277,15 @@ def test_a_font_file_must_be_a_font(tmp_path):
         g.evaluate("a")
     with pytest.raises(fg.NodeError, match=r"input 'font_file'.*a \.ttf or \.otf"):
         g.evaluate("b")
+
+
+@pytest.mark.parametrize("name", ["DejaVu Sans", "DejaVu Serif"])
+def test_gpos_kerning_agrees_with_the_legacy_kern_table_on_every_pair(name):
+    path = ktext.bundled_font_path(name)
+    tt = TTFont(path)
+    legacy = {k: v for t in tt["kern"].kernTables for k, v in t.kernTable.items()}
+    assert len(legacy) > 100
+    font = ktext.load_font(path.read_bytes())
+    pairs = list(legacy)
+    ours = font.kerning([p[0] for p in pairs], [p[1] for p in pairs])
+    np.testing.assert_array_equal(ours, [legacy[p] for p in pairs])
