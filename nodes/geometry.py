@@ -179,11 +179,24 @@ def _per_point(points: Points, **inputs: Any) -> dict[str, Any]:
     env = None
     for port, value in inputs.items():
         if isinstance(value, ElementValue):
-            env = element_env(points) if env is None else env
+            env = element_env(points, "point", value.names) if env is None else env
             try:
                 out[port] = value.evaluate(env, len(points), "points")
             except ValueError as exc:
                 raise InputError(port, str(exc)) from None
+            a = out[port]
+            vector = a.ndim == 2 and a.shape[1] == 3
+            if not vector and (port != "scale" or a.ndim != 1):
+                want = "[x, y, z]" if port == "align" else "[rx, ry, rz]"
+                example = '"=normal"' if port == "align" else '[0, 0, "=360 * rand(i)"]'
+                if port == "scale":
+                    want, example = "one factor or [sx, sy, sz]", '"=0.5 + rand(i)"'
+                got = a.shape[1] if a.ndim == 2 else 1
+                raise InputError(
+                    port,
+                    f"{value.text} gives {got} number(s) per point; {port} needs {want} per "
+                    f"point, e.g. {example}",
+                )
     return out
 
 

@@ -68,7 +68,7 @@ def controls_of(graph: Graph, values: dict[str, Any]) -> list[Control]:
     type) a list of its options; anything else (a vector, a list, a string) a text field
     holding its YAML.
     """
-    from formgraph.language.check import param_kind
+    from formgraph.language.params import param_kind
 
     out = []
     current = {**graph.params, **values}
@@ -233,7 +233,7 @@ class StudioSession:
 
     def _kept_values(self, graph: Graph) -> dict[str, Any]:
         from formgraph.core.types import TypeMismatch
-        from formgraph.language.check import check_param_value
+        from formgraph.language.params import check_param_value
 
         kept = {}
         for name, value in self.values.items():
