@@ -143,7 +143,7 @@ class Watcher(_Watched):
         Returns True when the new version is drawn; False when it is broken, in which case
         its error is shown in the window and on stderr and the last good geometry stays.
         """
-        from formgraph.cli.main import UsageError
+        from formgraph.core.errors import UsageError
 
         self.stamp = self._stamp()
         self.reloads += 1
@@ -215,7 +215,7 @@ def watch(
     """
     for item in sets:
         if "=" not in item:
-            from formgraph.cli.main import UsageError
+            from formgraph.core.errors import UsageError
 
             raise UsageError(f"--set takes NAME=VALUE, got {item!r}")
     from .entry import make_plotter, view_count
@@ -330,7 +330,7 @@ class ScreenshotWatcher(_Watched):
 
     def reload(self) -> bool:
         """Load, evaluate and render the file once; True when a new PNG was written."""
-        from formgraph.cli.main import UsageError
+        from formgraph.core.errors import UsageError
 
         from .entry import make_plotter
 

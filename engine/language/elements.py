@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from .expr import Bound
+from .bound import Bound
 from .model import Expr, Input, Items, Literal
 
 __all__ = ["VARIABLES", "ElementValue", "bind_elements", "element_env", "reads_elements"]
@@ -54,7 +54,7 @@ class ElementValue:
     Attributes
     ----------
     parts : tuple
-        :class:`~formgraph.language.expr.Bound` expressions and plain numbers.
+        :class:`~formgraph.language.bound.Bound` expressions and plain numbers.
     vector : bool
         Whether it was written as a list (``[0, 0, "=360 * rand(i)"]``).
     """
