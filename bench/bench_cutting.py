@@ -8,6 +8,9 @@ Cases:
   curves built from it — against shapely's ``union`` of the two ``Polygon``s of the same
   vertices (GEOS alone, nothing checked or oriented);
 * ``curves.boolean`` difference of the same pair;
+* ``curves.divide`` of a 10,000-vertex open polyline into 100,000 points at equal arc
+  length (with tangents and parameters) against shapely's ``line_interpolate_point`` at the
+  same distances, and of a cubic NURBS of 100 control points into 10,000 points;
 * ``curves.text`` of 1,000 characters (an English pangram repeated) at 10 mm: glyph
   outlines as exact NURBS, laid out with kerning, one curve per contour — against
   matplotlib's ``TextPath`` of the same text and font (which gives one path of Bezier
@@ -64,6 +67,29 @@ def run(table) -> None:  # noqa: ANN001 - the harness's Table
         table.time(case, "shapely (overlay only)", lambda: shapely.union(pa, pb), repeat=3)
     except ImportError:
         table.add(case, "shapely", None, "not installed (shapely)")
+
+    line = NurbsCurve.polyline(wiggly(N, 0.0))  # open: the loop without its closing edge
+    case = f"divide a {N:,}-vertex polyline into 100,000 points"
+    table.time(case, "formgraph", lambda: cutting.divide(line, count=100_000, ctx=ctx), repeat=3)
+    try:
+        import shapely
+
+        ls = shapely.LineString(wiggly(N, 0.0))
+        at = np.linspace(0.0, ls.length, 100_000)
+        table.time(case, "shapely", lambda: shapely.line_interpolate_point(ls, at), repeat=3)
+    except ImportError:
+        table.add(case, "shapely", None, "not installed (shapely)")
+    rng = np.random.default_rng(1)
+    cp = np.c_[np.cumsum(rng.normal(size=(100, 2)), axis=0), np.zeros(100)]
+    from formgraph.kernels import nurbs
+
+    cubic = NurbsCurve(cp, 3, nurbs.clamped_uniform_knots(100, 3))
+    table.time(
+        "divide a 100-point cubic NURBS into 10,000 points",
+        "formgraph",
+        lambda: cutting.divide(cubic, count=10_000, ctx=ctx),
+        repeat=3,
+    )
 
     text = (PANGRAM * 23)[:1000]
     case = "text of 1,000 characters"

@@ -16,8 +16,9 @@ import numpy as np
 
 from formgraph.core.errors import InputError
 from formgraph.core.registry import Context, Range, node
-from formgraph.core.types import Vec3
-from formgraph.geometry import Curve, NurbsCurve, frozen_array
+from formgraph.core.types import InputPath, Vec3
+from formgraph.geometry import Curve, NurbsCurve, Points, frozen_array
+from formgraph.kernels import curves as kc
 from formgraph.kernels.curves import regions as kregions
 from formgraph.kernels.curves import sampling as ksampling
 from formgraph.kernels.curves import shapes as kshapes
@@ -62,8 +63,11 @@ def rectangle(
     -------
     ``plate: {type: curves.rectangle, size: [80, 30], radius: 4}``
     """
-    port = "size" if len(size) != 2 or not all(s > 0 for s in size) else "radius"
-    cp, degree, knots, w = _kernel(port, kshapes.rounded_rectangle, size, center, radius)
+    try:
+        cp, degree, knots, w = kshapes.rounded_rectangle(size, center, radius)
+    except ValueError as exc:
+        port = next((q for q in ("size", "center") if str(exc).startswith(q)), "radius")
+        raise InputError(port, str(exc)) from None
     return NurbsCurve(cp, degree, knots, w)
 
 
@@ -73,6 +77,8 @@ def polygon(
     radius: Annotated[float, Range(min=0)],
     center: Vec3 = (0.0, 0.0, 0.0),
     angle: float = 0.0,
+    *,
+    ctx: Context,
 ) -> NurbsCurve:
     """A regular polygon, closed, counter-clockwise, its corners on a circle of ``radius``.
 
@@ -91,6 +97,7 @@ def polygon(
     -------
     ``hex: {type: curves.polygon, sides: 6, radius: 5}``
     """
+    ctx.guard(sides, "polygon corners")
     port = "sides" if sides < 3 else "radius"
     corners = _kernel(port, kshapes.regular_polygon, sides, radius, center, angle)
     return NurbsCurve.polyline(corners, closed=True)
@@ -142,14 +149,44 @@ def _rings(
     def guard(n: int) -> None:
         ctx.guard(total + n, "curve samples")
 
-    for i, c in enumerate(curves):  # one step per curve; its samples are vectorized
+    # NURBS of degree >= 2 are sampled together, a batch per degree (one vectorized pass)
+    batched: dict[int, np.ndarray] = {}
+    by_degree: dict[int, list[int]] = {}
+    tilted: list[int] = []
+    for i, c in enumerate(curves):
         if not _closed(c):
             raise InputError(
                 port,
                 f"curve {i} is open: a region is bounded by closed curves (close it, or "
                 "offset it with offset.marching_squares to get a band around it)",
             )
-        if isinstance(c, NurbsCurve):
+        if isinstance(c, NurbsCurve) and c.degree >= 2:
+            by_degree.setdefault(c.degree, []).append(i)
+        z = np.asarray(c.control_points)[:, 2] if isinstance(c, NurbsCurve) else c.sample(65)[:, 2]
+        if z.max() - z.min() > 1e-9 * max(1.0, float(np.abs(z).max())):
+            tilted.append(i)
+    if tilted:
+        shown = ", ".join(str(i) for i in tilted[:10]) + (", ..." if len(tilted) > 10 else "")
+        ctx.warn(
+            f"{port}: curve(s) {shown} are not parallel to the XY plane: their projection "
+            "onto it (z dropped) bounds the region"
+        )
+    for members in by_degree.values():
+        batch = [
+            (
+                curves[i].control_points,
+                curves[i].degree,
+                curves[i].knots,
+                curves[i].weights if curves[i].rational else None,
+            )
+            for i in members
+        ]
+        sampled_batch = _kernel(port, ksampling.sample_closed_batch, batch, tol, guard)
+        batched.update(zip(members, sampled_batch, strict=True))
+    for i, c in enumerate(curves):  # one step per curve; its samples are vectorized
+        if i in batched:
+            ring = batched[i]
+        elif isinstance(c, NurbsCurve):
             w = np.asarray(c.weights) if c.rational else None
             ring = _kernel(
                 port,
@@ -220,16 +257,25 @@ def _outlines(
     matches = kregions.match_rings(out_rings, sampled)
     # every outline's points in one frozen array, and its knots (the running chord length,
     # ends doubled) in another: each curve's arrays are views, shared rather than copied
-    xyz = frozen_array(np.c_[coords, np.zeros(len(coords))])
-    step = np.r_[0.0, np.hypot(*np.diff(coords, axis=0).T)]
+    m, rings = len(coords), len(offsets) - 1
+    flat = np.zeros((m, 3))
+    flat[:, :2] = coords
+    xyz = frozen_array(flat)
+    dx, dy = coords[1:, 0] - coords[:-1, 0], coords[1:, 1] - coords[:-1, 1]
+    step = np.empty(m)
+    step[0] = 0.0
+    np.sqrt(dx * dx + dy * dy, out=step[1:])
     step[offsets[:-1]] = 0.0  # each ring's length starts from 0
     chord = np.cumsum(step)
     chord -= np.repeat(chord[offsets[:-1]], np.diff(offsets))
-    slot = np.arange(len(coords)) + 2 * np.repeat(np.arange(len(offsets) - 1), np.diff(offsets))
-    knots = np.empty(len(coords) + 2 * (len(offsets) - 1))
-    knots[slot + 1] = chord
-    knots[slot[offsets[:-1]]] = 0.0
-    knots[slot[offsets[1:] - 1] + 2] = chord[offsets[1:] - 1]
+    # ring i's knots sit at [offsets[i] + 2 i, offsets[i + 1] + 2 i + 2): its chords with the
+    # first and last doubled
+    knots = np.empty(m + 2 * rings)
+    shift = 2 * np.repeat(np.arange(rings), np.diff(offsets))
+    knots[np.arange(m) + shift + 1] = chord
+    first = offsets[:-1] + 2 * np.arange(rings)
+    knots[first] = 0.0
+    knots[offsets[1:] + 2 * np.arange(rings) + 1] = chord[offsets[1:] - 1]
     knots = frozen_array(knots)
     result: list[Curve] = []
     for i, match in enumerate(matches):  # one step per outline
@@ -244,6 +290,11 @@ def _outlines(
 
 
 def _tolerance(tolerance: float | None, curves: list[Curve]) -> float:
+    """The sampling tolerance: given (and checked), else 1e-5 of the curves' extent. Polylines
+    are taken at their vertices, so when every curve is one no extent is needed."""
+    polylines = all(isinstance(c, NurbsCurve) and c.degree == 1 for c in curves)
+    if tolerance is None and polylines:
+        return 1.0  # unused: nothing is sampled
     extent = _extent(curves)
     if tolerance is None:
         return _TOLERANCE * (extent if extent > 0 else 1.0)
@@ -355,7 +406,17 @@ class Align(str, Enum):
     right = "right"  # ends there
 
 
-def _font(font: str) -> ktext.Font:
+def _font(font: str, font_file: str | None, ctx: Context) -> ktext.Font:
+    """The parsed font: the file the graph names (its bytes key the node), else a bundled
+    one."""
+    if font_file is not None:
+        if not font_file.lower().endswith((".ttf", ".otf")):
+            raise InputError("font_file", f"{font_file!r}: a font file is a .ttf or .otf")
+        _, data = ctx.read(font_file)
+        try:
+            return ktext.load_font(data)
+        except ValueError as exc:
+            raise InputError("font_file", f"{font_file!r}: {exc}") from None
     path = _kernel("font", ktext.bundled_font_path, font)
     try:
         data = path.read_bytes()
@@ -371,6 +432,7 @@ def text(
     font: str = "DejaVu Sans",
     align: Align = Align.left,
     position: Vec3 = (0.0, 0.0, 0.0),
+    font_file: InputPath | None = None,
     *,
     ctx: Context,
 ) -> list[Curve]:
@@ -398,6 +460,11 @@ def text(
         left, center or right: each line starts at, is centred on or ends at ``position``.
     position : Vec3
         Where the first line's baseline meets the alignment point.
+    font_file : InputPath | None
+        A TrueType or OpenType font (``.ttf``, ``.otf``) in the graph's folder (or the
+        inputs folder), e.g. ``fonts/Inter.otf``: used instead of ``font``. Confined as
+        every input path (no absolute path, no ``..``, no symlink out); its bytes are part
+        of the node's key, so editing the font recomputes the text.
 
     Example
     -------
@@ -406,11 +473,12 @@ def text(
     if not size > 0:
         raise InputError("size", f"size must be positive, got {size}")
     ctx.guard(len(text) * 64, "glyph control points")  # a glyph has tens of points
-    f = _font(font)
+    f = _font(font, font_file, ctx)
     degree, pts, offsets, missing = _kernel("text", ktext.layout, f, text, size, align.value)
     if missing:
+        chars = "".join(missing[:20])
         ctx.warn(
-            f"the font {font!r} has no glyph for {''.join(missing[:20])!r}: drawn as its "
+            f"the font {font_file or font!r} has no glyph for {chars!r}: drawn as its "
             "missing-glyph box"
         )
     ctx.guard(len(pts), "glyph control points")
@@ -428,3 +496,83 @@ def text(
             knots[pieces] = frozen_array(np.concatenate([ends[0], inner, ends[1]]))
         out.append(NurbsCurve(cp, degree, knots[pieces]))
     return out
+
+
+@node("curves.divide", version=1)
+def divide(
+    curve: Curve,
+    count: Annotated[int | None, Range(min=2)] = None,
+    spacing: Annotated[float | None, Range(min=0)] = None,
+    *,
+    ctx: Context,
+) -> Points:
+    """Points on a curve at equal arc length, with ``tangent`` and ``t`` point attributes.
+
+    Give ``count`` or ``spacing``. The arc length is integrated by Gauss-Legendre
+    quadrature on every knot span and inverted by safeguarded Newton steps, so the points
+    lie exactly on the curve (a polyline: along its straight segments); an open curve gets
+    both ends, a closed one its start and no repeat of it. ``tangent`` is the unit tangent
+    (the direction of travel) and ``t`` the curve parameter of each point: copy parts onto
+    the points aligned to the curve, or drive expressions by position along it.
+
+    Parameters
+    ----------
+    curve : Curve
+        Any curve.
+    count : int
+        Number of points (open: both ends included; closed: >= 3).
+    spacing : float
+        Distance along the curve between points; rounded so it divides the length evenly.
+
+    Example
+    -------
+    ``studs: {type: curves.divide, curve: "@rim", spacing: 5}``
+    """
+    if (count is None) == (spacing is None):
+        raise InputError("count", "give exactly one of count and spacing")
+    closed = _closed(curve)
+    k0, k1 = np.asarray(curve.knots)[[0, 1]] if isinstance(curve, NurbsCurve) else (0, 1)
+    if isinstance(curve, NurbsCurve) and curve.degree == 1 and k0 == k1:  # clamped polyline
+        cp = np.asarray(curve.control_points)
+        length = float(np.sum(np.linalg.norm(np.diff(cp, axis=0), axis=1)))
+        n = _divisions(length, count, spacing, closed, ctx)
+        s = np.arange(n) * (length / n) if closed else np.linspace(0.0, length, n)
+        t, xyz, tangent, _ = ksampling.polyline_at_lengths(cp, curve.knots, s)
+        return Points(xyz, point_data={"tangent": tangent, "t": t})
+    if isinstance(curve, NurbsCurve):
+        k = np.asarray(curve.knots)
+        breaks = np.unique(k[curve.degree : len(curve.control_points) + 1])
+        pieces = 1 if curve.degree == 1 else 16
+    else:
+        breaks, pieces = np.array(curve.domain), max(64, getattr(curve, "samples", 256))
+
+    def speed(tt: np.ndarray) -> np.ndarray:
+        return np.linalg.norm(curve.derivative(tt), axis=-1)
+
+    edges, cum = kc.arc_length_table(speed, breaks, pieces)
+    length = float(cum[-1])
+    n = _divisions(length, count, spacing, closed, ctx)
+    s = np.arange(n) * (length / n) if closed else np.linspace(0.0, length, n)
+    t = kc.parameters_at_lengths(speed, edges, cum, s)
+    xyz = np.asarray(curve.evaluate(t))
+    d = np.asarray(curve.derivative(t))
+    norm = np.linalg.norm(d, axis=1)
+    tangent = np.divide(d, norm[:, None], out=np.zeros_like(d), where=norm[:, None] > 0)
+    return Points(xyz, point_data={"tangent": tangent, "t": t})
+
+
+def _divisions(
+    length: float, count: int | None, spacing: float | None, closed: bool, ctx: Context
+) -> int:
+    """How many points divide a curve of ``length``: ``count``, or from ``spacing``."""
+    if not length > 0.0:
+        raise InputError("curve", "cannot divide a curve of zero length")
+    n = (
+        count
+        if count is not None
+        else _kernel("spacing", kc.resample_count, length, spacing, closed)
+    )
+    if closed and n < 3:
+        raise InputError("count", f"dividing a closed curve needs count >= 3, got {n}")
+    ctx.guard(n, "points")
+    return int(n)

@@ -345,3 +345,77 @@ def test_even_odd_regions_match_a_crossing_count(rings):
     polys = [shapely.Polygon(r) for r in rings]  # regular polygons: each valid alone
     xor = regions._xor_tree(np.array(polys, dtype=object))
     assert region.symmetric_difference(xor).area <= 1e-9 * max(xor.area, 1.0)
+
+
+# --------------------------------------------------------------------------- divide
+
+
+def test_divide_a_circle_into_equal_arcs_with_tangents_and_parameters():
+    c = circle(2.0, 1.0, -1.0)
+    pts = run("curves.divide", curve=c, count=8)
+    assert isinstance(pts, fg.Points) and len(pts) == 8
+    xy = pts.xyz[:, :2] - [1.0, -1.0]
+    np.testing.assert_allclose(np.linalg.norm(xy, axis=1), 2.0, atol=1e-12)
+    chords = np.linalg.norm(np.roll(xy, -1, axis=0) - xy, axis=1)
+    np.testing.assert_allclose(chords, 4 * math.sin(math.pi / 8), rtol=1e-9)
+    tangent = pts.point_data["tangent"]
+    np.testing.assert_allclose(np.linalg.norm(tangent, axis=1), 1.0, atol=1e-12)
+    # counter-clockwise: the tangent is the radius turned a quarter to the left
+    np.testing.assert_allclose(tangent[:, :2], np.c_[-xy[:, 1], xy[:, 0]] / 2, atol=1e-9)
+    t = pts.point_data["t"]
+    assert np.all(np.diff(t) > 0) and t[0] == pytest.approx(c.domain[0])
+    np.testing.assert_allclose(c.evaluate(t), pts.xyz, atol=1e-12)
+
+
+def test_divide_an_open_cubic_at_equal_arc_length():
+    rng = np.random.default_rng(5)
+    cp = np.c_[rng.normal(size=(6, 2)) * 3, np.zeros(6)]
+    c = NurbsCurve(cp, 3, nurbs.clamped_uniform_knots(6, 3))
+    pts = run("curves.divide", curve=c, count=11)
+    t = pts.point_data["t"]
+    dense = np.linspace(*c.domain, 200001)
+    p = c.evaluate(dense)
+    cum = np.concatenate([[0], np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))])
+    s = np.interp(t, dense, cum)
+    np.testing.assert_allclose(np.diff(s), cum[-1] / 10, rtol=1e-6)
+    np.testing.assert_allclose(pts.xyz[[0, -1]], cp[[0, -1]], atol=1e-12)
+
+
+def test_divide_by_spacing_rounds_to_divide_the_length():
+    line = NurbsCurve.polyline([[0, 0], [6, 0], [6, 4]])
+    pts = run("curves.divide", curve=line, spacing=2.4)  # 10 / 2.4 -> 4 pieces of 2.5
+    np.testing.assert_allclose(
+        pts.xyz[:, :2], [[0, 0], [2.5, 0], [5, 0], [6, 1.5], [6, 4]], atol=1e-12
+    )
+    np.testing.assert_allclose(pts.point_data["tangent"][1], [1, 0, 0], atol=1e-12)
+    np.testing.assert_allclose(pts.point_data["tangent"][3], [0, 1, 0], atol=1e-12)
+    np.testing.assert_allclose(line.evaluate(pts.point_data["t"]), pts.xyz, atol=1e-12)
+    # knots that are not the chord lengths: t still gives the same points back
+    uneven = NurbsCurve(line.control_points, 1, [0, 0, 0.3, 1, 1])
+    again = run("curves.divide", curve=uneven, spacing=2.4)
+    np.testing.assert_allclose(again.xyz, pts.xyz, atol=1e-12)
+    np.testing.assert_allclose(uneven.evaluate(again.point_data["t"]), again.xyz, atol=1e-12)
+
+
+def test_divide_needs_one_of_count_and_spacing():
+    with pytest.raises(fg.NodeError, match=r"input 'count'.*exactly one"):
+        run("curves.divide", curve=circle(1.0))
+    with pytest.raises(fg.NodeError, match=r"input 'count'.*count >= 3"):
+        run("curves.divide", curve=circle(1.0), count=2)
+
+
+def test_batch_sampling_is_the_sampling_of_each_curve():
+    glyphs = run("curves.text", text="Sg", size=7)
+    rect = run("curves.rectangle", size=[5, 3], radius=1, center=[9, 0])
+    curves = [circle(1.5, -3, 0), rect, *glyphs]
+    for degree in (2,):  # DejaVu's quadratics, the circle's and the rectangle's arcs
+        batch = [
+            (c.control_points, c.degree, c.knots, c.weights if c.rational else None)
+            for c in curves
+            if c.degree == degree
+        ]
+        together = sampling.sample_closed_batch(batch, 1e-4)
+        for args, got in zip(batch, together, strict=True):
+            alone = sampling.sample_nurbs(*args, 1e-4, closed=True)
+            assert got.shape == alone.shape  # the same samples, up to the parameter's rounding
+            np.testing.assert_allclose(got, alone, rtol=0, atol=1e-12)

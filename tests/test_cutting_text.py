@@ -228,3 +228,64 @@ def test_cff_outlines_are_exact_cubics_with_a_clockwise_hole():
     )
     assert curve.closed
     np.testing.assert_allclose(curve.evaluate(1.5)[:2], [575, 350])
+
+
+def test_a_font_file_in_the_graphs_folder_is_read_confined_and_keyed(tmp_path):
+    import shutil
+
+    (tmp_path / "fonts").mkdir()
+    shutil.copy(ktext.bundled_font_path("DejaVu Sans Bold"), tmp_path / "fonts" / "f.ttf")
+    (tmp_path / "g.yaml").write_text(
+        "formgraph: 1\n"
+        "nodes:\n"
+        "  bold: {type: curves.text, text: 'Wide', size: 10, font_file: fonts/f.ttf}\n"
+        "  plain: {type: curves.text, text: 'Wide', size: 10}\n"
+    )
+    g = fg.load(tmp_path / "g.yaml", out_dir=tmp_path / "out")
+
+    def width(curves):
+        x = np.concatenate([np.asarray(c.control_points)[:, 0] for c in curves])
+        return x.max() - x.min()
+
+    bold, plain = g.evaluate("bold"), g.evaluate("plain")
+    assert width(bold) > width(plain) * 1.05  # DejaVu Sans Bold is wider
+    # the file's bytes key the node: another font under the same name recomputes it
+    (tmp_path / "fonts" / "f.ttf").write_bytes(cff_font())
+    g2 = fg.load(tmp_path / "g.yaml", out_dir=tmp_path / "out")
+    assert g2.evaluate("bold") != bold
+    cubic = g2.evaluate("bold")
+    assert all(c.degree == 3 for c in cubic)  # the CFF font's cubics (its .notdef for "Wide")
+    # a path out of the graph's folder is refused when the graph is loaded
+    (tmp_path / "out.yaml").write_text(
+        "formgraph: 1\nnodes:\n  t: {type: curves.text, text: a, font_file: ../f.ttf}\n"
+    )
+    with pytest.raises(fg.GraphError, match=r"input 'font_file'.*leaves the inputs folder"):
+        fg.load(tmp_path / "out.yaml")
+
+
+def test_a_font_file_must_be_a_font(tmp_path):
+    (tmp_path / "bad.ttf").write_bytes(b"not a font")
+    (tmp_path / "notes.txt").write_text("x")
+    (tmp_path / "g.yaml").write_text(
+        "formgraph: 1\n"
+        "nodes:\n"
+        "  a: {type: curves.text, text: 'a', font_file: bad.ttf}\n"
+        "  b: {type: curves.text, text: 'a', font_file: notes.txt}\n"
+    )
+    g = fg.load(tmp_path / "g.yaml")
+    with pytest.raises(fg.NodeError, match=r"input 'font_file'.*'bad.ttf': cannot read the font"):
+        g.evaluate("a")
+    with pytest.raises(fg.NodeError, match=r"input 'font_file'.*a \.ttf or \.otf"):
+        g.evaluate("b")
+
+
+@pytest.mark.parametrize("name", ["DejaVu Sans", "DejaVu Serif"])
+def test_gpos_kerning_agrees_with_the_legacy_kern_table_on_every_pair(name):
+    path = ktext.bundled_font_path(name)
+    tt = TTFont(path)
+    legacy = {k: v for t in tt["kern"].kernTables for k, v in t.kernTable.items()}
+    assert len(legacy) > 100
+    font = ktext.load_font(path.read_bytes())
+    pairs = list(legacy)
+    ours = font.kerning([p[0] for p in pairs], [p[1] for p in pairs])
+    np.testing.assert_array_equal(ours, [legacy[p] for p in pairs])

@@ -172,3 +172,36 @@ def test_entries_survive_coercion_and_default_to_one_per_item():
     assert entries_of([c, c]) == [0, 1]
     with pytest.raises(ValueError, match="2 items but 1 entry"):
         Entries([c, c], [0])
+
+
+@pytest.mark.parametrize("kind, suffix", [("export.svg", "svg"), ("export.dxf", "dxf")])
+def test_layers_read_back_with_read_curves(tmp_path, kind, suffix):
+    g = fg.Graph(out_dir=tmp_path)
+    g.add("outer", "curves.rectangle", size=[40, 20], radius=3)
+    g.add("inner", "curves.rectangle", size=[30, 10], radius=1)
+    g.add("frame", "curves.boolean", a=["@outer"], b=["@inner"], operation="difference")
+    g.add("hole", "nurbs.circle", radius=2, center=[25, 0, 0])
+    g.add("mark", "nurbs.circle", radius=1, center=[0, 0, 0])
+    g.add(
+        "out", kind, curves=["@frame", "@hole", "@mark"], path=f"d.{suffix}",
+        layers=["cut", "engrave"], colors=["red", "blue"],
+    )  # fmt: skip
+    g.evaluate("out")
+    r = fg.Graph(out_dir=tmp_path, inputs_dir=tmp_path)
+    r.add("cut", "read.curves", path=f"d.{suffix}", layers=["cut"])
+    r.add("engrave", "read.curves", path=f"d.{suffix}", layers=["engrave"])
+    cut, engrave = r.evaluate("cut"), r.evaluate("engrave")
+    assert len(cut) == 2 and len(engrave) == 2  # the frame's two loops; the hole and mark
+
+    def area(curves):
+        total = 0.0
+        for c in curves:
+            p = np.asarray(c.evaluate(np.linspace(*c.domain, 4001)))[:-1, :2]
+            x, y = p[:, 0], p[:, 1]
+            total += abs(0.5 * (np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))
+        return total
+
+    assert area(engrave) == pytest.approx(np.pi * (4 + 1), rel=1e-5)
+    outer = 40 * 20 - (4 - np.pi) * 9
+    inner = 30 * 10 - (4 - np.pi) * 1
+    assert area(cut) == pytest.approx(outer + inner, rel=1e-5)

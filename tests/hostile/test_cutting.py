@@ -81,3 +81,26 @@ def test_degenerate_regions():
     g.add("x", "curves.boolean", a=[c, c], b=[])
     with pytest.warns(fg.FormgraphWarning, match="no area"):
         assert g.evaluate("x") == []
+
+
+def test_a_billion_sided_polygon_is_refused_before_it_is_built():
+    g = fg.Graph(budget=1_000_000)
+    g.add("p", "curves.polygon", sides=10**9, radius=1)
+    with pytest.raises(fg.BudgetError, match="polygon corners"):
+        g.evaluate("p")
+
+
+def test_a_rectangle_too_large_for_doubles_is_a_located_error():
+    g = fg.Graph()
+    g.add("r", "curves.rectangle", size=[1e308, 1e308], radius=1e307)
+    with pytest.raises(fg.NodeError, match=r"input 'size'.*too large"):
+        g.evaluate("r")
+
+
+def test_curves_out_of_the_xy_plane_are_projected_with_a_warning():
+    tilted = NurbsCurve.polyline([[0, 0, 0], [1, 0, 1], [1, 1, 2], [0, 1, 1]], closed=True)
+    g = fg.Graph()
+    g.add("u", "curves.union", curves=[tilted])
+    with pytest.warns(fg.FormgraphWarning, match=r"curves: curve\(s\) 0 are not parallel"):
+        (loop,) = g.evaluate("u")
+    assert np.allclose(np.asarray(loop.control_points)[:, 2], 0)

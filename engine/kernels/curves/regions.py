@@ -184,13 +184,19 @@ def match_rings(
         for i in keys.get(_key(ring), []) if keys else []:
             g = given[i]
             assert g is not None
-            if np.array_equal(np.unique(g, axis=0), np.unique(ring, axis=0)):
+            if np.array_equal(_sorted_points(g), _sorted_points(ring)):
                 match = (i, _ccw(g) == _ccw(ring))
                 break
         found.append(match)
     return found
 
 
+def _sorted_points(ring: np.ndarray) -> np.ndarray:
+    """The ring's points in lexicographic order (the same for any start and direction)."""
+    return ring[np.lexsort((ring[:, 1], ring[:, 0]))]
+
+
 def _ccw(ring: np.ndarray) -> bool:
     x, y = ring[:, 0], ring[:, 1]
-    return bool(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)) > 0)
+    twice = np.dot(x[:-1], y[1:]) - np.dot(y[:-1], x[1:]) + x[-1] * y[0] - y[-1] * x[0]
+    return bool(twice > 0)

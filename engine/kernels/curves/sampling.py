@@ -20,7 +20,14 @@ import numpy as np
 
 from ..nurbs import decompose_bezier
 
-__all__ = ["bezier_pieces", "chord_gap", "refine_chords", "sample_nurbs"]
+__all__ = [
+    "bezier_pieces",
+    "chord_gap",
+    "polyline_at_lengths",
+    "refine_chords",
+    "sample_closed_batch",
+    "sample_nurbs",
+]
 
 _GRID = 32  # parameters per piece where |C''| is looked at
 _SAFETY = 1.5  # on the sampled maximum of |C''|
@@ -180,3 +187,119 @@ def sample_nurbs(
     elif closed and len(p) > 1 and np.abs(p[0] - p[-1]).max() <= 1e-12 * max(1.0, np.abs(p).max()):
         p = p[:-1]
     return np.ascontiguousarray(p)
+
+
+def polyline_at_lengths(
+    control_points: np.ndarray, knots: np.ndarray, lengths: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+    """Points, parameters and unit tangents of a degree-1 NURBS at arc lengths, exactly.
+
+    A clamped degree-1 curve runs straight from control point i to i + 1 while its
+    parameter runs linearly over ``[knots[i + 1], knots[i + 2]]``, so the point at a length
+    is found by a binary search in the running chord length and a linear step (a
+    zero-length segment is never the one chosen).
+
+    Parameters
+    ----------
+    control_points : (n, 3) float
+    knots : (n + 2,) float
+    lengths : (m,) float
+        Arc lengths from the start, in ``[0, length]``.
+
+    Returns
+    -------
+    t : (m,) float
+    points : (m, 3) float
+    tangents : (m, 3) float
+        The unit direction of the segment each point lies on.
+    length : float
+        The curve's length.
+    """
+    cp = np.asarray(control_points, dtype=np.float64)
+    seg = np.diff(cp, axis=0)
+    size = np.sqrt(np.einsum("ij,ij->i", seg, seg))
+    cum = np.concatenate([[0.0], np.cumsum(size)])
+    s = np.asarray(lengths, dtype=np.float64)
+    i = np.clip(np.searchsorted(cum, s, side="right") - 1, 0, len(seg) - 1)
+    # past a run of zero-length segments at the very end, step back to a real one
+    real = np.flatnonzero(size > 0)
+    if real.size:
+        i = np.minimum(i, real[-1])
+    f = np.divide(s - cum[i], size[i], out=np.zeros_like(s), where=size[i] > 0)
+    f = np.clip(f, 0.0, 1.0)
+    k = np.asarray(knots, dtype=np.float64)
+    t = k[i + 1] + f * (k[i + 2] - k[i + 1])
+    tangent = np.divide(seg[i], size[i, None], out=np.zeros_like(seg[i]), where=size[i, None] > 0)
+    return t, cp[i] + f[:, None] * seg[i], tangent, float(cum[-1])
+
+
+def sample_closed_batch(
+    curves: list[tuple[np.ndarray, int, np.ndarray, np.ndarray | None]],
+    tol: float,
+    guard: Callable[[int], None] | None = None,
+) -> list[np.ndarray]:
+    """:func:`sample_nurbs` of many closed curves of one degree (>= 2) at once.
+
+    Every curve's Bezier pieces go into one array, so the curvature bound, the sampling and
+    each round of midpoint refinement are one vectorized pass over all of them (a line of
+    text is hundreds of glyph contours). Curve c's parameter is laid out on
+    ``[base_c, base_c + k_c]`` with a gap of 1 before the next, so one sorted array holds
+    every curve's samples and no chord joins two curves.
+
+    Returns
+    -------
+    list of (m_i, 2) float
+        Each curve's samples, its closing point left out.
+    """
+    if not tol > 0:
+        raise ValueError(f"the sampling tolerance must be positive, got {tol}")
+    if not curves:
+        return []
+    degrees = {int(c[1]) for c in curves}
+    if len(degrees) != 1 or min(degrees) < 2:
+        raise ValueError(f"a batch is of one degree >= 2, got degrees {sorted(degrees)}")
+    coef = [bezier_pieces(np.asarray(cp, dtype=np.float64), p, kn, w) for cp, p, kn, w in curves]
+    k = np.array([c.shape[0] for c in coef])
+    coef_all = np.concatenate(coef)
+    first_piece = np.concatenate([[0], np.cumsum(k)[:-1]])
+    base = first_piece + np.arange(len(k))  # the gap of 1 before each next curve
+    # the curvature bound per piece, then equal steps
+    total_pieces = int(k.sum())
+    g = np.tile(np.linspace(0.0, 1.0, _GRID + 1), total_pieces)
+    _, _, d2 = _evaluate(coef_all, np.repeat(np.arange(total_pieces), _GRID + 1), g, order=2)
+    curv = np.linalg.norm(d2, axis=1).reshape(total_pieces, _GRID + 1).max(axis=1)
+    steps = np.maximum(1, np.ceil(np.sqrt(_SAFETY * curv / (8.0 * tol)))).astype(np.int64)
+    if guard is not None:
+        guard(int(steps.sum()) + len(k))
+    piece_curve = np.repeat(np.arange(len(k)), k)
+    piece_local = np.arange(total_pieces) - first_piece[piece_curve]
+    start = np.concatenate([[0], np.cumsum(steps)[:-1]])
+    j = np.arange(int(steps.sum())) - np.repeat(start, steps)
+    t = j / np.repeat(steps, steps)
+    u = np.repeat(base[piece_curve] + piece_local, steps) + t
+    u = np.sort(np.concatenate([u, base + k]))  # each curve's end, u = base + k
+    curve_of = np.searchsorted(base, u, side="right") - 1
+
+    def at(uu: np.ndarray, cc: np.ndarray) -> np.ndarray:
+        local = np.minimum(np.floor(uu - base[cc]).astype(np.int64), k[cc] - 1)
+        return _evaluate(coef_all, first_piece[cc] + local, uu - base[cc] - local)[0]
+
+    pts = at(u, curve_of)
+    for _ in range(_ROUNDS):
+        same = curve_of[1:] == curve_of[:-1]
+        mid = 0.5 * (u[:-1] + u[1:])[same]
+        cm = curve_of[:-1][same]
+        mp = at(mid, cm)
+        a, b = pts[:-1][same], pts[1:][same]
+        far = chord_gap(a, b, mp) > tol
+        if not far.any():
+            break
+        if guard is not None:
+            guard(u.size + int(far.sum()))
+        order = np.argsort(np.concatenate([u, mid[far]]), kind="stable")
+        u = np.concatenate([u, mid[far]])[order]
+        pts = np.concatenate([pts, mp[far]])[order]
+        curve_of = np.concatenate([curve_of, cm[far]])[order]
+    ends = np.searchsorted(curve_of, np.arange(len(k) + 1))
+    # each curve without its last sample (its end, the start again)
+    return [np.ascontiguousarray(pts[ends[i] : ends[i + 1] - 1]) for i in range(len(k))]

@@ -79,6 +79,8 @@ def rounded_rectangle(
             f"got {radius!r}"
         )
     r = min(r, largest)
+    if not math.isfinite(2 * (w + h)):
+        raise ValueError(f"size {w:g} x {h:g} is too large: its perimeter is not a finite number")
     x0, x1, y0, y1 = c[0] - w / 2, c[0] + w / 2, c[1] - h / 2, c[1] + h / 2
     if r == 0:
         cp = np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1], [x0, y0]])

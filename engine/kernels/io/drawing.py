@@ -267,23 +267,27 @@ def svg_bytes(
         f'<svg xmlns="http://www.w3.org/2000/svg"{inkscape} version="1.1" '
         f'width="{fmt([size[0]])}{units}" height="{fmt([size[1]])}{units}" '
         f'viewBox="{fmt([x0, y0, size[0], size[1]])}">\n'
-        f'<g fill="none" stroke="#000000" stroke-width="{fmt([stroke_width])}" '
-        'stroke-linecap="round" stroke-linejoin="round">\n'
     ).encode()
+    style = (
+        f'fill="none" stroke-width="{fmt([stroke_width])}" '
+        'stroke-linecap="round" stroke-linejoin="round"'
+    )
     body = [_svg_path(path, decimals) for path in paths]
     lines = [head]
     if styles is None:
-        lines += body
+        lines += [f'<g {style} stroke="#000000">\n'.encode(), *body, b"</g>\n"]
     else:
         assert layers is not None
-        for name, color in styles.items():  # one group per layer
+        # one top-level group per layer: what Inkscape takes as a layer (a nested one would
+        # be a sub-layer) and what readers list as the drawing's layers
+        for name, color in styles.items():
             lines.append(
                 f'<g id="{name}" inkscape:groupmode="layer" inkscape:label="{name}" '
-                f'stroke="{color}">\n'.encode()
+                f'{style} stroke="{color}">\n'.encode()
             )
             lines += [b for b, layer in zip(body, layers, strict=True) if layer == name]
             lines.append(b"</g>\n")
-    lines.append(b"</g>\n</svg>\n")
+    lines.append(b"</svg>\n")
     return b"".join(lines)
 
 
