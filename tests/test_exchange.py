@@ -288,3 +288,50 @@ def test_rhino_round_trips_through_read_rhino_exactly(tmp_path):
         m.face_indices, box.face_indices
     )
     assert len(back.points) == 0
+
+
+# ------------------------------------------------------------------------ vertex colours
+
+COLOURED = """\
+  ball: {type: mesh.sphere, radius: 2}
+  paint: {type: attr.set, geometry: "@ball", name: color,
+    value: ["=clip(0.5 + x / 4, 0, 1)", "=clip(0.5 + y / 4, 0, 1)", 0.25]}
+"""
+
+
+def test_glb_carries_a_color_attribute_as_color_0(tmp_path):
+    g, out = _run(
+        tmp_path, COLOURED + "  x: {type: export.gltf, meshes: ['@paint'], path: c.glb}\n", "x"
+    )
+    scene = trimesh.load(io.BytesIO(Path(out).read_bytes()), file_type="glb", process=False)
+    (mesh,) = scene.geometry.values()
+    want = np.asarray(g.evaluate("paint").point_data["color"])
+    got = np.asarray(mesh.visual.vertex_colors)[:, :3] / 255.0
+    np.testing.assert_allclose(got, want, atol=1 / 255 + 1e-9)
+
+
+def test_3mf_carries_a_color_attribute_as_a_colour_group(tmp_path):
+    lib3mf = pytest.importorskip("lib3mf")
+    g, out = _run(
+        tmp_path, COLOURED + "  x: {type: export.3mf, meshes: ['@paint'], path: c.3mf}\n", "x"
+    )
+    model = lib3mf.get_wrapper().CreateModel()
+    reader = model.QueryReader("3mf")
+    reader.SetStrictModeActive(True)
+    reader.ReadFromFile(out)
+    assert reader.GetWarningCount() == 0
+    groups = model.GetColorGroups()
+    assert groups.MoveNext()
+    group = groups.GetCurrentColorGroup()
+    ids = group.GetAllPropertyIDs()
+    want = np.round(np.asarray(g.evaluate("paint").point_data["color"]) * 255)
+    assert len(ids) == len(want)
+    got = [(c.Red, c.Green, c.Blue) for c in (group.GetColor(i) for i in ids[:50])]
+    np.testing.assert_array_equal(got, want[:50])
+    objects = model.GetMeshObjects()
+    objects.MoveNext()
+    obj = objects.GetCurrentMeshObject()
+    for t in range(0, obj.GetTriangleCount(), 37):  # each corner's colour is its vertex's
+        prop, tri = obj.GetTriangleProperties(t), obj.GetTriangle(t).Indices
+        assert prop.ResourceID == group.GetResourceID()
+        assert [prop.PropertyIDs[j] for j in range(3)] == [ids[i] for i in tri]

@@ -58,6 +58,7 @@ def write_glb(
     *,
     names: Sequence[str] | None = None,
     scale: float = 1e-3,
+    colors: Sequence[np.ndarray | None] | None = None,
 ) -> bytes:
     """A binary glTF 2.0 file of triangle meshes.
 
@@ -67,6 +68,9 @@ def write_glb(
     names : sequence of str, optional
     scale : float
         Metres per model unit (glTF's unit is the metre; 1e-3 for millimetres).
+    colors : sequence of (n, 3) or (n, 4) float in 0..1, or None, optional
+        Each mesh's vertex colours, written as ``COLOR_0`` (float32, linear as glTF reads
+        them; clipped to 0..1).
 
     Returns
     -------
@@ -104,12 +108,20 @@ def write_glb(
         position = add((v * scale).astype("<f4"), 34962, 5126, "VEC3", True)
         normal = add(vertex_normals(v, tris).astype("<f4"), 34962, 5126, "VEC3", False)
         indices = add(tris.astype("<u4").ravel(), 34963, 5125, "SCALAR", False)
+        attributes = {"POSITION": position, "NORMAL": normal}
+        c = None if colors is None else colors[k]
+        if c is not None:
+            c = np.clip(np.asarray(c, dtype=np.float64).reshape(len(v), -1), 0.0, 1.0)
+            if c.shape[1] not in (3, 4):
+                raise ValueError(f"vertex colours need 3 or 4 components, got {c.shape[1]}")
+            kind = "VEC3" if c.shape[1] == 3 else "VEC4"
+            attributes["COLOR_0"] = add(c.astype("<f4"), 34962, 5126, kind, False)
         gmeshes.append(
             {
                 "name": names[k],
                 "primitives": [
                     {
-                        "attributes": {"POSITION": position, "NORMAL": normal},
+                        "attributes": attributes,
                         "indices": indices,
                         "mode": 4,
                     }

@@ -28,6 +28,7 @@ from .textscan import parse_floats
 __all__ = ["MAX_MODEL_BYTES", "UNITS", "read_3mf", "write_3mf"]
 
 CORE = "http://schemas.microsoft.com/3dmanufacturing/core/2015/02"
+MATERIAL = "http://schemas.microsoft.com/3dmanufacturing/material/2015/02"
 MODEL_REL = "http://schemas.microsoft.com/3dmanufacturing/2013/01/3dmodel"
 UNITS = {  # the unit's length in millimetres
     "micron": 1e-3,
@@ -63,6 +64,7 @@ def write_3mf(
     names: Sequence[str] | None = None,
     colors: Sequence[tuple[float, float, float, float]] | None = None,
     unit: str = "millimeter",
+    vertex_colors: Sequence[np.ndarray | None] | None = None,
 ) -> bytes:
     """A 3MF package of triangle meshes: one object and one build item per mesh.
 
@@ -75,6 +77,10 @@ def write_3mf(
         Each object's colour, as a base material's ``displaycolor``.
     unit : str
         One of :data:`UNITS`; the coordinates are written as they are, in that unit.
+    vertex_colors : sequence of (n, 3) or (n, 4) float in 0..1, or None, optional
+        Each mesh's vertex colours, as a colour group of the 3MF Materials and Properties
+        extension (one ``<m:color>`` per vertex, each triangle's ``p1 p2 p3`` its corners');
+        they take precedence over ``colors`` for that mesh.
 
     Returns
     -------
@@ -86,30 +92,50 @@ def write_3mf(
         raise ValueError(f"unknown unit {unit!r}; one of {', '.join(UNITS)}")
     n = len(meshes)
     names = list(names) if names is not None else [f"mesh {k + 1}" for k in range(n)]
+    vertex_colors = list(vertex_colors) if vertex_colors is not None else [None] * n
     parts = [
         '<?xml version="1.0" encoding="UTF-8"?>\n'
-        f'<model unit="{unit}" xml:lang="en-US" xmlns="{CORE}">\n<resources>\n'
+        f'<model unit="{unit}" xml:lang="en-US" xmlns="{CORE}" xmlns:m="{MATERIAL}">\n'
+        "<resources>\n"
     ]
-    first_object = 1
+    next_id = 1
     if colors is not None:
         bases = "".join(
             f'<base name={quoteattr(names[k])} displaycolor="{_hex(c)}"/>\n'
             for k, c in enumerate(colors)
         )
         parts.append(f'<basematerials id="1">\n{bases}</basematerials>\n')
-        first_object = 2
+        next_id = 2
     chunks: list[bytes] = ["".join(parts).encode()]
+    object_ids = []
     for k, (v, tris) in enumerate(meshes):
-        pid = f' pid="1" pindex="{k}"' if colors is not None else ""
+        v = np.asarray(v, dtype=np.float64)
+        group = None
+        if (
+            vertex_colors[k] is not None
+        ):  # the materials extension's colour group, a colour a vertex
+            group = next_id
+            next_id += 1
+            chunks.append(f'<m:colorgroup id="{group}">\n'.encode())
+            chunks.extend(_color_rows(np.asarray(vertex_colors[k], dtype=np.float64)))
+            chunks.append(b"</m:colorgroup>\n")
+        if group is not None:
+            pid = f' pid="{group}" pindex="0"'
+        elif colors is not None:
+            pid = f' pid="1" pindex="{k}"'
+        else:
+            pid = ""
+        object_ids.append(next_id)
         chunks.append(
-            f'<object id="{first_object + k}" type="model" name={quoteattr(names[k])}{pid}>'
+            f'<object id="{next_id}" type="model" name={quoteattr(names[k])}{pid}>'
             "<mesh>\n<vertices>\n".encode()
         )
-        chunks.extend(_vertex_rows(np.asarray(v, dtype=np.float64)))
+        next_id += 1
+        chunks.extend(_vertex_rows(v))
         chunks.append(b"</vertices>\n<triangles>\n")
-        chunks.extend(_triangle_rows(np.asarray(tris, dtype=np.int64).reshape(-1, 3)))
+        chunks.extend(_triangle_rows(np.asarray(tris, dtype=np.int64).reshape(-1, 3), group))
         chunks.append(b"</triangles>\n</mesh></object>\n")
-    items = "".join(f'<item objectid="{first_object + k}"/>' for k in range(n))
+    items = "".join(f'<item objectid="{i}"/>' for i in object_ids)
     chunks.append(f"</resources>\n<build>{items}</build>\n</model>\n".encode())
     model = b"".join(chunks)
     out = io.BytesIO()
@@ -150,24 +176,29 @@ def _vertex_rows(v: np.ndarray) -> list[bytes]:
     return out
 
 
-def _triangle_rows(t: np.ndarray) -> list[bytes]:
+def _triangle_rows(t: np.ndarray, group: int | None = None) -> list[bytes]:
     out = []
     for s in range(0, len(t), _BLOCK):
         b = t[s : s + _BLOCK]
-        out.append(
-            join_rows(
-                [
-                    b'<triangle v1="',
-                    format_int(b[:, 0]),
-                    b'" v2="',
-                    format_int(b[:, 1]),
-                    b'" v3="',
-                    format_int(b[:, 2]),
-                ],
-                b'"/>\n',
-            )
-        )
+        cols = [format_int(b[:, c]) for c in range(3)]
+        parts = [b'<triangle v1="', cols[0], b'" v2="', cols[1], b'" v3="', cols[2]]
+        if group is not None:  # the corners' colours are the vertices' own, by index
+            parts += [f'" pid="{group}" p1="'.encode(), cols[0], b'" p2="', cols[1], b'" p3="',
+                      cols[2]]  # fmt: skip
+        out.append(join_rows(parts, b'"/>\n'))
     return out
+
+
+def _color_rows(c: np.ndarray) -> list[bytes]:
+    """``<m:color color="#RRGGBBAA"/>`` rows, hex digits laid out as one canvas."""
+    c = np.clip(np.round(c.reshape(len(c), -1) * 255), 0, 255).astype(np.uint8)
+    if c.shape[1] not in (3, 4):
+        raise ValueError(f"vertex colours need 3 or 4 components, got {c.shape[1]}")
+    if c.shape[1] == 3:
+        c = np.column_stack([c, np.full(len(c), 255, np.uint8)])
+    digits = np.frombuffer(b"0123456789ABCDEF", np.uint8)
+    hexes = np.stack([digits[c >> 4], digits[c & 15]], axis=2).reshape(len(c), 8)
+    return [join_rows([b'<m:color color="#', hexes], b'"/>\n')] if len(c) else []
 
 
 # --------------------------------------------------------------------------------------------
