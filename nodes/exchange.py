@@ -238,8 +238,9 @@ def export_rhino(
     meshes : list[Mesh] | None
         Meshes.
     layers : list[str] | None
-        One layer name per object, curves first, then surfaces, then meshes (default: a
-        layer per kind, ``curves``, ``surfaces``, ``meshes``).
+        One layer name per object, curves first, then surfaces, then meshes; the last name
+        takes any further objects (default: a layer per kind, ``curves``, ``surfaces``,
+        ``meshes``).
     """
     c = _nurbs_curves(curves or [], "curves")
     s = _nurbs_surfaces(surfaces or [], "surfaces")

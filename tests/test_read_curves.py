@@ -223,3 +223,24 @@ def test_dxf_round_trips_our_own_export_exactly(tmp_path):
     t = np.linspace(want.knots[want.degree], want.knots[-want.degree - 1], 50)
     u = np.linspace(back.knots[back.degree], back.knots[-back.degree - 1], 50)
     np.testing.assert_allclose(back.evaluate(u), want.evaluate(t), atol=1e-9)
+
+
+def test_svg_layers_written_by_export_svg_are_read_back_by_name(tmp_path):
+    (tmp_path / "w.yaml").write_text(
+        HEAD + "  a: {type: nurbs.circle, radius: 5}\n"
+        "  b: {type: curves.rectangle, size: [30, 20], radius: 3}\n"
+        "  x: {type: export.svg, curves: ['@a', '@b'], layers: [cut, engrave], path: d.svg}\n"
+    )
+    g = fg.load(tmp_path / "w.yaml", out_dir=tmp_path)
+    data = Path(g.evaluate("x")).read_bytes()
+    (circle,) = _curves(tmp_path, "d.svg", data, layers="[cut]")
+    (rect,) = _curves(tmp_path, "d.svg", data, layers="[engrave]")
+    # the drawing is placed on its page: compare shapes about their centres
+    cp = circle.control_points[:, :2]  # the control square of an exact circle: its centre
+    centre = (cp.max(0) + cp.min(0)) / 2
+    np.testing.assert_allclose(
+        np.linalg.norm(_points(circle)[:, :2] - centre, axis=1), 5, atol=1e-12
+    )
+    r = rect.control_points[:, :2]
+    np.testing.assert_allclose(r.max(0) - r.min(0), [30, 20], atol=1e-12)
+    assert rect.degree == 2 and rect.rational  # the rounded corners came back as arcs

@@ -42,7 +42,7 @@ _TAG = re.compile(rb"<(/?)([^>]*?)(/?)>")
 @dataclass(frozen=True)
 class SvgCurve:
     curve: CurveArrays
-    layer: str  # the id (or Inkscape label) of its top-level group; "" outside any
+    layer: str  # its Inkscape layer's label (or id), else its outermost named group's id
 
 
 def _bounded(data: bytes, max_elements: int) -> None:
@@ -83,16 +83,18 @@ def read_svg(data: bytes, max_elements: int = MAX_ELEMENTS) -> list[SvgCurve]:
     flip = np.array([mm, -mm, 1.0])
     shift = np.array([0.0, height * mm if height else 0.0, 0.0])
     out: list[SvgCurve] = []
-    stack: list[tuple[object, str]] = [(doc, "")]
+    # (element, its layer, whether that layer is an Inkscape layer rather than a named group)
+    stack: list[tuple[object, str, bool]] = [(doc, "", False)]
     while stack:  # depth-first, without recursion
-        node, layer = stack.pop()
+        node, layer, marked = stack.pop()
         if isinstance(node, se.Group) or node is doc:
-            children = list(node)
-            for child in reversed(children):
-                name = layer
-                if isinstance(child, se.Group) and node is doc:
-                    name = _layer_name(child)
-                stack.append((child, name))
+            for child in reversed(list(node)):
+                name, mark = layer, marked
+                if isinstance(child, se.Group):
+                    is_layer = _is_layer(child)
+                    if is_layer or (not marked and not layer):  # innermost layer, else outermost id
+                        name, mark = (_layer_name(child) or layer), is_layer or marked
+                stack.append((child, name, mark))
             continue
         if not isinstance(node, se.Shape):
             continue
@@ -150,6 +152,11 @@ def _length(value: object) -> float:
     except (TypeError, ValueError):
         return 0.0
     return f if np.isfinite(f) and f > 0 else 0.0
+
+
+def _is_layer(group: object) -> bool:
+    values = getattr(group, "values", {}) or {}
+    return any(str(k).endswith("groupmode") and v == "layer" for k, v in values.items())
 
 
 def _layer_name(group: object) -> str:
