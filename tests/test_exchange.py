@@ -335,3 +335,33 @@ def test_3mf_carries_a_color_attribute_as_a_colour_group(tmp_path):
         prop, tri = obj.GetTriangleProperties(t), obj.GetTriangle(t).Indices
         assert prop.ResourceID == group.GetResourceID()
         assert [prop.PropertyIDs[j] for j in range(3)] == [ids[i] for i in tri]
+
+
+def test_read_rhino_takes_what_rhino3dm_writes(tmp_path):
+    r = pytest.importorskip("rhino3dm")
+    model = r.File3dm()
+    model.Objects.AddCurve(r.LineCurve(r.Point3d(0, 0, 0), r.Point3d(3, 4, 0)))
+    model.Objects.AddCircle(r.Circle(r.Point3d(1, 2, 0), 5.0))
+    model.Objects.AddSphere(r.Sphere(r.Point3d(0, 0, 0), 2.0))
+    model.Objects.AddPoint(r.Point3d(7, 8, 9))
+    mesh = r.Mesh()
+    for p in ((0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)):
+        mesh.Vertices.Add(*p)
+    mesh.Faces.AddFace(0, 1, 2, 3)
+    model.Objects.AddMesh(mesh)
+    model.Write(str(tmp_path / "m.3dm"), 8)
+    (tmp_path / "in.yaml").write_text(HEAD + "  m: {type: read.rhino, path: m.3dm}\n")
+    got = fg.load(tmp_path / "in.yaml").evaluate("m")
+    line, circle = got.curves
+    np.testing.assert_allclose(
+        line.evaluate([line.knots[0], line.knots[-1]]), [[0, 0, 0], [3, 4, 0]]
+    )
+    assert circle.rational
+    p = circle.evaluate(np.linspace(circle.knots[0], circle.knots[-1], 50))
+    np.testing.assert_allclose(np.linalg.norm(p - [1, 2, 0], axis=1), 5, atol=1e-12)
+    (sphere,) = got.surfaces
+    u, v = np.meshgrid(np.linspace(*sphere.domain_u, 7), np.linspace(*sphere.domain_v, 7))
+    s = sphere.evaluate(u.ravel(), v.ravel())
+    np.testing.assert_allclose(np.linalg.norm(s, axis=1), 2, atol=1e-12)
+    (m,) = got.meshes
+    assert m.face_offsets.tolist() == [0, 4] and got.points.xyz.tolist() == [[7, 8, 9]]
