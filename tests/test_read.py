@@ -70,7 +70,8 @@ def test_the_disk_cache_keys_by_content_across_processes(tmp_path):
 def test_watch_files_include_the_inputs(tmp_path):
     trimesh.creation.box().export(tmp_path / "part.stl")
     g = fg.load(_graph(tmp_path, "  m: {type: read.mesh, path: part.stl}\n"))
-    assert (tmp_path / "part.stl").resolve() in g.files
+    assert (tmp_path / "part.stl").resolve() in g.input_files
+    assert g.files == [tmp_path / "g.yaml"]  # what a sweep sends along: the graph's own text
 
 
 def test_an_inputs_folder_is_where_paths_start_and_stop(tmp_path):
@@ -360,3 +361,15 @@ def test_headless_watch_redraws_when_an_input_file_changes(tmp_path):
     os.utime(tmp_path / "data" / "part.stl", (later, later))  # a new stamp, even on coarse clocks
     assert w.poll() is True, err.getvalue()
     assert "80 faces" in out.getvalue() or len(out.getvalue().splitlines()) == 2
+
+
+def test_a_sweep_worker_reads_inputs_from_the_same_folder(tmp_path):
+    from formgraph.sweeps import cluster, tasks
+
+    (tmp_path / "data").mkdir()
+    trimesh.creation.box().export(tmp_path / "data" / "part.stl")
+    graph = _graph(tmp_path, "  m: {type: read.mesh, path: part.stl, weld: true}\n")
+    g = fg.load(graph, inputs_dir=tmp_path / "data")
+    bp = cluster.blueprint(g, None, False)  # what travels to a worker
+    assert bp.inputs == str((tmp_path / "data").resolve())
+    assert tasks._graph(bp).evaluate("m").n_faces == 12

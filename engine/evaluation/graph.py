@@ -193,11 +193,15 @@ class Graph:
 
     @property
     def files(self) -> list[Path]:
-        """The graph's file, every subgraph file it reads, and the input files its nodes
-        name as written (what ``watch`` watches)."""
+        """The graph's file and every subgraph file it reads (what a sweep sends along)."""
         own = [Path(self.file)] if self.file else []
-        subs = list(self._includes.files) if self._includes is not None else []
-        return own + subs + self._input_files()
+        return own + (list(self._includes.files) if self._includes is not None else [])
+
+    @property
+    def input_files(self) -> list[Path]:
+        """The files its read nodes name, resolved (a literal path, or a path from a param's
+        current value); ``watch`` watches them with :attr:`files`."""
+        return self._input_files()
 
     def _input_files(self) -> list[Path]:
         from ..core import safety
