@@ -200,14 +200,14 @@ def test_dxf_blocks_expand_with_layer_and_units(tmp_path):
 def test_dxf_nested_block_bomb_is_refused_by_the_budget(tmp_path):
     doc = _new()
     doc.blocks.new("L0").add_line((0, 0), (1, 0))
-    for level in range(1, 7):
+    for level in range(1, 6):
         blk = doc.blocks.new(f"L{level}")
         for k in range(10):
             blk.add_blockref(f"L{level - 1}", (k, 0))
-    doc.modelspace().add_blockref("L6", (0, 0))  # a million lines
+    doc.modelspace().add_blockref("L5", (0, 0))  # 100,000 lines
     t0 = time.perf_counter()
     with pytest.raises(fg.NodeError, match="over the budget"):
-        _curves(tmp_path, "bomb.dxf", _dxf(doc), budget=20_000)
+        _curves(tmp_path, "bomb.dxf", _dxf(doc), budget=3_000)
     assert time.perf_counter() - t0 < 30
 
 
