@@ -45,13 +45,15 @@ def parsed(path: str, what: str, fn, *args):
         raise InputError("path", f"{path!r}: cannot read it as {what}: {exc}") from None
 
 
-@node("read.mesh", version=1)
+@node("read.mesh", version=2)
 def mesh(path: InputPath, weld: bool = False, *, ctx: Context) -> Mesh:
     """Read a mesh file: STL (binary and ASCII), OBJ, PLY, OFF, 3MF or glTF/GLB.
 
     The format comes from the extension. OBJ, PLY and OFF polygons are kept as they are;
     STL is a triangle soup (three vertices per facet) until welded; 3MF and glTF give every
-    mesh their build or scene places, with its transform applied, joined into one mesh.
+    mesh their build or scene places, with its transform applied, joined into one mesh. A
+    PLY's extra vertex properties come in as point attributes (``red green blue`` as a
+    ``color`` in 0..1, ``nx ny nz`` as a ``normal``), as ``export.ply`` writes them.
     Units: 3MF's unit and glTF's metres become millimetres; the other formats have none.
 
     Parameters
@@ -74,10 +76,14 @@ def mesh(path: InputPath, weld: bool = False, *, ctx: Context) -> Mesh:
     _, data = ctx.read(path)
     v, fi, fo = parsed(path, "a mesh", readers.mesh_arrays, path, data)
     ctx.guard(len(fo) - 1, "faces")
+    attributes = parsed(path, "a mesh", readers.vertex_attributes, path, data)
     if weld:
+        if attributes:
+            ctx.warn(f"{path}: welding drops the vertex attributes ({', '.join(attributes)})")
+        attributes = {}
         v, fi, fo = repair.weld(v, fi, fo, 0.0)
     try:
-        return Mesh(v, fi, fo)
+        return Mesh(v, fi, fo, point_data=attributes or None)
     except ValueError as exc:
         raise InputError("path", f"{path!r}: {exc}") from None
 
@@ -128,7 +134,7 @@ def curves(path: InputPath, layers: list[str] | None = None, *, ctx: Context) ->
     return out
 
 
-@node("read.points", version=1)
+@node("read.points", version=2)
 def points(path: InputPath, *, ctx: Context) -> Points:
     """Read points: CSV (``.csv``), whitespace text (``.txt``, ``.xyz``) or PLY vertices.
 
@@ -149,7 +155,8 @@ def points(path: InputPath, *, ctx: Context) -> Points:
     ext = parsed(path, "points", readers.extension, path, readers.POINT_FORMATS)
     xyz = parsed(path, "points", readers.POINT_FORMATS[ext], data)
     ctx.guard(len(xyz), "points")
-    return Points(xyz)
+    attributes = parsed(path, "points", readers.vertex_attributes, path, data)
+    return Points(xyz, point_data=attributes or None)
 
 
 class RhinoContents(NamedTuple):

@@ -373,3 +373,21 @@ def test_a_sweep_worker_reads_inputs_from_the_same_folder(tmp_path):
     bp = cluster.blueprint(g, None, False)  # what travels to a worker
     assert bp.inputs == str((tmp_path / "data").resolve())
     assert tasks._graph(bp).evaluate("m").n_faces == 12
+
+
+def test_ply_attributes_written_by_export_ply_come_back(tmp_path):
+    (tmp_path / "w.yaml").write_text(
+        HEAD + "  ball: {type: mesh.sphere, radius: 2}\n"
+        "  paint: {type: attr.set, geometry: '@ball', name: color,"
+        " value: ['=clip(0.5 + x / 4, 0, 1)', 0.5, 0.25]}\n"
+        "  heat: {type: attr.set, geometry: '@paint', name: heat, value: '=z * z'}\n"
+        "  x: {type: export.ply, mesh: '@heat', path: c.ply}\n"
+    )
+    g = fg.load(tmp_path / "w.yaml", out_dir=tmp_path)
+    g.evaluate("x")
+    back = _read(tmp_path, "c.ply")
+    want = g.evaluate("heat")
+    np.testing.assert_allclose(back.point_data["color"], want.point_data["color"], atol=0.5 / 255)
+    np.testing.assert_array_equal(back.point_data["heat"], want.point_data["heat"])
+    pts = _points(tmp_path, "c.ply", (tmp_path / "c.ply").read_bytes())
+    assert len(pts) == want.n_vertices

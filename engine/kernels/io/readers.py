@@ -14,12 +14,19 @@ import numpy as np
 from .dxf_read import read_dxf
 from .gltf import read_gltf
 from .mesh_read import read_obj, read_off, read_stl
-from .ply_read import read_ply
+from .ply_read import point_data, read_ply
 from .points_read import read_ply_points, read_text_points
 from .svg_read import MAX_ELEMENTS, read_svg
 from .threemf import read_3mf
 
-__all__ = ["CURVE_FORMATS", "MESH_FORMATS", "POINT_FORMATS", "extension", "mesh_arrays"]
+__all__ = [
+    "CURVE_FORMATS",
+    "MESH_FORMATS",
+    "POINT_FORMATS",
+    "extension",
+    "mesh_arrays",
+    "vertex_attributes",
+]
 
 
 def _merged(parts: list[tuple[str, np.ndarray, np.ndarray]]) -> tuple[np.ndarray, ...]:
@@ -75,3 +82,9 @@ def mesh_arrays(name: str, data: bytes) -> tuple[np.ndarray, np.ndarray, np.ndar
         An unknown extension, or what the format's reader finds wrong.
     """
     return MESH_FORMATS[extension(name, MESH_FORMATS)](data)
+
+
+def vertex_attributes(name: str, data: bytes) -> dict[str, np.ndarray]:
+    """The per-vertex attributes the file carries (PLY's extra vertex properties: colour,
+    normals, anything else); none for the other formats."""
+    return point_data(data) if extension(name, {**MESH_FORMATS, **POINT_FORMATS}) == ".ply" else {}
