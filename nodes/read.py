@@ -53,7 +53,8 @@ def mesh(path: InputPath, weld: bool = False, *, ctx: Context) -> Mesh:
     STL is a triangle soup (three vertices per facet) until welded; 3MF and glTF give every
     mesh their build or scene places, with its transform applied, joined into one mesh. A
     PLY's extra vertex properties come in as point attributes (``red green blue`` as a
-    ``color`` in 0..1, ``nx ny nz`` as a ``normal``), as ``export.ply`` writes them.
+    ``color`` in 0..1, ``nx ny nz`` as a ``normal``), as ``export.ply`` writes them, and a
+    glTF's ``COLOR_0`` as ``color``.
     Units: 3MF's unit and glTF's metres become millimetres; the other formats have none.
 
     Parameters
@@ -74,9 +75,8 @@ def mesh(path: InputPath, weld: bool = False, *, ctx: Context) -> Mesh:
     ``part: {type: read.mesh, path: scan.stl, weld: true}``
     """
     _, data = ctx.read(path)
-    v, fi, fo = parsed(path, "a mesh", readers.mesh_arrays, path, data)
+    v, fi, fo, attributes = parsed(path, "a mesh", readers.mesh_data, path, data)
     ctx.guard(len(fo) - 1, "faces")
-    attributes = parsed(path, "a mesh", readers.vertex_attributes, path, data)
     if weld:
         if attributes:
             ctx.warn(f"{path}: welding drops the vertex attributes ({', '.join(attributes)})")

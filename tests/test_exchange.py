@@ -308,6 +308,9 @@ def test_glb_carries_a_color_attribute_as_color_0(tmp_path):
     want = np.asarray(g.evaluate("paint").point_data["color"])
     got = np.asarray(mesh.visual.vertex_colors)[:, :3] / 255.0
     np.testing.assert_allclose(got, want, atol=1 / 255 + 1e-9)
+    (tmp_path / "in.yaml").write_text(HEAD + "  m: {type: read.mesh, path: out/c.glb}\n")
+    back = fg.load(tmp_path / "in.yaml").evaluate("m")  # and our reader takes COLOR_0 back
+    np.testing.assert_allclose(back.point_data["color"], want, atol=1e-7)
 
 
 def test_3mf_carries_a_color_attribute_as_a_colour_group(tmp_path):

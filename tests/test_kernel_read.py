@@ -68,7 +68,7 @@ def test_3mf_round_trips_exactly(mesh, unit):
 def test_glb_round_trips_in_float32(mesh):
     v, fi, _ = mesh
     tris = fi[: (fi.size // 3) * 3].reshape(-1, 3)
-    ((_, back, t),) = read_gltf(write_glb([(v, tris)], scale=1.0), scale=1.0)
+    ((_, back, t, _),) = read_gltf(write_glb([(v, tris)], scale=1.0), scale=1.0)
     assert np.array_equal(back, v.astype(np.float32).astype(np.float64))
     assert np.array_equal(t, tris)
 

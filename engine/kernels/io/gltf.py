@@ -158,8 +158,9 @@ def write_glb(
 
 def read_gltf(data: bytes, *, scale: float = 1e3) -> list[tuple[str, np.ndarray, np.ndarray]]:
     """The triangle meshes a glTF 2.0 file (``.glb``, or ``.gltf`` JSON with embedded
-    ``data:`` buffers) places: ``(name, vertices (n, 3), triangles (t, 3))`` per mesh
-    instance, transforms applied, coordinates times ``scale`` (1000: metres to millimetres).
+    ``data:`` buffers) places: ``(name, vertices (n, 3), triangles (t, 3), colours (n, 3|4)
+    or None)`` per mesh instance (``COLOR_0``, normalized integers read as 0..1), transforms
+    applied, coordinates times ``scale`` (1000: metres to millimetres).
 
     Raises
     ------
@@ -202,7 +203,7 @@ def read_gltf(data: bytes, *, scale: float = 1e3) -> list[tuple[str, np.ndarray,
     out = []
     for k, m in placed:
         mesh = meshes[k] if isinstance(meshes[k], dict) else {}
-        verts, tris, base = [], [], 0
+        verts, tris, colors, base = [], [], [], 0
         for prim in mesh.get("primitives", []):
             if prim.get("mode", 4) != 4:
                 continue  # points and lines are not surfaces
@@ -220,10 +221,17 @@ def read_gltf(data: bytes, *, scale: float = 1e3) -> list[tuple[str, np.ndarray,
                 raise ValueError(f"mesh {k}: an index refers to a vertex that does not exist")
             verts.append(p @ m[:3, :3].T + m[:3, 3])
             tris.append(t.reshape(-1, 3) + base)
+            color = None
+            if "COLOR_0" in attrs:
+                color = _accessor(doc, buffers, attrs["COLOR_0"]).astype(np.float64)
+                if color.shape != (len(p), color.shape[1]) or color.shape[1] not in (3, 4):
+                    raise ValueError(f"mesh {k}: COLOR_0 does not hold a colour a vertex")
+            colors.append(color)
             base += len(p)
         if verts:
             name = str(mesh.get("name", f"mesh {k}"))
-            out.append((name, np.concatenate(verts) * scale, np.concatenate(tris)))
+            c = np.concatenate(colors) if all(x is not None for x in colors) else None
+            out.append((name, np.concatenate(verts) * scale, np.concatenate(tris), c))
     return out
 
 
