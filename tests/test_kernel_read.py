@@ -126,3 +126,10 @@ def test_a_chain_raises_lower_pieces_without_moving_them():
     np.testing.assert_allclose(curve.evaluate(t), np.outer(1 - t, [-2, 0, 0]), atol=1e-15)
     bern = np.stack([(1 - t) ** 3, 3 * t * (1 - t) ** 2, 3 * t**2 * (1 - t), t**3], axis=1)
     np.testing.assert_allclose(curve.evaluate(1 + t), bern @ cubic, atol=1e-14)
+
+
+def test_empty_and_face_free_files_read_as_empty_parts():
+    v, fi, fo = read_obj(b"v 0 0 0\nv 1 0 0\n")  # a point cloud as OBJ: no faces
+    assert v.shape == (2, 3) and fi.size == 0 and fo.tolist() == [0]
+    v, fi, fo = read_obj(b"")
+    assert v.shape == (0, 3) and fo.tolist() == [0]
