@@ -58,6 +58,21 @@ def test_an_edited_file_recomputes_an_unchanged_one_is_not_parsed(tmp_path):
     assert g.stats["m"].status == "computed" and g.stats["t"].status == "computed"
 
 
+def test_an_unchanged_file_is_not_even_read_again(tmp_path, monkeypatch):
+    from formgraph.core import safety
+
+    trimesh.creation.box().export(tmp_path / "part.stl")
+    g = fg.load(_graph(tmp_path, "  m: {type: read.mesh, path: part.stl}\n"))
+    reads = []
+    real = safety.read_input
+    monkeypatch.setattr(safety, "read_input", lambda p, *a: reads.append(p) or real(p, *a))
+    g.evaluate("m")
+    for _ in range(3):  # keyed again (as a sweep plans each variant): the stamp says unchanged
+        g.plan("m")
+        g.evaluate("m")
+    assert len(reads) == 1 and g.stats["m"].status == "cached"
+
+
 def test_the_disk_cache_keys_by_content_across_processes(tmp_path):
     trimesh.creation.box().export(tmp_path / "part.stl")
     path = _graph(tmp_path, "  m: {type: read.mesh, path: part.stl}\n")

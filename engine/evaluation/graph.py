@@ -120,6 +120,7 @@ class Graph:
         self._last: dict[str, tuple[str, str]] = {}  # node -> (key, identity) of its last output
         self._digests: dict[str, str | None] = {}  # cache key -> content digest, when computed
         self._written: dict[str, tuple[int, int] | None] = {}  # export key -> file stamp
+        self._input_digests: dict[str, tuple[tuple[int, ...], str]] = {}  # input -> (stamp, hash)
         self._parse_problems: list[Problem] = []
         self.outputs: dict[str, Any] = {}  # the `outputs:` mapping, for use as a subgraph
         self._output_lines: dict[str, int] = {}
@@ -260,6 +261,7 @@ class Graph:
                 self._digests,
                 self._written,
             )
+            child._input_digests = self._input_digests
             child._params, child._nodes, child.outputs = doc.params, doc.nodes, doc.outputs
             child._values = {n: p.default for n, p in doc.params.items()}
             child._subgraphs = dict(spec.subgraphs)
