@@ -339,12 +339,13 @@ def _cap_rules(mesh: Mesh, v: np.ndarray, fi: np.ndarray, fo: np.ndarray) -> tup
     return carry.mix(rows, index, weight, len(v)), carry.copy(faces)
 
 
-@node("mesh.solidify", version=1)
+@node("mesh.solidify", version=2)
 def solidify(
     mesh: Mesh,
     thickness: Annotated[float, Range(min=0)],
     offset: Annotated[float, Range(min=-1, max=1)] = 0.0,
     thickness_map: Annotated[Expression | None, Variables("x", "y", "z", "thickness")] = None,
+    planar_rims: bool = True,
     *,
     ctx: Context,
 ) -> Mesh:
@@ -366,6 +367,11 @@ def solidify(
     thickness_map : Expression | None
         A wall that varies: the thickness at each vertex as an expression in its position
         x, y, z and ``thickness``, e.g. "thickness * (1 + z / 5)". Each value must be > 0.
+    planar_rims : bool
+        Keep every planar boundary loop in its own plane: its vertices move along their
+        normals projected into the plane (the wall's thickness kept), so a shade whose
+        bottom rim lies on z = 0 still stands on z = 0. Loops that are not planar, or
+        whose surface lies nearly in the loop's plane, move along their normals.
     """
     if thickness <= 0:
         raise InputError("thickness", f"thickness must be > 0, got {thickness:g}")
@@ -386,7 +392,7 @@ def solidify(
                 f"{i} ({', '.join(f'{c:.6g}' for c in v[i])}); a thickness must be > 0",
             )
     try:
-        arrays = _topology("mesh", ks.solidify, *_arrays(mesh), t, offset)
+        arrays = _topology("mesh", ks.solidify, *_arrays(mesh), t, offset, planar_rims)
     except ValueError as exc:
         raise InputError("mesh", str(exc)) from None
     port, what = (

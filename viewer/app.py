@@ -159,6 +159,7 @@ class Session:
         self.targets = shown_nodes(self.graph, node) if self.graph is not None else []
         self.controls_x = 0.76  # where the column of sliders starts (fraction of the width)
         self._slider_values: dict[str, float] = {}
+        self._slider_specs: dict[str, Slider] = {}
         self.widgets: dict[str, Any] = {}  # slider widgets by param name
         shown = self.evaluate()
         self.scenes = self._make_scenes(len(shown), edges)
@@ -245,6 +246,7 @@ class Session:
         """
         if self.graph is None:
             raise ValueError("a geometry value has no params; pass a graph to use params")
+        self._require_open()
         old = dict(self.params)
         self.params.update(values)
         try:
@@ -264,8 +266,22 @@ class Session:
                     continue
                 self._slider_values[name] = value
                 rep.SetValue(float(value))
+                self._title_slider(name, value)
         self.plotter.render()
         return True
+
+    def closed(self) -> bool:
+        """Whether the plotter is closed (pyvista closes an off-screen plotter in show())."""
+        return getattr(self.plotter, "render_window", None) is None
+
+    def _require_open(self) -> None:
+        if self.closed():
+            raise RuntimeError(
+                "this session's plotter is closed, so nothing can be drawn in it: pyvista "
+                "closes a plotter at the end of show(), and off screen right away; keep it "
+                "open with plotter.show(auto_close=False), or take pictures with "
+                "plotter.screenshot(path) instead of show()"
+            )
 
     def replace_graph(self, graph: Graph, params: dict[str, Any] | None = None) -> None:
         """Show a new version of the graph (watch mode), keeping the camera if it still fits.
@@ -275,6 +291,7 @@ class Session:
         FormgraphError
             When the new version fails; what is drawn, and the session, stay as they were.
         """
+        self._require_open()
         old = (self.graph, self.targets, self.params, self.seconds)
         old_bounds = self.scene.bounds()
         try:
@@ -294,6 +311,8 @@ class Session:
     def report(self, message: str) -> None:
         """Show an error in the window and on stderr, keeping what is drawn."""
         print(message, file=sys.stderr)
+        if self.closed():
+            return  # no window to show it in: stderr has it
         kept = "\n(the picture is the last version that worked)" if self.scene.layers else ""
         self.scene.set_error(message + kept)
         self.plotter.render()
@@ -367,7 +386,20 @@ class Session:
         if self._slider_values.get(name) == v:
             return True
         self._slider_values[name] = v
+        self._title_slider(name, v)
         return self.apply_params(**{name: v})
+
+    def _title_slider(self, name: str, value: float) -> None:
+        """The slider's title, ``name = value   (min to max)``: the value lives in the
+        title, not in a label over the knob, which would run into the slider above."""
+        widget = self.widgets.get(name)
+        spec = self._slider_specs.get(name)
+        if widget is None or spec is None:
+            return
+        shown = f"{value:.0f}" if spec.integer else f"{value:.4g}"
+        widget.GetRepresentation().SetTitleText(
+            f"{name} = {shown}   ({spec.min:g} to {spec.max:g})"
+        )
 
     def toggles(self) -> list[str]:
         """Every bool graph param (each gets a check box)."""
@@ -437,6 +469,8 @@ class Session:
             )
             _style_slider(widget.GetRepresentation())
             self.widgets[s.name] = widget
+            self._slider_specs[s.name] = s
+            self._title_slider(s.name, s.value)
         if toggles:
             self.add_toggles(0.74 - len(sliders) * step - 0.02)
         self._make_room()
@@ -490,6 +524,7 @@ def _style_slider(rep: Any) -> None:
     rep.SetEndCapLength(0.004)
     rep.SetEndCapWidth(0.022)
     rep.SetLabelHeight(0.018)
+    rep.ShowSliderLabelOff()  # the value is in the title (see Session._title_slider)
     rep.GetTubeProperty().SetColor(pv.Color("#c8c8c8").float_rgb)
     rep.GetCapProperty().SetColor(pv.Color("#c8c8c8").float_rgb)
     rep.GetSliderProperty().SetColor(pv.Color(PALETTE[0]).float_rgb)

@@ -119,9 +119,11 @@ def _parser() -> argparse.ArgumentParser:
         "--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS
     )
 
+    from .serve import add_parser as add_serve
     from .sweep import add_parsers
 
     add_parsers(sub)
+    add_serve(sub)
     return ap
 
 
@@ -398,7 +400,14 @@ COMMANDS = {
     "schema": cmd_schema,
     "sweep": lambda args: _sweep_command("cmd_sweep", args),
     "cache": lambda args: _sweep_command("cmd_cache", args),
+    "serve": lambda args: _serve_command(args),
 }
+
+
+def _serve_command(args: argparse.Namespace) -> int:
+    from .serve import cmd_serve
+
+    return cmd_serve(args)
 
 
 def _sweep_command(name: str, args: argparse.Namespace) -> int:

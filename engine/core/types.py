@@ -20,6 +20,7 @@ import numpy as np
 
 from ..geometry import (
     Curve,
+    Field,
     Geometry,
     Mesh,
     NurbsCurve,
@@ -147,6 +148,7 @@ GEOMETRY_TYPES: dict[str, type] = {
     "Surface": Surface,
     "NurbsSurface": NurbsSurface,
     "Mesh": Mesh,
+    "Field": Field,
 }
 SCALARS: dict[str, type] = {"int": int, "float": float, "bool": bool, "str": str}
 

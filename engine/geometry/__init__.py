@@ -14,6 +14,7 @@ part of their equality, hash, state and ``to_pyvista()``. The math lives in
 - ``curves``: :class:`Curve`, :class:`NurbsCurve`, :class:`ParametricCurve`
 - ``surfaces``: :class:`Surface`, :class:`NurbsSurface`, :class:`ParametricSurface`
 - ``mesh``: :class:`Mesh`
+- ``field``: :class:`Field`, a signed distance function kept as its recipe
 """
 
 from __future__ import annotations
@@ -30,6 +31,7 @@ from .base import (
     storable,
 )
 from .curves import Curve, NurbsCurve, ParametricCurve
+from .field import Field
 from .mesh import Mesh
 from .points import Points
 from .surfaces import NurbsSurface, ParametricSurface, Surface
@@ -38,6 +40,7 @@ __all__ = [
     "STORABLE",
     "AttributeMap",
     "Curve",
+    "Field",
     "Geometry",
     "Mesh",
     "NurbsCurve",
