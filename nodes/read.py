@@ -97,8 +97,9 @@ def curves(path: InputPath, layers: list[str] | None = None, *, ctx: Context) ->
     bulges as exact arcs; each SVG subpath and each DXF polyline is one curve. SVG: the
     document's ``width``/``height`` and ``viewBox`` give millimetres (else one user unit is
     one CSS pixel, 25.4/96 mm), transforms are applied, y points up with the page's
-    lower-left corner at the origin. DXF: blocks are expanded, ``$INSUNITS`` scales to mm,
-    text, hatches and points are passed over (counted in a warning).
+    lower-left corner at the origin; text not converted to paths and images are passed over
+    (counted in a warning). DXF: blocks are expanded, ``$INSUNITS`` scales to mm, text,
+    hatches and points are passed over (counted in a warning).
 
     Parameters
     ----------

@@ -244,3 +244,12 @@ def test_svg_layers_written_by_export_svg_are_read_back_by_name(tmp_path):
     r = rect.control_points[:, :2]
     np.testing.assert_allclose(r.max(0) - r.min(0), [30, 20], atol=1e-12)
     assert rect.degree == 2 and rect.rational  # the rounded corners came back as arcs
+
+
+def test_svg_text_not_converted_to_paths_is_reported(tmp_path):
+    data = (
+        b'<svg xmlns="http://www.w3.org/2000/svg" width="10mm" height="10mm" viewBox="0 0 10 10">'
+        b'<text x="1" y="5">Hi</text><circle cx="5" cy="5" r="2"/></svg>'
+    )
+    with pytest.warns(fg.FormgraphWarning, match=r"passed over what is not a curve \(1 text\)"):
+        assert len(_curves(tmp_path, "t.svg", data)) == 1

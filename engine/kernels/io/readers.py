@@ -60,7 +60,7 @@ MESH_FORMATS = {  # data -> (vertices, face_indices, face_offsets, point attribu
 
 
 CURVE_FORMATS = {  # (data, element budget) -> (curves with a .curve and a .layer, skipped)
-    ".svg": lambda data, budget: (read_svg(data, min(MAX_ELEMENTS, budget)), {}),
+    ".svg": lambda data, budget: read_svg(data, min(MAX_ELEMENTS, budget)),
     ".dxf": lambda data, budget: read_dxf(data, budget),
 }
 

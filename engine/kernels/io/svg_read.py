@@ -25,6 +25,7 @@ from __future__ import annotations
 import io
 import math
 import re
+from collections import Counter
 from dataclasses import dataclass
 
 import numpy as np
@@ -63,8 +64,9 @@ def _bounded(data: bytes, max_elements: int) -> None:
         raise ValueError(f"elements nest {deepest:,} deep, over the budget of {MAX_DEPTH}")
 
 
-def read_svg(data: bytes, max_elements: int = MAX_ELEMENTS) -> list[SvgCurve]:
-    """Every drawn shape of an SVG file as exact NURBS arrays, one per subpath.
+def read_svg(data: bytes, max_elements: int = MAX_ELEMENTS) -> tuple[list[SvgCurve], Counter]:
+    """Every drawn shape of an SVG file as exact NURBS arrays, one per subpath, and a count
+    of what was passed over (``text`` not converted to paths, ``image``).
 
     Raises
     ------
@@ -83,6 +85,7 @@ def read_svg(data: bytes, max_elements: int = MAX_ELEMENTS) -> list[SvgCurve]:
     flip = np.array([mm, -mm, 1.0])
     shift = np.array([0.0, height * mm if height else 0.0, 0.0])
     out: list[SvgCurve] = []
+    passed: Counter = Counter()
     # (element, its layer, whether that layer is an Inkscape layer rather than a named group)
     stack: list[tuple[object, str, bool]] = [(doc, "", False)]
     while stack:  # depth-first, without recursion
@@ -97,6 +100,8 @@ def read_svg(data: bytes, max_elements: int = MAX_ELEMENTS) -> list[SvgCurve]:
                 stack.append((child, name, mark))
             continue
         if not isinstance(node, se.Shape):
+            if isinstance(node, se.Text | se.Image):
+                passed[type(node).__name__.lower()] += 1
             continue
         if node.values.get("visibility") == "hidden":
             continue
@@ -106,7 +111,7 @@ def read_svg(data: bytes, max_elements: int = MAX_ELEMENTS) -> list[SvgCurve]:
         for chain in _chains(se.Path(node), se):
             cp, p, k, w = chain.curve()
             out.append(SvgCurve(((cp @ lin.T + move) * flip + shift, p, k, w), layer))
-    return out
+    return out, passed
 
 
 _UNIT_MM = {
