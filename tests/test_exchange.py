@@ -368,3 +368,20 @@ def test_read_rhino_takes_what_rhino3dm_writes(tmp_path):
     np.testing.assert_allclose(np.linalg.norm(s, axis=1), 2, atol=1e-12)
     (m,) = got.meshes
     assert m.face_offsets.tolist() == [0, 4] and got.points.xyz.tolist() == [[7, 8, 9]]
+
+
+def test_step_rational_curve_stays_a_circle_in_opencascade(tmp_path):
+    from OCP.BRep import BRep_Tool
+
+    g, out = _run(
+        tmp_path,
+        "  c: {type: nurbs.circle, radius: 3}\n  x: {type: export.step, curves: ['@c'], path: c.step}\n",
+        "x",
+    )
+    (edge,) = _occ_items(_occ(out), "EDGE")
+    curve = BRep_Tool.Curve_s(edge, 0, 1)
+    assert curve.IsRational()
+    c = g.evaluate("c")
+    for t in np.linspace(c.knots[0], c.knots[-1], 17):
+        p = curve.Value(float(t))
+        np.testing.assert_allclose([p.X(), p.Y(), p.Z()], c.evaluate([t])[0], atol=1e-12)
