@@ -375,7 +375,8 @@ def test_step_rational_curve_stays_a_circle_in_opencascade(tmp_path):
 
     g, out = _run(
         tmp_path,
-        "  c: {type: nurbs.circle, radius: 3}\n  x: {type: export.step, curves: ['@c'], path: c.step}\n",
+        "  c: {type: nurbs.circle, radius: 3}\n"
+        "  x: {type: export.step, curves: ['@c'], path: c.step}\n",
         "x",
     )
     (edge,) = _occ_items(_occ(out), "EDGE")
