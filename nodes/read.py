@@ -53,8 +53,8 @@ def mesh(path: InputPath, weld: bool = False, *, ctx: Context) -> Mesh:
     STL is a triangle soup (three vertices per facet) until welded; 3MF and glTF give every
     mesh their build or scene places, with its transform applied, joined into one mesh. A
     PLY's extra vertex properties come in as point attributes (``red green blue`` as a
-    ``color`` in 0..1, ``nx ny nz`` as a ``normal``), as ``export.ply`` writes them, and a
-    glTF's ``COLOR_0`` as ``color``.
+    ``color`` in 0..1, ``nx ny nz`` as a ``normal``), as ``export.ply`` writes them; a
+    glTF's ``COLOR_0`` and a 3MF colour group as ``color``.
     Units: 3MF's unit and glTF's metres become millimetres; the other formats have none.
 
     Parameters

@@ -81,7 +81,7 @@ def test_3mf_units_scale_on_reading(tmp_path):
     )
     from formgraph.kernels.io.threemf import read_3mf
 
-    ((_, v, _),) = read_3mf(Path(out).read_bytes())
+    ((_, v, _, _),) = read_3mf(Path(out).read_bytes())
     np.testing.assert_allclose(v, g.evaluate("box").vertices * 25.4)
 
 
@@ -338,6 +338,9 @@ def test_3mf_carries_a_color_attribute_as_a_colour_group(tmp_path):
         prop, tri = obj.GetTriangleProperties(t), obj.GetTriangle(t).Indices
         assert prop.ResourceID == group.GetResourceID()
         assert [prop.PropertyIDs[j] for j in range(3)] == [ids[i] for i in tri]
+    (tmp_path / "in.yaml").write_text(HEAD + "  m: {type: read.mesh, path: out/c.3mf}\n")
+    back = fg.load(tmp_path / "in.yaml").evaluate("m")  # our reader takes the group back
+    np.testing.assert_allclose(back.point_data["color"][:, :3], want / 255, atol=1e-12)
 
 
 def test_read_rhino_takes_what_rhino3dm_writes(tmp_path):

@@ -58,7 +58,7 @@ def test_stl_binary_round_trips_as_float32_facets(mesh):
 def test_3mf_round_trips_exactly(mesh, unit):
     v, fi, _ = mesh
     tris = fi[: (fi.size // 3) * 3].reshape(-1, 3)
-    ((_, back, t),) = read_3mf(write_3mf([(v, tris)], unit=unit))
+    ((_, back, t, _),) = read_3mf(write_3mf([(v, tris)], unit=unit))
     scale = {"millimeter": 1.0, "inch": 25.4}[unit]
     assert np.array_equal(back, v * scale) and np.array_equal(t, tris)
 

@@ -211,11 +211,11 @@ _COMPONENT = re.compile(rb"<(?:\w+:)?component\b([^>]*?)/?>")
 MAX_DEPTH = 32  # components within components
 
 
-def read_3mf(
-    data: bytes, max_bytes: int = MAX_MODEL_BYTES
-) -> list[tuple[str, np.ndarray, np.ndarray]]:
-    """The meshes a 3MF package builds: ``(name, vertices (n, 3), triangles (t, 3))`` per
-    build item, in millimetres, with the item's and its components' transforms applied.
+def read_3mf(data: bytes, max_bytes: int = MAX_MODEL_BYTES) -> list[tuple]:
+    """The meshes a 3MF package builds: ``(name, vertices (n, 3), triangles (t, 3), colours
+    (n, 4) or None)`` per build item, in millimetres, with the item's and its components'
+    transforms applied; colours from a Materials-extension colour group the object and its
+    triangles' corners point into.
 
     Raises
     ------
@@ -262,7 +262,7 @@ def _member(z: zipfile.ZipFile, info: zipfile.ZipInfo, cap: int) -> bytes:
     return out
 
 
-def _model_meshes(model: bytes) -> list[tuple[str, np.ndarray, np.ndarray]]:
+def _model_meshes(model: bytes) -> list[tuple]:
     head = re.search(rb"<(?:\w+:)?model\b([^>]*)>", model)
     if head is None:
         raise ValueError("the model part has no <model> element")
@@ -270,13 +270,15 @@ def _model_meshes(model: bytes) -> list[tuple[str, np.ndarray, np.ndarray]]:
     if unit not in UNITS:
         raise ValueError(f"unknown model unit {unit!r}")
     scale = UNITS[unit]
+    groups = _color_groups(model)
     objects: dict[bytes, tuple[str, object]] = {}
     for attrs, body in _OBJECT.findall(model):
         a = dict(_ATTR.findall(attrs))
         oid = a.get(b"id", b"")
         name = a.get(b"name", b"object " + oid).decode("utf-8", "replace")
         if re.search(rb"<(?:\w+:)?mesh\b", body):
-            objects[oid] = (name, _mesh_of(body, oid))
+            v, t = _mesh_of(body, oid)
+            objects[oid] = (name, (v, t, _vertex_colors(body, a, groups, len(v), t)))
         else:
             comps = [dict(_ATTR.findall(c)) for c in _COMPONENT.findall(body)]
             objects[oid] = (name, [(c.get(b"objectid", b""), c.get(b"transform")) for c in comps])
@@ -295,7 +297,51 @@ def _model_meshes(model: bytes) -> list[tuple[str, np.ndarray, np.ndarray]]:
             if pieces
             else np.zeros((0, 3), np.int64)
         )
-        out.append((objects[oid][0], v * scale, t))
+        colors = [p[2] for p in pieces]
+        c = np.concatenate(colors) if pieces and all(x is not None for x in colors) else None
+        out.append((objects[oid][0], v * scale, t, c))
+    return out
+
+
+_GROUP = re.compile(rb"<(?:\w+:)?colorgroup\b([^>]*)>(.*?)</(?:\w+:)?colorgroup\s*>", re.S)
+
+
+def _color_groups(model: bytes) -> dict[bytes, np.ndarray]:
+    """The Materials extension's colour groups: id -> (k, 4) RGBA in 0..1."""
+    out = {}
+    for attrs, body in _GROUP.findall(model):
+        gid = dict(_ATTR.findall(attrs)).get(b"id", b"")
+        hexes = re.findall(rb'\bcolor\s*=\s*"#([0-9A-Fa-f]{6}(?:[0-9A-Fa-f]{2})?)"', body)
+        if len(hexes) != len(re.findall(rb"<(?:\w+:)?color\b", body)):
+            raise ValueError(
+                f"colour group {gid.decode()!r} holds a colour that is not #RRGGBB[AA]"
+            )
+        rows = [h + b"FF" if len(h) == 6 else h for h in hexes]
+        raw = np.frombuffer(bytes.fromhex(b"".join(rows).decode()), np.uint8)
+        out[gid] = raw.reshape(-1, 4) / 255.0
+    return out
+
+
+def _vertex_colors(body: bytes, attrs: dict, groups: dict, n: int, t: np.ndarray):
+    """A colour a vertex from a colour group the triangles' corners point into (p1 p2 p3,
+    or the object's default pindex), or None when the object has no colour group."""
+    pid = attrs.get(b"pid")
+    if pid not in groups or not t.size:
+        return None
+    colors = groups[pid]
+    ts = re.search(rb"<(?:\w+:)?triangles\b[^>]*>(.*?)</(?:\w+:)?triangles\s*>", body, re.S)
+    block = ts.group(1) if ts else b""
+    corners = [re.findall(rb"\b" + k + rb'\s*=\s*"(\d+)"', block) for k in (b"p1", b"p2", b"p3")]
+    out = np.zeros((n, 4))
+    default = int(attrs.get(b"pindex", b"0") or 0)
+    if not 0 <= default < len(colors):
+        raise ValueError(f"an object's pindex {default} is outside its colour group")
+    out[:] = colors[default]
+    if all(len(c) == len(t) for c in corners):  # every corner names its colour
+        idx = np.array(corners, dtype=np.int64).T
+        if idx.size and idx.max() >= len(colors):
+            raise ValueError("a triangle's colour index is outside its colour group")
+        out[t.ravel()] = colors[idx.ravel()]
     return out
 
 
@@ -306,8 +352,8 @@ def _flatten(objects, oid: bytes, m: np.ndarray, depth: int) -> list:
         raise ValueError(f"a component names object {oid.decode()!r}, which is not there")
     _, what = objects[oid]
     if isinstance(what, tuple):
-        v, t = what
-        return [(v @ m[:3] + m[3], t)]
+        v, t, c = what
+        return [(v @ m[:3] + m[3], t, c)]
     out = []
     for child, transform in what:
         c = _transform(transform)
