@@ -92,7 +92,7 @@ def mesh(path: InputPath, weld: bool = False, *, ctx: Context) -> Mesh:
 def curves(path: InputPath, layers: list[str] | None = None, *, ctx: Context) -> list[Curve]:
     """Read the curves of an SVG or DXF drawing, exactly, in millimetres.
 
-    Lines come in as degree-1 curves, Béziers as Béziers, arcs, circles and ellipses as
+    Lines come in as degree-1 curves, Beziers as Beziers, arcs, circles and ellipses as
     rational quadratics, DXF SPLINEs with their own degree, knots and weights, DXF polyline
     bulges as exact arcs; each SVG subpath and each DXF polyline is one curve. SVG: the
     document's ``width``/``height`` and ``viewBox`` give millimetres (else one user unit is
