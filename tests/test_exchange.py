@@ -13,6 +13,19 @@ import trimesh
 import formgraph as fg
 
 HEAD = "formgraph: 1\nnodes:\n"
+
+
+@pytest.fixture(autouse=True)
+def _keep_locale():
+    """lib3mf's writer sets the process's locale to "C" and leaves it there, which turns
+    Python's default text encoding into ASCII for every later test: put it back."""
+    import locale
+
+    saved = locale.setlocale(locale.LC_ALL, None)
+    yield
+    locale.setlocale(locale.LC_ALL, saved)
+
+
 TWO = (
     "  ball: {type: mesh.sphere, radius: 2}\n"
     "  box: {type: mesh.box, size: [1, 2, 3], center: [5, 0, 0]}\n"

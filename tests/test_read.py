@@ -16,6 +16,17 @@ from formgraph.kernels.io.exporters import obj_bytes, ply_binary, stl_ascii, stl
 HEAD = "formgraph: 1\nnodes:\n"
 
 
+@pytest.fixture(autouse=True)
+def _keep_locale():
+    """lib3mf's writer sets the process's locale to "C" and leaves it there, which turns
+    Python's default text encoding into ASCII for every later test: put it back."""
+    import locale
+
+    saved = locale.setlocale(locale.LC_ALL, None)
+    yield
+    locale.setlocale(locale.LC_ALL, saved)
+
+
 def _graph(folder: Path, body: str, name: str = "g.yaml") -> Path:
     path = folder / name
     path.write_text(HEAD + body)
