@@ -47,6 +47,12 @@ def _triangles(meshes: list[Mesh], ctx: Context) -> list[tuple[np.ndarray, np.nd
     return out
 
 
+def _vertex_colour(mesh: Mesh) -> np.ndarray | None:
+    """A mesh's ``color`` point attribute when it is RGB or RGBA (0..1), else None."""
+    c = mesh.point_data.get("color")
+    return c if c is not None and c.ndim == 2 and c.shape[1] in (3, 4) else None
+
+
 def _per_mesh(values: list | None, meshes: list[Mesh], port: str) -> list | None:
     if values is not None and len(values) != len(meshes):
         raise InputError(port, f"{len(values)} {port} for {len(meshes)} meshes: give one each")
@@ -96,7 +102,7 @@ def export_3mf(
             names=names,
             colors=rgba,
             unit=units.value,
-            vertex_colors=[m.point_data.get("color") for m in meshes],
+            vertex_colors=[_vertex_colour(m) for m in meshes],
         )
     except ValueError as exc:
         raise InputError("meshes", str(exc)) from None
@@ -132,7 +138,7 @@ def export_gltf(
     """
     _per_mesh(names, meshes, "names")
     scale = threemf.UNITS[units.value] / 1000.0
-    colors = [m.point_data.get("color") for m in meshes]
+    colors = [_vertex_colour(m) for m in meshes]  # a ``color`` point attribute: COLOR_0
     try:
         data = gltf.write_glb(_triangles(meshes, ctx), names=names, scale=scale, colors=colors)
     except ValueError as exc:

@@ -124,8 +124,10 @@ class Watcher(_Watched):
         edges: bool | None = None,
         camera: Camera | None = None,
         inputs_dir: str | os.PathLike[str] | None = None,
+        color: str | None = None,
     ):
         super().__init__(path, node, sets, out_dir, budget, layout, edges, camera, inputs_dir)
+        self.color = color
         self.plotter = plotter
         self.session: Session | None = None
         self.reloads = 0
@@ -157,6 +159,7 @@ class Watcher(_Watched):
                     layout=self.layout,
                     edges=self.edges,
                     camera=self.camera,
+                    color=self.color,
                 )
                 self.session.add_keys()
                 self.session.scene.set_error(None)  # an error left by a broken start
@@ -202,6 +205,7 @@ def watch(
     edges: bool | None = None,
     camera: Camera | None = None,
     inputs_dir: str | os.PathLike[str] | None = None,
+    color: str | None = None,
 ) -> Watcher:
     """Open a window on ``graph_path`` that redraws whenever the file is saved.
 
@@ -237,6 +241,7 @@ def watch(
         edges=edges,
         camera=camera,
         inputs_dir=inputs_dir,
+        color=color,
     )
     watcher.reload()
     plotter.add_timer_event(
@@ -311,8 +316,10 @@ class ScreenshotWatcher(_Watched):
         out: Any = None,
         err: Any = None,
         inputs_dir: str | os.PathLike[str] | None = None,
+        color: str | None = None,
     ):
         super().__init__(path, node, sets, out_dir, budget, layout, edges, camera, inputs_dir)
+        self.color = color
         self.screenshot = Path(screenshot)
         self.size = size
         self.out = out if out is not None else sys.stdout
@@ -346,6 +353,7 @@ class ScreenshotWatcher(_Watched):
                     layout=self.layout,
                     edges=self.edges,
                     camera=self.camera,
+                    color=self.color,
                 )
                 self.screenshot.parent.mkdir(parents=True, exist_ok=True)
                 tmp = self.screenshot.with_name(f".{self.screenshot.name}.{os.getpid()}.tmp.png")

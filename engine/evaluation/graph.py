@@ -417,23 +417,54 @@ class Graph:
     def evaluate(self, nodes: str | Iterable[str], **params: Any) -> Any:
         """Evaluate one node (returns its output) or several (returns a dict by name).
 
-        Keyword arguments override params for this call only.
+        A name may pick one output of a node with several, ``"a.ring"``, as the wire
+        ``@a.ring`` does. Keyword arguments override params for this call only.
         """
         if not self._checked:
             self.check()
         values = dict(self._values)
         values.update(self._checked_params(params))
         names = _node_names(nodes)
-        for n in names:
-            if n not in self._nodes:
-                from ..language.params import suggest
-
-                raise GraphError(f"{self.file_label}: no node '{n}'{suggest(n, self._nodes)}")
+        picks = {n: self._output_of(n) for n in names}
         run = _Run(self, values)
         self.stats = run.stats
-        run.run(names)
-        outs = {n: run.results[n] for n in names}
+        run.run(list(dict.fromkeys(node for node, _ in picks.values())))
+        outs = {
+            n: run.results[node] if output is None else getattr(run.results[node], output)
+            for n, (node, output) in picks.items()
+        }
         return outs[names[0]] if isinstance(nodes, str) else outs
+
+    def _output_of(self, name: str) -> tuple[str, str | None]:
+        """(node, output) of ``name``: a node, or ``node.output`` as a wire spells it."""
+        from ..language.params import suggest
+
+        if name in self._nodes:
+            return name, None
+        node, _, output = name.rpartition(".")
+        if node in self._nodes:
+            spec = self.node_types().get(self._nodes[node].type)
+            if spec is not None and spec.multi_output and output in spec.outputs:
+                return node, output
+            if spec is not None:
+                outs = ", ".join(f"{node}.{o}" for o in spec.outputs) if spec.multi_output else ""
+                raise GraphError(
+                    f"{self.file_label}: node '{node}' ({spec.name}) has no output '{output}'"
+                    + (f"; its outputs are {outs}" if outs else "; it has one output")
+                )
+        raise GraphError(f"{self.file_label}: no node '{name}'{suggest(name, self._nodes)}")
+
+    def frames(self, node: str, **params: Any) -> list[Any]:
+        """Every step's output of simulated node ``node``, in order (``@node.frames``)."""
+        nd = self._nodes.get(node)
+        if nd is None or nd.simulate is None:
+            raise GraphError(f"{self.file_label}: '{node}' is not a simulated node (simulate:)")
+        if not self._checked:
+            self.check()
+        run = _Run(self, {**self._values, **self._checked_params(params)})
+        self.stats = run.stats
+        run.run([node])
+        return run.frames_of(node)
 
     def sinks(self) -> list[str]:
         """Nodes nothing else reads from (exports, usually), in author order."""

@@ -35,7 +35,7 @@ from ..core.errors import (
     Problem,
     Where,
 )
-from ..core.registry import Context, NodeSpec, node_types
+from ..core.registry import Context, Estimate, NodeSpec, RunTally, node_types
 from ..core.types import Entries, TypeMismatch
 from ..language.elements import bind_elements, reads_elements
 from ..language.model import FRAMES, STEP, Expr, Input, Items, Literal, NodeDef, Wire, wires_of
@@ -99,6 +99,7 @@ class _Run(LanguageRun, SimulationRun):
             self.out_path = Path(os.path.abspath(g.out_dir))
         self.out_dir = str(self.out_path)
         self.total = 0
+        self.tally = RunTally(g.budget)  # what this run's nodes hold together
         self.started: set[str] = set()  # nodes that began computing, for the progress line
         self.quiet = False  # inside run(): numpy's warnings are silenced once, not per node
         # node -> input path -> (file, bytes): read once when keyed, handed to the node
@@ -132,6 +133,9 @@ class _Run(LanguageRun, SimulationRun):
             if r is not None and not wires_of(r.source):
                 self.repeat_items(n)
                 self.precheck_nested(n)
+            elif r is not None:  # over a wire: what its source would make, before it runs
+                for w in wires_of(r.source):
+                    self.precheck_source(n, r.name, w.node, self.where(n, "repeat"))
             if self.g._nodes[n].simulate is not None:
                 self.step_count(n)
         for n in order:
@@ -426,6 +430,21 @@ class _Run(LanguageRun, SimulationRun):
                 raise GraphError([Problem(self.where(name, port), str(exc))]) from None
         return kwargs
 
+    def estimate(self, name: str, spec: NodeSpec, kwargs: dict[str, Any]) -> float | None:
+        """What node ``name`` would make on ``kwargs``, by running it only to its first
+        budget check (``Context.guard``); None when it makes no such check."""
+        if not spec.wants_context or isinstance(spec, SubgraphSpec):
+            return None
+        ctx = Context(name, self.out_path, self.g.budget, [], probe=True)
+        try:
+            with contextlib.nullcontext() if self.quiet else _quiet_numpy():
+                spec.func(**{**kwargs, "ctx": ctx})
+        except Estimate as est:
+            return float(est.elements)
+        except Exception:  # the real call reports it, located
+            return None
+        return None
+
     def call(
         self,
         name: str,
@@ -443,6 +462,7 @@ class _Run(LanguageRun, SimulationRun):
                 self.g.budget,
                 warnings,
                 inputs=lambda relpath: self.read_input(name, relpath),
+                tally=self.tally,
             )
         if self.g.progress is not None:  # counted as it goes: linear in the graph's size
             self.g.progress(name, len(self.started) - (name in self.started), self.total)

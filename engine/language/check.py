@@ -32,6 +32,48 @@ from .params import check_param_value, suggest
 from .simulation import is_state_placeholder, steps_problem
 
 
+def _expression_ports_take_text(g: Outline, nd: NodeDef, spec: NodeSpec) -> None:
+    """Read ``z: "=wall/2"`` on an expression port as the expression ``wall/2``.
+
+    An expression port takes the text of an expression; written with the ``=`` of a
+    param expression it is still one expression (over the port's variables and the
+    params), so the ``=`` is dropped rather than the text evaluated once with the param
+    defaults. ``"=shape"`` naming a text param still passes that param's text.
+    """
+    for port, value in nd.inputs.items():
+        if not isinstance(value, Expr) or port not in spec.inputs:
+            continue
+        if not spec.inputs[port].type.is_expression:
+            continue
+        if value.compiled.is_bare_name:
+            p = g.params.get(value.text.strip())
+            if p is not None and (isinstance(p.default, str) or p.type is not None):
+                continue
+        nd.inputs[port] = Literal(value.text)
+
+
+def infer_fed(g: Outline, registry: Mapping[str, NodeSpec]) -> None:
+    """Set each param's ``fed``: float when the expressions that read it feed float ports
+    only (``radius: "=r"``), None when any feeds an int port (``count: "=r"``) or none does.
+    """
+    votes: dict[str, set[type]] = {name: set() for name in g.params}
+    for nd in g.nodes.values():
+        spec = registry.get(nd.type)
+        if spec is None:
+            continue
+        for port, value in nd.inputs.items():
+            if not isinstance(value, Expr) or port not in spec.inputs:
+                continue
+            bases = {k.base for k in spec.inputs[port].type.kinds if not k.is_list}
+            kind = float if float in bases and int not in bases else int if int in bases else None
+            if kind is None:
+                continue
+            for name in value.compiled.names & votes.keys():
+                votes[name].add(kind)
+    for name, p in g.params.items():
+        p.fed = float if votes[name] == {float} else None
+
+
 @dataclass(frozen=True)
 class Outline:
     """What the checker reads of a graph: where it came from, its params and its nodes.
@@ -70,6 +112,7 @@ def check_graph(g: Outline, extra: list[Problem] | None = None) -> list[Problem]
 
     from .expr import CONSTANTS, FUNCTIONS
 
+    infer_fed(g, registry)
     for p in g.params.values():
         if not p.name.isidentifier() or p.name.startswith("_"):
             problems.append(
@@ -101,6 +144,8 @@ def check_graph(g: Outline, extra: list[Problem] | None = None) -> list[Problem]
 
     for nd in g.nodes.values():
         spec = registry.get(nd.type)
+        if spec is not None:
+            _expression_ports_take_text(g, nd, spec)
         if spec is None:
             if nd.type.endswith((".yaml", ".yml")):
                 continue  # a graph file: its problems come from reading it
@@ -316,7 +361,13 @@ def _check_node(
         add(message, port)
     loop = loop or step
     for port in nd.raw:
-        if port not in spec.inputs:
+        if port not in spec.inputs and nd.raw[port] is None and " " in str(port):
+            add(
+                f"the text {port!r} became an input of its own, because inside {{...}} a "
+                "', ' ends a value: put text that holds ', ' in quotes",
+                port,
+            )
+        elif port not in spec.inputs:
             add(
                 f"'{nd.type}' has no input '{port}'{suggest(port, spec.inputs)}; its inputs are "
                 f"{', '.join(spec.inputs) or 'none'}",

@@ -164,6 +164,13 @@ class Bound:
     def __call__(self, **variables: Any) -> Any:
         return self.compiled(self.params, **variables)
 
+    def taylor(self, variable: str, **variables: Any) -> tuple[Any, Any, Any]:
+        """Value, first and second derivative in ``variable``, exact (see
+        :mod:`~formgraph.language.derivative`; raises ``NotDifferentiable`` for noise)."""
+        from .derivative import taylor
+
+        return taylor(self.compiled.text, variable, {**self.params, **variables})
+
 
 def compile_expression(text: str, allowed: set[str] | frozenset[str] | None = None) -> Compiled:
     """Compile ``text`` into a :class:`Compiled` closure tree.

@@ -27,7 +27,9 @@ def param_kind(p: ParamDef) -> type | None:
     """The scalar type of a param without a declared ``type:``, read from how it is written.
 
     A number is an ``int`` only when its default, min and max are all written as whole
-    numbers (``{default: 3, min: 0.5, max: 10}`` is a float); None for anything else.
+    numbers (``{default: 3, min: 0.5, max: 10}`` is a float) and it feeds no port that
+    asks for a float only (``r: 2`` feeding a radius is a float: ``p.fed``, set by the
+    check's ``infer_fed``); None for anything else.
     """
     if p.type is not None:
         return None
@@ -35,7 +37,8 @@ def param_kind(p: ParamDef) -> type | None:
     if isinstance(d, (bool, str)):
         return type(d)
     if _whole(d):
-        return int if all(_whole(b) for b in (p.min, p.max) if b is not None) else float
+        whole = all(_whole(b) for b in (p.min, p.max) if b is not None)
+        return int if whole and p.fed is not float else float
     if isinstance(d, float):
         return float
     return None

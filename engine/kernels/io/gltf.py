@@ -66,6 +66,9 @@ def write_glb(
     ----------
     meshes : sequence of (vertices (n, 3) float, triangles (t, 3) int)
     names : sequence of str, optional
+    colors : sequence of (n, 3) or (n, 4) float in 0..1 or None, optional
+        Vertex colours per mesh, written as ``COLOR_0`` (float RGB or RGBA, linear as
+        glTF defines it).
     scale : float
         Metres per model unit (glTF's unit is the metre; 1e-3 for millimetres).
     colors : sequence of (n, 3) or (n, 4) float in 0..1, or None, optional
