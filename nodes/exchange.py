@@ -59,7 +59,7 @@ def _per_mesh(values: list | None, meshes: list[Mesh], port: str) -> list | None
     return values
 
 
-@node("export.3mf", version=1)
+@node("export.3mf", version=2)
 def export_3mf(
     meshes: list[Mesh],
     path: OutputPath,
@@ -73,8 +73,9 @@ def export_3mf(
 
     A valid 3MF core package (content types, relationships, the model with its unit);
     polygons are triangulated (ear clipping for concave ones); each object carries its name
-    and, given ``colors``, a base material of that colour. Slicers read the unit, so a part
-    arrives at its size.
+    and, given ``colors``, a base material of that colour; a mesh with a ``color`` point
+    attribute (3 or 4 components in 0..1) carries it per vertex instead, as a colour group
+    of the Materials extension. Slicers read the unit, so a part arrives at its size.
 
     Parameters
     ----------
@@ -95,11 +96,20 @@ def export_3mf(
         rgba = [css_rgba(c) for c in colors] if colors is not None else None
     except ValueError as exc:
         raise InputError("colors", str(exc)) from None
-    data = threemf.write_3mf(_triangles(meshes, ctx), names=names, colors=rgba, unit=units.value)
+    try:
+        data = threemf.write_3mf(
+            _triangles(meshes, ctx),
+            names=names,
+            colors=rgba,
+            unit=units.value,
+            vertex_colors=[_vertex_colour(m) for m in meshes],
+        )
+    except ValueError as exc:
+        raise InputError("meshes", str(exc)) from None
     return str(ctx.write(path, data))
 
 
-@node("export.gltf", version=1)
+@node("export.gltf", version=2)
 def export_gltf(
     meshes: list[Mesh],
     path: OutputPath,
@@ -111,9 +121,9 @@ def export_gltf(
     """Write meshes as binary glTF 2.0 (``.glb``), for the web and AR viewers.
 
     One node and mesh each: float32 positions (with their bounds), smooth vertex normals
-    (area-weighted) and uint32 triangle indices in one binary chunk; a ``color`` point
-    attribute (RGB or RGBA in 0..1) becomes the vertex colours ``COLOR_0``. glTF's unit is the
-    metre, so coordinates are scaled from ``units`` (a 100 mm vase is 0.1 m in the file).
+    (area-weighted) and uint32 triangle indices in one binary chunk, and vertex colours
+    (``COLOR_0``) from a ``color`` point attribute (3 or 4 components in 0..1). glTF's unit
+    is the metre, so coordinates are scaled from ``units`` (a 100 mm vase is 0.1 m).
 
     Parameters
     ----------
@@ -129,7 +139,10 @@ def export_gltf(
     _per_mesh(names, meshes, "names")
     scale = threemf.UNITS[units.value] / 1000.0
     colors = [_vertex_colour(m) for m in meshes]  # a ``color`` point attribute: COLOR_0
-    data = gltf.write_glb(_triangles(meshes, ctx), names=names, scale=scale, colors=colors)
+    try:
+        data = gltf.write_glb(_triangles(meshes, ctx), names=names, scale=scale, colors=colors)
+    except ValueError as exc:
+        raise InputError("meshes", str(exc)) from None
     return str(ctx.write(path, data))
 
 
@@ -231,8 +244,9 @@ def export_rhino(
     meshes : list[Mesh] | None
         Meshes.
     layers : list[str] | None
-        One layer name per object, curves first, then surfaces, then meshes (default: a
-        layer per kind, ``curves``, ``surfaces``, ``meshes``).
+        One layer name per object, curves first, then surfaces, then meshes; the last name
+        takes any further objects (default: a layer per kind, ``curves``, ``surfaces``,
+        ``meshes``).
     """
     c = _nurbs_curves(curves or [], "curves")
     s = _nurbs_surfaces(surfaces or [], "surfaces")

@@ -45,13 +45,16 @@ def parsed(path: str, what: str, fn, *args):
         raise InputError("path", f"{path!r}: cannot read it as {what}: {exc}") from None
 
 
-@node("read.mesh", version=1)
+@node("read.mesh", version=2)
 def mesh(path: InputPath, weld: bool = False, *, ctx: Context) -> Mesh:
     """Read a mesh file: STL (binary and ASCII), OBJ, PLY, OFF, 3MF or glTF/GLB.
 
     The format comes from the extension. OBJ, PLY and OFF polygons are kept as they are;
     STL is a triangle soup (three vertices per facet) until welded; 3MF and glTF give every
-    mesh their build or scene places, with its transform applied, joined into one mesh.
+    mesh their build or scene places, with its transform applied, joined into one mesh. A
+    PLY's extra vertex properties come in as point attributes (``red green blue`` as a
+    ``color`` in 0..1, ``nx ny nz`` as a ``normal``), as ``export.ply`` writes them; a
+    glTF's ``COLOR_0`` and a 3MF colour group as ``color``.
     Units: 3MF's unit and glTF's metres become millimetres; the other formats have none.
 
     Parameters
@@ -72,12 +75,15 @@ def mesh(path: InputPath, weld: bool = False, *, ctx: Context) -> Mesh:
     ``part: {type: read.mesh, path: scan.stl, weld: true}``
     """
     _, data = ctx.read(path)
-    v, fi, fo = parsed(path, "a mesh", readers.mesh_arrays, path, data)
+    v, fi, fo, attributes = parsed(path, "a mesh", readers.mesh_data, path, data)
     ctx.guard(len(fo) - 1, "faces")
     if weld:
+        if attributes:
+            ctx.warn(f"{path}: welding drops the vertex attributes ({', '.join(attributes)})")
+        attributes = {}
         v, fi, fo = repair.weld(v, fi, fo, 0.0)
     try:
-        return Mesh(v, fi, fo)
+        return Mesh(v, fi, fo, point_data=attributes or None)
     except ValueError as exc:
         raise InputError("path", f"{path!r}: {exc}") from None
 
@@ -86,13 +92,14 @@ def mesh(path: InputPath, weld: bool = False, *, ctx: Context) -> Mesh:
 def curves(path: InputPath, layers: list[str] | None = None, *, ctx: Context) -> list[Curve]:
     """Read the curves of an SVG or DXF drawing, exactly, in millimetres.
 
-    Lines come in as degree-1 curves, Béziers as Béziers, arcs, circles and ellipses as
+    Lines come in as degree-1 curves, Beziers as Beziers, arcs, circles and ellipses as
     rational quadratics, DXF SPLINEs with their own degree, knots and weights, DXF polyline
     bulges as exact arcs; each SVG subpath and each DXF polyline is one curve. SVG: the
     document's ``width``/``height`` and ``viewBox`` give millimetres (else one user unit is
     one CSS pixel, 25.4/96 mm), transforms are applied, y points up with the page's
-    lower-left corner at the origin. DXF: blocks are expanded, ``$INSUNITS`` scales to mm,
-    text, hatches and points are passed over (counted in a warning).
+    lower-left corner at the origin; text not converted to paths and images are passed over
+    (counted in a warning). DXF: blocks are expanded, ``$INSUNITS`` scales to mm, text,
+    hatches and points are passed over (counted in a warning).
 
     Parameters
     ----------
@@ -128,7 +135,7 @@ def curves(path: InputPath, layers: list[str] | None = None, *, ctx: Context) ->
     return out
 
 
-@node("read.points", version=1)
+@node("read.points", version=2)
 def points(path: InputPath, *, ctx: Context) -> Points:
     """Read points: CSV (``.csv``), whitespace text (``.txt``, ``.xyz``) or PLY vertices.
 
@@ -149,7 +156,8 @@ def points(path: InputPath, *, ctx: Context) -> Points:
     ext = parsed(path, "points", readers.extension, path, readers.POINT_FORMATS)
     xyz = parsed(path, "points", readers.POINT_FORMATS[ext], data)
     ctx.guard(len(xyz), "points")
-    return Points(xyz)
+    attributes = parsed(path, "points", readers.vertex_attributes, path, data)
+    return Points(xyz, point_data=attributes or None)
 
 
 class RhinoContents(NamedTuple):

@@ -13,6 +13,19 @@ import trimesh
 import formgraph as fg
 
 HEAD = "formgraph: 1\nnodes:\n"
+
+
+@pytest.fixture(autouse=True)
+def _keep_locale():
+    """lib3mf's writer sets the process's locale to "C" and leaves it there, which turns
+    Python's default text encoding into ASCII for every later test: put it back."""
+    import locale
+
+    saved = locale.setlocale(locale.LC_ALL, None)
+    yield
+    locale.setlocale(locale.LC_ALL, saved)
+
+
 TWO = (
     "  ball: {type: mesh.sphere, radius: 2}\n"
     "  box: {type: mesh.box, size: [1, 2, 3], center: [5, 0, 0]}\n"
@@ -81,7 +94,7 @@ def test_3mf_units_scale_on_reading(tmp_path):
     )
     from formgraph.kernels.io.threemf import read_3mf
 
-    ((_, v, _),) = read_3mf(Path(out).read_bytes())
+    ((_, v, _, _),) = read_3mf(Path(out).read_bytes())
     np.testing.assert_allclose(v, g.evaluate("box").vertices * 25.4)
 
 
@@ -288,3 +301,104 @@ def test_rhino_round_trips_through_read_rhino_exactly(tmp_path):
         m.face_indices, box.face_indices
     )
     assert len(back.points) == 0
+
+
+# ------------------------------------------------------------------------ vertex colours
+
+COLOURED = """\
+  ball: {type: mesh.sphere, radius: 2}
+  paint: {type: attr.set, geometry: "@ball", name: color,
+    value: ["=clip(0.5 + x / 4, 0, 1)", "=clip(0.5 + y / 4, 0, 1)", 0.25]}
+"""
+
+
+def test_glb_carries_a_color_attribute_as_color_0(tmp_path):
+    g, out = _run(
+        tmp_path, COLOURED + "  x: {type: export.gltf, meshes: ['@paint'], path: c.glb}\n", "x"
+    )
+    scene = trimesh.load(io.BytesIO(Path(out).read_bytes()), file_type="glb", process=False)
+    (mesh,) = scene.geometry.values()
+    want = np.asarray(g.evaluate("paint").point_data["color"])
+    got = np.asarray(mesh.visual.vertex_colors)[:, :3] / 255.0
+    np.testing.assert_allclose(got, want, atol=1 / 255 + 1e-9)
+    (tmp_path / "in.yaml").write_text(HEAD + "  m: {type: read.mesh, path: out/c.glb}\n")
+    back = fg.load(tmp_path / "in.yaml").evaluate("m")  # and our reader takes COLOR_0 back
+    np.testing.assert_allclose(back.point_data["color"], want, atol=1e-7)
+
+
+def test_3mf_carries_a_color_attribute_as_a_colour_group(tmp_path):
+    lib3mf = pytest.importorskip("lib3mf")
+    g, out = _run(
+        tmp_path, COLOURED + "  x: {type: export.3mf, meshes: ['@paint'], path: c.3mf}\n", "x"
+    )
+    model = lib3mf.get_wrapper().CreateModel()
+    reader = model.QueryReader("3mf")
+    reader.SetStrictModeActive(True)
+    reader.ReadFromFile(out)
+    assert reader.GetWarningCount() == 0
+    groups = model.GetColorGroups()
+    assert groups.MoveNext()
+    group = groups.GetCurrentColorGroup()
+    ids = group.GetAllPropertyIDs()
+    want = np.round(np.asarray(g.evaluate("paint").point_data["color"]) * 255)
+    assert len(ids) == len(want)
+    got = [(c.Red, c.Green, c.Blue) for c in (group.GetColor(i) for i in ids[:50])]
+    np.testing.assert_array_equal(got, want[:50])
+    objects = model.GetMeshObjects()
+    objects.MoveNext()
+    obj = objects.GetCurrentMeshObject()
+    for t in range(0, obj.GetTriangleCount(), 37):  # each corner's colour is its vertex's
+        prop, tri = obj.GetTriangleProperties(t), obj.GetTriangle(t).Indices
+        assert prop.ResourceID == group.GetResourceID()
+        assert [prop.PropertyIDs[j] for j in range(3)] == [ids[i] for i in tri]
+    (tmp_path / "in.yaml").write_text(HEAD + "  m: {type: read.mesh, path: out/c.3mf}\n")
+    back = fg.load(tmp_path / "in.yaml").evaluate("m")  # our reader takes the group back
+    np.testing.assert_allclose(back.point_data["color"][:, :3], want / 255, atol=1e-12)
+
+
+def test_read_rhino_takes_what_rhino3dm_writes(tmp_path):
+    r = pytest.importorskip("rhino3dm")
+    model = r.File3dm()
+    model.Objects.AddCurve(r.LineCurve(r.Point3d(0, 0, 0), r.Point3d(3, 4, 0)))
+    model.Objects.AddCircle(r.Circle(r.Point3d(1, 2, 0), 5.0))
+    model.Objects.AddSphere(r.Sphere(r.Point3d(0, 0, 0), 2.0))
+    model.Objects.AddPoint(r.Point3d(7, 8, 9))
+    mesh = r.Mesh()
+    for p in ((0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)):
+        mesh.Vertices.Add(*p)
+    mesh.Faces.AddFace(0, 1, 2, 3)
+    model.Objects.AddMesh(mesh)
+    model.Write(str(tmp_path / "m.3dm"), 8)
+    (tmp_path / "in.yaml").write_text(HEAD + "  m: {type: read.rhino, path: m.3dm}\n")
+    got = fg.load(tmp_path / "in.yaml").evaluate("m")
+    line, circle = got.curves
+    np.testing.assert_allclose(
+        line.evaluate([line.knots[0], line.knots[-1]]), [[0, 0, 0], [3, 4, 0]]
+    )
+    assert circle.rational
+    p = circle.evaluate(np.linspace(circle.knots[0], circle.knots[-1], 50))
+    np.testing.assert_allclose(np.linalg.norm(p - [1, 2, 0], axis=1), 5, atol=1e-12)
+    (sphere,) = got.surfaces
+    u, v = np.meshgrid(np.linspace(*sphere.domain_u, 7), np.linspace(*sphere.domain_v, 7))
+    s = sphere.evaluate(u.ravel(), v.ravel())
+    np.testing.assert_allclose(np.linalg.norm(s, axis=1), 2, atol=1e-12)
+    (m,) = got.meshes
+    assert m.face_offsets.tolist() == [0, 4] and got.points.xyz.tolist() == [[7, 8, 9]]
+
+
+def test_step_rational_curve_stays_a_circle_in_opencascade(tmp_path):
+    from OCP.BRep import BRep_Tool
+
+    g, out = _run(
+        tmp_path,
+        "  c: {type: nurbs.circle, radius: 3}\n"
+        "  x: {type: export.step, curves: ['@c'], path: c.step}\n",
+        "x",
+    )
+    (edge,) = _occ_items(_occ(out), "EDGE")
+    curve = BRep_Tool.Curve_s(edge, 0, 1)
+    assert curve.IsRational()
+    c = g.evaluate("c")
+    for t in np.linspace(c.knots[0], c.knots[-1], 17):
+        p = curve.Value(float(t))
+        np.testing.assert_allclose([p.X(), p.Y(), p.Z()], c.evaluate([t])[0], atol=1e-12)

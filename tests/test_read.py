@@ -16,6 +16,17 @@ from formgraph.kernels.io.exporters import obj_bytes, ply_binary, stl_ascii, stl
 HEAD = "formgraph: 1\nnodes:\n"
 
 
+@pytest.fixture(autouse=True)
+def _keep_locale():
+    """lib3mf's writer sets the process's locale to "C" and leaves it there, which turns
+    Python's default text encoding into ASCII for every later test: put it back."""
+    import locale
+
+    saved = locale.setlocale(locale.LC_ALL, None)
+    yield
+    locale.setlocale(locale.LC_ALL, saved)
+
+
 def _graph(folder: Path, body: str, name: str = "g.yaml") -> Path:
     path = folder / name
     path.write_text(HEAD + body)
@@ -58,6 +69,21 @@ def test_an_edited_file_recomputes_an_unchanged_one_is_not_parsed(tmp_path):
     assert g.stats["m"].status == "computed" and g.stats["t"].status == "computed"
 
 
+def test_an_unchanged_file_is_not_even_read_again(tmp_path, monkeypatch):
+    from formgraph.core import safety
+
+    trimesh.creation.box().export(tmp_path / "part.stl")
+    g = fg.load(_graph(tmp_path, "  m: {type: read.mesh, path: part.stl}\n"))
+    reads = []
+    real = safety.read_input
+    monkeypatch.setattr(safety, "read_input", lambda p, *a: reads.append(p) or real(p, *a))
+    g.evaluate("m")
+    for _ in range(3):  # keyed again (as a sweep plans each variant): the stamp says unchanged
+        g.plan("m")
+        g.evaluate("m")
+    assert len(reads) == 1 and g.stats["m"].status == "cached"
+
+
 def test_the_disk_cache_keys_by_content_across_processes(tmp_path):
     trimesh.creation.box().export(tmp_path / "part.stl")
     path = _graph(tmp_path, "  m: {type: read.mesh, path: part.stl}\n")
@@ -70,7 +96,8 @@ def test_the_disk_cache_keys_by_content_across_processes(tmp_path):
 def test_watch_files_include_the_inputs(tmp_path):
     trimesh.creation.box().export(tmp_path / "part.stl")
     g = fg.load(_graph(tmp_path, "  m: {type: read.mesh, path: part.stl}\n"))
-    assert (tmp_path / "part.stl").resolve() in g.files
+    assert (tmp_path / "part.stl").resolve() in g.input_files
+    assert g.files == [tmp_path / "g.yaml"]  # what a sweep sends along: the graph's own text
 
 
 def test_an_inputs_folder_is_where_paths_start_and_stop(tmp_path):
@@ -338,7 +365,7 @@ def test_run_with_set_file_from_the_command_line(tmp_path):
     assert "80" in r.stdout
 
 
-def test_headless_watch_redraws_when_an_input_file_changes(tmp_path):
+def test_watch_watches_the_input_files(tmp_path):
     pytest.importorskip("pyvista")
     import os
     import time
@@ -346,17 +373,47 @@ def test_headless_watch_redraws_when_an_input_file_changes(tmp_path):
     from formgraph import viewer
 
     (tmp_path / "data").mkdir()
+    part = tmp_path / "data" / "part.stl"
+    trimesh.creation.box().export(part)
+    graph = _graph(tmp_path, "  m: {type: read.mesh, path: part.stl, weld: true}\n")
+    w = viewer.ScreenshotWatcher(
+        graph, tmp_path / "m.png", "m", out=io.StringIO(), err=io.StringIO(),
+        out_dir=tmp_path / "o", inputs_dir=tmp_path / "data",
+    )  # fmt: skip
+    g, _ = w._load(None)  # what a reload loads, without drawing it
+    assert part.resolve() in w.files and g.evaluate("m").n_faces == 12
+    before = w._stamp()
+    trimesh.creation.icosphere(1).export(part)
+    later = time.time() + 5
+    os.utime(part, (later, later))  # a new stamp, even on a coarse clock
+    assert w._stamp() != before  # the next poll reloads
+
+
+def test_a_sweep_worker_reads_inputs_from_the_same_folder(tmp_path):
+    from formgraph.sweeps import cluster, tasks
+
+    (tmp_path / "data").mkdir()
     trimesh.creation.box().export(tmp_path / "data" / "part.stl")
     graph = _graph(tmp_path, "  m: {type: read.mesh, path: part.stl, weld: true}\n")
-    png, out, err = tmp_path / "m.png", io.StringIO(), io.StringIO()
-    w = viewer.ScreenshotWatcher(
-        graph, png, "m", size=(160, 120), out=out, err=err, out_dir=tmp_path / "o",
-        inputs_dir=tmp_path / "data",
-    )  # fmt: skip
-    assert w.reload() is True and (tmp_path / "data" / "part.stl").resolve() in w.files
-    assert w.poll() is None
-    trimesh.creation.icosphere(1).export(tmp_path / "data" / "part.stl")
-    later = time.time() + 5
-    os.utime(tmp_path / "data" / "part.stl", (later, later))  # a new stamp, even on coarse clocks
-    assert w.poll() is True, err.getvalue()
-    assert "80 faces" in out.getvalue() or len(out.getvalue().splitlines()) == 2
+    g = fg.load(graph, inputs_dir=tmp_path / "data")
+    bp = cluster.blueprint(g, None, False)  # what travels to a worker
+    assert bp.inputs == str((tmp_path / "data").resolve())
+    assert tasks._graph(bp).evaluate("m").n_faces == 12
+
+
+def test_ply_attributes_written_by_export_ply_come_back(tmp_path):
+    (tmp_path / "w.yaml").write_text(
+        HEAD + "  ball: {type: mesh.sphere, radius: 2}\n"
+        "  paint: {type: attr.set, geometry: '@ball', name: color,"
+        " value: ['=clip(0.5 + x / 4, 0, 1)', 0.5, 0.25]}\n"
+        "  heat: {type: attr.set, geometry: '@paint', name: heat, value: '=z * z'}\n"
+        "  x: {type: export.ply, mesh: '@heat', path: c.ply}\n"
+    )
+    g = fg.load(tmp_path / "w.yaml", out_dir=tmp_path)
+    g.evaluate("x")
+    back = _read(tmp_path, "c.ply")
+    want = g.evaluate("heat")
+    np.testing.assert_allclose(back.point_data["color"], want.point_data["color"], atol=0.5 / 255)
+    np.testing.assert_array_equal(back.point_data["heat"], want.point_data["heat"])
+    pts = _points(tmp_path, "c.ply", (tmp_path / "c.ply").read_bytes())
+    assert len(pts) == want.n_vertices

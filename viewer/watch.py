@@ -80,7 +80,7 @@ class _Watched:
         graph = load(
             self.path, out_dir=self.out_dir, budget=self.budget, inputs_dir=self.inputs_dir
         )
-        self.files = [self.path, *graph.files[1:]]
+        self.files = [self.path, *graph.files[1:], *graph.input_files]
         self.stamp = self._stamp()
         if memory is not None:
             graph.memory = memory  # an edit recomputes what it reaches

@@ -119,6 +119,7 @@ class Graph:
         self._last: dict[str, tuple[str, str]] = {}  # node -> (key, identity) of its last output
         self._digests: dict[str, str | None] = {}  # cache key -> content digest, when computed
         self._written: dict[str, tuple[int, int] | None] = {}  # export key -> file stamp
+        self._input_digests: dict[str, tuple[tuple[int, ...], str]] = {}  # input -> (stamp, hash)
         self._parse_problems: list[Problem] = []
         self.outputs: dict[str, Any] = {}  # the `outputs:` mapping, for use as a subgraph
         self._output_lines: dict[str, int] = {}
@@ -192,11 +193,15 @@ class Graph:
 
     @property
     def files(self) -> list[Path]:
-        """The graph's file, every subgraph file it reads, and the input files its nodes
-        name as written (what ``watch`` watches)."""
+        """The graph's file and every subgraph file it reads (what a sweep sends along)."""
         own = [Path(self.file)] if self.file else []
-        subs = list(self._includes.files) if self._includes is not None else []
-        return own + subs + self._input_files()
+        return own + (list(self._includes.files) if self._includes is not None else [])
+
+    @property
+    def input_files(self) -> list[Path]:
+        """The files its read nodes name, resolved (a literal path, or a path from a param's
+        current value); ``watch`` watches them with :attr:`files`."""
+        return self._input_files()
 
     def _input_files(self) -> list[Path]:
         from ..core import safety
@@ -255,6 +260,7 @@ class Graph:
                 self._digests,
                 self._written,
             )
+            child._input_digests = self._input_digests
             child._params, child._nodes, child.outputs = doc.params, doc.nodes, doc.outputs
             child._values = {n: p.default for n, p in doc.params.items()}
             child._subgraphs = dict(spec.subgraphs)

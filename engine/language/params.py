@@ -148,10 +148,12 @@ def file_value(name: str, declared: Any, text: str) -> Any:
         raise GraphError(f"--set {name}: {exc}") from None
     try:
         if base is Mesh and not many:
-            return Mesh(*readers.mesh_arrays(text, data))
+            v, fi, fo, attributes = readers.mesh_data(text, data)
+            return Mesh(v, fi, fo, point_data=attributes or None)
         if base is Points and not many:
             ext = readers.extension(text, readers.POINT_FORMATS)
-            return Points(readers.POINT_FORMATS[ext](data))
+            attributes = readers.vertex_attributes(text, data)
+            return Points(readers.POINT_FORMATS[ext](data), point_data=attributes or None)
         if base.__name__ in ("Curve", "NurbsCurve"):
             ext = readers.extension(text, readers.CURVE_FORMATS)
             found, _ = readers.CURVE_FORMATS[ext](data, DEFAULT_BUDGET)

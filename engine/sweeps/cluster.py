@@ -146,6 +146,7 @@ def blueprint(g: Graph, cache_dir: str | None, worker_cache: bool) -> Blueprint:
         worker_cache,
         files,
         str(Path(g.file).resolve()) if g.file else "",
+        str(Path(g.input_base).resolve()),
     )
 
 

@@ -41,6 +41,8 @@ class Blueprint:
     files: dict[str, str] = field(default_factory=dict)  # subgraph files, by path from
     # the graph's folder: a worker without them (another machine) writes them out
     path: str = ""  # the graph file's absolute path on the client
+    inputs: str = ""  # the folder its read nodes read, absolute on the client (same machine,
+    # or the same path on every worker)
 
     def __dask_tokenize__(self) -> str:  # Dask names the graph by hashing it: keep it cheap
         return self.token
@@ -116,6 +118,7 @@ def _graph(bp: Blueprint) -> Graph:
             budget=bp.budget,
             memory_bytes=0,  # Dask holds the values; a second copy would only cost memory
             out_dir=tempfile.gettempdir(),
+            inputs_dir=bp.inputs or None,
         )
         g.set(**bp.params)
         if len(_GRAPHS) >= 4:

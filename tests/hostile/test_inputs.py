@@ -155,3 +155,27 @@ def test_a_gltf_accessor_past_its_buffer_is_refused():
     }
     with pytest.raises(ValueError, match="runs past"):
         read_gltf(json.dumps(doc).encode())
+
+
+LAUGHS = (
+    b'<?xml version="1.0"?><!DOCTYPE l [<!ENTITY a "aaaaaaaaaa">'
+    + b"".join(
+        f'<!ENTITY {n} "{("&" + p + ";") * 10}">'.encode()
+        for p, n in zip("abcdefg", "bcdefgh", strict=True)
+    )
+    + b']><svg xmlns="http://www.w3.org/2000/svg"><text>&h;</text></svg>'
+)
+XXE = (
+    b'<?xml version="1.0"?><!DOCTYPE svg [<!ENTITY x SYSTEM "file:///etc/hostname">]>'
+    b'<svg xmlns="http://www.w3.org/2000/svg"><text>&x;</text></svg>'
+)
+
+
+@pytest.mark.parametrize("data", [LAUGHS, XXE], ids=["billion-laughs", "external-entity"])
+def test_svg_entity_attacks_are_refused(tmp_path, data):
+    (tmp_path / "a.svg").write_bytes(data)
+    (tmp_path / "g.yaml").write_text(
+        "formgraph: 1\nnodes:\n  c: {type: read.curves, path: a.svg}\n"
+    )
+    with pytest.raises(fg.NodeError, match="not an SVG document"):
+        fg.load(tmp_path / "g.yaml").evaluate("c")

@@ -71,6 +71,9 @@ def write_glb(
         glTF defines it).
     scale : float
         Metres per model unit (glTF's unit is the metre; 1e-3 for millimetres).
+    colors : sequence of (n, 3) or (n, 4) float in 0..1, or None, optional
+        Each mesh's vertex colours, written as ``COLOR_0`` (float32, linear as glTF reads
+        them; clipped to 0..1).
 
     Returns
     -------
@@ -109,10 +112,12 @@ def write_glb(
         normal = add(vertex_normals(v, tris).astype("<f4"), 34962, 5126, "VEC3", False)
         indices = add(tris.astype("<u4").ravel(), 34963, 5125, "SCALAR", False)
         attributes = {"POSITION": position, "NORMAL": normal}
-        colour = None if colors is None else colors[k]
-        if colour is not None:
-            c = np.clip(np.asarray(colour, dtype=np.float64).reshape(len(v), -1), 0.0, 1.0)
-            kind = "VEC4" if c.shape[1] == 4 else "VEC3"
+        c = None if colors is None else colors[k]
+        if c is not None:
+            c = np.clip(np.asarray(c, dtype=np.float64).reshape(len(v), -1), 0.0, 1.0)
+            if c.shape[1] not in (3, 4):
+                raise ValueError(f"vertex colours need 3 or 4 components, got {c.shape[1]}")
+            kind = "VEC3" if c.shape[1] == 3 else "VEC4"
             attributes["COLOR_0"] = add(c.astype("<f4"), 34962, 5126, kind, False)
         gmeshes.append(
             {
@@ -156,8 +161,9 @@ def write_glb(
 
 def read_gltf(data: bytes, *, scale: float = 1e3) -> list[tuple[str, np.ndarray, np.ndarray]]:
     """The triangle meshes a glTF 2.0 file (``.glb``, or ``.gltf`` JSON with embedded
-    ``data:`` buffers) places: ``(name, vertices (n, 3), triangles (t, 3))`` per mesh
-    instance, transforms applied, coordinates times ``scale`` (1000: metres to millimetres).
+    ``data:`` buffers) places: ``(name, vertices (n, 3), triangles (t, 3), colours (n, 3|4)
+    or None)`` per mesh instance (``COLOR_0``, normalized integers read as 0..1), transforms
+    applied, coordinates times ``scale`` (1000: metres to millimetres).
 
     Raises
     ------
@@ -200,7 +206,7 @@ def read_gltf(data: bytes, *, scale: float = 1e3) -> list[tuple[str, np.ndarray,
     out = []
     for k, m in placed:
         mesh = meshes[k] if isinstance(meshes[k], dict) else {}
-        verts, tris, base = [], [], 0
+        verts, tris, colors, base = [], [], [], 0
         for prim in mesh.get("primitives", []):
             if prim.get("mode", 4) != 4:
                 continue  # points and lines are not surfaces
@@ -218,10 +224,17 @@ def read_gltf(data: bytes, *, scale: float = 1e3) -> list[tuple[str, np.ndarray,
                 raise ValueError(f"mesh {k}: an index refers to a vertex that does not exist")
             verts.append(p @ m[:3, :3].T + m[:3, 3])
             tris.append(t.reshape(-1, 3) + base)
+            color = None
+            if "COLOR_0" in attrs:
+                color = _accessor(doc, buffers, attrs["COLOR_0"]).astype(np.float64)
+                if color.shape != (len(p), color.shape[1]) or color.shape[1] not in (3, 4):
+                    raise ValueError(f"mesh {k}: COLOR_0 does not hold a colour a vertex")
+            colors.append(color)
             base += len(p)
         if verts:
             name = str(mesh.get("name", f"mesh {k}"))
-            out.append((name, np.concatenate(verts) * scale, np.concatenate(tris)))
+            c = np.concatenate(colors) if all(x is not None for x in colors) else None
+            out.append((name, np.concatenate(verts) * scale, np.concatenate(tris), c))
     return out
 
 

@@ -15,7 +15,7 @@ import numpy as np
 
 from .textscan import Lines, line_numbers, parse_floats, token_starts
 
-__all__ = ["PlyElement", "read_ply", "read_ply_vertices"]
+__all__ = ["PlyElement", "point_data", "read_ply", "read_ply_vertices"]
 
 _TYPES = {
     "char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1",
@@ -98,6 +98,42 @@ def read_ply_vertices(data: bytes) -> dict[str, np.ndarray]:
     """Every scalar property of a PLY file's ``vertex`` element, by name (faces skipped)."""
     columns, _ = _read(data, want_faces=False)
     return columns
+
+
+def point_data(data: bytes) -> dict[str, np.ndarray]:
+    """The vertex attributes of a PLY file, named as formgraph writes them
+    (:func:`formgraph.kernels.io.exporters.ply_binary`): ``red green blue [alpha]`` as a
+    ``color`` in 0..1 (integers divided by their type's maximum), ``nx ny nz`` as a
+    ``normal``, ``name_0 .. name_k`` as one (n, k) ``name``, any other scalar as itself."""
+    fmt, elements, _ = _header(data)
+    vertex = next(e for e in elements if e.name == "vertex")
+    types = {p[0]: p[1] for p in vertex.properties if p[2] is None}
+    columns = read_ply_vertices(data)
+    out: dict[str, np.ndarray] = {}
+    used = {"x", "y", "z"}
+    rgb = [c for c in ("red", "green", "blue", "alpha") if c in columns]
+    if {"red", "green", "blue"} <= set(rgb):
+        kind = np.dtype(_TYPES[types["red"]])
+        scale = float(np.iinfo(kind).max) if kind.kind in "iu" else 1.0
+        out["color"] = np.column_stack([columns[c] for c in rgb]) / scale
+        used |= set(rgb)
+    if {"nx", "ny", "nz"} <= set(columns):
+        out["normal"] = np.column_stack([columns[c] for c in ("nx", "ny", "nz")])
+        used |= {"nx", "ny", "nz"}
+    vectors: dict[str, list[tuple[int, str]]] = {}
+    for name in columns:
+        base, _, index = name.rpartition("_")
+        if name not in used and base and index.isdigit():
+            vectors.setdefault(base, []).append((int(index), name))
+    for base, parts in vectors.items():
+        parts.sort()
+        if [k for k, _ in parts] == list(range(len(parts))) and base not in columns:
+            out[base] = np.column_stack([columns[n] for _, n in parts])
+            used |= {n for _, n in parts}
+    for name, values in columns.items():
+        if name not in used:
+            out[name] = values
+    return out
 
 
 def _read(data: bytes, want_faces: bool):

@@ -14,28 +14,45 @@ import numpy as np
 from .dxf_read import read_dxf
 from .gltf import read_gltf
 from .mesh_read import read_obj, read_off, read_stl
-from .ply_read import read_ply
+from .ply_read import point_data, read_ply
 from .points_read import read_ply_points, read_text_points
 from .svg_read import MAX_ELEMENTS, read_svg
 from .threemf import read_3mf
 
-__all__ = ["CURVE_FORMATS", "MESH_FORMATS", "POINT_FORMATS", "extension", "mesh_arrays"]
+__all__ = [
+    "CURVE_FORMATS",
+    "MESH_FORMATS",
+    "POINT_FORMATS",
+    "extension",
+    "mesh_arrays",
+    "mesh_data",
+    "vertex_attributes",
+]
 
 
-def _merged(parts: list[tuple[str, np.ndarray, np.ndarray]]) -> tuple[np.ndarray, ...]:
+def _merged(parts: list[tuple]) -> tuple:
+    """One mesh of several placed ones; a ``color`` when every part has one."""
     if not parts:
         raise ValueError("the file places no triangle mesh")
     shift = np.cumsum([0] + [len(p[1]) for p in parts[:-1]])
     v = np.concatenate([p[1] for p in parts])
     t = np.concatenate([p[2] + s for p, s in zip(parts, shift, strict=True)]).astype(np.int64)
-    return v, t.ravel(), np.arange(0, t.size + 1, 3, dtype=np.int64)
+    colors = [p[3] if len(p) > 3 else None for p in parts]
+    attributes = {}
+    if all(c is not None for c in colors) and len({c.shape[1] for c in colors}) == 1:
+        attributes["color"] = np.concatenate(colors)
+    return v, t.ravel(), np.arange(0, t.size + 1, 3, dtype=np.int64), attributes
 
 
-MESH_FORMATS = {
-    ".stl": read_stl,
-    ".obj": read_obj,
-    ".ply": read_ply,
-    ".off": read_off,
+def _plain(reader):
+    return lambda data: (*reader(data), {})
+
+
+MESH_FORMATS = {  # data -> (vertices, face_indices, face_offsets, point attributes)
+    ".stl": _plain(read_stl),
+    ".obj": _plain(read_obj),
+    ".ply": lambda data: (*read_ply(data), point_data(data)),
+    ".off": _plain(read_off),
     ".3mf": lambda data: _merged(read_3mf(data)),
     ".glb": lambda data: _merged(read_gltf(data)),
     ".gltf": lambda data: _merged(read_gltf(data)),
@@ -43,7 +60,7 @@ MESH_FORMATS = {
 
 
 CURVE_FORMATS = {  # (data, element budget) -> (curves with a .curve and a .layer, skipped)
-    ".svg": lambda data, budget: (read_svg(data, min(MAX_ELEMENTS, budget)), {}),
+    ".svg": lambda data, budget: read_svg(data, min(MAX_ELEMENTS, budget)),
     ".dxf": lambda data, budget: read_dxf(data, budget),
 }
 
@@ -66,8 +83,10 @@ def extension(name: str, formats: dict) -> str:
     return ext
 
 
-def mesh_arrays(name: str, data: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(vertices, face_indices, face_offsets)`` of the mesh file ``name`` holding ``data``.
+def mesh_data(name: str, data: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict]:
+    """``(vertices, face_indices, face_offsets, point attributes)`` of the mesh file
+    ``name`` holding ``data`` (attributes: a PLY's extra vertex properties, a glTF's
+    ``COLOR_0`` as ``color``).
 
     Raises
     ------
@@ -75,3 +94,14 @@ def mesh_arrays(name: str, data: bytes) -> tuple[np.ndarray, np.ndarray, np.ndar
         An unknown extension, or what the format's reader finds wrong.
     """
     return MESH_FORMATS[extension(name, MESH_FORMATS)](data)
+
+
+def mesh_arrays(name: str, data: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(vertices, face_indices, face_offsets)`` of a mesh file, attributes dropped."""
+    return mesh_data(name, data)[:3]
+
+
+def vertex_attributes(name: str, data: bytes) -> dict[str, np.ndarray]:
+    """The per-vertex attributes a point file carries (a PLY's extra vertex properties);
+    none for the text formats."""
+    return point_data(data) if extension(name, POINT_FORMATS) == ".ply" else {}

@@ -90,8 +90,9 @@ def write_3dm(
 ) -> bytes:
     """A Rhino 8 ``.3dm`` file of the objects, model units millimetres.
 
-    ``layers`` names each object's layer (curves first, then surfaces, then meshes); by
-    default ``curves``, ``surfaces`` and ``meshes``.
+    ``layers`` names each object's layer (curves first, then surfaces, then meshes; the
+    last name takes any further objects, as the drawing exports' layers do); by default
+    ``curves``, ``surfaces`` and ``meshes``.
     """
     import rhino3dm as r
 
@@ -100,8 +101,10 @@ def write_3dm(
     count = len(curves) + len(surfaces) + len(meshes)
     if layers is None:
         layers = ["curves"] * len(curves) + ["surfaces"] * len(surfaces) + ["meshes"] * len(meshes)
-    if len(layers) != count:
-        raise ValueError(f"{len(layers)} layers for {count} objects: give one each")
+    layers = list(layers)
+    if len(layers) > count or (count and not layers):
+        raise ValueError(f"{len(layers)} layers for {count} objects: give at most one each")
+    layers += layers[-1:] * (count - len(layers))
     index: dict[str, int] = {}
     for name in layers:
         if name not in index:

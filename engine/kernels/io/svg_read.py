@@ -25,6 +25,7 @@ from __future__ import annotations
 import io
 import math
 import re
+from collections import Counter
 from dataclasses import dataclass
 
 import numpy as np
@@ -42,7 +43,7 @@ _TAG = re.compile(rb"<(/?)([^>]*?)(/?)>")
 @dataclass(frozen=True)
 class SvgCurve:
     curve: CurveArrays
-    layer: str  # the id (or Inkscape label) of its top-level group; "" outside any
+    layer: str  # its Inkscape layer's label (or id), else its outermost named group's id
 
 
 def _bounded(data: bytes, max_elements: int) -> None:
@@ -63,8 +64,9 @@ def _bounded(data: bytes, max_elements: int) -> None:
         raise ValueError(f"elements nest {deepest:,} deep, over the budget of {MAX_DEPTH}")
 
 
-def read_svg(data: bytes, max_elements: int = MAX_ELEMENTS) -> list[SvgCurve]:
-    """Every drawn shape of an SVG file as exact NURBS arrays, one per subpath.
+def read_svg(data: bytes, max_elements: int = MAX_ELEMENTS) -> tuple[list[SvgCurve], Counter]:
+    """Every drawn shape of an SVG file as exact NURBS arrays, one per subpath, and a count
+    of what was passed over (``text`` not converted to paths, ``image``).
 
     Raises
     ------
@@ -83,18 +85,23 @@ def read_svg(data: bytes, max_elements: int = MAX_ELEMENTS) -> list[SvgCurve]:
     flip = np.array([mm, -mm, 1.0])
     shift = np.array([0.0, height * mm if height else 0.0, 0.0])
     out: list[SvgCurve] = []
-    stack: list[tuple[object, str]] = [(doc, "")]
+    passed: Counter = Counter()
+    # (element, its layer, whether that layer is an Inkscape layer rather than a named group)
+    stack: list[tuple[object, str, bool]] = [(doc, "", False)]
     while stack:  # depth-first, without recursion
-        node, layer = stack.pop()
+        node, layer, marked = stack.pop()
         if isinstance(node, se.Group) or node is doc:
-            children = list(node)
-            for child in reversed(children):
-                name = layer
-                if isinstance(child, se.Group) and node is doc:
-                    name = _layer_name(child)
-                stack.append((child, name))
+            for child in reversed(list(node)):
+                name, mark = layer, marked
+                if isinstance(child, se.Group):
+                    is_layer = _is_layer(child)
+                    if is_layer or (not marked and not layer):  # innermost layer, else outermost id
+                        name, mark = (_layer_name(child) or layer), is_layer or marked
+                stack.append((child, name, mark))
             continue
         if not isinstance(node, se.Shape):
+            if isinstance(node, se.Text | se.Image):
+                passed[type(node).__name__.lower()] += 1
             continue
         if node.values.get("visibility") == "hidden":
             continue
@@ -104,7 +111,7 @@ def read_svg(data: bytes, max_elements: int = MAX_ELEMENTS) -> list[SvgCurve]:
         for chain in _chains(se.Path(node), se):
             cp, p, k, w = chain.curve()
             out.append(SvgCurve(((cp @ lin.T + move) * flip + shift, p, k, w), layer))
-    return out
+    return out, passed
 
 
 _UNIT_MM = {
@@ -150,6 +157,11 @@ def _length(value: object) -> float:
     except (TypeError, ValueError):
         return 0.0
     return f if np.isfinite(f) and f > 0 else 0.0
+
+
+def _is_layer(group: object) -> bool:
+    values = getattr(group, "values", {}) or {}
+    return any(str(k).endswith("groupmode") and v == "layer" for k, v in values.items())
 
 
 def _layer_name(group: object) -> str:

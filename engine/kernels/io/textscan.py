@@ -61,9 +61,9 @@ class Lines:
             out = np.concatenate([out, np.array([10], np.uint8)])  # the last line's newline
             lengths = lengths.copy()
             lengths[-1] += 1
-        new_starts = np.concatenate([[0], np.cumsum(lengths)[:-1]]).astype(np.int64)
+        new_starts = (np.cumsum(lengths) - lengths).astype(np.int64)
         if skip:
-            out = out.copy() if not out.flags.writeable or out.base is not None else out
+            # out is a fresh array (boolean indexing copies): blank the prefixes in place
             out[(new_starts[:, None] + np.arange(skip)).ravel()] = 32
         return out, new_starts
 

@@ -28,6 +28,7 @@ from .textscan import parse_floats
 __all__ = ["MAX_MODEL_BYTES", "UNITS", "read_3mf", "write_3mf"]
 
 CORE = "http://schemas.microsoft.com/3dmanufacturing/core/2015/02"
+MATERIAL = "http://schemas.microsoft.com/3dmanufacturing/material/2015/02"
 MODEL_REL = "http://schemas.microsoft.com/3dmanufacturing/2013/01/3dmodel"
 UNITS = {  # the unit's length in millimetres
     "micron": 1e-3,
@@ -63,6 +64,7 @@ def write_3mf(
     names: Sequence[str] | None = None,
     colors: Sequence[tuple[float, float, float, float]] | None = None,
     unit: str = "millimeter",
+    vertex_colors: Sequence[np.ndarray | None] | None = None,
 ) -> bytes:
     """A 3MF package of triangle meshes: one object and one build item per mesh.
 
@@ -75,6 +77,10 @@ def write_3mf(
         Each object's colour, as a base material's ``displaycolor``.
     unit : str
         One of :data:`UNITS`; the coordinates are written as they are, in that unit.
+    vertex_colors : sequence of (n, 3) or (n, 4) float in 0..1, or None, optional
+        Each mesh's vertex colours, as a colour group of the 3MF Materials and Properties
+        extension (one ``<m:color>`` per vertex, each triangle's ``p1 p2 p3`` its corners');
+        they take precedence over ``colors`` for that mesh.
 
     Returns
     -------
@@ -86,30 +92,50 @@ def write_3mf(
         raise ValueError(f"unknown unit {unit!r}; one of {', '.join(UNITS)}")
     n = len(meshes)
     names = list(names) if names is not None else [f"mesh {k + 1}" for k in range(n)]
+    vertex_colors = list(vertex_colors) if vertex_colors is not None else [None] * n
     parts = [
         '<?xml version="1.0" encoding="UTF-8"?>\n'
-        f'<model unit="{unit}" xml:lang="en-US" xmlns="{CORE}">\n<resources>\n'
+        f'<model unit="{unit}" xml:lang="en-US" xmlns="{CORE}" xmlns:m="{MATERIAL}">\n'
+        "<resources>\n"
     ]
-    first_object = 1
+    next_id = 1
     if colors is not None:
         bases = "".join(
             f'<base name={quoteattr(names[k])} displaycolor="{_hex(c)}"/>\n'
             for k, c in enumerate(colors)
         )
         parts.append(f'<basematerials id="1">\n{bases}</basematerials>\n')
-        first_object = 2
+        next_id = 2
     chunks: list[bytes] = ["".join(parts).encode()]
+    object_ids = []
     for k, (v, tris) in enumerate(meshes):
-        pid = f' pid="1" pindex="{k}"' if colors is not None else ""
+        v = np.asarray(v, dtype=np.float64)
+        group = None
+        if (
+            vertex_colors[k] is not None
+        ):  # the materials extension's colour group, a colour a vertex
+            group = next_id
+            next_id += 1
+            chunks.append(f'<m:colorgroup id="{group}">\n'.encode())
+            chunks.extend(_color_rows(np.asarray(vertex_colors[k], dtype=np.float64)))
+            chunks.append(b"</m:colorgroup>\n")
+        if group is not None:
+            pid = f' pid="{group}" pindex="0"'
+        elif colors is not None:
+            pid = f' pid="1" pindex="{k}"'
+        else:
+            pid = ""
+        object_ids.append(next_id)
         chunks.append(
-            f'<object id="{first_object + k}" type="model" name={quoteattr(names[k])}{pid}>'
+            f'<object id="{next_id}" type="model" name={quoteattr(names[k])}{pid}>'
             "<mesh>\n<vertices>\n".encode()
         )
-        chunks.extend(_vertex_rows(np.asarray(v, dtype=np.float64)))
+        next_id += 1
+        chunks.extend(_vertex_rows(v))
         chunks.append(b"</vertices>\n<triangles>\n")
-        chunks.extend(_triangle_rows(np.asarray(tris, dtype=np.int64).reshape(-1, 3)))
+        chunks.extend(_triangle_rows(np.asarray(tris, dtype=np.int64).reshape(-1, 3), group))
         chunks.append(b"</triangles>\n</mesh></object>\n")
-    items = "".join(f'<item objectid="{first_object + k}"/>' for k in range(n))
+    items = "".join(f'<item objectid="{i}"/>' for i in object_ids)
     chunks.append(f"</resources>\n<build>{items}</build>\n</model>\n".encode())
     model = b"".join(chunks)
     out = io.BytesIO()
@@ -150,24 +176,29 @@ def _vertex_rows(v: np.ndarray) -> list[bytes]:
     return out
 
 
-def _triangle_rows(t: np.ndarray) -> list[bytes]:
+def _triangle_rows(t: np.ndarray, group: int | None = None) -> list[bytes]:
     out = []
     for s in range(0, len(t), _BLOCK):
         b = t[s : s + _BLOCK]
-        out.append(
-            join_rows(
-                [
-                    b'<triangle v1="',
-                    format_int(b[:, 0]),
-                    b'" v2="',
-                    format_int(b[:, 1]),
-                    b'" v3="',
-                    format_int(b[:, 2]),
-                ],
-                b'"/>\n',
-            )
-        )
+        cols = [format_int(b[:, c]) for c in range(3)]
+        parts = [b'<triangle v1="', cols[0], b'" v2="', cols[1], b'" v3="', cols[2]]
+        if group is not None:  # the corners' colours are the vertices' own, by index
+            parts += [f'" pid="{group}" p1="'.encode(), cols[0], b'" p2="', cols[1], b'" p3="',
+                      cols[2]]  # fmt: skip
+        out.append(join_rows(parts, b'"/>\n'))
     return out
+
+
+def _color_rows(c: np.ndarray) -> list[bytes]:
+    """``<m:color color="#RRGGBBAA"/>`` rows, hex digits laid out as one canvas."""
+    c = np.clip(np.round(c.reshape(len(c), -1) * 255), 0, 255).astype(np.uint8)
+    if c.shape[1] not in (3, 4):
+        raise ValueError(f"vertex colours need 3 or 4 components, got {c.shape[1]}")
+    if c.shape[1] == 3:
+        c = np.column_stack([c, np.full(len(c), 255, np.uint8)])
+    digits = np.frombuffer(b"0123456789ABCDEF", np.uint8)
+    hexes = np.stack([digits[c >> 4], digits[c & 15]], axis=2).reshape(len(c), 8)
+    return [join_rows([b'<m:color color="#', hexes], b'"/>\n')] if len(c) else []
 
 
 # --------------------------------------------------------------------------------------------
@@ -180,11 +211,11 @@ _COMPONENT = re.compile(rb"<(?:\w+:)?component\b([^>]*?)/?>")
 MAX_DEPTH = 32  # components within components
 
 
-def read_3mf(
-    data: bytes, max_bytes: int = MAX_MODEL_BYTES
-) -> list[tuple[str, np.ndarray, np.ndarray]]:
-    """The meshes a 3MF package builds: ``(name, vertices (n, 3), triangles (t, 3))`` per
-    build item, in millimetres, with the item's and its components' transforms applied.
+def read_3mf(data: bytes, max_bytes: int = MAX_MODEL_BYTES) -> list[tuple]:
+    """The meshes a 3MF package builds: ``(name, vertices (n, 3), triangles (t, 3), colours
+    (n, 4) or None)`` per build item, in millimetres, with the item's and its components'
+    transforms applied; colours from a Materials-extension colour group the object and its
+    triangles' corners point into.
 
     Raises
     ------
@@ -231,7 +262,7 @@ def _member(z: zipfile.ZipFile, info: zipfile.ZipInfo, cap: int) -> bytes:
     return out
 
 
-def _model_meshes(model: bytes) -> list[tuple[str, np.ndarray, np.ndarray]]:
+def _model_meshes(model: bytes) -> list[tuple]:
     head = re.search(rb"<(?:\w+:)?model\b([^>]*)>", model)
     if head is None:
         raise ValueError("the model part has no <model> element")
@@ -239,13 +270,15 @@ def _model_meshes(model: bytes) -> list[tuple[str, np.ndarray, np.ndarray]]:
     if unit not in UNITS:
         raise ValueError(f"unknown model unit {unit!r}")
     scale = UNITS[unit]
+    groups = _color_groups(model)
     objects: dict[bytes, tuple[str, object]] = {}
     for attrs, body in _OBJECT.findall(model):
         a = dict(_ATTR.findall(attrs))
         oid = a.get(b"id", b"")
         name = a.get(b"name", b"object " + oid).decode("utf-8", "replace")
         if re.search(rb"<(?:\w+:)?mesh\b", body):
-            objects[oid] = (name, _mesh_of(body, oid))
+            v, t = _mesh_of(body, oid)
+            objects[oid] = (name, (v, t, _vertex_colors(body, a, groups, len(v), t)))
         else:
             comps = [dict(_ATTR.findall(c)) for c in _COMPONENT.findall(body)]
             objects[oid] = (name, [(c.get(b"objectid", b""), c.get(b"transform")) for c in comps])
@@ -264,7 +297,51 @@ def _model_meshes(model: bytes) -> list[tuple[str, np.ndarray, np.ndarray]]:
             if pieces
             else np.zeros((0, 3), np.int64)
         )
-        out.append((objects[oid][0], v * scale, t))
+        colors = [p[2] for p in pieces]
+        c = np.concatenate(colors) if pieces and all(x is not None for x in colors) else None
+        out.append((objects[oid][0], v * scale, t, c))
+    return out
+
+
+_GROUP = re.compile(rb"<(?:\w+:)?colorgroup\b([^>]*)>(.*?)</(?:\w+:)?colorgroup\s*>", re.S)
+
+
+def _color_groups(model: bytes) -> dict[bytes, np.ndarray]:
+    """The Materials extension's colour groups: id -> (k, 4) RGBA in 0..1."""
+    out = {}
+    for attrs, body in _GROUP.findall(model):
+        gid = dict(_ATTR.findall(attrs)).get(b"id", b"")
+        hexes = re.findall(rb'\bcolor\s*=\s*"#([0-9A-Fa-f]{6}(?:[0-9A-Fa-f]{2})?)"', body)
+        if len(hexes) != len(re.findall(rb"<(?:\w+:)?color\b", body)):
+            raise ValueError(
+                f"colour group {gid.decode()!r} holds a colour that is not #RRGGBB[AA]"
+            )
+        rows = [h + b"FF" if len(h) == 6 else h for h in hexes]
+        raw = np.frombuffer(bytes.fromhex(b"".join(rows).decode()), np.uint8)
+        out[gid] = raw.reshape(-1, 4) / 255.0
+    return out
+
+
+def _vertex_colors(body: bytes, attrs: dict, groups: dict, n: int, t: np.ndarray):
+    """A colour a vertex from a colour group the triangles' corners point into (p1 p2 p3,
+    or the object's default pindex), or None when the object has no colour group."""
+    pid = attrs.get(b"pid")
+    if pid not in groups or not t.size:
+        return None
+    colors = groups[pid]
+    ts = re.search(rb"<(?:\w+:)?triangles\b[^>]*>(.*?)</(?:\w+:)?triangles\s*>", body, re.S)
+    block = ts.group(1) if ts else b""
+    corners = [re.findall(rb"\b" + k + rb'\s*=\s*"(\d+)"', block) for k in (b"p1", b"p2", b"p3")]
+    out = np.zeros((n, 4))
+    default = int(attrs.get(b"pindex", b"0") or 0)
+    if not 0 <= default < len(colors):
+        raise ValueError(f"an object's pindex {default} is outside its colour group")
+    out[:] = colors[default]
+    if all(len(c) == len(t) for c in corners):  # every corner names its colour
+        idx = np.array(corners, dtype=np.int64).T
+        if idx.size and idx.max() >= len(colors):
+            raise ValueError("a triangle's colour index is outside its colour group")
+        out[t.ravel()] = colors[idx.ravel()]
     return out
 
 
@@ -275,8 +352,8 @@ def _flatten(objects, oid: bytes, m: np.ndarray, depth: int) -> list:
         raise ValueError(f"a component names object {oid.decode()!r}, which is not there")
     _, what = objects[oid]
     if isinstance(what, tuple):
-        v, t = what
-        return [(v @ m[:3] + m[3], t)]
+        v, t, c = what
+        return [(v @ m[:3] + m[3], t, c)]
     out = []
     for child, transform in what:
         c = _transform(transform)
