@@ -177,6 +177,9 @@ def face_vectors(
     fo = np.asarray(face_offsets, dtype=np.int64)
     if fo.size < 2:
         return np.zeros((0, 3))
+    n_faces = fo.size - 1
+    if fi.size == 3 * n_faces and fo[-1] == fi.size and (np.diff(fo) == 3).all():
+        return _triangle_vectors(v, fi.reshape(-1, 3))
     # about the first corner of each face, for conditioning far from the origin
     base = np.repeat(v[fi[fo[:-1]]], np.diff(fo), axis=0)
     p = v[fi] - base
@@ -184,11 +187,28 @@ def face_vectors(
     return np.add.reduceat(np.cross(p, q), fo[:-1], axis=0)
 
 
+def _triangle_vectors(v: np.ndarray, tri: np.ndarray) -> np.ndarray:
+    """Newell vectors of triangles: ``(b - a) x (c - a)``, the same as the polygon formula
+    for three corners, on one contiguous array per coordinate (no per-corner repeat, no
+    reduceat, no (m, 3) cross product with its short last axis)."""
+    cols = [np.ascontiguousarray(v[:, k]) for k in range(3)]
+    a = [np.take(c, tri[:, 0]) for c in cols]
+    e1 = [np.take(c, tri[:, 1]) - ak for c, ak in zip(cols, a, strict=True)]
+    e2 = [np.take(c, tri[:, 2]) - ak for c, ak in zip(cols, a, strict=True)]
+    out = np.empty((tri.shape[0], 3))
+    out[:, 0] = e1[1] * e2[2] - e1[2] * e2[1]
+    out[:, 1] = e1[2] * e2[0] - e1[0] * e2[2]
+    out[:, 2] = e1[0] * e2[1] - e1[1] * e2[0]
+    return out
+
+
 def face_areas(
     vertices: np.ndarray, face_indices: np.ndarray, face_offsets: np.ndarray
 ) -> np.ndarray:
     """(n_faces,) area of each face (half the length of its Newell vector)."""
-    return 0.5 * np.linalg.norm(face_vectors(vertices, face_indices, face_offsets), axis=1)
+    n = face_vectors(vertices, face_indices, face_offsets)
+    x, y, z = n[:, 0], n[:, 1], n[:, 2]
+    return 0.5 * np.sqrt(x * x + y * y + z * z)
 
 
 def signed_volume(
