@@ -123,9 +123,22 @@ class Graph:
         self._subgraphs: dict[str, SubgraphSpec] = {}  # graph-file node types -> specs
         self._includes: Includes | None = None
         self._children: dict[Any, Graph] = {}  # subgraph path -> its graph, caches shared
+        self._replay: dict[tuple[str, ...], Any] = {}  # targets -> last run's keys (run.py)
         self._checked = False
         self.stats: dict[str, NodeStat] = {}
         self.progress: Progress | None = None
+
+    @property
+    def _checked(self) -> bool:
+        """Whether the graph as it stands was checked. Every change sets it False, which
+        also forgets the keys kept from the last runs (they were of the graph before)."""
+        return self.__checked
+
+    @_checked.setter
+    def _checked(self, value: bool) -> None:
+        self.__checked = value
+        if not value:
+            self._replay.clear()
 
     # ----------------------------------------------------------------------- building
 
