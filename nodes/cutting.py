@@ -108,15 +108,26 @@ class Operation(str, Enum):
 def _extent(curves: list[Curve]) -> float:
     """The largest side of the XY box around the curves (their control points when NURBS:
     the curve lies in their hull)."""
-    pts = np.concatenate(
-        [
-            np.asarray(c.control_points)[:, :2]
-            if isinstance(c, NurbsCurve)
-            else np.asarray(c.sample(65))[:, :2]
-            for c in curves
+    box = np.array([np.inf, np.inf, -np.inf, -np.inf])
+    for c in curves:  # one step per curve; a column at a time (numpy's axis=0 min is slow)
+        p = np.asarray(c.control_points) if isinstance(c, NurbsCurve) else c.sample(65)
+        x, y = p[:, 0], p[:, 1]
+        box = np.r_[
+            np.minimum(box[:2], [x.min(), y.min()]), np.maximum(box[2:], [x.max(), y.max()])
         ]
-    )
-    return float((pts.max(axis=0) - pts.min(axis=0)).max())
+    return float((box[2:] - box[:2]).max())
+
+
+def _closed(c: Curve) -> bool:
+    """Whether a curve closes: a clamped NURBS ends on its first and last control points
+    (no evaluation needed); any other curve is asked."""
+    if isinstance(c, NurbsCurve):
+        p, k = c.degree, np.asarray(c.knots)
+        if k[0] == k[p] and k[-1] == k[-1 - p]:
+            cp = np.asarray(c.control_points)
+            scale = max(1.0, float(np.abs(cp[[0, -1]]).max()))
+            return bool(np.linalg.norm(cp[0] - cp[-1]) <= 1e-9 * scale)
+    return c.closed
 
 
 def _rings(
@@ -132,7 +143,7 @@ def _rings(
         ctx.guard(total + n, "curve samples")
 
     for i, c in enumerate(curves):  # one step per curve; its samples are vectorized
-        if not c.closed:
+        if not _closed(c):
             raise InputError(
                 port,
                 f"curve {i} is open: a region is bounded by closed curves (close it, or "
@@ -172,9 +183,9 @@ def _rings(
 
 def _distinct(ring: np.ndarray) -> np.ndarray:
     """The ring without consecutive repeats (nor a repeat of the first point at the end)."""
-    keep = np.ones(len(ring), dtype=bool)
-    keep[1:] = np.any(ring[1:] != ring[:-1], axis=1)
-    r = ring[keep]
+    d = np.diff(ring, axis=0)
+    repeat = (d[:, 0] == 0) & (d[:, 1] == 0)
+    r = ring if not repeat.any() else ring[np.r_[True, ~repeat]]
     if len(r) > 1 and np.array_equal(r[0], r[-1]):
         r = r[:-1]
     return r
@@ -202,18 +213,33 @@ def _outlines(
     """The region's boundary as closed curves; an input curve the operation left whole
     comes back as itself (exact), turned to the right direction."""
     coords, offsets, _ = kregions.rings_of(region)
-    out_rings = [coords[offsets[i] : offsets[i + 1]] for i in range(len(offsets) - 1)]
+    if len(offsets) < 2:
+        ctx.warn("the result is empty: the regions leave no area")
+        return []
+    out_rings = [coords[offsets[i] : offsets[i + 1] - 1] for i in range(len(offsets) - 1)]
     matches = kregions.match_rings(out_rings, sampled)
+    # every outline's points in one frozen array, and its knots (the running chord length,
+    # ends doubled) in another: each curve's arrays are views, shared rather than copied
+    xyz = frozen_array(np.c_[coords, np.zeros(len(coords))])
+    step = np.r_[0.0, np.hypot(*np.diff(coords, axis=0).T)]
+    step[offsets[:-1]] = 0.0  # each ring's length starts from 0
+    chord = np.cumsum(step)
+    chord -= np.repeat(chord[offsets[:-1]], np.diff(offsets))
+    slot = np.arange(len(coords)) + 2 * np.repeat(np.arange(len(offsets) - 1), np.diff(offsets))
+    knots = np.empty(len(coords) + 2 * (len(offsets) - 1))
+    knots[slot + 1] = chord
+    knots[slot[offsets[:-1]]] = 0.0
+    knots[slot[offsets[1:] - 1] + 2] = chord[offsets[1:] - 1]
+    knots = frozen_array(knots)
     result: list[Curve] = []
-    for ring, match in zip(out_rings, matches, strict=True):  # one step per outline
+    for i, match in enumerate(matches):  # one step per outline
         if match is not None:
             c = curves[match[0]]
             assert isinstance(c, NurbsCurve)
             result.append(_flat(c) if match[1] else _flat(_reversed(c)))
         else:
-            result.append(NurbsCurve.polyline(np.c_[ring, np.zeros(len(ring))], closed=True))
-    if not result:
-        ctx.warn("the result is empty: the regions leave no area")
+            a, b = offsets[i], offsets[i + 1]
+            result.append(NurbsCurve(xyz[a:b], 1, knots[a + 2 * i : b + 2 * i + 2]))
     return result
 
 

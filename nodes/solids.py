@@ -403,7 +403,14 @@ def boolean(
     """
     ma = _solid("a", _clipping, ctx, kb.to_manifold, *_arrays(a), "the mesh")
     mb = _solid("b", _clipping, ctx, kb.to_manifold, *_arrays(b), "the mesh")
-    out = Mesh(*kb.from_manifold(kb.combine(ma, mb, operation)))
+    for port, mesh, m in (("a", a, ma), ("b", b, mb)):
+        if m.is_empty() and mesh.n_faces:
+            ctx.warn(f"input {port} bounds no volume (its faces collapsed): an empty solid")
+    try:
+        both = kb.combine(ma, mb, operation, whats=("the mesh", "the mesh"))
+    except kb.NotSolidError as exc:
+        raise InputError("ab"[exc.operand or 0], str(exc)) from None
+    out = Mesh(*kb.from_manifold(both))
     if out.n_faces == 0:
         ctx.warn(f"the {kb.Operation(operation).value} is empty")
     return out
@@ -419,7 +426,10 @@ def union(meshes: list[Mesh], *, ctx: Context) -> Mesh:
         Closed, manifold, outward meshes; they may overlap.
     """
     ctx.guard(sum(m.n_faces for m in meshes), "faces")
-    return Mesh(*_solid("meshes", _clipping, ctx, kb.union, [_arrays(m) for m in meshes]))
+    out = Mesh(*_solid("meshes", _clipping, ctx, kb.union, [_arrays(m) for m in meshes]))
+    if out.n_faces == 0 and any(m.n_faces for m in meshes):
+        ctx.warn("the union is empty: every mesh bounds no volume (their faces collapsed)")
+    return out
 
 
 # -------------------------------------------------------------------------------- measures

@@ -294,3 +294,54 @@ def test_an_empty_result_warns():
     g.add("n", "curves.boolean", a=[square(1)], b=[square(2)], operation="difference")
     with pytest.warns(fg.FormgraphWarning, match="leave no area"):
         assert g.evaluate("n") == []
+
+
+def test_nameplate_graph_cuts_to_size_on_layers(tmp_path):
+    import xml.etree.ElementTree as ET
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    g = fg.load(root / "graphs" / "nameplate.yaml", out_dir=tmp_path)
+    cut = g.evaluate("cut")
+    assert len(cut) == 4 and all(c.closed for c in cut)
+    boxes = sorted(np.ptp(np.asarray(c.control_points)[:, :2], axis=0).tolist() for c in cut)
+    # half the kerf (0.05) outside the 80 x 30 plate, inside the three holes of radius 1.6
+    np.testing.assert_allclose(boxes[-1], [80.1, 30.1], atol=2e-3)
+    np.testing.assert_allclose(boxes[:3], [[3.1, 3.1]] * 3, atol=2e-3)
+    assert sum(signed_area(c) < 0 for c in cut) == 3
+    svg = ET.parse(g.evaluate("svg")).getroot()
+    ns = "{http://www.w3.org/2000/svg}"
+    groups = {e.get("id"): e for e in svg.iter(f"{ns}g") if e.get("id")}
+    assert groups["cut"].get("stroke") == "#ff0000" and len(groups["cut"]) == 4
+    assert groups["engrave"].get("stroke") == "#0000ff" and len(groups["engrave"]) == 14
+
+
+@st.composite
+def ring_sets(draw):
+    """Polygons around random centres: some nested, some overlapping, some apart."""
+    k = draw(st.integers(1, 6))
+    rings = []
+    for _ in range(k):
+        cx, cy = draw(st.floats(-3, 3)), draw(st.floats(-3, 3))
+        r = draw(st.floats(0.3, 3))
+        n = draw(st.integers(3, 12))
+        a = np.linspace(0, 2 * np.pi, n, endpoint=False) + draw(st.floats(0, 1))
+        rings.append(np.c_[cx + r * np.cos(a), cy + r * np.sin(a)])
+    return rings
+
+
+@settings(max_examples=40, deadline=None)
+@given(ring_sets())
+def test_even_odd_regions_match_a_crossing_count(rings):
+    region = regions.even_odd_region(rings)
+    g = np.random.default_rng(0).uniform(-6.5, 6.5, size=(4000, 2))
+    ours = shapely.contains_xy(region, g[:, 0], g[:, 1])
+    ref = even_odd_inside(rings, g)
+    # points within a hair of a ring may go either way; everything else must agree
+    lines = shapely.MultiLineString([np.r_[r, r[:1]] for r in rings])
+    near = shapely.distance(shapely.points(g), lines) < 1e-9
+    assert np.array_equal(ours[~near], ref[~near])
+    # the fast path (rings that neither cross nor touch) and the xor tree agree
+    polys = [shapely.Polygon(r) for r in rings]  # regular polygons: each valid alone
+    xor = regions._xor_tree(np.array(polys, dtype=object))
+    assert region.symmetric_difference(xor).area <= 1e-9 * max(xor.area, 1.0)

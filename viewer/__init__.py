@@ -22,11 +22,14 @@ if sys.platform.startswith("linux") and not os.environ.get("DISPLAY"):
 
 from .app import LAYOUTS, Session, shown_nodes
 from .entry import make_plotter, screenshot, show
+from .frame import CAMERAS, Camera
 from .scene import Scene
 from .watch import ScreenshotWatcher, Watcher, display_problem, watch
 
 __all__ = [
+    "CAMERAS",
     "LAYOUTS",
+    "Camera",
     "Scene",
     "ScreenshotWatcher",
     "Session",

@@ -21,6 +21,7 @@ from formgraph.evaluation.graph import Graph, load
 from formgraph.language.check import param_kind
 from formgraph.language.model import Items, Wire, parse_input
 
+from .frame import Camera
 from .scene import PALETTE, TEXT_COLOR, Scene, fit_scenes
 
 __all__ = ["LAYOUTS", "Session", "Slider", "shown_nodes"]
@@ -122,6 +123,8 @@ class Session:
         and size.
     edges : bool, optional
         Draw mesh face edges always (True), never (False), or on coarse meshes (None).
+    camera : Camera, optional
+        Where the views look from (:class:`~.frame.Camera`); automatic if None.
     """
 
     def __init__(
@@ -134,6 +137,7 @@ class Session:
         timing: bool = True,
         layout: str = "overlay",
         edges: bool | None = None,
+        camera: Camera | None = None,
     ):
         if layout not in LAYOUTS:
             raise ValueError(f"layout must be one of {', '.join(LAYOUTS)}, got {layout!r}")
@@ -153,6 +157,8 @@ class Session:
         self.widgets: dict[str, Any] = {}  # slider widgets by param name
         shown = self.evaluate()
         self.scenes = self._make_scenes(len(shown), edges)
+        for scene in self.scenes:
+            scene.camera = camera or Camera()
         self._draw(shown)
         self.fit_camera()
         self._status()

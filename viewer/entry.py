@@ -14,6 +14,7 @@ from typing import Any
 from formgraph.evaluation.graph import Graph, load
 
 from .app import Session, shown_nodes
+from .frame import Camera
 
 __all__ = ["make_plotter", "screenshot", "show", "view_count"]
 
@@ -62,6 +63,7 @@ def show(
     layout: str = "overlay",
     edges: bool | None = None,
     jupyter_backend: str | None = None,
+    camera: Camera | None = None,
     **params: Any,
 ) -> Session:
     """Open an interactive window on a graph's results (or ``node``) or on geometry values.
@@ -82,6 +84,8 @@ def show(
         All nodes in one view, or one view per node side by side (linked cameras).
     edges : bool, optional
         Mesh face edges always (True), never (False), on coarse meshes (None).
+    camera : Camera, optional
+        Where to look from first (``Camera("top")``); automatic if None.
     **params
         Graph param values.
 
@@ -97,7 +101,9 @@ def show(
     plotter = make_plotter(
         views, layout, size, controls=_has_controls(source), title=_window_title(source)
     )
-    session = Session(source, node, plotter=plotter, params=params, layout=layout, edges=edges)
+    session = Session(
+        source, node, plotter=plotter, params=params, layout=layout, edges=edges, camera=camera
+    )
     session.add_sliders()
     session.add_keys()
     plotter.show(jupyter_backend=jupyter_backend)
@@ -112,11 +118,14 @@ def screenshot(
     *,
     layout: str = "overlay",
     edges: bool | None = None,
+    camera: Camera | None = None,
     **params: Any,
 ) -> Path:
     """Render a graph's results (or ``node``, or geometry values) off screen to a PNG.
 
-    The parent folder of ``path`` is created. Returns the path written.
+    The parent folder of ``path`` is created. Returns the path written. ``camera`` (a
+    :class:`~.frame.Camera`: ``Camera("top")``, ``Camera(azimuth=30, elevation=20)``) says
+    where to look from; by default straight on for flat geometry, else isometric.
 
     Example
     -------
@@ -130,7 +139,14 @@ def screenshot(
     plotter = make_plotter(views, layout, size, off_screen=True)
     try:
         Session(
-            source, node, plotter=plotter, params=params, timing=False, layout=layout, edges=edges
+            source,
+            node,
+            plotter=plotter,
+            params=params,
+            timing=False,
+            layout=layout,
+            edges=edges,
+            camera=camera,
         )
         path.parent.mkdir(parents=True, exist_ok=True)
         plotter.screenshot(str(path))

@@ -19,6 +19,8 @@ import numpy as np
 from .style import TEXT_COLOR
 
 __all__ = [
+    "CAMERAS",
+    "Camera",
     "ScaleBar",
     "fit",
     "fit_scenes",
@@ -30,6 +32,75 @@ __all__ = [
 ]
 
 SAMPLE = 6000  # points projected to frame a view (a strided sample of larger meshes)
+
+#: named views as (azimuth, elevation) in degrees: azimuth about +z from the front (the
+#: camera on -y, 0) toward the right side (+x, 90), elevation up from the XY plane
+CAMERAS = {
+    "iso": (135.0, float(np.degrees(np.arctan(1 / np.sqrt(2))))),  # from (1, 1, 1)
+    "top": (0.0, 90.0),
+    "front": (0.0, 0.0),
+    "side": (90.0, 0.0),
+    "bottom": (0.0, -90.0),
+}
+_STRAIGHT = {"top": 2, "bottom": 2, "front": 1, "side": 0}  # the axis a straight view drops
+
+
+class Camera:
+    """Where a view looks from: a named view, turned by an azimuth and an elevation.
+
+    ``Camera()`` is the automatic choice (straight on for flat geometry, else isometric).
+    A named view alone is straight on without perspective for ``top``, ``front``, ``side``
+    and ``bottom`` (with the scale bar, as a drawing), in perspective for ``iso``. Giving
+    ``azimuth`` or ``elevation`` replaces that angle of the view (``iso`` when none is
+    named) and looks in perspective.
+
+    Raises
+    ------
+    ValueError
+        An unknown view, an angle that is not a finite number, an elevation outside
+        -90..90.
+    """
+
+    def __init__(
+        self, view: str | None = None, azimuth: float | None = None, elevation: float | None = None
+    ):
+        if view is not None and view not in CAMERAS:
+            raise ValueError(f"camera must be one of {', '.join(CAMERAS)}, got {view!r}")
+        for name, angle in (("azimuth", azimuth), ("elevation", elevation)):
+            if angle is not None and (
+                isinstance(angle, bool)
+                or not isinstance(angle, (int, float))
+                or not np.isfinite(angle)
+            ):
+                raise ValueError(f"{name} must be a finite number of degrees, got {angle!r}")
+        if elevation is not None and not -90 <= elevation <= 90:
+            raise ValueError(f"elevation must be from -90 to 90 degrees, got {elevation:g}")
+        self.view, self.azimuth, self.elevation = view, azimuth, elevation
+
+    @property
+    def automatic(self) -> bool:
+        return self.view is None and self.azimuth is None and self.elevation is None
+
+    def straight_axis(self) -> int | None:
+        """The axis a straight (parallel) view looks along, or None in perspective."""
+        if self.azimuth is not None or self.elevation is not None:
+            return None
+        return _STRAIGHT.get(self.view or "")
+
+    def direction(self) -> tuple[np.ndarray, np.ndarray]:
+        """Unit vectors from the focal point to the camera, and the view's up."""
+        az0, el0 = CAMERAS[self.view or "iso"]
+        az = np.radians(az0 if self.azimuth is None else self.azimuth)
+        el = np.radians(el0 if self.elevation is None else self.elevation)
+        toward = np.array([np.cos(el) * np.sin(az), -np.cos(el) * np.cos(az), np.sin(el)])
+        # up is +z, except looking straight down or up, where it is the screen's +y
+        up = np.array([0.0, 0.0, 1.0])
+        if abs(np.cos(el)) < 1e-9:
+            up = np.array([-np.sin(az), np.cos(az), 0.0])
+        return toward, up
+
+    def __repr__(self) -> str:
+        return f"Camera({self.view!r}, azimuth={self.azimuth!r}, elevation={self.elevation!r})"
 
 
 def view_axis(bounds: Sequence[float], rel: float = 1e-9) -> int | None:
@@ -190,8 +261,16 @@ def fit_scenes(scenes: Sequence[Any]) -> None:
         points = np.concatenate([points, corners])
     scene.activate()
     p = scene.plotter
-    views = {None: p.view_isometric, 2: p.view_xy, 1: p.view_xz, 0: p.view_yz}
-    views[axis](render=False)
+    camera: Camera = getattr(scene, "camera", None) or Camera()
+    if camera.automatic:
+        views = {None: p.view_isometric, 2: p.view_xy, 1: p.view_xz, 0: p.view_yz}
+        views[axis](render=False)
+    else:
+        axis = camera.straight_axis()
+        toward, up = camera.direction()
+        centre = bounds.reshape(3, 2).mean(axis=1)
+        reach = max(float(np.ptp(bounds.reshape(3, 2), axis=1).max()), 1e-9)
+        p.camera_position = [tuple(centre + 4 * reach * toward), tuple(centre), tuple(up)]
     p.camera.parallel_projection = axis is not None  # a drawing: no perspective
     p.reset_camera(render=False, bounds=tuple(bounds))
     w, h = scene.size()

@@ -24,7 +24,7 @@ import numpy as np
 
 from formgraph.geometry import Curve, Geometry, Mesh, NurbsCurve, NurbsSurface, Points, Surface
 
-from .frame import ScaleBar, fit_scenes, nice_range, sample, size_text, view_axis
+from .frame import Camera, ScaleBar, fit_scenes, nice_range, sample, size_text, view_axis
 from .style import (
     BACKGROUND,
     COARSE_FACES,
@@ -242,6 +242,7 @@ class Scene:
         self._drawn_legend: list[Any] = []
         self._legend_width = 0.0  # fraction of the view's width the legend takes
         self.free = (0.0, 0.0, 1.0, 1.0)  # where the last fit put the picture (fractions)
+        self.camera = Camera()  # where fit_scenes looks from (automatic unless told)
         self.activate()
         self.renderer = plotter.renderer
         plotter.set_background(BACKGROUND)

@@ -24,16 +24,23 @@ BACKGROUND = (255, 255, 255)
 FAILED = (236, 226, 226)
 
 
-def render_cell(value: Any, size: tuple[int, int] = CELL) -> bytes:
+def render_cell(
+    value: Any, size: tuple[int, int] = CELL, camera: tuple[Any, Any, Any] | None = None
+) -> bytes:
     """A PNG (bytes) of ``value`` drawn off screen as ``formgraph view`` draws it, without
-    the bounds grid (its labels do not survive a cell's size); the camera fits the value."""
+    the bounds grid (its labels do not survive a cell's size); the camera fits the value,
+    looking from ``camera`` = (view, azimuth, elevation) as :class:`~.frame.Camera` takes
+    them (automatic if None)."""
     import pyvista as pv
 
     from .app import Session
+    from .frame import Camera
 
     plotter = pv.Plotter(off_screen=True, window_size=list(size))
     try:
-        session = Session(value, plotter=plotter, timing=False)
+        session = Session(
+            value, plotter=plotter, timing=False, camera=Camera(*camera) if camera else None
+        )
         if session.scene.show_grid:
             session.scene.toggle_grid()
             session.scene.fit_camera()

@@ -26,6 +26,7 @@ from formgraph.evaluation.graph import load
 
 from .app import Session
 from .entry import _window_title
+from .frame import Camera
 from .scene import Scene
 
 __all__ = ["ScreenshotWatcher", "Watcher", "display_problem", "watch"]
@@ -43,7 +44,9 @@ class _Watched:
         budget: int,
         layout: str,
         edges: bool | None,
+        camera: Camera | None = None,
     ):
+        self.camera = camera
         self.path = Path(path)
         self.node = node
         self.sets = list(sets)
@@ -115,8 +118,9 @@ class Watcher(_Watched):
         budget: int = DEFAULT_BUDGET,
         layout: str = "overlay",
         edges: bool | None = None,
+        camera: Camera | None = None,
     ):
-        super().__init__(path, node, sets, out_dir, budget, layout, edges)
+        super().__init__(path, node, sets, out_dir, budget, layout, edges, camera)
         self.plotter = plotter
         self.session: Session | None = None
         self.reloads = 0
@@ -147,6 +151,7 @@ class Watcher(_Watched):
                     params=params,
                     layout=self.layout,
                     edges=self.edges,
+                    camera=self.camera,
                 )
                 self.session.add_keys()
                 self.session.scene.set_error(None)  # an error left by a broken start
@@ -190,6 +195,7 @@ def watch(
     interval: float = 0.3,
     layout: str = "overlay",
     edges: bool | None = None,
+    camera: Camera | None = None,
 ) -> Watcher:
     """Open a window on ``graph_path`` that redraws whenever the file is saved.
 
@@ -221,6 +227,7 @@ def watch(
         budget=budget,
         layout=layout,
         edges=edges,
+        camera=camera,
     )
     watcher.reload()
     plotter.add_timer_event(
@@ -269,8 +276,8 @@ class ScreenshotWatcher(_Watched):
 
     Parameters
     ----------
-    path, node, sets, out_dir, budget, layout, edges
-        As for :class:`Watcher`.
+    path, node, sets, out_dir, budget, layout, edges, camera
+        As for :class:`Watcher` (``camera``: a :class:`~.frame.Camera`, automatic if None).
     screenshot : str or path
         The PNG to (re)write.
     size : (int, int)
@@ -291,10 +298,11 @@ class ScreenshotWatcher(_Watched):
         size: tuple[int, int] = (1024, 768),
         layout: str = "overlay",
         edges: bool | None = None,
+        camera: Camera | None = None,
         out: Any = None,
         err: Any = None,
     ):
-        super().__init__(path, node, sets, out_dir, budget, layout, edges)
+        super().__init__(path, node, sets, out_dir, budget, layout, edges, camera)
         self.screenshot = Path(screenshot)
         self.size = size
         self.out = out if out is not None else sys.stdout
@@ -327,6 +335,7 @@ class ScreenshotWatcher(_Watched):
                     timing=False,
                     layout=self.layout,
                     edges=self.edges,
+                    camera=self.camera,
                 )
                 self.screenshot.parent.mkdir(parents=True, exist_ok=True)
                 tmp = self.screenshot.with_name(f".{self.screenshot.name}.{os.getpid()}.tmp.png")

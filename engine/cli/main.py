@@ -17,7 +17,14 @@ from typing import Any
 
 from ..core.errors import FormgraphError, FormgraphWarning, GraphError
 from ..core.terminal import StatusLine
-from .options import UsageError, graph_options, parse_sets, size_text
+from .options import (
+    UsageError,
+    camera_arg,
+    camera_options,
+    graph_options,
+    parse_sets,
+    size_text,
+)
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -61,6 +68,7 @@ def _parser() -> argparse.ArgumentParser:
             "--edges", action="store_true", help="draw every mesh face's edges (default: coarse)"
         )
         p.add_argument("--size", default="1024x768", metavar="WxH")
+        camera_options(p)
         p.add_argument("--out", default="out", metavar="DIR", help=argparse.SUPPRESS)
 
     view = sub.add_parser("view", help="show nodes' outputs (window, or PNG with --screenshot)")
@@ -133,7 +141,8 @@ def _profile_table(stats: dict[str, Any], nodes: dict[str, str]) -> str:
         items = getattr(st, "items", None)
         notes = list(st.warnings)
         if items is not None:  # a repeated node: one row, with how many of its items ran
-            notes.insert(0, f"{items} items, {st.computed_items}/{items} computed")
+            unit = getattr(st, "unit", "items")  # a simulated node's items are its steps
+            notes.insert(0, f"{items} {unit}, {st.computed_items}/{items} computed")
         rows.append(
             f"{name:<24} {nodes.get(name, ''):<24} {st.status:<9} {st.seconds:>9.4f} "
             f"{size:>10}  {'; '.join(notes)}"
@@ -233,13 +242,21 @@ def cmd_view(args: argparse.Namespace) -> int:
     params = parse_sets(g, args.set)
     nodes = args.nodes or None
     edges = True if args.edges else None
+    camera = camera_arg(args)
     if args.screenshot:
         path = viewer.screenshot(
-            g, args.screenshot, node=nodes, size=size, layout=args.layout, edges=edges, **params
+            g,
+            args.screenshot,
+            node=nodes,
+            size=size,
+            layout=args.layout,
+            edges=edges,
+            camera=camera,
+            **params,
         )
         print(f"wrote {path}")
         return 0
-    viewer.show(g, node=nodes, size=size, layout=args.layout, edges=edges, **params)
+    viewer.show(g, node=nodes, size=size, layout=args.layout, edges=edges, camera=camera, **params)
     return 0
 
 
@@ -259,6 +276,7 @@ def cmd_watch(args: argparse.Namespace) -> int:
         size=size,
         layout=args.layout,
         edges=edges,
+        camera=camera_arg(args),
     )
     if args.screenshot:
         viewer.ScreenshotWatcher(args.graph, args.screenshot, nodes, **options).run(

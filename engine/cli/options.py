@@ -49,6 +49,36 @@ def graph_options(p: argparse.ArgumentParser) -> None:
     )
 
 
+def camera_options(p: argparse.ArgumentParser) -> None:
+    """``--camera``, ``--azimuth`` and ``--elevation``: where a picture looks from."""
+    p.add_argument(
+        "--camera",
+        choices=("iso", "top", "front", "side", "bottom"),
+        help="look from a named view (default: straight on for flat geometry, else iso)",
+    )
+    p.add_argument(
+        "--azimuth",
+        type=float,
+        metavar="DEG",
+        help="turn about +z: 0 looks from the front (-y), 90 from the right side (+x)",
+    )
+    p.add_argument(
+        "--elevation", type=float, metavar="DEG", help="look from above (90) or below (-90)"
+    )
+
+
+def camera_arg(args: argparse.Namespace) -> Any:
+    """The ``formgraph.viewer.Camera`` of ``--camera/--azimuth/--elevation`` (or None)."""
+    from formgraph.viewer.frame import Camera
+
+    if args.camera is None and args.azimuth is None and args.elevation is None:
+        return None
+    try:
+        return Camera(args.camera, args.azimuth, args.elevation)
+    except ValueError as exc:
+        raise UsageError(f"--{exc}") from None  # "--elevation must be from -90 to 90 ..."
+
+
 def parse_sets(graph: Any, items: Sequence[str]) -> dict[str, Any]:
     """``NAME=VALUE`` pairs parsed by each param's type (YAML scalars, lists allowed)."""
     out: dict[str, Any] = {}

@@ -9,7 +9,7 @@ import sys
 import time
 from typing import Any
 
-from .options import UsageError, graph_options, parse_sets, size_text
+from .options import UsageError, camera_arg, camera_options, graph_options, parse_sets, size_text
 
 __all__ = ["add_parsers", "cmd_cache", "cmd_sweep"]
 
@@ -48,6 +48,7 @@ def add_parsers(sub: Any) -> None:
     sw.add_argument("--export", action="store_true", help="write each variant's exports")
     sw.add_argument("--render", metavar="NODE", help="draw NODE per variant into sheet.png")
     sw.add_argument("--per-sheet", type=int, default=100, metavar="N", help=argparse.SUPPRESS)
+    camera_options(sw)
     sw.add_argument(
         "--scheduler", metavar="ADDRESS", help="an existing Dask scheduler (tcp://host:8786)"
     )
@@ -69,6 +70,12 @@ def add_parsers(sub: Any) -> None:
     cache.add_argument(
         "--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS
     )
+
+
+def _camera(args: argparse.Namespace) -> tuple[Any, Any, Any] | None:
+    """The sheet's camera as the plain (view, azimuth, elevation) the workers are sent."""
+    camera = camera_arg(args)
+    return None if camera is None else (camera.view, camera.azimuth, camera.elevation)
 
 
 def cmd_sweep(args: argparse.Namespace) -> int:
@@ -113,6 +120,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
             workers=args.workers,
             cache_dir=cache_dir,
             per_sheet=args.per_sheet,
+            camera=_camera(args),
             progress=progress,
         )
     except ValueError as exc:

@@ -1,4 +1,9 @@
-"""Writing files safely: atomically, and only inside the output directory.
+"""Reading and writing files safely: regular files only, atomically, inside the output directory.
+
+Every file formgraph reads (graphs, subgraph parts, the inputs of read nodes) goes through
+:func:`read_regular`: a FIFO, a device or a socket named as a graph would block ``open`` or
+``read`` forever, so the file is opened without blocking and refused unless it is a regular
+file, and never read past its size limit.
 
 A graph downloaded from someone else must not write anywhere but the output directory, so
 every export path is relative, free of ``..``, and still inside the directory after symlinks
@@ -10,8 +15,10 @@ next write into its folder.
 
 from __future__ import annotations
 
+import errno
 import os
 import re
+import stat
 import tempfile
 import time
 from collections.abc import Iterable
@@ -175,6 +182,55 @@ def _same_file(target: Path, tmp: Path, chunk: int = 1 << 20) -> bool:
                     return True
     except OSError:
         return False
+
+
+_KINDS = {
+    stat.S_IFIFO: "a FIFO (named pipe)",
+    stat.S_IFCHR: "a character device",
+    stat.S_IFBLK: "a block device",
+    stat.S_IFSOCK: "a socket",
+    stat.S_IFDIR: "a folder",
+}
+
+
+def read_regular(path: str | os.PathLike[str], *, max_bytes: int) -> bytes:
+    """The bytes of a regular file, at most ``max_bytes`` of them.
+
+    Opened with ``O_NONBLOCK`` (a FIFO's ``open`` returns at once instead of waiting for a
+    writer) and checked with ``fstat`` on the open descriptor, so what is read is what was
+    checked.
+
+    Raises
+    ------
+    OSError
+        The file cannot be opened; it is not a regular file (``errno.EINVAL``, "is a FIFO
+        (named pipe), not a regular file"); it is larger than ``max_bytes``
+        (``errno.EFBIG``, "is larger than 16 MiB").
+    """
+    fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+    try:
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode):
+            kind = _KINDS.get(stat.S_IFMT(st.st_mode), "not a file")
+            raise OSError(errno.EINVAL, f"it is {kind}, not a regular file", str(path))
+        if st.st_size > max_bytes:
+            raise OSError(errno.EFBIG, f"it is larger than {_size(max_bytes)}", str(path))
+        chunks, total = [], 0
+        while total <= max_bytes:  # the file may grow while it is read
+            chunk = os.read(fd, min(1 << 20, max_bytes + 1 - total))
+            if not chunk:
+                break
+            chunks.append(chunk)
+            total += len(chunk)
+        if total > max_bytes:
+            raise OSError(errno.EFBIG, f"it is larger than {_size(max_bytes)}", str(path))
+        return b"".join(chunks)
+    finally:
+        os.close(fd)
+
+
+def _size(n: int) -> str:
+    return f"{n // (1 << 20)} MiB" if n >= 1 << 20 and n % (1 << 20) == 0 else f"{n:,} bytes"
 
 
 def _holds(path: Path, data: memoryview, chunk: int = 1 << 20) -> bool:

@@ -200,6 +200,17 @@ class PortType:
             return True
         return all(any(_kind_accepts(k, o) for k in self.kinds) for o in other.kinds)
 
+    def holds(self, value: Any) -> bool:
+        """Whether ``value`` could be this port's output: geometry of the port's class (or a
+        list of it), anything but geometry for a number, text or other plain port.
+
+        For values read back from the disk cache, where an entry can be well formed and
+        still of another node (a Points where a measure belongs): a mismatch is a miss.
+        """
+        if self.same_as is not None or (value is None and self.optional):
+            return True
+        return any(_kind_holds(k, value) for k in self.kinds)
+
     def coerce(self, value: Any) -> Any:
         """The value a node function receives for the literal ``value``.
 
@@ -234,6 +245,19 @@ class PortType:
 
 def _is_geometry(base: Any) -> bool:
     return isinstance(base, type) and issubclass(base, Geometry)
+
+
+def _kind_holds(k: Kind, value: Any) -> bool:
+    if k.base is Any:
+        return True
+    if k.is_list and isinstance(value, np.ndarray):  # numbers stored as one array
+        return not _is_geometry(k.base)
+    if k.is_list and not isinstance(value, (list, tuple)):
+        return False
+    items = value if k.is_list else [value]
+    if _is_geometry(k.base):
+        return all(isinstance(v, k.base) for v in items)
+    return not any(isinstance(v, Geometry) for v in items)
 
 
 def _kind_accepts(k: Kind, o: Kind) -> bool:

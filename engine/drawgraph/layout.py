@@ -91,7 +91,15 @@ def _repeat_mark(graph: Any, name: str) -> list[str]:
     return [f"repeat {', '.join(loops)}".strip()] if loops is not None else []
 
 
-MARKS: list[Mark] = [_export_mark, _subgraph_mark, _repeat_mark]
+def _simulate_mark(graph: Any, name: str) -> list[str]:
+    sim = getattr(graph._nodes[name], "simulate", None)
+    return [f"simulate {sim.state}"] if sim is not None else []
+
+
+MARKS: list[Mark] = [_export_mark, _subgraph_mark, _repeat_mark, _simulate_mark]
+
+#: marks drawn as a stack of boxes: one box per item (a repeat) or per step (a simulation)
+STACKED = ("repeat", "simulate")
 
 
 def node_marks(graph: Any, name: str, marks: Iterable[Mark] | None = None) -> list[str]:
@@ -234,9 +242,16 @@ def _model(graph: Any, marks: Iterable[Mark] | None) -> tuple[dict[str, Box], li
                 box.outputs.append(("" if not spec.multi_output else out, label))
         else:
             box.outputs.append(("", "outputs"))
+        if getattr(nd, "simulate", None) is not None and box.outputs:  # every step's output
+            box.outputs.append(("frames", f"list[{box.outputs[0][1]}]"))
         inputs = dict(nd.inputs)
         for loop, source in (_repeat_of(graph, name) or {}).items():
             inputs[f"repeat {loop}"] = source
+        sim = getattr(nd, "simulate", None)
+        if sim is not None:  # the state comes from 'from' (step 0), then from itself
+            inputs.pop(sim.state, None)
+            inputs[f"{sim.state} from"] = sim.source
+            inputs["steps" if "steps" not in inputs else "simulate steps"] = sim.steps
         for port, value in inputs.items():
             port_type = spec.inputs[port].type if spec is not None and port in spec.inputs else None
             used = False
@@ -539,7 +554,7 @@ def _box(d: Drawing, box: Box) -> None:
     if box.is_param:
         d.add(Rect(box.x, box.y, w, h, PARAM_FILL, PARAM_STROKE, 1.2, 9.0, cls="param"))
     else:
-        if any(m.startswith("repeat") for m in box.marks):  # a stack: one box per item
+        if any(m.startswith(STACKED) for m in box.marks):  # a stack: one box per item
             for off in (6.0, 3.0):
                 d.add(Rect(box.x + off, box.y - off, w, h, "white", "#888888", 1.0, 5.0, "stack"))
         fill = STATUS_FILL[box.status]

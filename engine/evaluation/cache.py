@@ -21,6 +21,7 @@ import json
 import math
 import os
 import re
+import stat
 import tempfile
 import time
 import uuid
@@ -239,6 +240,10 @@ class DiskCache:
     Entries are written to a temp file and renamed into place, so concurrent writers of the
     same key each leave a whole file; a reader that finds a bad entry (truncated, corrupt,
     wrong checksum, unknown format) deletes it and reports a miss.
+
+    No symlink inside the folder is ever followed (the folder itself may be one): a shard
+    folder or entry that is a link is neither read, written through, pruned nor cleared,
+    so a planted link cannot make ``cache clear`` delete, or a run write, files elsewhere.
     """
 
     def __init__(self, root: str | os.PathLike[str], max_bytes: int | None = None):
@@ -249,9 +254,23 @@ class DiskCache:
     def _path(self, key: str) -> Path:
         return self.root / key[:2] / f"{key}.npz"
 
+    def _shard(self, key: str) -> Path | None:
+        """The folder of ``key``'s entry, None when it is a symlink or not a folder."""
+        shard = self.root / key[:2]
+        try:
+            st = os.lstat(shard)
+        except OSError:
+            return shard  # not there yet: put makes it
+        return shard if stat.S_ISDIR(st.st_mode) else None
+
     def has(self, key: str) -> bool:
         """Whether an entry for ``key`` exists (not read, so not checked: a hint only)."""
-        return self._path(key).is_file()
+        if self._shard(key) is None:
+            return False
+        try:
+            return stat.S_ISREG(os.lstat(self._path(key)).st_mode)
+        except OSError:
+            return False
 
     def get(self, key: str) -> tuple[bool, Any]:
         hit, value, _ = self.get_entry(key)
@@ -260,11 +279,13 @@ class DiskCache:
     def get_entry(self, key: str) -> tuple[bool, Any, str | None]:
         """(hit, value, identity recorded with it)."""
         path = self._path(key)
-        _mark_used(path)
+        if self._shard(key) is None:
+            return False, None, None
         try:
-            data = path.read_bytes()
+            data = _read_entry(path)
         except OSError:
             return False, None, None
+        _mark_used(path)
         try:
             arrays = _read_npz(data)
             # json's parser refuses absurd nesting itself (RecursionError, a miss); what it
@@ -322,6 +343,8 @@ class DiskCache:
         path = self._path(key)
         try:
             path.parent.mkdir(parents=True, exist_ok=True)
+            if self._shard(key) is None:
+                return False  # a link planted in the cache: never write through it
             fd, tmp = tempfile.mkstemp(prefix=".", suffix=".tmp", dir=path.parent)
             try:
                 with os.fdopen(fd, "wb") as fh:
@@ -463,36 +486,47 @@ def parse_size(text: str) -> int:
     return int(float(m.group(1)) * _UNITS[unit])
 
 
-def _entry_paths(root: Path) -> list[Path]:
-    """The cache's own entry files (``xx/<key>.npz``), nothing else in the folder."""
-    out: list[Path] = []
+def _shards(root: Path) -> list[os.DirEntry[str]]:
+    """The cache's shard folders (``xx/``), never a symlink to a folder."""
     try:
-        subdirs = [d for d in os.scandir(root) if len(d.name) == 2 and d.is_dir()]
+        return [d for d in os.scandir(root) if len(d.name) == 2 and d.is_dir(follow_symlinks=False)]
     except OSError:
-        return out
-    for d in subdirs:
+        return []
+
+
+def _entry_paths(root: Path) -> list[Path]:
+    """The cache's own entry files (``xx/<key>.npz``, regular files, not links), nothing
+    else in the folder."""
+    out: list[Path] = []
+    for d in _shards(root):
         try:
-            names = os.listdir(d.path)
+            entries = list(os.scandir(d.path))
         except OSError:
             continue
-        out.extend(Path(d.path, n) for n in names if _ENTRY.fullmatch(n) and n[:2] == d.name)
+        out.extend(
+            Path(e.path)
+            for e in entries
+            if _ENTRY.fullmatch(e.name)
+            and e.name[:2] == d.name
+            and e.is_file(follow_symlinks=False)
+        )
     return out
 
 
 def _remove_stale_temps(root: Path, age: float = 3600.0) -> None:
     now = time.time()
-    try:
-        subdirs = [d for d in os.scandir(root) if len(d.name) == 2 and d.is_dir()]
-    except OSError:
-        return
-    for d in subdirs:
+    for d in _shards(root):
         try:
             temps = [e for e in os.scandir(d.path) if e.name.startswith(".")]
         except OSError:
             continue
         for e in temps:
             try:
-                if e.name.endswith(".tmp") and now - e.stat().st_mtime > age:
+                if (
+                    e.name.endswith(".tmp")
+                    and e.is_file(follow_symlinks=False)
+                    and now - e.stat(follow_symlinks=False).st_mtime > age
+                ):
                     os.unlink(e.path)
             except OSError:
                 pass
@@ -501,9 +535,21 @@ def _remove_stale_temps(root: Path, age: float = 3600.0) -> None:
 def _mark_used(path: Path) -> None:
     """Record a read as the entry's last use (its modification time), for LRU pruning."""
     try:
-        os.utime(path)
-    except OSError:
+        os.utime(path, follow_symlinks=False)
+    except (OSError, NotImplementedError):
         pass
+
+
+def _read_entry(path: Path) -> bytes:
+    """An entry's bytes, from a regular file only (never through a link, never a FIFO)."""
+    fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
+    try:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            raise OSError(f"{path} is not a regular file")
+        with os.fdopen(fd, "rb", closefd=False) as fh:
+            return fh.read()
+    finally:
+        os.close(fd)
 
 
 def _unlink(path: Path) -> bool:

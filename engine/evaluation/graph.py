@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from ..core import safety
 from ..core.errors import (
     CycleError,
     ExpressionError,
@@ -61,17 +62,10 @@ def load(
     _check_budgets(budget, memory_bytes)
     path = Path(path)
     try:
-        with open(path, "rb") as fh:  # never read more than the format allows
-            data = fh.read(MAX_BYTES + 1)
-        if len(data) > MAX_BYTES:
-            raise GraphError(
-                Problem(
-                    Where(str(path)), f"the file is larger than {MAX_BYTES // (1024 * 1024)} MiB"
-                )
-            )
-        text = data.decode("utf-8")
+        text = safety.read_regular(path, max_bytes=MAX_BYTES).decode("utf-8")
     except (OSError, UnicodeDecodeError) as exc:
-        raise GraphError(Problem(Where(str(path)), f"cannot read the graph file: {exc}")) from None
+        why = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+        raise GraphError(Problem(Where(str(path)), f"cannot read the graph file: {why}")) from None
     return Graph.from_text(
         text,
         file=str(path),
@@ -297,6 +291,10 @@ class Graph:
             nd.set_repeat(value)
             self._checked = False
             return
+        if port == "simulate":  # not an input: the node's steps
+            nd.set_simulate(value)
+            self._checked = False
+            return
         nd.raw[port] = value
         nd.parse_errors.pop(port, None)
         try:
@@ -453,22 +451,26 @@ class Graph:
         run.results.update(inputs)
         nd = self._nodes[step.name]
         spec = run.registry[nd.type]
-        if nd.repeat is None:
+        if nd.repeat is None and nd.simulate is None:
             run.keys[step.name] = step.key
         else:
             run.key(step.name)  # its items' keys (the count may come from an input)
         t0 = time.perf_counter()
         if not spec.is_export:
-            if nd.repeat is None:
-                hit, value, source = run.lookup(step.key, spec)
-            else:
+            if nd.repeat is not None:
                 hit, value, source = run.lookup_items(step.name, spec)
+            elif nd.simulate is not None:
+                hit, value, source = run.lookup_steps(step.name, spec)
+            else:
+                hit, value, source = run.lookup(step.key, spec)
             if hit:
                 return value, NodeStat("cached", time.perf_counter() - t0, source=source)
-        if nd.repeat is None:
-            value = run.compute(step.name, nd, spec)
-        else:
+        if nd.repeat is not None:
             value = run.compute_items(step.name, nd, spec)
+        elif nd.simulate is not None:
+            value = run.compute_steps(step.name, nd, spec)
+        else:
+            value = run.compute(step.name, nd, spec)
         return value, run.stats[step.name]
 
     def cached(self, step: Step) -> tuple[bool, Any]:
@@ -479,7 +481,7 @@ class Graph:
         nd = self._nodes[step.name]
         run = _Run(self, dict(self._values), pure=True)
         spec = run.registry[nd.type]
-        if spec.is_export or nd.repeat is not None:
+        if spec.is_export or nd.repeat is not None or nd.simulate is not None:
             return False, None
         hit, value, _ = run.lookup(step.key, spec)
         return hit, value

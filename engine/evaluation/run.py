@@ -35,10 +35,11 @@ from ..core.errors import (
 )
 from ..core.registry import Context, NodeSpec, node_types
 from ..core.types import Entries, TypeMismatch
-from ..language.model import Expr, Input, Items, Literal, NodeDef, Wire, wires_of
+from ..language.model import FRAMES, STEP, Expr, Input, Items, Literal, NodeDef, Wire, wires_of
 from ..language.subgraph import SubgraphSpec
 from . import cache as _cache
 from .items import LanguageRun, file_stamp, input_names, reads_loop
+from .simulation import SimulationRun
 from .stats import NodeStat, Step
 
 __all__ = ["GraphView", "NodeStat", "Step"]  # the records are in .stats
@@ -68,7 +69,7 @@ class GraphView(Protocol):
     def _child(self, spec: SubgraphSpec) -> GraphView: ...
 
 
-class _Run(LanguageRun):
+class _Run(LanguageRun, SimulationRun):
     """One evaluation call: memoized keys, identities and values, and the run record."""
 
     def __init__(
@@ -128,12 +129,15 @@ class _Run(LanguageRun):
             if r is not None and not wires_of(r.source):
                 self.repeat_items(n)
                 self.precheck_nested(n)
+            if self.g._nodes[n].simulate is not None:
+                self.step_count(n)
         for n in order:
             key = self.key(n)
             if key in self.g._identity and not self.registry[self.g._nodes[n].type].is_export:
                 st = self.stats.setdefault(n, NodeStat("cached", 0.0, source="identity"))
                 if n in self.item_keys:
                     st.items = len(self.item_keys[n])
+                    st.unit = "steps" if self.g._nodes[n].simulate is not None else st.unit
             else:
                 self.fetch(n)
         for t in targets:
@@ -208,7 +212,12 @@ class _Run(LanguageRun):
         if digest is not None:  # a subgraph: its file tree's content
             parts["file"] = digest
         loop = nd.repeat.name if nd.repeat is not None else None
+        sim = nd.simulate
+        if sim is not None:
+            loop = STEP
         for port, value in nd.inputs.items():
+            if sim is not None and port == sim.state:
+                continue  # the previous step's key stands for it
             if loop is not None and reads_loop(value, loop, spec.inputs[port].type):
                 # known item by item: the authored text and the params it reads here, the
                 # item's own token in the item's key
@@ -222,6 +231,8 @@ class _Run(LanguageRun):
             parts["inputs"][port] = self.key_part(name, port, spec, value)
         if spec.is_export:
             parts["out_dir"] = self.out_dir
+        if sim is not None:
+            return self.step_keys(name, parts)
         if nd.repeat is None:
             self.keys[name] = _cache.key_of(parts)
             return self.keys[name]
@@ -264,6 +275,8 @@ class _Run(LanguageRun):
         if isinstance(value, Literal):
             return value.value
         if isinstance(value, Wire):
+            if value.output == FRAMES and self.g._nodes[value.node].simulate is not None:
+                return self.frames_of(value.node)
             out = self.results[value.node]
             if value.output and self.registry[self.g._nodes[value.node].type].multi_output:
                 return getattr(out, value.output)
@@ -312,6 +325,8 @@ class _Run(LanguageRun):
                 t0 = time.perf_counter()
                 if nd.repeat is not None:
                     hit, value, source = self.lookup_items(n, spec)
+                elif nd.simulate is not None:
+                    hit, value, source = self.lookup_steps(n, spec)
                 else:
                     hit, value, source = self.lookup(self.keys[n], spec)
                 if hit:
@@ -321,6 +336,9 @@ class _Run(LanguageRun):
                     )
                     if nd.repeat is not None:
                         self.stats[n].items = len(self.item_keys[n])
+                    elif nd.simulate is not None:
+                        self.stats[n].items = len(self.item_keys[n])
+                        self.stats[n].unit = "steps"
                     stack.pop()
                     continue
                 missed.add(n)
@@ -330,6 +348,8 @@ class _Run(LanguageRun):
                 continue
             if nd.repeat is not None:
                 self.results[n] = self.compute_items(n, nd, spec)
+            elif nd.simulate is not None:
+                self.results[n] = self.compute_steps(n, nd, spec)
             else:
                 self.results[n] = self.compute(n, nd, spec)
             stack.pop()
@@ -342,6 +362,8 @@ class _Run(LanguageRun):
         if not hit and self.g.disk is not None:
             hit, value, identity = self.g.disk.get_entry(key)
             source = "disk"
+            if hit and not _holds(spec, value):
+                hit = False  # a well-formed entry of another type (a foreign or forged file)
             if hit:
                 self.g.memory.put(key, value)
         if hit and spec.is_export:
@@ -529,3 +551,12 @@ def _warn(message: str) -> None:
     while frame is not None and frame.f_code.co_filename.startswith(_PACKAGE):
         frame, level = frame.f_back, level + 1
     _warnings.warn(message, FormgraphWarning, stacklevel=level)
+
+
+def _holds(spec: NodeSpec, value: Any) -> bool:
+    """Whether a value read from the disk cache has the shape of ``spec``'s output(s)."""
+    if not spec.multi_output:
+        return spec.output_type(None).holds(value)
+    if not isinstance(value, (list, tuple)) or len(value) != len(spec.outputs):
+        return False
+    return all(t.holds(v) for t, v in zip(spec.outputs.values(), value, strict=True))

@@ -19,6 +19,7 @@ class NodeStat:
     source: str = ""  # where a cached value came from: 'memory' or 'disk'
     items: int | None = None  # a repeated node: how many items it has
     computed_items: int = 0  # ... and how many of them were computed (not cached)
+    unit: str = "items"  # what the items are: 'steps' for a simulated node
     inner: dict[str, NodeStat] | None = None  # a subgraph node: its own nodes' stats
 
 

@@ -99,7 +99,7 @@ class Mesh(Geometry):
 
     @functools.cached_property
     def area(self) -> float:
-        """Total face area (Newell's vector per face: exact for planar polygons)."""
+        """Total face area: of the triangles we export (each face fanned from its first corner)."""
         from ..kernels.mesh import measure
 
         return float(measure.face_areas(*self.state().values()).sum())

@@ -29,6 +29,17 @@ REPEAT = {
     },
     "description": "run the node once per item: {name: count | list | '@list' | '@points'}",
 }
+SIMULATE = {
+    "type": "object",
+    "properties": {
+        "state": {"type": "string", "description": "the input that takes the previous step"},
+        "from": {"description": "step 0: a wire, an expression or a literal"},
+        "steps": {"anyOf": [{"type": "integer", "minimum": 0}, EXPR]},
+    },
+    "required": ["state", "from", "steps"],
+    "additionalProperties": False,
+    "description": "run the node steps times, each step's output the next step's state",
+}
 GRAPH_FILE = {
     "type": "string",
     "pattern": r"\.ya?ml$",
@@ -118,9 +129,19 @@ def json_schema() -> dict[str, Any]:
                     "properties": {
                         "type": {"const": name},
                         "repeat": REPEAT,
+                        "simulate": SIMULATE,
                         **{p.name: port_schema(p) for p in spec.inputs.values()},
                     },
-                    "required": ["type", *[p.name for p in spec.inputs.values() if p.required]],
+                    # a simulated node may leave its state input out
+                    "anyOf": [
+                        {
+                            "required": [
+                                "type",
+                                *[p.name for p in spec.inputs.values() if p.required],
+                            ]
+                        },
+                        {"required": ["type", "simulate"]},
+                    ],
                     "additionalProperties": False,
                 },
             }
@@ -165,6 +186,7 @@ def json_schema() -> dict[str, Any]:
                     "properties": {
                         "type": {"anyOf": [{"enum": list(registry)}, GRAPH_FILE]},
                         "repeat": REPEAT,
+                        "simulate": SIMULATE,
                     },
                     "allOf": branches,
                 },

@@ -27,7 +27,7 @@ from ..core.types import (
     number_text,
 )
 from .expr import compile_expression
-from .model import Expr, Input, Items, Literal, NodeDef, ParamDef, Wire
+from .model import FRAMES, Expr, Input, Items, Literal, NodeDef, ParamDef, Wire
 
 
 def suggest(name: str, options: Any) -> str:
@@ -239,6 +239,8 @@ def _output_type(
     spec = registry.get(nd.type) if nd is not None else None
     if spec is None or wire.node in seen:
         return None
+    if wire.output == FRAMES and nd.simulate is not None and FRAMES not in spec.outputs:
+        return as_list(spec.output_type(None))  # every step's output
     if (wire.output is not None and wire.output not in spec.outputs) or (
         wire.output is None and spec.multi_output
     ):
@@ -368,6 +370,12 @@ def _check_node(
     repeat_problems, loop = _check_repeat(g, nd, registry)
     for message in repeat_problems:
         add(message, "repeat")
+    from .simulation import check_simulate, is_state_placeholder
+
+    simulate_problems, step = check_simulate(g, nd, spec, registry)
+    for message, port in simulate_problems:
+        add(message, port)
+    loop = loop or step
     for port in nd.raw:
         if port not in spec.inputs:
             add(
@@ -376,6 +384,8 @@ def _check_node(
                 port,
             )
     for port, p in spec.inputs.items():
+        if is_state_placeholder(nd, port):
+            continue  # each step's input is the previous step's output
         if port not in nd.raw:
             if p.required:
                 add(f"missing required input ({p.type.name})", port)
@@ -438,6 +448,13 @@ def _check_wire(g: Outline, pt: PortType, wire: Wire, registry: dict[str, NodeSp
     spec = registry.get(target.type)
     if spec is None:
         return []  # reported on the target itself
+    if wire.output == FRAMES and target.simulate is not None and not spec.multi_output:
+        produced = output_type(g, wire, registry) or as_list(spec.output_type(None))
+        return (
+            []
+            if pt.accepts(produced)
+            else [f"expected {pt.name}, got {produced.name} from '{wire}'"]
+        )
     if wire.output is not None and wire.output not in spec.outputs:
         if not spec.multi_output:
             return [f"'{target.type}' has a single output: write '@{wire.node}', not '{wire}'"]

@@ -166,6 +166,53 @@ def parse_repeat(raw: Any) -> Repeat:
     return Repeat(name, parse_input(source))
 
 
+@dataclass(frozen=True)
+class Simulate:
+    """A node's ``simulate: {state, from, steps}``: the node runs ``steps`` times, each
+    step's output the next step's ``state`` input, ``from`` its value at step 0.
+
+    ``source`` (the ``from``) is any input (mostly a wire); ``steps`` a count (an int, or an
+    expression giving one). The node's expressions see the step index as ``step``.
+    """
+
+    state: str
+    source: Input
+    steps: Input
+
+
+#: the name a simulated node's expressions see the step index under (1, 2, ... steps)
+STEP = "step"
+#: the output of a simulated node that holds every step's output, in order
+FRAMES = "frames"
+
+_SIMULATE_KEYS = ("state", "from", "steps")
+
+
+def parse_simulate(raw: Any) -> Simulate:
+    """Parse an authored ``simulate:`` mapping.
+
+    Raises
+    ------
+    ExpressionError
+        For anything but ``{state: port, from: ..., steps: ...}``, or a malformed wire or
+        expression.
+    """
+    example = 'e.g. simulate: {state: curve, from: "@seed", steps: "=steps"}'
+    if not isinstance(raw, dict):
+        raise ExpressionError(f"simulate takes state, from and steps, {example}")
+    missing = [k for k in _SIMULATE_KEYS if k not in raw]
+    extra = sorted(str(k) for k in raw if k not in _SIMULATE_KEYS)
+    if missing or extra:
+        what = f"needs {', '.join(missing)}" if missing else f"has no '{extra[0]}'"
+        raise ExpressionError(f"simulate {what}: it takes state, from and steps, {example}")
+    state = raw["state"]
+    if not isinstance(state, str) or not _is_name(state):
+        raise ExpressionError(f"simulate's state is the name of an input, got {state!r}")
+    if isinstance(raw["steps"], bool):
+        raise ExpressionError(f"simulate's steps is a count, got {raw['steps']!r}")
+    return Simulate(state, parse_input(raw["from"]), parse_input(raw["steps"]))
+
+
 @dataclass
 class ParamDef:
     """A graph parameter: default, optional declared type, range and doc."""
@@ -210,6 +257,8 @@ class NodeDef:
     parse_errors: dict[str, str] = field(default_factory=dict)
     repeat: Repeat | None = None
     repeat_raw: Any = None  # as authored, for save()
+    simulate: Simulate | None = None
+    simulate_raw: Any = None  # as authored, for save()
 
     @classmethod
     def make(
@@ -224,6 +273,8 @@ class NodeDef:
         nd = cls(name, type_, raw, {}, line, dict(input_lines or {}))
         if "repeat" in raw:
             nd.set_repeat(raw.pop("repeat"))
+        if "simulate" in raw:
+            nd.set_simulate(raw.pop("simulate"))
         for port, value in raw.items():
             try:
                 nd.inputs[port] = parse_input(value)
@@ -242,13 +293,31 @@ class NodeDef:
         except ExpressionError as exc:
             self.parse_errors["repeat"] = str(exc.problems[0].message)
 
+    def set_simulate(self, raw: Any) -> None:
+        """Set (or with None, remove) the node's ``simulate:``."""
+        self.parse_errors.pop("simulate", None)
+        self.simulate, self.simulate_raw = None, raw
+        if raw is None:
+            return
+        try:
+            self.simulate = parse_simulate(raw)
+        except ExpressionError as exc:
+            self.parse_errors["simulate"] = str(exc.problems[0].message)
+
     def upstream(self) -> list[str]:
         wires = [w.node for v in self.inputs.values() for w in wires_of(v)]
         if self.repeat is not None:
             wires += [w.node for w in wires_of(self.repeat.source)]
+        if self.simulate is not None:
+            wires += [
+                w.node for s in (self.simulate.source, self.simulate.steps) for w in wires_of(s)
+            ]
         return wires
 
     def to_yaml(self) -> dict[str, Any]:
-        if self.repeat_raw is None:
-            return {"type": self.type, **self.raw}
-        return {"type": self.type, "repeat": self.repeat_raw, **self.raw}
+        out: dict[str, Any] = {"type": self.type}
+        if self.repeat_raw is not None:
+            out["repeat"] = self.repeat_raw
+        if self.simulate_raw is not None:
+            out["simulate"] = self.simulate_raw
+        return {**out, **self.raw}

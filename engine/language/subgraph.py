@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from ..core import safety
 from ..core.errors import Problem, Where
 from ..core.registry import REQUIRED, NodeSpec, Port, node_types
 from ..core.types import Kind, PortType, Range
@@ -56,6 +57,11 @@ def _param_port(p: ParamDef) -> Port:
         return Port(p.name, t, REQUIRED if p.default is None else p.default, p.doc)
     base: Any = param_kind(p) or Any  # an int only when written whole throughout
     return Port(p.name, PortType((Kind(base),), range=rng), p.default, p.doc)
+
+
+MAX_NESTING = 50
+"""How deep graph files may use graph files (a part of a part of ...): far beyond any design,
+and shallow enough that checking and evaluating them never meets Python's recursion limit."""
 
 
 def _chain_text(chain: list[tuple[str, str]]) -> str:
@@ -145,16 +151,24 @@ class Includes:
         if path in stack:
             names = [*(str(p.name) for p in stack[stack.index(path) :]), path.name]
             return None, [Problem(where, f"include cycle: {' -> '.join(names)}{suffix}")]
+        if len(stack) > MAX_NESTING:
+            names = [p.name for p in stack]
+            shown = [*names[:2], "...", *names[-2:]] if len(names) > 5 else names
+            return None, [
+                Problem(
+                    where,
+                    f"subgraph '{text}' would nest graph files more than {MAX_NESTING} deep "
+                    f"({' -> '.join(shown)} -> {path.name}); flatten some of the parts",
+                )
+            ]
         if path in self.loaded:
             return self.loaded[path]
         try:
-            with open(path, "rb") as fh:
-                data = fh.read(MAX_BYTES + 1)
-            if len(data) > MAX_BYTES:
-                raise OSError(f"larger than {MAX_BYTES // (1024 * 1024)} MiB")
+            data = safety.read_regular(path, max_bytes=MAX_BYTES)
             source = data.decode("utf-8")
         except (OSError, UnicodeDecodeError) as exc:
-            return None, [Problem(where, f"cannot read the subgraph file '{text}': {exc}{suffix}")]
+            why = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+            return None, [Problem(where, f"cannot read the subgraph file '{text}': {why}{suffix}")]
         self.files.append(path)
         doc = parse(source, label)
         inner_chain = [*chain, (nd.name, file_label)] if file_label != label else list(chain)

@@ -176,6 +176,33 @@ class Sweep:
         return "\n".join(lines)
 
 
+_FORMULA = ("=", "+", "-", "@", "\t", "\r")  # what a spreadsheet reads as a formula's start
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def _inert(text: str) -> str:
+    """A text cell a spreadsheet shows as text: one leading ``'`` before ``= + - @`` (and
+    before a ``'`` already leading such a cell, so :func:`_active` undoes exactly this);
+    numbers (``-1.5``) are left as they are."""
+    if text.lstrip("'").startswith(_FORMULA) and not _is_number(text):
+        return "'" + text
+    return text
+
+
+def _active(text: str) -> str:
+    """The text :func:`_inert` was given."""
+    if text.startswith("'") and text.lstrip("'").startswith(_FORMULA):
+        return text[1:]
+    return text
+
+
 def _cell(v: Any) -> str:
     if v is None:
         return ""
@@ -183,12 +210,15 @@ def _cell(v: Any) -> str:
         return "true" if v else "false"
     if isinstance(v, float):
         return repr(v)
-    if isinstance(v, (int, str)):
+    if isinstance(v, int):
         return str(v)
-    return json.dumps(v)
+    if isinstance(v, str):
+        return _inert(v)  # params, file names and errors: never a formula (CSV injection)
+    return _inert(json.dumps(v))
 
 
 def _parse_cell(text: str, kind: type | None) -> Any:
+    text = _active(text)
     if kind is None or text == "":
         return text if kind is str or kind is None else None
     if kind is bool:
@@ -206,7 +236,9 @@ def _line(values: Sequence[str]) -> str:
 
 
 def _table_text(columns: Sequence[str], rows: Iterable[Mapping[str, Any]]) -> str:
-    return _line(columns) + "".join(_line([_cell(r.get(c)) for c in columns]) for r in rows)
+    return _line([_inert(c) for c in columns]) + "".join(
+        _line([_cell(r.get(c)) for c in columns]) for r in rows
+    )
 
 
 def _write_atomic(path: Path, text: str) -> None:
@@ -233,7 +265,7 @@ class _Table:
             return {}
         text = text[: text.rfind("\n") + 1]  # a line cut short by a crash is dropped
         reader = csv.reader(io.StringIO(text))
-        if next(reader, None) != self.columns:
+        if next(reader, None) != [_inert(c) for c in self.columns]:
             return {}
         out: dict[int, dict[str, str]] = {}
         for cells in reader:
@@ -298,6 +330,7 @@ def sweep(
     workers: int | None = None,
     cache_dir: Any = _GRAPH_CACHE,
     size: tuple[int, int] = (256, 192),
+    camera: tuple[Any, Any, Any] | None = None,
     per_sheet: int = 100,
     on_row: Callable[[dict[str, Any]], None] | None = None,
     progress: Callable[[int, int, int, float], None] | None = None,
@@ -322,6 +355,9 @@ def sweep(
     render : str, optional
         A node drawn for each variant, tiled into ``out/sheet.png`` (``per_sheet`` cells of
         ``size`` pixels each, then ``sheet-2.png``, ...).
+    camera : (view, azimuth, elevation), optional
+        Where the cells look from, as ``formgraph.viewer.Camera`` takes them
+        (``("top", None, None)``, ``(None, 30, 20)``); default: each cell fits its value.
     out : path, optional
         Where ``sweep.csv`` grows as variants finish; rerunning the same sweep there keeps
         the rows already done (needed for export and render).
@@ -365,7 +401,12 @@ def sweep(
         raise ValueError("vary at least one param")
     if (export or render) and out is None:
         raise ValueError("export and render write files: give out=")
-    targets = Targets(targets.measures, targets.exports, render, size, targets.build)
+    if camera is not None:
+        from formgraph.viewer.frame import Camera
+
+        camera = tuple(camera)
+        Camera(*camera)  # a ValueError for a bad view or angle, before anything runs
+    targets = Targets(targets.measures, targets.exports, render, size, targets.build, camera)
     variants = sample(domains, method, samples, seed)
     base = g.params
     columns = ["variant"]
@@ -480,5 +521,5 @@ def _kept(
     row.update({c: params[c] for c in columns if c in params})
     row.update(status="ok", error="", seconds=_parse_cell(cells["seconds"], float))
     row.update({c: _parse_cell(cells[c], k) for c, k in kinds.items()})
-    row.update({e: cells[e] for e in exports})
+    row.update({e: _active(cells[e]) for e in exports})
     return row

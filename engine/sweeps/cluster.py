@@ -32,9 +32,11 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from ..core import safety
 from ..core.errors import FormgraphError
 from ..evaluation.cache import DiskCache, default_cache_dir, key_of
 from ..evaluation.graph import Graph, Step
+from ..language.yamlio import MAX_BYTES
 from .tasks import (
     Blueprint,
     Job,
@@ -73,6 +75,7 @@ class Targets:
     render: str | None = None
     size: tuple[int, int] = (256, 192)
     build: tuple[str, ...] = ()  # nodes only built (nothing measured, exported or drawn)
+    camera: tuple[Any, Any, Any] | None = None  # (view, azimuth, elevation) of the cells
 
     @property
     def nodes(self) -> list[str]:
@@ -127,7 +130,7 @@ def blueprint(g: Graph, cache_dir: str | None, worker_cache: bool) -> Blueprint:
         for path in g.files[1:]:
             try:
                 rel = Path(path).resolve().relative_to(root).as_posix()
-                files[rel] = Path(path).read_text(encoding="utf-8")
+                files[rel] = safety.read_regular(path, max_bytes=MAX_BYTES).decode("utf-8")
             except (OSError, ValueError, UnicodeDecodeError) as exc:
                 raise SweepError(
                     f"{g.file_label}: cannot send {path} to Dask workers: {exc}"
@@ -172,7 +175,9 @@ def build(
         steps = g.plan(names, **params)
         totals.naive += len(steps)
         by_name = {s.name: s for s in steps}
-        row_key = "row-" + key_of([by_name[n].key for n in names] + [list(targets.size)])
+        row_key = "row-" + key_of(
+            [by_name[n].key for n in names] + [list(targets.size), list(targets.camera or ())]
+        )
         if row_key in rows:
             rows[row_key].append(index)
             continue
@@ -192,7 +197,7 @@ def build(
             users[s.key] = users.get(s.key, 0) + 1
         plans.append((row_key, kept, params))
     dsk: dict[str, Any] = {}
-    job = RowJob(targets.measures, targets.exports, targets.render, targets.size)
+    job = RowJob(targets.measures, targets.exports, targets.render, targets.size, targets.camera)
     row_plans = []
     for row_key, steps, params in plans:
         by_name = {s.name: s for s in steps}

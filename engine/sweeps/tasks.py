@@ -212,9 +212,13 @@ class RowJob:
     exports: tuple[str, ...]
     render: str | None
     size: tuple[int, int]
+    camera: tuple[Any, Any, Any] | None = None
 
     def __dask_tokenize__(self) -> str:
-        return key_of([list(m) for m in self.measures] + [list(self.exports), self.render])
+        return key_of(
+            [list(m) for m in self.measures]
+            + [list(self.exports), self.render, list(self.camera or ())]
+        )
 
 
 @dataclass(frozen=True)
@@ -293,7 +297,7 @@ def run_row(bp: Blueprint, job: RowJob, plan: RowPlan, shared: dict[str, Outcome
             try:
                 from formgraph.viewer.sheet import render_cell
 
-                image = render_cell(values[job.render], job.size)
+                image = render_cell(values[job.render], job.size, job.camera)
             except Exception as exc:
                 error = f"render: {one_line(exc)}"
     exports = {n: values[n] for n in job.exports} if error is None else {}

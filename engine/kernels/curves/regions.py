@@ -14,7 +14,7 @@ rings become a region and how the result comes back.
   alternately: even-odd for a self-intersecting ring) and the rings are combined by
   symmetric difference, pairwise in a balanced tree.
 - The result comes back as rings with outer boundaries counter-clockwise and holes
-  clockwise (``orient_polygons``), each without its closing point.
+  clockwise (``orient_polygons``), each closed by its first point.
 """
 
 from __future__ import annotations
@@ -35,9 +35,10 @@ def _linearrings(rings: Sequence[np.ndarray]) -> np.ndarray:
     if np.any(sizes < 3):
         i = int(np.argmax(sizes < 3))
         raise ValueError(f"ring {i} has {sizes[i]} distinct points; a region needs 3 or more")
-    coords = np.concatenate(rings)
-    index = np.repeat(np.arange(len(rings)), sizes)
-    return shapely.linearrings(coords, indices=index)
+    out = np.empty(len(rings), dtype=object)
+    for i, r in enumerate(rings):  # one call per ring (GEOS copies its points in C)
+        out[i] = shapely.linearrings(r)
+    return out
 
 
 def _xor_tree(geoms: np.ndarray) -> shapely.Geometry:
@@ -69,7 +70,7 @@ def even_odd_region(rings: Sequence[np.ndarray]) -> shapely.Geometry:
     if shapely.is_simple(shapely.multilinestrings(lr)):
         return _nested(lr)
     polys = shapely.polygons(lr)
-    bad = ~shapely.is_valid(polys)
+    bad = ~shapely.is_simple(lr)
     if bad.any():
         polys[bad] = shapely.make_valid(polys[bad], method="linework")
     return _xor_tree(polys)
@@ -99,11 +100,14 @@ def each_region(rings: Sequence[np.ndarray]) -> shapely.Geometry:
     """The union of the rings' regions, each ring read on its own (by the even-odd rule)."""
     if len(rings) == 0:
         return shapely.Polygon()
-    polys = shapely.polygons(_linearrings(rings))
-    bad = ~shapely.is_valid(polys)
+    lr = _linearrings(rings)
+    polys = shapely.polygons(lr)
+    bad = ~shapely.is_simple(lr)  # a ring that does not touch itself bounds a valid polygon
     if bad.any():
         polys[bad] = shapely.make_valid(polys[bad], method="linework")
-    return polys[0] if len(polys) == 1 else shapely.union_all(polys)
+    if len(polys) == 1:
+        return polys[0]
+    return shapely.union(polys[0], polys[1]) if len(polys) == 2 else shapely.union_all(polys)
 
 
 def boolean(a: shapely.Geometry, b: shapely.Geometry, operation: str) -> shapely.Geometry:
@@ -128,7 +132,8 @@ def rings_of(region: shapely.Geometry) -> tuple[np.ndarray, np.ndarray, np.ndarr
     Returns
     -------
     coords : (N, 2) float
-        Every ring's points, without closing points, ring after ring.
+        Every ring's points, each ring closed (its first point repeated at its end), ring
+        after ring; no point repeats the one before it.
     offsets : (r + 1,) int
         Ring i is ``coords[offsets[i]:offsets[i + 1]]``.
     hole : (r,) bool
@@ -145,12 +150,12 @@ def rings_of(region: shapely.Geometry) -> tuple[np.ndarray, np.ndarray, np.ndarr
     hole = np.ones(len(rings), dtype=bool)
     hole[np.concatenate([[0], np.cumsum(interiors + 1)[:-1]])] = False
     coords, index = shapely.get_coordinates(rings, return_index=True)
+    d = np.diff(coords, axis=0)
+    repeat = np.r_[False, (d[:, 0] == 0) & (d[:, 1] == 0) & (index[1:] == index[:-1])]
+    if repeat.any():  # GEOS leaves none in an overlay's result; kept safe all the same
+        coords, index = coords[~repeat], index[~repeat]
     sizes = np.bincount(index, minlength=len(rings))
-    last = np.cumsum(sizes) - 1  # the closing point of each ring
-    keep = np.ones(len(coords), dtype=bool)
-    keep[last] = False
-    offsets = np.concatenate([[0], np.cumsum(sizes - 1)])
-    return coords[keep], offsets, hole
+    return coords, np.concatenate([[0], np.cumsum(sizes)]), hole
 
 
 def _key(ring: np.ndarray) -> tuple[int, float, float]:

@@ -137,7 +137,7 @@ def _parse(digest: str, data: bytes) -> Font:
             pairs,
             classes,
         )
-    except (TTLibError, KeyError, AssertionError, struct.error) as exc:
+    except (TTLibError, KeyError, AssertionError, IndexError, TypeError, struct.error) as exc:
         raise ValueError(f"cannot read the font: {exc}") from None
 
 

@@ -8,6 +8,15 @@ consistently oriented, outward solid is refused with a sentence that counts the 
 and names one of them, never with the library's own exception text; the check comes from
 our edge table, before manifold3d sees the mesh, because manifold3d 3.5 can crash the
 process (not only refuse) on open, messy input.
+
+What passes the edge table can still be wrong for manifold3d, silently: an unused vertex far
+away widens the bounding box its tolerance is taken from (1e-12 of the largest coordinate),
+coordinates past :data:`MAX_COORDINATE` overflow its volumes, a solid smaller than the other
+operand's tolerance is erased, a mesh whose faces all collapsed bounds nothing, and parts that
+overlap (two coincident copies of a box) are read as a double shell. So unused vertices are
+dropped, overlapping parts of one mesh are fused first (their union, as ``mesh.union`` does),
+a collapsed mesh is the empty solid (:func:`collapsed`), and the rest is refused with a
+sentence.
 """
 
 from __future__ import annotations
@@ -21,8 +30,11 @@ from .measure import is_closed_oriented, signed_volume, solid_report
 from .meshops import triangulate
 
 __all__ = [
+    "MAX_COORDINATE",
     "NotSolidError",
     "Operation",
+    "check_precision",
+    "collapsed",
     "boolean",
     "combine",
     "from_manifold",
@@ -33,8 +45,18 @@ __all__ = [
 MeshArrays = tuple[np.ndarray, np.ndarray, np.ndarray]
 
 
+MAX_COORDINATE = 1e100
+"""The largest coordinate a boolean takes: a cube that size has a volume of 1e300, near the
+largest float64; beyond it manifold3d's volumes and tolerances are inf or nan."""
+
+#: a solid must be this many times manifold3d's tolerance across, or the boolean erases it
+_RESOLVED = 1e3
+
+
 class NotSolidError(ValueError):
-    """A mesh handed to a boolean does not bound a solid."""
+    """A mesh handed to a boolean does not bound a solid (``operand``: which one, if known)."""
+
+    operand: int | None = None
 
 
 class Operation(str, Enum):
@@ -90,16 +112,19 @@ def to_manifold(
     face_offsets: np.ndarray,
     what: str = "the mesh",
     max_tests: int | None = None,
+    fuse: bool = True,
 ) -> object:
     """A ``manifold3d.Manifold`` of a closed outward mesh (float64, no copy of triangles).
 
-    ``max_tests`` limits the ear clipping of faces that are not triangles (see
+    Unused vertices are dropped; overlapping parts are fused when ``fuse`` (see
+    :func:`_fused`). ``max_tests`` limits the ear clipping of faces that are not triangles (see
     :func:`~.meshops.triangulate`).
 
     Raises
     ------
     NotSolidError
-        Open, non-manifold, misoriented or inside-out input, as a sentence.
+        Open, non-manifold, misoriented, inside-out, overlapping or out-of-range input, as
+        a sentence (a collapsed one is the empty manifold).
     WorkLimitError
         Triangulating its faces would need more than ``max_tests`` corner tests.
     """
@@ -110,6 +135,13 @@ def to_manifold(
     fo = np.asarray(face_offsets, dtype=np.int64)
     if fo.size < 2:
         raise NotSolidError(f"{what} has no faces")
+    v, fi = _drop_unused(v, fi)
+    big = float(np.abs(v).max())
+    if not big <= MAX_COORDINATE:
+        raise NotSolidError(
+            f"{what} reaches a coordinate of {big:.3g}, beyond the {MAX_COORDINATE:.0e} a "
+            "boolean can represent (its volume would overflow float64); scale it down"
+        )
     # our own check first: manifold3d can crash (not only refuse) on open, messy input
     if not is_closed_oriented(fi, fo, len(v)):
         raise NotSolidError(_why_not_solid(v, fi, fo, what))
@@ -123,12 +155,88 @@ def to_manifold(
             f"{what} is not a valid solid for the boolean (manifold3d: {m.status().name}); it "
             "may be degenerate or intersect itself"
         )
+    if collapsed(m):
+        import manifold3d
+
+        return manifold3d.Manifold()  # no volume: the empty solid, not a degenerate shell
     if m.volume() < 0:
         vol = float(signed_volume(v, fi, fo).sum())
         raise NotSolidError(
             f"{what} is inside out (its volume is {vol:.6g}); mesh.orient turns it outward"
         )
-    return m
+    return _fused(m, what) if fuse else m
+
+
+def collapsed(m: object) -> bool:
+    """Whether a manifold bounds no volume: no triangles left, or thinner (volume over
+    area) than its tolerance -- e.g. a box with every vertex at one point, which manifold3d
+    keeps as 12 degenerate triangles at the origin (tolerance 0) and then cuts wrongly."""
+    if m.is_empty():  # type: ignore[attr-defined]
+        return True
+    area = m.surface_area()  # type: ignore[attr-defined]
+    return area == 0 or abs(m.volume()) <= m.get_tolerance() * area  # type: ignore[attr-defined]
+
+
+def _drop_unused(v: np.ndarray, fi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The vertices the faces use, renumbered (an unused vertex still sets the tolerance)."""
+    used = np.zeros(len(v), bool)
+    used[fi] = True
+    if used.all():
+        return v, fi
+    new = np.cumsum(used) - 1
+    return np.ascontiguousarray(v[used]), new[fi]
+
+
+def _fused(m: object, what: str) -> object:
+    """``m`` with its overlapping parts fused (two coincident copies read as one solid).
+
+    manifold3d assumes its input does not intersect itself; a mesh of parts that overlap is
+    read as a multiple cover and its booleans come out wrong (a difference that removes
+    nothing). Parts of positive volume are fused by their union; a mesh with cavities (parts
+    of negative volume) is kept when its positive parts are disjoint and refused otherwise.
+    """
+    import manifold3d
+
+    parts = m.decompose()  # type: ignore[attr-defined]
+    if len(parts) < 2:
+        return m
+    volumes = np.array([p.volume() for p in parts])
+    solids = [p for p, vol in zip(parts, volumes, strict=True) if vol > 0]
+    fused = manifold3d.Manifold.batch_boolean(solids, manifold3d.OpType.Add)
+    total = float(volumes[volumes > 0].sum())
+    overlap = total - fused.volume()
+    if overlap <= 1e-9 * total:
+        return m
+    if len(solids) == len(parts):
+        return fused
+    raise NotSolidError(
+        f"{what} has {len(solids)} solid parts that overlap (by a volume of {overlap:.6g}) "
+        f"and {len(parts) - len(solids)} cavities; mesh.union the parts before cutting cavities"
+    )
+
+
+def check_precision(manifolds: Sequence[object], whats: Sequence[str]) -> None:
+    """Refuse a boolean whose smallest operand is below the tolerance of the largest.
+
+    manifold3d merges what is closer than its tolerance, 1e-12 of the largest coordinate of
+    an operand; in a boolean the larger tolerance holds for both, so a unit box beside a
+    box 1e13 across would come out empty, or whole, depending on the order.
+    """
+    tol = max(m.get_tolerance() for m in manifolds)  # type: ignore[attr-defined]
+    for i, (m, what) in enumerate(zip(manifolds, whats, strict=True)):
+        if m.is_empty():  # type: ignore[attr-defined]
+            continue  # the empty solid is exact at any scale
+        box = np.asarray(m.bounding_box()).reshape(2, 3)  # type: ignore[attr-defined]
+        size = float(np.linalg.norm(box[1] - box[0]))
+        if size < _RESOLVED * tol:
+            exc = NotSolidError(
+                f"{what} is {size:.3g} across, too small beside the other operand: manifold3d "
+                f"works to {tol:.3g} there (1e-12 of the largest coordinate), so the result "
+                "would be meaningless; scale the parts closer in size or move them near the "
+                "origin"
+            )
+            exc.operand = i
+            raise exc
 
 
 def from_manifold(m: object) -> MeshArrays:
@@ -160,9 +268,12 @@ def boolean(a: MeshArrays, b: MeshArrays, operation: Operation | str = "union") 
     return from_manifold(combine(to_manifold(*a, "input a"), to_manifold(*b, "input b"), operation))
 
 
-def combine(a: object, b: object, operation: Operation | str = "union") -> object:
-    """The boolean of two ``manifold3d.Manifold`` values."""
+def combine(
+    a: object, b: object, operation: Operation | str = "union", whats: Sequence[str] = ("a", "b")
+) -> object:
+    """The boolean of two ``manifold3d.Manifold`` values (see :func:`check_precision`)."""
     op = Operation(operation)
+    check_precision((a, b), whats)
     if op is Operation.union:
         return a + b  # type: ignore[operator]
     if op is Operation.difference:
@@ -179,11 +290,13 @@ def union(meshes: Sequence[MeshArrays], max_tests: int | None = None) -> MeshArr
     """
     import manifold3d
 
-    parts = [
-        p
+    solids = [
+        to_manifold(*m, what=f"mesh {i}", max_tests=max_tests, fuse=False)
         for i, m in enumerate(meshes)
-        for p in to_manifold(*m, what=f"mesh {i}", max_tests=max_tests).decompose()
     ]
+    if solids:
+        check_precision(solids, [f"mesh {i}" for i in range(len(solids))])
+    parts = [p for m in solids for p in m.decompose()]
     if not parts:
         return np.zeros((0, 3)), np.zeros(0, np.int64), np.zeros(1, np.int64)
     return from_manifold(manifold3d.Manifold.batch_boolean(parts, manifold3d.OpType.Add))

@@ -4,7 +4,7 @@
   of them run it the same way (one sort of the edge keys);
 - :func:`union_find`: connected components of a graph given by edge lists, optionally with
   a parity per edge (two-colouring, used to orient faces), by hooking and pointer jumping;
-- :func:`face_areas`, :func:`signed_volume`, :func:`solid_report`: area by Newell's vector,
+- :func:`face_areas`, :func:`signed_volume`, :func:`solid_report`: area of the exported fan,
   volume by the divergence theorem over the fan triangles of each face.
 
 A mesh is ``vertices (n, 3)``, ``face_indices (m,)`` and ``face_offsets (n_faces + 1,)``.
@@ -205,10 +205,30 @@ def _triangle_vectors(v: np.ndarray, tri: np.ndarray) -> np.ndarray:
 def face_areas(
     vertices: np.ndarray, face_indices: np.ndarray, face_offsets: np.ndarray
 ) -> np.ndarray:
-    """(n_faces,) area of each face (half the length of its Newell vector)."""
-    n = face_vectors(vertices, face_indices, face_offsets)
-    x, y, z = n[:, 0], n[:, 1], n[:, 2]
-    return 0.5 * np.sqrt(x * x + y * y + z * z)
+    """(n_faces,) area of each face as exported: the fan of triangles from its first corner.
+
+    STL, OBJ-triangles and the booleans write a polygon as the fan ``(a, b, c), (a, c, d),
+    ...``; a warped quad's fan has more area than its projection on the best-fit plane
+    (Newell's vector, :func:`face_vectors`), so the area is the sum of the fan triangles'
+    areas. Each counts with the sign of its agreement with the face's Newell normal, so a
+    planar concave face -- whose fan folds over itself -- still measures its exact area.
+    """
+    v = np.asarray(vertices, dtype=np.float64)
+    fi = np.asarray(face_indices, dtype=np.int64)
+    fo = np.asarray(face_offsets, dtype=np.int64)
+    if fo.size < 2:
+        return np.zeros(0)
+    sizes = np.diff(fo)
+    if fi.size == 3 * sizes.size and fo[-1] == fi.size and (sizes == 3).all():
+        n = _triangle_vectors(v, fi.reshape(-1, 3))  # a triangle is its own fan
+        x, y, z = n[:, 0], n[:, 1], n[:, 2]
+        return 0.5 * np.sqrt(x * x + y * y + z * z)
+    base = np.repeat(v[fi[fo[:-1]]], sizes, axis=0)
+    cross = np.cross(v[fi] - base, v[fi[next_corner(fo)]] - base)  # fan triangles, doubled
+    newell = np.add.reduceat(cross, fo[:-1], axis=0)
+    along = np.einsum("ij,ij->i", cross, np.repeat(newell, sizes, axis=0))
+    signed = np.where(along < 0, -1.0, 1.0) * np.linalg.norm(cross, axis=1)
+    return 0.5 * np.add.reduceat(signed, fo[:-1])
 
 
 def signed_volume(

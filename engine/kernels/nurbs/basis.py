@@ -354,7 +354,10 @@ def _check_degree_and_knots(degree: int, knots: np.ndarray, n: int, what: str) -
             f"{what}knots give an empty domain: knots[{degree}] = {knots[degree]:g} and "
             f"knots[{n}] = {knots[n]:g} must differ"
         )
-    values, counts = np.unique(knots, return_counts=True)
+    # multiplicities as run lengths of the (now known sorted) knots: no second sort
+    starts = np.concatenate([[0], np.flatnonzero(dk != 0) + 1])
+    counts = np.diff(np.append(starts, len(knots)))
+    values = knots[starts]
     if np.any(counts > degree + 1):
         i = int(np.argmax(counts > degree + 1))
         raise ValueError(
