@@ -79,6 +79,7 @@ class NodeSpec:
 
 
 _REGISTRY: dict[str, NodeSpec] = {}
+_SORTED: dict[str, NodeSpec] = {}  # _REGISTRY in name order, rebuilt after a registration
 
 
 def node(name: str, *, version: int = 1) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
@@ -93,6 +94,7 @@ def node(name: str, *, version: int = 1) -> Callable[[Callable[..., Any]], Calla
         if name in _REGISTRY and _REGISTRY[name].func.__qualname__ != func.__qualname__:
             raise ValueError(f"node type {name!r} is registered twice")
         _REGISTRY[name] = _spec_from_function(name, version, func)
+        _SORTED.clear()
         return func
 
     return register
@@ -102,7 +104,11 @@ def node_types() -> dict[str, NodeSpec]:
     """Every registered node type, by name (importing the node families first)."""
     import formgraph.nodes  # noqa: F401  (registers the families on import)
 
-    return dict(sorted(_REGISTRY.items()))
+    # Sorted once per registration (every run asks; a sweep's plan, once per variant).
+    if len(_SORTED) != len(_REGISTRY):
+        _SORTED.clear()
+        _SORTED.update(sorted(_REGISTRY.items()))
+    return dict(_SORTED)
 
 
 def _spec_from_function(name: str, version: int, func: Callable[..., Any]) -> NodeSpec:

@@ -118,6 +118,7 @@ class Graph:
         self._includes: Includes | None = None
         self._children: dict[Any, Graph] = {}  # subgraph path -> its graph, caches shared
         self._replay: dict[tuple[str, ...], Any] = {}  # targets -> last run's keys (run.py)
+        self._pure_root: tuple[str, Path] | None = None  # out_dir -> its root, for plans
         self._checked = False
         self.stats: dict[str, NodeStat] = {}
         self.progress: Progress | None = None
@@ -420,6 +421,30 @@ class Graph:
             export = run.registry[self._nodes[n].type].is_export
             steps.append(Step(n, run.key(n), up, export, tuple(run.keys[u] for u in up)))
         return steps
+
+    def plans(
+        self, targets: str | Iterable[str], variants: Iterable[dict[str, Any]]
+    ) -> list[list[Step]]:
+        """:meth:`plan` of each of many param sets (a sweep's variants): the same steps,
+        with the graph checked, the order found and the run set up once for all of them."""
+        if not self._checked:
+            self.check()
+        names = [targets] if isinstance(targets, str) else list(targets)
+        order = self._order(names)
+        ups = [tuple(dict.fromkeys(self._nodes[n].upstream())) for n in order]
+        registry = {**node_types(), **self._subgraphs}
+        exports = [registry[self._nodes[n].type].is_export for n in order]
+        out = []
+        for params in variants:
+            values = dict(self._values)
+            values.update(self._checked_params(params))
+            run = _Run(self, values, pure=True)
+            steps = []
+            for n, up, export in zip(order, ups, exports, strict=True):
+                key = run.key(n)
+                steps.append(Step(n, key, up, export, tuple(run.keys[u] for u in up)))
+            out.append(steps)
+        return out
 
     def compute_step(
         self,

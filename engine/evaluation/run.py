@@ -91,10 +91,19 @@ class _Run(LanguageRun, SimulationRun):
         self.inner: dict[str, dict[str, NodeStat]] = {}  # subgraph node -> its run's stats
         self.results: dict[str, Any] = {}
         self.stats: dict[str, NodeStat] = {}
-        try:
-            self.out_path = safety.output_root(g.out_dir)
-        except PathError:  # only an export needs it: each says why, at its own line
-            self.out_path = Path(os.path.abspath(g.out_dir))
+        memo = getattr(g, "_pure_root", None) if pure else None
+        if memo is not None and memo[0] == str(g.out_dir):
+            # A plan or a step keys with the folder's name only (a sweep plans every variant
+            # and runs every step through one: one look at the file system, not thousands);
+            # an export still checks where it writes.
+            self.out_path = memo[1]
+        else:
+            try:
+                self.out_path = safety.output_root(g.out_dir)
+            except PathError:  # only an export needs it: each says why, at its own line
+                self.out_path = Path(os.path.abspath(g.out_dir))
+            if pure:
+                g._pure_root = (str(g.out_dir), self.out_path)
         self.out_dir = str(self.out_path)
         self.total = 0
         self.started: set[str] = set()  # nodes that began computing, for the progress line
