@@ -119,6 +119,7 @@ class Graph:
         self._children: dict[Any, Graph] = {}  # subgraph path -> its graph, caches shared
         self._replay: dict[tuple[str, ...], Any] = {}  # targets -> last run's keys (run.py)
         self._pure_root: tuple[str, Path] | None = None  # out_dir -> its root, for plans
+        self._step_params: tuple[str, dict[str, Any]] | None = None  # compute_step's last
         self._checked = False
         self.stats: dict[str, NodeStat] = {}
         self.progress: Progress | None = None
@@ -134,6 +135,7 @@ class Graph:
         self.__checked = value
         if not value:
             self._replay.clear()
+            self._step_params = None
 
     # ----------------------------------------------------------------------- building
 
@@ -318,6 +320,7 @@ class Graph:
     def set(self, **params: Any) -> None:
         """Change param values for later evaluations."""
         self._values.update(self._checked_params(params))
+        self._step_params = None
 
     def _checked_params(self, params: dict[str, Any]) -> dict[str, Any]:
         problems = []
@@ -466,8 +469,19 @@ class Graph:
         NodeError, GraphError
             As :meth:`evaluate` does for the node.
         """
-        values = dict(self._values)
-        values.update(self._checked_params(params))
+        # A variant's steps come one after another with the same params: checked once.
+        memo = self._step_params
+        try:
+            text = _cache.key_text(params) if params else ""
+        except (TypeError, ValueError):
+            text = None
+        if memo is not None and text is not None and memo[0] == text:
+            values = dict(memo[1])
+        else:
+            values = dict(self._values)
+            values.update(self._checked_params(params))
+            self._step_params = (text, values)
+            values = dict(values)
         run = _Run(self, values, pure=True)
         if out_dir is not None:
             run.out_path = Path(out_dir).resolve()
