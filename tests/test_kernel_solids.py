@@ -585,3 +585,28 @@ def test_triangle_face_vectors_match_the_polygon_formula():
     np.testing.assert_allclose(fast, general, rtol=1e-9, atol=1e-9)
     a, b, c = v[tri[:, 0]], v[tri[:, 1]], v[tri[:, 2]]
     np.testing.assert_allclose(fast, np.cross(b - a, c - a), rtol=1e-9, atol=1e-9)
+
+
+def test_triangle_signed_volumes_match_the_fan_formula():
+    from formgraph.kernels.mesh import measure
+
+    rng = np.random.default_rng(7)
+    v = rng.normal(size=(40, 3))
+    tri = rng.integers(0, 40, (100, 3))
+    fo = np.arange(0, 301, 3)
+    origins = rng.normal(size=(100, 3))
+    for origin in (None, origins[0], origins):
+        fast = measure.signed_volume(v, tri.ravel(), fo, origin)
+        # the general path: the same triangles plus one quad, which is dropped after
+        general = measure.signed_volume(
+            v,
+            np.r_[tri.ravel(), [0, 1, 2, 3]],
+            np.r_[fo, 304],
+            None
+            if origin is None
+            else (np.r_[origins, [[0, 0, 0]]] if origin.ndim == 2 else origin),
+        )[:-1]
+        if origin is None:  # the default origins differ (the quad's corners are in the box)
+            assert np.sum(fast) == pytest.approx(np.sum(general), abs=1e-9)
+        else:
+            np.testing.assert_allclose(fast, general, rtol=1e-9, atol=1e-12)

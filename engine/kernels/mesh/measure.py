@@ -253,6 +253,15 @@ def signed_volume(
         used = v[fi]
         origin = 0.5 * (used.min(axis=0) + used.max(axis=0))
     origin = np.asarray(origin, dtype=np.float64)
+    if fi.size == 3 * n_faces and fo[-1] == fi.size and (np.diff(fo) == 3).all():
+        # Triangles: one cone each, on contiguous coordinate columns (no fan, no bincount).
+        tri = fi.reshape(-1, 3)
+        o = [origin[:, k] if origin.ndim == 2 else origin[k] for k in range(3)]
+        cols = [np.ascontiguousarray(v[:, k]) for k in range(3)]
+        p = [[np.take(cols[k], tri[:, c]) - o[k] for k in range(3)] for c in range(3)]
+        (x0, y0, z0), (x1, y1, z1), (x2, y2, z2) = p
+        det = x0 * (y1 * z2 - z1 * y2) + y0 * (z1 * x2 - x1 * z2) + z0 * (x1 * y2 - y1 * x2)
+        return det / 6.0
     tris = fan_triangles(fi, fo)
     face = np.repeat(np.arange(n_faces), np.diff(fo) - 2)
     o = origin[face] if origin.ndim == 2 else origin
