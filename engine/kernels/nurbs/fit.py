@@ -144,20 +144,16 @@ def fit_columns(
 
 
 def _fit_open(flat: np.ndarray, params: np.ndarray, p: int, knots: np.ndarray) -> np.ndarray:
-    """Open interpolation: scipy's compiled collocation and LAPACK banded solve
-    (``make_interp_spline`` on our knots), checked by how far the curve misses the data at
-    the parameters; where it misses by more than 1e-10 of the data's size (a nearly
-    singular system) or scipy refuses, the rows' own solve decides (refinement, a dense
-    solve when small, or a clear error)."""
-    from scipy.interpolate import make_interp_spline
-
+    """Open interpolation: scipy's compiled collocation and LAPACK's banded LU
+    (``gbsv``, partial pivoting), checked by how far the curve misses the data at the
+    parameters; where it misses by more than 1e-10 of the data's size (a nearly singular
+    system) or the solve refuses, the rows' own solve decides (refinement, a dense solve
+    when small, or a clear error)."""
     k = flat.shape[0]
     if k > 4 * (p + 1) and np.isfinite(flat).all():
         try:
             with np.errstate(all="ignore"):
-                spline = make_interp_spline(params, flat, k=p, t=knots, check_finite=False)
-                ctrl = np.asarray(spline.c)
-                miss = np.abs(spline(params) - flat).max(initial=0.0)
+                ctrl, miss = _collocation_solve(flat, params, p, knots)
             scale = float(np.abs(flat).max(initial=0.0))
             if np.isfinite(ctrl).all() and miss <= 1e-10 * max(scale, 1e-300):
                 return ctrl
@@ -165,6 +161,53 @@ def _fit_open(flat: np.ndarray, params: np.ndarray, p: int, knots: np.ndarray) -
             pass
     cols, rows = _collocation_rows(p, knots, params)
     return solve_banded_rows(cols, rows, flat)
+
+
+def _collocation_solve(
+    flat: np.ndarray, params: np.ndarray, p: int, knots: np.ndarray
+) -> tuple[np.ndarray, float]:
+    """The interpolating coefficients and the largest miss at the parameters.
+
+    What ``make_interp_spline`` does (scipy's compiled collocation into LAPACK band storage,
+    then ``gbsv``), with the band kept so the miss is one pass over its ``2 p + 1``
+    diagonals rather than an evaluation of the curve. The collocation routine is scipy's
+    own, not public (``_dierckx._coloc`` since 1.15): where it is missing, the public
+    ``make_interp_spline`` and an evaluation do the same.
+    """
+    try:
+        from scipy.interpolate import _dierckx
+
+        coloc = _dierckx._coloc
+    except (ImportError, AttributeError):
+        coloc = None
+    if coloc is None:
+        from scipy.interpolate import make_interp_spline
+
+        spline = make_interp_spline(params, flat, k=p, t=knots, check_finite=False)
+        ctrl = np.asarray(spline.c)
+        return ctrl, float(np.abs(spline(params) - flat).max(initial=0.0))
+    from scipy.linalg import get_lapack_funcs
+
+    n = flat.shape[0]
+    kl = ku = p
+    ab = np.zeros((2 * kl + ku + 1, n), dtype=np.float64, order="F")
+    coloc(np.ascontiguousarray(params), np.ascontiguousarray(knots), p, ab.T, 0)
+    band = ab[kl:].copy()  # band[ku + i - j, j] = A[i, j]
+    rhs = np.array(flat, dtype=np.float64, order="F")
+    (gbsv,) = get_lapack_funcs(("gbsv",), (ab, rhs))
+    _, _, ctrl, info = gbsv(kl, ku, ab, rhs, overwrite_ab=True, overwrite_b=True)
+    if info != 0:
+        raise np.linalg.LinAlgError("the collocation matrix is singular")
+    # The miss, column by column (gbsv's Fortran-ordered answer is contiguous that way).
+    cols = np.asarray(ctrl).T
+    miss = np.array(flat.T, order="C")
+    for o in range(-kl, ku + 1):  # diagonal j - i = o
+        d = band[ku - o]
+        if o >= 0:
+            miss[:, : n - o] -= d[o:] * cols[:, o:]
+        else:
+            miss[:, -o:] -= d[: n + o] * cols[:, : n + o]
+    return np.ascontiguousarray(ctrl), float(np.abs(miss).max(initial=0.0))
 
 
 def _collocation_rows(p: int, knots: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
