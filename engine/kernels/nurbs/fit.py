@@ -157,10 +157,20 @@ def _fit_open(flat: np.ndarray, params: np.ndarray, p: int, knots: np.ndarray) -
             scale = float(np.abs(flat).max(initial=0.0))
             if np.isfinite(ctrl).all() and miss <= 1e-10 * max(scale, 1e-300):
                 return ctrl
-        except (ValueError, np.linalg.LinAlgError):
-            pass
+        except (ValueError, TypeError, AttributeError, np.linalg.LinAlgError):
+            pass  # (scipy's internals moved, or it refused: the rows' solve decides)
     cols, rows = _collocation_rows(p, knots, params)
     return solve_banded_rows(cols, rows, flat)
+
+
+def _scipy_coloc():
+    """scipy's compiled collocation into band storage, if this scipy has it (else None)."""
+    try:
+        from scipy.interpolate import _dierckx
+
+        return _dierckx._coloc
+    except (ImportError, AttributeError):
+        return None
 
 
 def _collocation_solve(
@@ -174,12 +184,7 @@ def _collocation_solve(
     own, not public (``_dierckx._coloc`` since 1.15): where it is missing, the public
     ``make_interp_spline`` and an evaluation do the same.
     """
-    try:
-        from scipy.interpolate import _dierckx
-
-        coloc = _dierckx._coloc
-    except (ImportError, AttributeError):
-        coloc = None
+    coloc = _scipy_coloc()
     if coloc is None:
         from scipy.interpolate import make_interp_spline
 
