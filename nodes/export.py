@@ -87,6 +87,10 @@ def obj(mesh: Mesh, path: OutputPath, normals: bool = False, *, ctx: Context) ->
 def ply(mesh: Mesh, path: OutputPath, *, ctx: Context) -> str:
     """Write a mesh as binary little-endian PLY: double coordinates, polygon faces kept.
 
+    Every point and face attribute is written: a ``color`` (3 or 4 components in 0..1) as
+    ``uchar red green blue [alpha]``, which viewers show, a ``normal`` as ``nx ny nz``, any
+    other as ``double`` properties (``name``, or ``name_0, name_1, ...`` for a vector).
+
     Parameters
     ----------
     mesh : Mesh
@@ -94,7 +98,7 @@ def ply(mesh: Mesh, path: OutputPath, *, ctx: Context) -> str:
     path : OutputPath
         File path relative to the output directory.
     """
-    data = ply_binary(mesh.vertices, mesh.face_indices, mesh.face_offsets)
+    data = ply_binary(*mesh.arrays, mesh.point_data, mesh.face_data)
     return str(ctx.write(path, data))
 
 

@@ -15,7 +15,7 @@ import numpy as np
 
 from formgraph.core.errors import InputError
 from formgraph.core.registry import Context, Range, node
-from formgraph.core.types import SameAs, Vec3
+from formgraph.core.types import PerElement, SameAs, Vec3
 from formgraph.geometry import (
     Curve,
     Geometry,
@@ -26,10 +26,11 @@ from formgraph.geometry import (
     ParametricSurface,
     Points,
     Surface,
-    frozen_array,
 )
+from formgraph.kernels.attributes import propagate as carry
 from formgraph.kernels.geometry import affine, instancing
 from formgraph.kernels.mesh import meshops
+from formgraph.language.elements import ElementValue, element_env
 
 
 class _Shared:
@@ -95,7 +96,7 @@ def transform_one(g: Geometry, linear: np.ndarray, offset: np.ndarray) -> Geomet
         For a geometry type it does not know.
     """
     if isinstance(g, Points):
-        return Points(affine.apply(g.xyz, linear, offset))
+        return Points(affine.apply(g.xyz, linear, offset), carry.turn(g.point_data, linear))
     if isinstance(g, NurbsCurve):
         w = g.weights if g.rational else None
         return NurbsCurve(affine.apply(g.control_points, linear, offset), g.degree, g.knots, w)
@@ -113,7 +114,13 @@ def transform_one(g: Geometry, linear: np.ndarray, offset: np.ndarray) -> Geomet
         fi = g.face_indices
         if np.linalg.det(linear) < 0:
             fi = meshops.reverse_faces(fi, g.face_offsets)
-        return Mesh(affine.apply(g.vertices, linear, offset), fi, g.face_offsets)
+        return Mesh(
+            affine.apply(g.vertices, linear, offset),
+            fi,
+            g.face_offsets,
+            carry.turn(g.point_data, linear),
+            carry.turn(g.face_data, linear),
+        )
     raise ValueError(f"cannot transform a {type(g).__name__}")
 
 
@@ -166,6 +173,20 @@ def transform(
     return out if isinstance(geometry, list) else out[0]
 
 
+def _per_point(points: Points, **inputs: Any) -> dict[str, Any]:
+    """The inputs written as per-element expressions, evaluated over every point at once."""
+    out = dict(inputs)
+    env = None
+    for port, value in inputs.items():
+        if isinstance(value, ElementValue):
+            env = element_env(points) if env is None else env
+            try:
+                out[port] = value.evaluate(env, len(points), "points")
+            except ValueError as exc:
+                raise InputError(port, str(exc)) from None
+    return out
+
+
 def _frames(n: int, scale: Any, rotate: Any, align: Any) -> np.ndarray:
     try:
         return affine.frames(
@@ -179,8 +200,9 @@ def _frames(n: int, scale: Any, rotate: Any, align: Any) -> np.ndarray:
         raise InputError(next((p for p in ("rotate", "align") if p in msg), "scale"), msg) from None
 
 
-Scale = float | list[float] | list[Vec3]
-Rotate = Vec3 | list[Vec3]
+Scale = Annotated[float | list[float] | list[Vec3], PerElement("points")]
+Rotate = Annotated[Vec3 | list[Vec3], PerElement("points")]
+Align = Annotated[Vec3 | list[Vec3] | None, PerElement("points")]
 
 
 @node("mesh.copy_to_points", version=1)
@@ -189,7 +211,7 @@ def mesh_copy_to_points(
     points: Points,
     scale: Scale = 1.0,
     rotate: Rotate = (0.0, 0.0, 0.0),
-    align: Rotate | None = None,
+    align: Align = None,
     *,
     ctx: Context,
 ) -> Mesh:
@@ -199,6 +221,13 @@ def mesh_copy_to_points(
     along ``align[k]`` (the minimal rotation, Rodrigues' formula), then moved to point k.
     The mesh's origin lands on the point. Copies follow the points' order; a mirroring
     scale reverses that copy's faces.
+
+    ``scale``, ``rotate`` and ``align`` may be expressions evaluated per point, over the
+    point's ``x y z``, ``i``, ``count``, its attributes and the params:
+    ``scale: "=0.5 + rand(i)"``, ``rotate: [0, 0, "=360 * rand(i, 1)"]``, ``align: "=normal"``.
+    Attributes: each copy keeps the part's (a ``normal`` turned with the copy), the point's
+    attributes go onto its copy's vertices, and a ``copy`` point attribute holds each
+    vertex's copy index.
 
     Parameters
     ----------
@@ -223,7 +252,8 @@ def mesh_copy_to_points(
     n = len(points)
     ctx.guard(n * mesh.n_faces, "faces")
     ctx.guard(n * mesh.n_vertices * 3, "coordinates")
-    linear = _frames(n, scale, rotate, align)
+    per = _per_point(points, scale=scale, rotate=rotate, align=align)
+    linear = _frames(n, per["scale"], per["rotate"], per["align"])
     mirrored = np.linalg.det(linear) < 0
     rev = meshops.reverse_faces(mesh.face_indices, mesh.face_offsets) if mirrored.any() else None
     v, fi, fo = instancing.copy_mesh(
@@ -231,22 +261,19 @@ def mesh_copy_to_points(
     )
     if not np.isfinite(v).all():
         raise InputError("points", "the copies' coordinates overflow (not finite)")
-    return _valid_mesh(v, fi, fo)
-
-
-def _valid_mesh(v: np.ndarray, fi: np.ndarray, fo: np.ndarray) -> Mesh:
-    """A Mesh of fresh arrays that are valid by construction (copies of a valid mesh's
-    faces, shifted): frozen (one copy into an immutable buffer, so no one can make them
-    writable again) but not validated again, which for 10,000 copies would cost more than
-    building them."""
-    out = Mesh.__new__(Mesh)
-    for name, a, dtype in (
-        ("vertices", v, np.float64),
-        ("face_indices", fi, np.int64),
-        ("face_offsets", fo, np.int64),
-    ):
-        object.__setattr__(out, name, frozen_array(a, dtype))
-    return out
+    # the part's attributes on every copy (a normal turned with it), the point's
+    # attributes on its copy's vertices, and ``copy``: the index of each vertex's copy
+    m, f = mesh.n_vertices, mesh.n_faces
+    which_v = np.repeat(np.arange(n), m)
+    tile_v = carry.copy(np.tile(np.arange(m), n))
+    point_data = carry.turn(carry.carried(mesh, point=tile_v)["point_data"], linear, which_v)
+    point_data.update(carry.carried(points, point=carry.copy(which_v))["point_data"])
+    point_data["copy"] = which_v.astype(np.float64)
+    tile_f = carry.copy(np.tile(np.arange(f), n))
+    face_data = carry.turn(
+        carry.carried(mesh, face=tile_f)["face_data"], linear, np.repeat(np.arange(n), f)
+    )
+    return Mesh.trusted(v, fi, fo, point_data, face_data)
 
 
 @node("curves.copy_to_points", version=1)
@@ -255,14 +282,15 @@ def curves_copy_to_points(
     points: Points,
     scale: Scale = 1.0,
     rotate: Rotate = (0.0, 0.0, 0.0),
-    align: Rotate | None = None,
+    align: Align = None,
     *,
     ctx: Context,
 ) -> list[Curve]:
     """A copy of the curve on every point, as a list (NURBS copies stay exact).
 
     The copies are placed as by ``mesh.copy_to_points``: scale, rotate (degrees about x, y,
-    z), turn +z along ``align``, move the origin to the point. A NURBS curve's control
+    z), turn +z along ``align``, move the origin to the point; each of the three may be a
+    per-point expression (``scale: "=1 + 0.5 * noise(x, y)"``). A NURBS curve's control
     points for every copy are one array operation; weights are kept.
 
     Parameters
@@ -279,7 +307,8 @@ def curves_copy_to_points(
         A direction for each copy's +z, one or one per point; None keeps the orientation.
     """
     n = len(points)
-    linear = _frames(n, scale, rotate, align)
+    per = _per_point(points, scale=scale, rotate=rotate, align=align)
+    linear = _frames(n, per["scale"], per["rotate"], per["align"])
     offsets = points.xyz
     if isinstance(curve, NurbsCurve):
         ctx.guard(n * len(curve.control_points) * 3, "coordinates")
@@ -306,7 +335,8 @@ def sample_surface(
     """Points at the centres of a u x v grid of cells over a surface, with unit normals.
 
     Cell (i, j) is centred at parameters ``u0 + (i + 1/2) (u1 - u0) / u`` and likewise in
-    v; points run along v first (row i holds v points). Normals are ``S_u x S_v``
+    v; points run along v first (row i holds v points). The points carry ``normal``,
+    ``u`` and ``v`` point attributes (so ``align: "=normal"`` works). Normals are ``S_u x S_v``
     normalized: exact derivatives on a NURBS surface (The NURBS Book A3.6), central
     differences on a parametric one.
 
@@ -336,4 +366,5 @@ def sample_surface(
     if (length <= 1e-300).any():
         ctx.warn("the surface is degenerate at some samples; their normal is +z")
     normals = np.where(length > 1e-300, normals / np.where(length > 0, length, 1), [0, 0, 1.0])
-    return Samples(Points(xyz), normals)
+    # the points carry their normal and their surface parameters as attributes too
+    return Samples(Points(xyz, {"normal": normals, "u": gu, "v": gv}), normals)

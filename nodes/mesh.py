@@ -16,6 +16,7 @@ from formgraph.core.errors import InputError
 from formgraph.core.registry import Context, Range, node
 from formgraph.core.types import Faces, Vec3
 from formgraph.geometry import Mesh, Points
+from formgraph.kernels.attributes import propagate as carry
 from formgraph.kernels.mesh import (
     HalfEdges,
     MeshTopologyError,
@@ -137,10 +138,19 @@ def catmull_clark(
     creases = _creases(mesh, he, crease_angle)
     if creases is None and sharpness is not None:
         ctx.warn("sharpness has no effect without crease_angle")
-    out = subdivision.catmull_clark(
-        *_arrays(mesh), levels, creases=creases, sharpness=None if creases is None else sharpness
+    # point attributes ride along as extra columns: the same stencils as the points
+    stacked = carry.columns(mesh.vertices, mesh.point_data)
+    v, fi, fo = subdivision.catmull_clark(
+        stacked,
+        mesh.face_indices,
+        mesh.face_offsets,
+        levels,
+        creases=creases,
+        sharpness=None if creases is None else sharpness,
     )
-    return Mesh(*out)
+    v, point_data = carry.split_columns(v, mesh.point_data)
+    faces = carry.copy(subdivision.catmull_clark_face_parents(mesh.face_offsets, levels))
+    return Mesh(v, fi, fo, point_data, carry.carried(mesh, face=faces)["face_data"])
 
 
 @node("mesh.doo_sabin", version=1)
@@ -162,7 +172,14 @@ def doo_sabin(mesh: Mesh, levels: Annotated[int, Range(min=0)] = 1, *, ctx: Cont
     """
     he = _halfedges(mesh)
     _guard_counts(ctx, subdivision.doo_sabin_counts(he, levels))
-    return Mesh(*subdivision.doo_sabin(*_arrays(mesh), levels))
+    stacked = carry.columns(mesh.vertices, mesh.point_data)
+    faces = carry.columns(np.zeros((mesh.n_faces, 3)), mesh.face_data)
+    v, fi, fo, fv = subdivision.doo_sabin(
+        stacked, mesh.face_indices, mesh.face_offsets, levels, face_values=faces
+    )
+    v, point_data = carry.split_columns(v, mesh.point_data)
+    _, face_data = carry.split_columns(fv, mesh.face_data)
+    return Mesh(v, fi, fo, point_data, face_data)
 
 
 @node("mesh.triangulate", version=1)
@@ -180,7 +197,9 @@ def triangulate(mesh: Mesh, *, ctx: Context) -> Mesh:
         Any polygon mesh.
     """
     try:
-        return Mesh(*meshops.triangulate(*_arrays(mesh), max_tests=ctx.budget))
+        v, fi, fo = meshops.triangulate(*_arrays(mesh), max_tests=ctx.budget)
+        parents = np.repeat(np.arange(mesh.n_faces), mesh.face_sizes - 2)
+        return Mesh(v, fi, fo, **carry.carried(mesh, carry.SAME, carry.copy(parents)))
     except WorkLimitError as exc:
         ctx.guard(exc.work, "triangle-corner tests of ear clipping")
         raise
@@ -196,7 +215,18 @@ def merge(meshes: list[Mesh], *, ctx: Context) -> Mesh:
         The meshes, in order.
     """
     ctx.guard(sum(m.n_faces for m in meshes), "faces")
-    return Mesh(*meshops.merge([_arrays(m) for m in meshes]))
+    return merged(meshes, ctx)
+
+
+def merged(meshes: list[Mesh], ctx: Context) -> Mesh:
+    """The meshes laid end to end, with their attributes (0 where one lacks an attribute
+    the others have; an attribute whose shape differs between them is dropped, warned)."""
+    v, fi, fo = meshops.merge([_arrays(m) for m in meshes])
+    point_data, p_bad = carry.concat([m.point_data for m in meshes], [m.n_vertices for m in meshes])
+    face_data, f_bad = carry.concat([m.face_data for m in meshes], [m.n_faces for m in meshes])
+    for name in p_bad + f_bad:
+        ctx.warn(f"attribute {name!r} has different shapes on the meshes; it was dropped")
+    return Mesh(v, fi, fo, point_data, face_data)
 
 
 @node("mesh.transform", version=1)
@@ -229,4 +259,11 @@ def transform(
     fi = mesh.face_indices
     if np.prod(np.broadcast_to(np.asarray(scale, dtype=np.float64), (3,))) < 0:
         fi = meshops.reverse_faces(fi, mesh.face_offsets)
-    return Mesh(v, fi, mesh.face_offsets)
+    linear = meshops.transform(np.eye(3), 0.0, rotate, scale).T  # the map's linear part
+    return Mesh(
+        v,
+        fi,
+        mesh.face_offsets,
+        carry.turn(mesh.point_data, linear),
+        carry.turn(mesh.face_data, linear),
+    )

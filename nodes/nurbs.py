@@ -588,7 +588,8 @@ def tessellate(
 
     A row of the grid that sits at one point (a pole: a revolve whose profile ends on the
     axis, a sphere's tip) becomes one vertex, its quads triangles: no zero-area faces, and
-    a revolve to the axis comes out closed there.
+    a revolve to the axis comes out closed there. Each vertex carries its surface
+    parameters as the ``u`` and ``v`` point attributes.
 
     Parameters
     ----------
@@ -600,4 +601,4 @@ def tessellate(
         Number of faces along v.
     """
     ctx.guard((u + 1) * (v + 1), "vertices")
-    return surface.tessellate(u, v)
+    return surface.tessellate(u, v, with_uv=True)

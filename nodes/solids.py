@@ -17,6 +17,8 @@ from formgraph.core.errors import InputError
 from formgraph.core.registry import Context, Range, node
 from formgraph.core.types import Expression, Variables, Vec3
 from formgraph.geometry import Mesh
+from formgraph.kernels.attributes import booleans as kab
+from formgraph.kernels.attributes import propagate as carry
 from formgraph.kernels.mesh import MeshTopologyError, meshops
 from formgraph.kernels.mesh import boolean as kb
 from formgraph.kernels.mesh import primitives as kp
@@ -232,13 +234,19 @@ def weld(
         duplicated vertices, never features); 0: exact duplicates only.
     """
     try:
-        out = Mesh(*kr.weld(*_arrays(mesh), tolerance))
+        v, fi, fo = kr.weld(*_arrays(mesh), tolerance)
     except ValueError as exc:
         raise InputError("tolerance", str(exc)) from None
-    dropped = mesh.n_faces - out.n_faces
+    dropped = mesh.n_faces - (fo.size - 1)
+    # each group keeps its first vertex's position, and so its attributes
+    points = carry.copy(carry.by_position(mesh.vertices, v))
+    faces = carry.SAME
     if dropped:
         ctx.warn(f"{dropped} faces collapsed and were dropped")
-    return out
+        if mesh.face_data:
+            faces = carry.DROP
+            ctx.warn("with faces dropped, the face attributes were dropped too")
+    return Mesh(v, fi, fo, **carry.carried(mesh, points, faces))
 
 
 @node("mesh.orient", version=1)
@@ -263,7 +271,7 @@ def orient(mesh: Mesh, *, ctx: Context) -> Mesh:
             f"part of the mesh cannot be oriented (it is one-sided, like a Moebius strip): "
             f"faces still disagree across {conflicts} of its edges"
         )
-    return Mesh(mesh.vertices, fi, mesh.face_offsets)
+    return Mesh(mesh.vertices, fi, mesh.face_offsets, mesh.point_data, mesh.face_data)
 
 
 @node("mesh.flip", version=1)
@@ -279,6 +287,8 @@ def flip(mesh: Mesh) -> Mesh:
         mesh.vertices,
         meshops.reverse_faces(mesh.face_indices, mesh.face_offsets),
         mesh.face_offsets,
+        mesh.point_data,
+        mesh.face_data,
     )
 
 
@@ -301,7 +311,8 @@ def cap(mesh: Mesh, *, ctx: Context) -> Mesh:
     mesh : Mesh
         An oriented manifold mesh (mesh.weld and mesh.orient make one).
     """
-    out = Mesh(*_topology("mesh", _clipping, ctx, kr.cap, *_arrays(mesh)))
+    v, fi, fo = _topology("mesh", _clipping, ctx, kr.cap, *_arrays(mesh))
+    out = Mesh(v, fi, fo, **carry.carried(mesh, *_cap_rules(mesh, v, fi, fo)))
     if out.n_faces > mesh.n_faces:
         flat = kr.flat_open_parts(*_arrays(mesh))
         if flat:
@@ -314,12 +325,27 @@ def cap(mesh: Mesh, *, ctx: Context) -> Mesh:
     return out
 
 
-@node("mesh.solidify", version=1)
+def _cap_rules(mesh: Mesh, v: np.ndarray, fi: np.ndarray, fo: np.ndarray) -> tuple:
+    """The old vertices and faces keep theirs; a fan's centre vertex gets the mean of its
+    loop's vertices (the centre is their mean too), a cap face 0."""
+    n, f = mesh.n_vertices, mesh.n_faces
+    caps = fi[mesh.face_offsets[-1] :].reshape(-1, 3)
+    fan = caps[caps[:, 0] >= n]
+    count = np.bincount(fan[:, 0] - n, minlength=len(v) - n)
+    rows = np.concatenate([np.arange(n), fan[:, 0]])
+    index = np.concatenate([np.arange(n), fan[:, 1]])
+    weight = np.concatenate([np.ones(n), 1.0 / count[fan[:, 0] - n]])
+    faces = np.concatenate([np.arange(f), np.full(fo.size - 1 - f, -1)])
+    return carry.mix(rows, index, weight, len(v)), carry.copy(faces)
+
+
+@node("mesh.solidify", version=2)
 def solidify(
     mesh: Mesh,
     thickness: Annotated[float, Range(min=0)],
     offset: Annotated[float, Range(min=-1, max=1)] = 0.0,
     thickness_map: Annotated[Expression | None, Variables("x", "y", "z", "thickness")] = None,
+    planar_rims: bool = True,
     *,
     ctx: Context,
 ) -> Mesh:
@@ -341,6 +367,11 @@ def solidify(
     thickness_map : Expression | None
         A wall that varies: the thickness at each vertex as an expression in its position
         x, y, z and ``thickness``, e.g. "thickness * (1 + z / 5)". Each value must be > 0.
+    planar_rims : bool
+        Keep every planar boundary loop in its own plane: its vertices move along their
+        normals projected into the plane (the wall's thickness kept), so a shade whose
+        bottom rim lies on z = 0 still stands on z = 0. Loops that are not planar, or
+        whose surface lies nearly in the loop's plane, move along their normals.
     """
     if thickness <= 0:
         raise InputError("thickness", f"thickness must be > 0, got {thickness:g}")
@@ -361,7 +392,7 @@ def solidify(
                 f"{i} ({', '.join(f'{c:.6g}' for c in v[i])}); a thickness must be > 0",
             )
     try:
-        arrays = _topology("mesh", ks.solidify, *_arrays(mesh), t, offset)
+        arrays = _topology("mesh", ks.solidify, *_arrays(mesh), t, offset, planar_rims)
     except ValueError as exc:
         raise InputError("mesh", str(exc)) from None
     port, what = (
@@ -369,7 +400,13 @@ def solidify(
         if thickness_map is not None
         else ("thickness", f"thickness {thickness:g}")
     )
-    return Mesh(*_within_floats(arrays, port, f"{what} with offset {offset:g}"))
+    v, fi, fo = _within_floats(arrays, port, f"{what} with offset {offset:g}")
+    # front and back copies of every vertex and face, a rim quad per boundary edge
+    he = mesh.halfedges
+    points = carry.copy(np.tile(np.arange(mesh.n_vertices), 2))
+    rims = he.face[he.boundary_halfedges]
+    faces = carry.copy(np.concatenate([np.arange(mesh.n_faces)] * 2 + [rims]))
+    return Mesh(v, fi, fo, **carry.carried(mesh, points, faces))
 
 
 # -------------------------------------------------------------------------------- booleans
@@ -401,8 +438,15 @@ def boolean(
     operation : Operation
         union, difference or intersection.
     """
-    ma = _solid("a", _clipping, ctx, kb.to_manifold, *_arrays(a), "the mesh")
-    mb = _solid("b", _clipping, ctx, kb.to_manifold, *_arrays(b), "the mesh")
+    attributed = bool(a.point_data or b.point_data or a.face_data or b.face_data)
+    if attributed:
+        points, faces = _joined([a, b], ctx)
+        pa, pb = _split_props(points, [a.n_vertices, b.n_vertices])
+        ma = _solid("a", _clipping, ctx, kab.to_manifold, *_arrays(a), pa, 0, "the mesh")
+        mb = _solid("b", _clipping, ctx, kab.to_manifold, *_arrays(b), pb, a.n_faces, "the mesh")
+    else:
+        ma = _solid("a", _clipping, ctx, kb.to_manifold, *_arrays(a), "the mesh")
+        mb = _solid("b", _clipping, ctx, kb.to_manifold, *_arrays(b), "the mesh")
     for port, mesh, m in (("a", a, ma), ("b", b, mb)):
         if m.is_empty() and mesh.n_faces:
             ctx.warn(f"input {port} bounds no volume (its faces collapsed): an empty solid")
@@ -410,7 +454,10 @@ def boolean(
         both = kb.combine(ma, mb, operation, whats=("the mesh", "the mesh"))
     except kb.NotSolidError as exc:
         raise InputError("ab"[exc.operand or 0], str(exc)) from None
-    out = Mesh(*kb.from_manifold(both))
+    if attributed:
+        out = _attributed(*kab.from_manifold(both, pa.shape[1]), points, faces)
+    else:
+        out = Mesh(*kb.from_manifold(both))
     if out.n_faces == 0:
         ctx.warn(f"the {kb.Operation(operation).value} is empty")
     return out
@@ -426,10 +473,47 @@ def union(meshes: list[Mesh], *, ctx: Context) -> Mesh:
         Closed, manifold, outward meshes; they may overlap.
     """
     ctx.guard(sum(m.n_faces for m in meshes), "faces")
-    out = Mesh(*_solid("meshes", _clipping, ctx, kb.union, [_arrays(m) for m in meshes]))
+    if not any(m.point_data or m.face_data for m in meshes):
+        out = Mesh(*_solid("meshes", _clipping, ctx, kb.union, [_arrays(m) for m in meshes]))
+    else:
+        points, faces = _joined(meshes, ctx)
+        props = _split_props(points, [m.n_vertices for m in meshes])
+        v, fi, fo, p, face = _solid(
+            "meshes", _clipping, ctx, kab.union, [_arrays(m) for m in meshes], props
+        )
+        out = _attributed(v, fi, fo, p, face, points, faces)
     if out.n_faces == 0 and any(m.n_faces for m in meshes):
         ctx.warn("the union is empty: every mesh bounds no volume (their faces collapsed)")
     return out
+
+
+def _joined(meshes: list[Mesh], ctx: Context) -> tuple[dict, dict]:
+    points, p_bad = carry.concat([m.point_data for m in meshes], [m.n_vertices for m in meshes])
+    faces, f_bad = carry.concat([m.face_data for m in meshes], [m.n_faces for m in meshes])
+    for name in p_bad + f_bad:
+        ctx.warn(f"attribute {name!r} has different shapes on the inputs; it was dropped")
+    return points, faces
+
+
+def _split_props(points: dict, sizes: list[int]) -> list[np.ndarray]:
+    stacked = carry.columns(np.zeros((sum(sizes), 3)), points)[:, 3:]
+    return np.split(stacked, np.cumsum(sizes)[:-1])
+
+
+def _attributed(
+    v: np.ndarray,
+    fi: np.ndarray,
+    fo: np.ndarray,
+    props: np.ndarray,
+    face: np.ndarray,
+    points: dict,
+    faces: dict,
+) -> Mesh:
+    """A boolean's result with its point attributes (interpolated by manifold3d) and face
+    attributes (from each triangle's source face)."""
+    _, point_data = carry.split_columns(np.column_stack([v, props]), points)
+    face_data = {k: a[face] for k, a in faces.items()}
+    return Mesh(v, fi, fo, point_data, face_data)
 
 
 # -------------------------------------------------------------------------------- measures

@@ -11,6 +11,7 @@ from formgraph.core.registry import Context, node
 from formgraph.core.types import Expression, Variables
 from formgraph.geometry import Mesh, NurbsSurface, ParametricSurface, Points
 from formgraph.kernels import curves as kc
+from formgraph.kernels.attributes import propagate as carry
 from formgraph.kernels.mesh import grid_faces
 
 
@@ -53,7 +54,8 @@ def grid(
 
     Faces run counter-clockwise when rows advance along +x and points within a row along
     +y. Closing u joins the last row to the first; closing v joins each row's last point
-    to its first (a tube, or with both, a torus).
+    to its first (a tube, or with both, a torus). The rows' point attributes are carried;
+    ``u`` (the row, 0 to 1) and ``v`` (along the row, 0 to 1) are added.
 
     Parameters
     ----------
@@ -68,7 +70,17 @@ def grid(
     nu, nv = g.shape[:2]
     ctx.guard((nu if closed_u else nu - 1) * (nv if closed_v else nv - 1), "faces")
     fi, fo = grid_faces(nu, nv, closed_u, closed_v)
-    return Mesh(g.reshape(-1, 3), fi, fo)
+    # the rows' attributes, and where each vertex sits in the grid: u by row, v along it
+    data, dropped = carry.concat([p.point_data for p in points], [len(p) for p in points])
+    for name in dropped:
+        ctx.warn(f"attribute {name!r} has different shapes on the rows; it was dropped")
+    gu, gv = np.meshgrid(
+        np.arange(nu) / (nu if closed_u else max(nu - 1, 1)),
+        np.arange(nv) / (nv if closed_v else max(nv - 1, 1)),
+        indexing="ij",
+    )
+    data.update(u=gu.reshape(-1), v=gv.reshape(-1))
+    return Mesh(g.reshape(-1, 3), fi, fo, data)
 
 
 @node("surfaces.parametric", version=1)

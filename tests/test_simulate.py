@@ -259,7 +259,7 @@ def test_set_input_changes_and_removes_a_simulation():
 def test_profile_and_drawing_show_steps(tmp_path, capsys):
     path = tmp_path / "count.yaml"
     path.write_text(COUNT)
-    assert main(["run", str(path), "--out", str(tmp_path / "out"), "--profile"]) == 0
+    assert main(["run", str(path), "--out", str(tmp_path / "out"), "--profile", "--no-cache"]) == 0
     assert "20 steps, 20/20 computed" in capsys.readouterr().out
     g = fg.load(path)
     assert node_marks(g, "count") == ["simulate a"]

@@ -1,4 +1,4 @@
-"""Subgraphs: graph files used as node types (engine/language/subgraph.py, engine/evaluation/items.py)."""
+"""Subgraphs: graph files used as node types (language/subgraph.py, evaluation/items.py)."""
 
 from __future__ import annotations
 

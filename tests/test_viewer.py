@@ -29,7 +29,8 @@ pv.OFF_SCREEN = True
 
 from formgraph import viewer  # noqa: E402
 from formgraph.viewer import gallery  # noqa: E402
-from formgraph.viewer.scene import expand, nice_range, view_axis  # noqa: E402
+from formgraph.viewer.datasets import expand  # noqa: E402
+from formgraph.viewer.scene import nice_range, view_axis  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 GRAPHS = sorted((ROOT / "graphs").glob("*.yaml"))

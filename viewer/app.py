@@ -18,8 +18,8 @@ from typing import Any
 
 from formgraph.core.errors import FormgraphError, GraphError, Problem, Where
 from formgraph.evaluation.graph import Graph, load
-from formgraph.language.check import param_kind
 from formgraph.language.model import Items, Wire, parse_input
+from formgraph.language.params import param_kind
 
 from .frame import Camera
 from .scene import PALETTE, TEXT_COLOR, Scene, fit_scenes
@@ -58,7 +58,7 @@ def shown_nodes(graph: Graph, node: str | Iterable[str] | None = None) -> list[s
 
 
 def _check_target(graph: Graph, registry: dict[str, Any], target: str) -> None:
-    from formgraph.language.check import suggest
+    from formgraph.language.params import suggest
 
     where = Where(graph.file)
     if target in graph.nodes:
@@ -125,6 +125,9 @@ class Session:
         Draw mesh face edges always (True), never (False), or on coarse meshes (None).
     camera : Camera, optional
         Where the views look from (:class:`~.frame.Camera`); automatic if None.
+    color : str, optional
+        Colour the points and meshes by this attribute (point or face), with a colour bar;
+        a 3-component ``color`` attribute is shown as the RGB colours it holds.
     """
 
     def __init__(
@@ -138,6 +141,7 @@ class Session:
         layout: str = "overlay",
         edges: bool | None = None,
         camera: Camera | None = None,
+        color: str | None = None,
     ):
         if layout not in LAYOUTS:
             raise ValueError(f"layout must be one of {', '.join(LAYOUTS)}, got {layout!r}")
@@ -150,10 +154,12 @@ class Session:
         self.layout = layout
         self.params: dict[str, Any] = dict(params or {})
         self.timing = timing
+        self.color = color  # an attribute to colour by (with a colour bar), or None
         self.seconds: float | None = None
         self.targets = shown_nodes(self.graph, node) if self.graph is not None else []
         self.controls_x = 0.76  # where the column of sliders starts (fraction of the width)
         self._slider_values: dict[str, float] = {}
+        self._slider_specs: dict[str, Slider] = {}
         self.widgets: dict[str, Any] = {}  # slider widgets by param name
         shown = self.evaluate()
         self.scenes = self._make_scenes(len(shown), edges)
@@ -165,7 +171,7 @@ class Session:
 
     def _make_scenes(self, n: int, edges: bool | None) -> list[Scene]:
         if self.layout == "overlay":
-            return [Scene(self.plotter, edges=edges)]
+            return [Scene(self.plotter, edges=edges, color_by=self.color)]
         rows, cols = self.plotter.shape
         if rows != 1 or cols < n:
             raise ValueError(
@@ -174,7 +180,10 @@ class Session:
             )
         colors: dict[str, str] = {}
         scenes = [
-            Scene(self.plotter, (0, i), titled=True, edges=edges, colors=colors) for i in range(n)
+            Scene(
+                self.plotter, (0, i), titled=True, edges=edges, colors=colors, color_by=self.color
+            )
+            for i in range(n)
         ]
         if n > 1:
             self.plotter.link_views(list(range(n)))
@@ -237,6 +246,7 @@ class Session:
         """
         if self.graph is None:
             raise ValueError("a geometry value has no params; pass a graph to use params")
+        self._require_open()
         old = dict(self.params)
         self.params.update(values)
         try:
@@ -256,8 +266,22 @@ class Session:
                     continue
                 self._slider_values[name] = value
                 rep.SetValue(float(value))
+                self._title_slider(name, value)
         self.plotter.render()
         return True
+
+    def closed(self) -> bool:
+        """Whether the plotter is closed (pyvista closes an off-screen plotter in show())."""
+        return getattr(self.plotter, "render_window", None) is None
+
+    def _require_open(self) -> None:
+        if self.closed():
+            raise RuntimeError(
+                "this session's plotter is closed, so nothing can be drawn in it: pyvista "
+                "closes a plotter at the end of show(), and off screen right away; keep it "
+                "open with plotter.show(auto_close=False), or take pictures with "
+                "plotter.screenshot(path) instead of show()"
+            )
 
     def replace_graph(self, graph: Graph, params: dict[str, Any] | None = None) -> None:
         """Show a new version of the graph (watch mode), keeping the camera if it still fits.
@@ -267,6 +291,7 @@ class Session:
         FormgraphError
             When the new version fails; what is drawn, and the session, stay as they were.
         """
+        self._require_open()
         old = (self.graph, self.targets, self.params, self.seconds)
         old_bounds = self.scene.bounds()
         try:
@@ -286,6 +311,8 @@ class Session:
     def report(self, message: str) -> None:
         """Show an error in the window and on stderr, keeping what is drawn."""
         print(message, file=sys.stderr)
+        if self.closed():
+            return  # no window to show it in: stderr has it
         kept = "\n(the picture is the last version that worked)" if self.scene.layers else ""
         self.scene.set_error(message + kept)
         self.plotter.render()
@@ -359,7 +386,20 @@ class Session:
         if self._slider_values.get(name) == v:
             return True
         self._slider_values[name] = v
+        self._title_slider(name, v)
         return self.apply_params(**{name: v})
+
+    def _title_slider(self, name: str, value: float) -> None:
+        """The slider's title, ``name = value   (min to max)``: the value lives in the
+        title, not in a label over the knob, which would run into the slider above."""
+        widget = self.widgets.get(name)
+        spec = self._slider_specs.get(name)
+        if widget is None or spec is None:
+            return
+        shown = f"{value:.0f}" if spec.integer else f"{value:.4g}"
+        widget.GetRepresentation().SetTitleText(
+            f"{name} = {shown}   ({spec.min:g} to {spec.max:g})"
+        )
 
     def toggles(self) -> list[str]:
         """Every bool graph param (each gets a check box)."""
@@ -429,6 +469,8 @@ class Session:
             )
             _style_slider(widget.GetRepresentation())
             self.widgets[s.name] = widget
+            self._slider_specs[s.name] = s
+            self._title_slider(s.name, s.value)
         if toggles:
             self.add_toggles(0.74 - len(sliders) * step - 0.02)
         self._make_room()
@@ -482,6 +524,7 @@ def _style_slider(rep: Any) -> None:
     rep.SetEndCapLength(0.004)
     rep.SetEndCapWidth(0.022)
     rep.SetLabelHeight(0.018)
+    rep.ShowSliderLabelOff()  # the value is in the title (see Session._title_slider)
     rep.GetTubeProperty().SetColor(pv.Color("#c8c8c8").float_rgb)
     rep.GetCapProperty().SetColor(pv.Color("#c8c8c8").float_rgb)
     rep.GetSliderProperty().SetColor(pv.Color(PALETTE[0]).float_rgb)

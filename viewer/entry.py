@@ -64,6 +64,7 @@ def show(
     edges: bool | None = None,
     jupyter_backend: str | None = None,
     camera: Camera | None = None,
+    color: str | None = None,
     **params: Any,
 ) -> Session:
     """Open an interactive window on a graph's results (or ``node``) or on geometry values.
@@ -86,6 +87,8 @@ def show(
         Mesh face edges always (True), never (False), on coarse meshes (None).
     camera : Camera, optional
         Where to look from first (``Camera("top")``); automatic if None.
+    color : str, optional
+        Colour points and meshes by this attribute, with a colour bar.
     **params
         Graph param values.
 
@@ -102,7 +105,14 @@ def show(
         views, layout, size, controls=_has_controls(source), title=_window_title(source)
     )
     session = Session(
-        source, node, plotter=plotter, params=params, layout=layout, edges=edges, camera=camera
+        source,
+        node,
+        plotter=plotter,
+        params=params,
+        layout=layout,
+        edges=edges,
+        camera=camera,
+        color=color,
     )
     session.add_sliders()
     session.add_keys()
@@ -119,13 +129,15 @@ def screenshot(
     layout: str = "overlay",
     edges: bool | None = None,
     camera: Camera | None = None,
+    color: str | None = None,
     **params: Any,
 ) -> Path:
     """Render a graph's results (or ``node``, or geometry values) off screen to a PNG.
 
     The parent folder of ``path`` is created. Returns the path written. ``camera`` (a
     :class:`~.frame.Camera`: ``Camera("top")``, ``Camera(azimuth=30, elevation=20)``) says
-    where to look from; by default straight on for flat geometry, else isometric.
+    where to look from; by default straight on for flat geometry, else isometric. ``color``
+    names an attribute to colour points and meshes by, with a colour bar.
 
     Example
     -------
@@ -147,6 +159,7 @@ def screenshot(
             layout=layout,
             edges=edges,
             camera=camera,
+            color=color,
         )
         path.parent.mkdir(parents=True, exist_ok=True)
         plotter.screenshot(str(path))

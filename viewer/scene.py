@@ -22,8 +22,9 @@ from typing import Any
 
 import numpy as np
 
-from formgraph.geometry import Curve, Geometry, Mesh, NurbsCurve, NurbsSurface, Points, Surface
+from formgraph.geometry import Mesh
 
+from .datasets import KINDS, colour_by, datasets_of, describe, expand, geometry_items, vertices_of
 from .frame import Camera, ScaleBar, fit_scenes, nice_range, sample, size_text, view_axis
 from .style import (
     BACKGROUND,
@@ -35,7 +36,6 @@ from .style import (
     apply_material,
     mix,
     set_edges,
-    shaded,
     style,
 )
 
@@ -44,130 +44,17 @@ __all__ = [
     "TEXT_COLOR",
     "Layer",
     "Scene",
-    "expand",
     "fit_scenes",
-    "geometry_items",
     "nice_range",
     "view_axis",
 ]
 
-# the four kinds of drawn geometry, in drawing order, the control overlays, and the lines
+# the control overlays, and the lines
 # drawn along feature edges and open boundaries of surfaces and meshes
-KINDS = ("meshes", "surfaces", "curves", "points")
 OVERLAYS = ("polygon", "net")
 LINES = ("features",)
 LEGEND_FACE = {"meshes": "rectangle", "surfaces": "rectangle", "curves": "line", "points": "circle"}
 STATUS_HEIGHT = 26  # pixels a line of text takes at the top or bottom of a view
-
-
-def expand(label: str, value: Any) -> list[tuple[str, Any]]:
-    """Split a multi-output tuple into one ``(label.field, value)`` pair per output."""
-    if isinstance(value, tuple) and hasattr(value, "_fields"):
-        return [(f"{label}.{name}", getattr(value, name)) for name in value._fields]
-    return [(label, value)]
-
-
-def geometry_items(value: Any) -> list[Geometry]:
-    """Every geometry in ``value`` (a geometry, or lists and tuples of them, nested)."""
-    if isinstance(value, Geometry):
-        return [value]
-    if isinstance(value, (list, tuple)):
-        return [g for v in value for g in geometry_items(v)]
-    return []
-
-
-def describe(value: Any, items: Sequence[Geometry]) -> str:
-    """A few words for the legend: what the value is and how big."""
-    if not items:
-        text = repr(value)
-        text = text if len(text) <= 30 else text[:27] + "..."
-        return f"{type(value).__name__} {text}, nothing to draw"
-    if len(items) > 1:
-        names = sorted({type(g).__name__ for g in items})
-        return f"{len(items)} x {names[0] if len(names) == 1 else 'geometry'}"
-    g = items[0]
-    if isinstance(g, Mesh):
-        return f"Mesh, {g.n_faces:,} faces"
-    if isinstance(g, Points):
-        return f"Points, {len(g):,}"
-    return type(g).__name__
-
-
-# ---------------------------------------------------------------------------- datasets
-
-
-def _polylines(chains: Sequence[np.ndarray]) -> Any:
-    """One PolyData holding every chain of points as a polyline."""
-    import pyvista as pv
-
-    chains = [np.asarray(c, dtype=np.float64) for c in chains if len(c) >= 2]
-    if not chains:
-        return None
-    pts = np.concatenate(chains)
-    sizes = np.array([len(c) for c in chains])
-    starts = np.concatenate([[0], np.cumsum(sizes)[:-1]])
-    cells = np.insert(np.arange(len(pts)), starts, sizes)
-    return pv.PolyData(pts, lines=cells)
-
-
-def _merge(datasets: Sequence[Any]) -> Any:
-    datasets = [d for d in datasets if d is not None and d.n_points > 0]
-    if not datasets:
-        return None
-    if len(datasets) == 1:
-        return datasets[0]
-    return datasets[0].append_polydata(*datasets[1:])
-
-
-def _control_net(cp: np.ndarray) -> Any:
-    """The rows and columns of a (nu, nv, 3) control grid as polylines."""
-    import pyvista as pv
-
-    nu, nv, _ = cp.shape
-    idx = np.arange(nu * nv).reshape(nu, nv)
-    rows = np.hstack([np.full((nu, 1), nv), idx]).ravel()
-    cols = np.hstack([np.full((nv, 1), nu), idx.T]).ravel()
-    return pv.PolyData(np.array(cp.reshape(-1, 3)), lines=np.concatenate([rows, cols]))
-
-
-def _surface_resolution(s: Surface) -> tuple[int, int]:
-    if isinstance(s, NurbsSurface):
-        spans_u = max(1, len(np.unique(s.knots_u)) - 1)
-        spans_v = max(1, len(np.unique(s.knots_v)) - 1)
-        return int(np.clip(8 * spans_u, 32, 128)), int(np.clip(8 * spans_v, 32, 128))
-    return 64, 64
-
-
-def datasets_of(items: Sequence[Geometry]) -> dict[str, Any]:
-    """The PolyData of each kind, overlay and line set present in ``items``.
-
-    Surfaces and meshes come with split point normals for smooth shading; ``features``
-    holds their feature edges and open boundaries (see :func:`~.style.shaded`).
-    """
-    import pyvista as pv
-
-    points = [np.asarray(g.xyz) for g in items if isinstance(g, Points) and len(g)]
-    curves = [g for g in items if isinstance(g, Curve)]
-    surfaces = [g for g in items if isinstance(g, Surface)]
-    meshes = [g for g in items if isinstance(g, Mesh) and g.n_faces]
-    surface_data = _merge([s.tessellate(*_surface_resolution(s)).to_pyvista() for s in surfaces])
-    mesh_data = _merge([m.to_pyvista() for m in meshes])
-    out: dict[str, Any] = {
-        "points": pv.PolyData(np.concatenate(points)) if points else None,
-        "curves": _polylines([c.display_points() for c in curves]),
-        "polygon": _polylines([c.control_points for c in curves if isinstance(c, NurbsCurve)]),
-        "net": _merge(
-            [_control_net(s.control_points) for s in surfaces if isinstance(s, NurbsSurface)]
-        ),
-    }
-    lines = []
-    for kind, data in (("surfaces", surface_data), ("meshes", mesh_data)):
-        if data is None:
-            continue
-        out[kind], edges = shaded(data)
-        lines.append(edges)
-    out["features"] = _merge(lines)
-    return {k: v for k, v in out.items() if v is not None and v.n_points > 0}
 
 
 # ------------------------------------------------------------------------------- scene
@@ -215,6 +102,9 @@ class Scene:
         (None, at most :data:`~.style.COARSE_FACES` faces).
     colors : dict, optional
         Label -> colour, shared between scenes so that a node keeps its colour.
+    color_by : str, optional
+        An attribute to colour points, surfaces and meshes by, with a colour bar (a
+        ``color`` of 3 or 4 components in 0..1 is drawn as those colours).
     """
 
     def __init__(
@@ -225,8 +115,10 @@ class Scene:
         titled: bool = False,
         edges: bool | None = None,
         colors: dict[str, str] | None = None,
+        color_by: str | None = None,
     ):
         self.plotter = plotter
+        self.color_by = color_by
         self.subplot = subplot
         self.titled = titled
         self.edges = edges
@@ -323,15 +215,18 @@ class Scene:
                 continue
             part.data.copy_from(new)
             if part.vertices is not None:
-                part.vertices.copy_from(_vertices(new))
+                part.vertices.copy_from(vertices_of(new))
         self._layer_edges(layer)
 
     def _add_part(self, layer: Layer, kind: str, data: Any) -> Part:
-        actor = self.plotter.add_mesh(data, reset_camera=False, **style(kind, layer.color))
+        options = style(kind, layer.color)
+        if kind in ("points", "surfaces", "meshes"):
+            options.update(colour_by(data, self.color_by))
+        actor = self.plotter.add_mesh(data, reset_camera=False, **options)
         apply_material(actor, kind)
         part = Part(data, actor)
         if kind in OVERLAYS:
-            part.vertices = _vertices(data)
+            part.vertices = vertices_of(data)
             points = dict(style("points", mix(layer.color, "black", 0.35)), point_size=7)
             part.vertex_actor = self.plotter.add_mesh(part.vertices, reset_camera=False, **points)
             self._set_overlay_visible(
@@ -606,12 +501,6 @@ class Scene:
             if actor is not None:
                 out[name] = _text_of(actor)
         return out
-
-
-def _vertices(data: Any) -> Any:
-    import pyvista as pv
-
-    return pv.PolyData(np.array(data.points))
 
 
 def _text_of(actor: Any) -> str:

@@ -45,8 +45,10 @@ class _Watched:
         layout: str,
         edges: bool | None,
         camera: Camera | None = None,
+        inputs_dir: str | os.PathLike[str] | None = None,
     ):
         self.camera = camera
+        self.inputs_dir = inputs_dir  # the read nodes' folder (--inputs), if not the graph's
         self.path = Path(path)
         self.node = node
         self.sets = list(sets)
@@ -75,7 +77,9 @@ class _Watched:
         ``--set`` params read against it; the files to watch become its files."""
         from formgraph.cli.main import parse_sets
 
-        graph = load(self.path, out_dir=self.out_dir, budget=self.budget)
+        graph = load(
+            self.path, out_dir=self.out_dir, budget=self.budget, inputs_dir=self.inputs_dir
+        )
         self.files = [self.path, *graph.files[1:]]
         self.stamp = self._stamp()
         if memory is not None:
@@ -119,8 +123,9 @@ class Watcher(_Watched):
         layout: str = "overlay",
         edges: bool | None = None,
         camera: Camera | None = None,
+        inputs_dir: str | os.PathLike[str] | None = None,
     ):
-        super().__init__(path, node, sets, out_dir, budget, layout, edges, camera)
+        super().__init__(path, node, sets, out_dir, budget, layout, edges, camera, inputs_dir)
         self.plotter = plotter
         self.session: Session | None = None
         self.reloads = 0
@@ -196,6 +201,7 @@ def watch(
     layout: str = "overlay",
     edges: bool | None = None,
     camera: Camera | None = None,
+    inputs_dir: str | os.PathLike[str] | None = None,
 ) -> Watcher:
     """Open a window on ``graph_path`` that redraws whenever the file is saved.
 
@@ -213,7 +219,9 @@ def watch(
     views = 1
     if layout == "side":  # the window's views are fixed: as many as the first version shows
         try:
-            views = view_count(load(graph_path, out_dir=out_dir, budget=budget), node)
+            views = view_count(
+                load(graph_path, out_dir=out_dir, budget=budget, inputs_dir=inputs_dir), node
+            )
         except FormgraphError:
             views = 1 if node is None else len([node] if isinstance(node, str) else list(node))
     title = _window_title(graph_path) + " (watching)"
@@ -228,6 +236,7 @@ def watch(
         layout=layout,
         edges=edges,
         camera=camera,
+        inputs_dir=inputs_dir,
     )
     watcher.reload()
     plotter.add_timer_event(
@@ -301,8 +310,9 @@ class ScreenshotWatcher(_Watched):
         camera: Camera | None = None,
         out: Any = None,
         err: Any = None,
+        inputs_dir: str | os.PathLike[str] | None = None,
     ):
-        super().__init__(path, node, sets, out_dir, budget, layout, edges, camera)
+        super().__init__(path, node, sets, out_dir, budget, layout, edges, camera, inputs_dir)
         self.screenshot = Path(screenshot)
         self.size = size
         self.out = out if out is not None else sys.stdout

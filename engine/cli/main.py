@@ -68,6 +68,12 @@ def _parser() -> argparse.ArgumentParser:
             "--edges", action="store_true", help="draw every mesh face's edges (default: coarse)"
         )
         p.add_argument("--size", default="1024x768", metavar="WxH")
+        p.add_argument(
+            "--color",
+            metavar="NAME",
+            default=None,
+            help="colour points and meshes by an attribute, with a colour bar",
+        )
         camera_options(p)
         p.add_argument("--out", default="out", metavar="DIR", help=argparse.SUPPRESS)
 
@@ -113,9 +119,11 @@ def _parser() -> argparse.ArgumentParser:
         "--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS
     )
 
+    from .serve import add_parser as add_serve
     from .sweep import add_parsers
 
     add_parsers(sub)
+    add_serve(sub)
     return ap
 
 
@@ -164,7 +172,13 @@ def cmd_run(args: argparse.Namespace) -> int:
     from ..evaluation.graph import load
 
     cache_dir = None if args.no_cache else (args.cache_dir or default_cache_dir())
-    g = load(args.graph, out_dir=args.out, cache_dir=cache_dir, budget=args.budget)
+    g = load(
+        args.graph,
+        out_dir=args.out,
+        cache_dir=cache_dir,
+        budget=args.budget,
+        inputs_dir=args.inputs,
+    )
     params = parse_sets(g, args.set)
     progress = _ProgressLine(sys.stderr)
     g.progress = progress
@@ -195,7 +209,7 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 def cmd_check(args: argparse.Namespace) -> int:
     from ..evaluation.graph import load
-    from ..language.check import param_warnings
+    from ..language.params import param_warnings
 
     g = load(args.graph)
     for p in param_warnings(g.param_defs, g.file_label):
@@ -238,7 +252,7 @@ def cmd_view(args: argparse.Namespace) -> int:
     size = _size_arg(args.size)
     if not args.screenshot:
         _no_window("view", args)
-    g = _graph.load(args.graph, out_dir=args.out, budget=args.budget)
+    g = _graph.load(args.graph, out_dir=args.out, budget=args.budget, inputs_dir=args.inputs)
     params = parse_sets(g, args.set)
     nodes = args.nodes or None
     edges = True if args.edges else None
@@ -252,11 +266,21 @@ def cmd_view(args: argparse.Namespace) -> int:
             layout=args.layout,
             edges=edges,
             camera=camera,
+            color=args.color,
             **params,
         )
         print(f"wrote {path}")
         return 0
-    viewer.show(g, node=nodes, size=size, layout=args.layout, edges=edges, camera=camera, **params)
+    viewer.show(
+        g,
+        node=nodes,
+        size=size,
+        layout=args.layout,
+        edges=edges,
+        camera=camera,
+        color=args.color,
+        **params,
+    )
     return 0
 
 
@@ -272,6 +296,7 @@ def cmd_watch(args: argparse.Namespace) -> int:
     options = dict(
         sets=args.set,
         out_dir=args.out,
+        inputs_dir=args.inputs,
         budget=args.budget,
         size=size,
         layout=args.layout,
@@ -299,7 +324,13 @@ def cmd_graph(args: argparse.Namespace) -> int:
     if output != "-" and Path(output).suffix.lower() not in (".svg", ".png"):
         raise UsageError(f"-o {output}: the drawing is written as .svg or .png")
     cache_dir = None if args.no_cache else (args.cache_dir or default_cache_dir())
-    g = load(args.graph, out_dir=args.out, cache_dir=cache_dir, budget=args.budget)
+    g = load(
+        args.graph,
+        out_dir=args.out,
+        cache_dir=cache_dir,
+        budget=args.budget,
+        inputs_dir=args.inputs,
+    )
     g.set(**parse_sets(g, args.set))  # the param boxes show the values used
     failure: FormgraphError | None = None
     if args.run:
@@ -330,7 +361,7 @@ def cmd_graph(args: argparse.Namespace) -> int:
 def cmd_nodes(args: argparse.Namespace) -> int:
     from ..core.registry import node_types
     from ..language.catalogue import catalogue_text, markdown, node_text
-    from ..language.check import suggest
+    from ..language.params import suggest
 
     if args.markdown:
         sys.stdout.write(markdown())
@@ -369,7 +400,14 @@ COMMANDS = {
     "schema": cmd_schema,
     "sweep": lambda args: _sweep_command("cmd_sweep", args),
     "cache": lambda args: _sweep_command("cmd_cache", args),
+    "serve": lambda args: _serve_command(args),
 }
+
+
+def _serve_command(args: argparse.Namespace) -> int:
+    from .serve import cmd_serve
+
+    return cmd_serve(args)
 
 
 def _sweep_command(name: str, args: argparse.Namespace) -> int:

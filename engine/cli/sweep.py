@@ -99,7 +99,13 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     cache_dir: Any = None
     if not args.no_cache:
         cache_dir = args.cache_dir or default_cache_dir()
-    g = load(args.graph, out_dir=args.out, cache_dir=cache_dir, budget=args.budget)
+    g = load(
+        args.graph,
+        out_dir=args.out,
+        cache_dir=cache_dir,
+        budget=args.budget,
+        inputs_dir=getattr(args, "inputs", None),
+    )
     g.set(**parse_sets(g, args.set))
     if args.scheduler and not args.no_cache and not args.cache_dir:
         cache_dir = EACH_WORKER  # the client's folder means nothing on other machines

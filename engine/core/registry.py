@@ -72,6 +72,11 @@ class NodeSpec:
     def is_export(self) -> bool:
         return any(p.type.is_output_path for p in self.inputs.values())
 
+    @functools.cached_property
+    def input_paths(self) -> tuple[str, ...]:
+        """The ports that name files the node reads (their bytes key the node)."""
+        return tuple(n for n, p in self.inputs.items() if p.type.is_input_path)
+
     def output_type(self, output: str | None) -> PortType:
         if output is None:
             return next(iter(self.outputs.values()))
@@ -87,7 +92,7 @@ def node(name: str, *, version: int = 1) -> Callable[[Callable[..., Any]], Calla
 
     ``version`` is part of every cache key: bump it when the node's results change.
     """
-    if not re.fullmatch(r"[a-z][a-z0-9_]*\.[a-z][a-z0-9_]*", name):
+    if not re.fullmatch(r"[a-z][a-z0-9_]*\.[a-z0-9][a-z0-9_]*", name):  # export.3mf
         raise ValueError(f"node type names are 'family.name' in lower case, got {name!r}")
 
     def register(func: Callable[..., Any]) -> Callable[..., Any]:
@@ -200,6 +205,7 @@ class Context:
     budget: int = DEFAULT_BUDGET
     warnings: list[str] = field(default_factory=list)
     written: list[Path] = field(default_factory=list)
+    inputs: Callable[[str], tuple[Path, bytes]] | None = None  # input path -> (file, bytes)
 
     def guard(self, elements: int | float, what: str = "elements") -> None:
         """Refuse, before allocating, an output of more than the element budget."""
@@ -216,6 +222,14 @@ class Context:
         target = safety.write_atomic(self.out_dir, path, data)
         self.written.append(target)
         return target
+
+    def read(self, path: str) -> tuple[Path, bytes]:
+        """The file an input path names and its bytes: the very bytes hashed into this
+        node's cache key, read once (regular files only, capped; see
+        :func:`formgraph.core.safety.read_regular`)."""
+        if self.inputs is None:
+            raise RuntimeError("this context reads no input files")
+        return self.inputs(path)
 
     def warn(self, message: str) -> None:
         """Record a warning in this node's stats (shown by the CLI)."""

@@ -1,4 +1,4 @@
-"""Reading and writing files safely: regular files only, atomically, inside the output directory.
+"""Reading and writing files safely: regular files only, atomically, inside their folder.
 
 Every file formgraph reads (graphs, subgraph parts, the inputs of read nodes) goes through
 :func:`read_regular`: a FIFO, a device or a socket named as a graph would block ``open`` or
@@ -11,6 +11,10 @@ are followed. Files appear whole or not at all (temp file in the same folder, fs
 ``os.replace``), and a file that already holds exactly the bytes is left untouched. A temp
 file names the process that writes it, so one left behind by a killed run is removed by the
 next write into its folder.
+
+Inputs (the files ``read.*`` nodes read) follow the export paths' rules inside the inputs
+folder (the graph's folder unless the run names one): :func:`resolve_input`, then
+:func:`read_input`, under :data:`MAX_INPUT_BYTES`.
 """
 
 from __future__ import annotations
@@ -34,12 +38,21 @@ _TMP = re.compile(r"^\..+\.fgtmp-(\d+)-[^.]+\.tmp$")
 STALE_SECONDS = 24 * 3600  # a temp file this old is stale whoever wrote it
 
 
-def path_problem(relpath: str) -> str | None:
-    """Why ``relpath`` may not be an output path, or None when it may (no file access)."""
+MAX_INPUT_BYTES = 1 << 30  # the largest input file a read node opens
+
+
+def path_problem(
+    relpath: str, what: str = "output path", root: str = "the output directory"
+) -> str | None:
+    """Why ``relpath`` may not be an output path, or None when it may (no file access).
+
+    ``what`` and ``root`` name the path and its folder in the message (``"input path"``,
+    ``"the inputs folder"`` for the files a graph reads).
+    """
     if not isinstance(relpath, str) or not relpath.strip():
-        return "an output path must be a non-empty relative path"
+        return f"an {what} must be a non-empty relative path"
     if "\x00" in relpath:
-        return "an output path must not contain NUL characters"
+        return f"an {what} must not contain NUL characters"
     posix, win = PurePosixPath(relpath), PureWindowsPath(relpath)
     if (
         posix.is_absolute()
@@ -47,19 +60,17 @@ def path_problem(relpath: str) -> str | None:
         or win.drive
         or relpath.startswith(("/", "\\", "~"))
     ):
-        return f"output path {relpath!r} is absolute; give a path relative to the output directory"
+        return f"{what} {relpath!r} is absolute; give a path relative to {root}"
     if ".." in posix.parts or ".." in win.parts:
-        return f"output path {relpath!r} leaves the output directory ('..')"
+        return f"{what} {relpath!r} leaves {root} ('..')"
     shown = relpath if len(relpath) <= 60 else relpath[:57] + "..."
     if len(relpath) > MAX_PATH_CHARS:
-        return (
-            f"output path {shown!r} is {len(relpath):,} characters long (at most {MAX_PATH_CHARS})"
-        )
+        return f"{what} {shown!r} is {len(relpath):,} characters long (at most {MAX_PATH_CHARS})"
     parts = [p for p in relpath.replace("\\", "/").split("/") if p not in ("", ".")]
     if len(parts) > MAX_PATH_PARTS:
-        return f"output path {shown!r} is {len(parts):,} folders deep (at most {MAX_PATH_PARTS})"
+        return f"{what} {shown!r} is {len(parts):,} folders deep (at most {MAX_PATH_PARTS})"
     if any(len(p) > MAX_NAME_CHARS for p in parts):
-        return f"output path {shown!r} has a name longer than {MAX_NAME_CHARS} characters"
+        return f"{what} {shown!r} has a name longer than {MAX_NAME_CHARS} characters"
     return None
 
 
@@ -90,22 +101,56 @@ def resolve_output(out_dir: str | os.PathLike[str], relpath: str) -> Path:
     PathError
         For absolute paths, ``..``, and symlinks (of folders or of the file) leading out.
     """
-    problem = path_problem(relpath)
+    return _inside(output_root(out_dir), relpath, "output path", "the output directory")
+
+
+def resolve_input(
+    root: str | os.PathLike[str], relpath: str, base: str | os.PathLike[str] | None = None
+) -> Path:
+    """The absolute path of the input ``relpath`` (relative to ``base``, default ``root``),
+    refusing any escape from ``root`` by the rules of :func:`resolve_output`.
+
+    Raises
+    ------
+    PathError
+        For absolute paths, ``..``, a symlink leading out of ``root``, or a root that
+        cannot be followed.
+    """
+    where = "the inputs folder"
+    top = _root(root, "inputs folder")
+    if base is None:
+        return _inside(top, relpath, "input path", where)
+    real = _inside(_root(base, "inputs folder"), relpath, "input path", where)
+    if real != top and top not in real.parents:
+        raise PathError(
+            f"input path {relpath!r} leads outside the inputs folder {str(top)!r} (through a "
+            f"symlink)"
+        )
+    return real
+
+
+def _root(folder: str | os.PathLike[str], what: str) -> Path:
+    try:
+        return Path(folder).resolve()
+    except (OSError, RuntimeError) as exc:  # RuntimeError: a symlink loop (Python < 3.13)
+        raise PathError(f"the {what} {str(folder)!r} cannot be followed: {exc}") from None
+
+
+def _inside(root: Path, relpath: str, what: str, where: str) -> Path:
+    problem = path_problem(relpath, what, where)
     if problem:
         raise PathError(problem)
-    root = output_root(out_dir)
     try:
         target = root / PurePosixPath(relpath.replace("\\", "/"))
         real = target.resolve()  # follows any symlinks that exist along the way
     except (OSError, RuntimeError) as exc:  # RuntimeError: a symlink loop (Python < 3.13)
-        raise PathError(f"output path {relpath!r} cannot be followed: {exc}") from None
+        raise PathError(f"{what} {relpath!r} cannot be followed: {exc}") from None
     if real != root and root not in real.parents:
         raise PathError(
-            f"output path {relpath!r} leads outside the output directory {str(root)!r} "
-            f"(through a symlink)"
+            f"{what} {relpath!r} leads outside {where} {str(root)!r} (through a symlink)"
         )
     if real == root:
-        raise PathError(f"output path {relpath!r} names the output directory itself")
+        raise PathError(f"{what} {relpath!r} names {where} itself")
     return real
 
 
@@ -282,3 +327,18 @@ def _running(pid: int) -> bool:
     except (PermissionError, OverflowError, OSError):
         return True  # someone else's process, or a number we cannot ask about: keep it
     return True
+
+
+
+def read_input(path: str | os.PathLike[str], max_bytes: int = MAX_INPUT_BYTES) -> bytes:
+    """The bytes of an input file (:func:`read_regular`), its refusal a :class:`PathError`
+    saying why in a sentence ("does not exist", "is a FIFO (named pipe), not a regular file",
+    "is larger than 1024 MiB")."""
+    try:
+        return read_regular(path, max_bytes=max_bytes)
+    except FileNotFoundError:
+        raise PathError(f"{os.fspath(path)!r} does not exist") from None
+    except OSError as exc:
+        why = exc.strerror or str(exc)
+        why = why[3:] if why.startswith("it ") else why
+        raise PathError(f"{os.fspath(path)!r} {why}") from None

@@ -20,6 +20,7 @@ import numpy as np
 
 from ..geometry import (
     Curve,
+    Field,
     Geometry,
     Mesh,
     NurbsCurve,
@@ -78,6 +79,11 @@ class OutputPath(str):
     """A relative output path, checked not to leave the output directory."""
 
 
+class InputPath(str):
+    """A relative path of a file a node reads, checked not to leave the inputs folder; the
+    file's bytes are part of the node's cache key."""
+
+
 def number_text(x: float) -> str:
     """A number for a message: ``%g`` style, and an int too large for a float by its size."""
     if isinstance(x, int) and not -(10**15) < x < 10**15:
@@ -120,6 +126,16 @@ class Variables:
         object.__setattr__(self, "names", tuple(names))
 
 
+@dataclass(frozen=True)
+class PerElement:
+    """A port that also takes expressions evaluated once per element of the geometry on
+    input ``of`` (over the element's ``x y z``, ``i``, ``count``, its attributes and the
+    params): ``scale: "=0.5 + rand(i)"``. A plain value, or an expression of the params
+    alone, is an ordinary input."""
+
+    of: str
+
+
 class TypeMismatch(ValueError):
     """A literal or wire that does not fit a port."""
 
@@ -132,6 +148,7 @@ GEOMETRY_TYPES: dict[str, type] = {
     "Surface": Surface,
     "NurbsSurface": NurbsSurface,
     "Mesh": Mesh,
+    "Field": Field,
 }
 SCALARS: dict[str, type] = {"int": int, "float": float, "bool": bool, "str": str}
 
@@ -163,6 +180,7 @@ class PortType:
     range: Range | None = None
     variables: tuple[str, ...] = ()
     same_as: str | None = None  # an output typed like one of the node's inputs
+    per_element: str | None = None  # takes per-element expressions over this input
 
     @property
     def name(self) -> str:
@@ -182,6 +200,10 @@ class PortType:
     @functools.cached_property
     def is_output_path(self) -> bool:
         return any(k.base is OutputPath for k in self.kinds)
+
+    @functools.cached_property
+    def is_input_path(self) -> bool:
+        return any(k.base is InputPath for k in self.kinds)
 
     @functools.cached_property
     def is_geometry(self) -> bool:
@@ -367,7 +389,7 @@ def _coerce_kind(k: Kind, value: Any) -> Any:
         if not math.isfinite(f):
             raise TypeMismatch(f"expected a finite float, got {f}")
         return f
-    if base in (str, Expression, OutputPath):
+    if base in (str, Expression, OutputPath, InputPath):
         if isinstance(value, str):
             return value
         raise TypeMismatch(f"expected {base.__name__}, got {describe(value)}")
@@ -455,6 +477,7 @@ def port_type(hint: Any) -> PortType:
     rng: Range | None = None
     variables: tuple[str, ...] = ()
     same_as: str | None = None
+    per_element: str | None = None
     if typing.get_origin(hint) is typing.Annotated:
         hint, *extras = typing.get_args(hint)
         for x in extras:
@@ -464,6 +487,8 @@ def port_type(hint: Any) -> PortType:
                 variables = x.names
             elif isinstance(x, SameAs):
                 same_as = x.port
+            elif isinstance(x, PerElement):
+                per_element = x.of
     optional = False
     alternatives = [hint]
     if typing.get_origin(hint) in (typing.Union, _pytypes.UnionType):
@@ -478,7 +503,7 @@ def port_type(hint: Any) -> PortType:
             kinds.append(Kind(item, True))
         else:
             kinds.append(Kind(alt, False))
-    return PortType(tuple(kinds), optional, rng, variables, same_as)
+    return PortType(tuple(kinds), optional, rng, variables, same_as, per_element)
 
 
 def type_by_name(name: str) -> PortType:

@@ -29,8 +29,9 @@ from ..core.errors import (
 )
 from ..core.registry import DEFAULT_BUDGET, NodeSpec, node_types
 from ..core.types import TypeMismatch, describe, type_by_name
-from ..language.check import Outline, check_graph, check_param_value
+from ..language.check import Outline, check_graph
 from ..language.model import NodeDef, ParamDef, parse_input
+from ..language.params import check_param_value
 from ..language.subgraph import Includes, SubgraphSpec, is_graph_type
 from ..language.yamlio import MAX_BYTES, MAX_DEPTH, dump, parse
 from . import cache as _cache
@@ -49,8 +50,12 @@ def load(
     cache_dir: str | os.PathLike[str] | None = None,
     budget: int = DEFAULT_BUDGET,
     memory_bytes: int = 1 << 30,
+    inputs_dir: str | os.PathLike[str] | None = None,
 ) -> Graph:
     """Read and check a graph file.
+
+    The files its ``read.*`` nodes name are relative to the graph file's folder and may not
+    leave it; ``inputs_dir`` names another folder to read them from (and confine them to).
 
     Raises
     ------
@@ -73,6 +78,7 @@ def load(
         cache_dir=cache_dir,
         budget=budget,
         memory_bytes=memory_bytes,
+        inputs_dir=inputs_dir,
     )
 
 
@@ -96,11 +102,14 @@ class Graph:
         memory_bytes: int = 1 << 30,
         description: str = "",
         file: str | None = None,
+        inputs_dir: str | os.PathLike[str] | None = None,
     ):
         _check_budgets(budget, memory_bytes)
         self.file = file
         self.description = description
         self.out_dir = Path(out_dir)
+        self.inputs_dir = Path(inputs_dir) if inputs_dir is not None else None
+        self._input_root: Path | None = None  # a subgraph's: its top graph's folder
         self.budget = budget
         self.memory = _cache.MemoryCache(memory_bytes)
         self.disk = _cache.DiskCache(cache_dir) if cache_dir is not None else None
@@ -186,10 +195,48 @@ class Graph:
         return self._includes.resolve_all(self._nodes, self.file_label, base)
 
     @property
+    def input_base(self) -> Path:
+        """The folder that input paths are relative to: the inputs folder when one is named,
+        else the graph file's folder (the working directory for a graph built in code)."""
+        if self.inputs_dir is not None:
+            return self.inputs_dir
+        return Path(self.file).resolve().parent if self.file else Path.cwd()
+
+    @property
+    def input_root(self) -> Path:
+        """The folder no input path may leave (a subgraph's is its top graph's)."""
+        return self._input_root if self._input_root is not None else self.input_base
+
+    @property
     def files(self) -> list[Path]:
-        """The graph's file and every subgraph file it reads (what ``watch`` watches)."""
+        """The graph's file, every subgraph file it reads, and the input files its nodes
+        name as written (what ``watch`` watches)."""
         own = [Path(self.file)] if self.file else []
-        return own + (list(self._includes.files) if self._includes is not None else [])
+        subs = list(self._includes.files) if self._includes is not None else []
+        return own + subs + self._input_files()
+
+    def _input_files(self) -> list[Path]:
+        from ..core import safety
+        from ..language.model import Expr, Literal
+
+        found: list[Path] = []
+        types = node_types()
+        for nd in self._nodes.values():
+            spec = types.get(nd.type)
+            for port in spec.input_paths if spec is not None else ():
+                value = nd.inputs.get(port)
+                try:
+                    if isinstance(value, Literal):
+                        text = value.value
+                    elif isinstance(value, Expr):  # a path from a param: its current value
+                        text = value.value(self._values)
+                    else:
+                        continue
+                    if isinstance(text, str):
+                        found.append(safety.resolve_input(self.input_root, text, self.input_base))
+                except (GraphError, KeyError, ValueError, TypeError, ZeroDivisionError):
+                    continue  # a loop's or a missing param's: the check or the run says why
+        return list(dict.fromkeys(found))
 
     def as_node_spec(self) -> SubgraphSpec:
         """This graph as a node type, as another graph using its file sees it (its params
@@ -211,7 +258,13 @@ class Graph:
         if child is None:
             doc = spec.document
             assert doc is not None
-            child = type(self)(file=spec.label, description=doc.description, out_dir=self.out_dir)
+            child = type(self)(
+                file=spec.label,
+                description=doc.description,
+                out_dir=self.out_dir,
+                inputs_dir=self.inputs_dir,
+            )
+            child._input_root = self.input_root  # its inputs beside its file, inside the root
             child.budget = self.budget
             child.memory, child.disk = self.memory, self.disk
             child._identity, child._digests, child._written = (
@@ -256,7 +309,7 @@ class Graph:
         self._values[name] = default
         self._checked = False
 
-    def add(self, name: str, type: str, **inputs: Any) -> None:
+    def add(self, name: str, type: str, /, **inputs: Any) -> None:
         """Add (or replace) node ``name`` of node type ``type`` with its inputs."""
         if not isinstance(name, str) or not isinstance(type, str):
             what = "node name" if not isinstance(name, str) else "node type"
@@ -328,7 +381,7 @@ class Graph:
         for name, value in params.items():
             p = self._params.get(name)
             if p is None:
-                from ..language.check import suggest
+                from ..language.params import suggest
 
                 problems.append(
                     Problem(
@@ -384,7 +437,7 @@ class Graph:
         names = _node_names(nodes)
         for n in names:
             if n not in self._nodes:
-                from ..language.check import suggest
+                from ..language.params import suggest
 
                 raise GraphError(f"{self.file_label}: no node '{n}'{suggest(n, self._nodes)}")
         run = _Run(self, values)

@@ -11,6 +11,7 @@ are evaluated by the :class:`formgraph.evaluation.items.LanguageRun` mixin.
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import os
 import sys
 import time
@@ -35,6 +36,7 @@ from ..core.errors import (
 )
 from ..core.registry import Context, NodeSpec, node_types
 from ..core.types import Entries, TypeMismatch
+from ..language.elements import bind_elements, reads_elements
 from ..language.model import FRAMES, STEP, Expr, Input, Items, Literal, NodeDef, Wire, wires_of
 from ..language.subgraph import SubgraphSpec
 from . import cache as _cache
@@ -108,6 +110,8 @@ class _Run(LanguageRun, SimulationRun):
         self.total = 0
         self.started: set[str] = set()  # nodes that began computing, for the progress line
         self.quiet = False  # inside run(): numpy's warnings are silenced once, not per node
+        # node -> input path -> (file, bytes): read once when keyed, handed to the node
+        self.input_files: dict[str, dict[str, tuple[Path, bytes]]] = {}
 
     def where(self, name: str, port: str | None = None) -> Where:
         nd = self.g._nodes[name]
@@ -151,6 +155,7 @@ class _Run(LanguageRun, SimulationRun):
                 self.fetch(n)
         for t in targets:
             self.fetch(t)
+        self.input_files.clear()  # the bytes of inputs whose nodes came from a cache
         if replayed is None:
             self.remember(targets, order)
 
@@ -159,7 +164,8 @@ class _Run(LanguageRun, SimulationRun):
     # still what they were has the same keys, so the order and the keys of the last such run
     # are reused instead of rebuilding every key's text (2 ms for 200 nodes; the check of
     # the identities is a dict look-up a node). Only plain runs: no plan (pure), no wired
-    # subgraph params (tokens), no repeated nodes (their items are found with their keys).
+    # subgraph params (tokens), no repeated or simulated nodes (their items and steps are
+    # found with their keys), no input files (their bytes are in the keys).
     _REPLAYS = 8  # target lists remembered per graph
 
     def _replay_state(self, order: list[str]) -> tuple | None:
@@ -187,7 +193,10 @@ class _Run(LanguageRun, SimulationRun):
         return order
 
     def remember(self, targets: list[str], order: list[str]) -> None:
-        if any(self.g._nodes[n].repeat is not None for n in order):
+        if getattr(self, "keyed_files", False):  # an input file may change between runs
+            return
+        nodes = self.g._nodes
+        if any(nodes[n].repeat is not None or nodes[n].simulate is not None for n in order):
             return
         state = self._replay_state(order)
         if state is None:
@@ -236,8 +245,18 @@ class _Run(LanguageRun, SimulationRun):
                     "params": {n: self.tokens.get(n, self.values[n]) for n in names},
                     "wires": [self.key_part(name, port, spec, w) for w in wires_of(value)],
                 }
+                if port in spec.input_paths:  # a file per item, read when the item runs:
+                    parts["inputs"][port]["unkeyed"] = os.urandom(8).hex()  # never trusted
                 continue
             parts["inputs"][port] = self.key_part(name, port, spec, value)
+            if port in spec.input_paths:
+                if wires_of(value):  # a path known only when its wire runs: never trusted
+                    parts["inputs"][port] = {
+                        "wired": parts["inputs"][port],
+                        "unkeyed": os.urandom(8).hex(),
+                    }
+                else:
+                    parts["inputs"][port] = self.input_file(name, port, parts["inputs"][port])
         if spec.is_export:
             parts["out_dir"] = self.out_dir
         if sim is not None:
@@ -252,12 +271,48 @@ class _Run(LanguageRun, SimulationRun):
         self.keys[name] = _cache.key_of({"repeat": items})
         return self.keys[name]
 
+    def input_file(self, name: str, port: str, relpath: Any) -> Any:
+        """The key part of an input file: its path and a hash of its bytes (kept for the
+        node, which parses exactly the bytes its key holds)."""
+        if not isinstance(relpath, str):
+            return relpath  # the check or the node says what is wrong with it
+        here = self.where(name, port)
+        try:
+            path = safety.resolve_input(self.g.input_root, relpath, self.g.input_base)
+        except PathError as exc:
+            raise PathError([Problem(here, p.message) for p in exc.problems]) from None
+        try:
+            data = safety.read_input(path)
+        except PathError as exc:
+            raise PathError(
+                [Problem(here, f"cannot read input {relpath!r}: {p.message}") for p in exc.problems]
+            ) from None
+        self.input_files.setdefault(name, {})[relpath] = (path, data)
+        self.keyed_files = True  # keys that hold file bytes: never replayed (_Run.remember)
+        return {"path": relpath, "bytes": hashlib.blake2b(data, digest_size=20).hexdigest()}
+
+    def read_input(self, name: str, relpath: str) -> tuple[Path, bytes]:
+        """What a node's ``ctx.read`` returns: the bytes keyed, else the file read now (a
+        path that came down a wire)."""
+        held = self.input_files.get(name, {}).get(relpath)
+        if held is not None:
+            return held
+        path = safety.resolve_input(self.g.input_root, relpath, self.g.input_base)
+        return path, safety.read_input(path)
+
     def key_part(self, name: str, port: str, spec: NodeSpec, value: Input) -> Any:
         if isinstance(value, Wire):
             return {"wire": self.identity(value.node), "output": value.output}
         if isinstance(value, Items):
             return [self.key_part(name, port, spec, i) for i in value.items]
         pt = spec.inputs[port].type
+        if pt.per_element and reads_elements(value, self.values):
+            element = bind_elements(value, self.values)  # per element: text and params
+            names = sorted(element.names & set(self.values))
+            return {
+                "per_element": element.text,
+                "params": {n: self.tokens.get(n, self.values[n]) for n in names},
+            }
         if pt.is_expression:  # the text, and the values of the params the text reads
             from ..language.expr import compile_expression
 
@@ -408,6 +463,10 @@ class _Run(LanguageRun, SimulationRun):
                 else:
                     kwargs[port] = p.type.coerce(p.default)
                 continue
+            values = self.values if env is None else env
+            if p.type.per_element and reads_elements(nd.inputs[port], values):
+                kwargs[port] = bind_elements(nd.inputs[port], values)
+                continue
             raw = self.resolve(name, port, nd.inputs[port], env)
             if isinstance(nd.inputs[port], Wire) and isinstance(raw, list):
                 raw = Entries(raw, [0] * len(raw))  # one wire: one entry, however many items
@@ -431,7 +490,13 @@ class _Run(LanguageRun, SimulationRun):
         """Run the node function (or the subgraph) on ``kwargs``: (value, seconds, warnings)."""
         warnings: list[str] = []
         if spec.wants_context:
-            kwargs["ctx"] = Context(name, self.out_path, self.g.budget, warnings)
+            kwargs["ctx"] = Context(
+                name,
+                self.out_path,
+                self.g.budget,
+                warnings,
+                inputs=lambda relpath: self.read_input(name, relpath),
+            )
         if self.g.progress is not None:  # counted as it goes: linear in the graph's size
             self.g.progress(name, len(self.started) - (name in self.started), self.total)
         self.started.add(name)
@@ -465,6 +530,8 @@ class _Run(LanguageRun, SimulationRun):
             raise NodeError(self.where(name), nd.type, str(exc)) from exc
         except Exception as exc:
             raise NodeError(self.where(name), nd.type, f"{type(exc).__name__}: {exc}") from exc
+        finally:
+            self.input_files.pop(name, None)
         for w in warnings:
             _warn(f"{self.where(name).prefix()}: {w}")
         return value, time.perf_counter() - t0, warnings

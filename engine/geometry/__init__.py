@@ -3,27 +3,44 @@
 Every type is a frozen dataclass over read-only float64/int64 arrays, so a node can never
 change what another node sees. Each has ``to_pyvista()`` (pyvista imported lazily),
 ``nbytes`` (for the memory cache) and ``state()`` / :func:`from_state` (plain arrays and
-JSON-able scalars, for the on-disk cache; no pickle). The math lives in
+JSON-able scalars, for the on-disk cache; no pickle). ``Points`` and ``Mesh`` carry per-element
+attributes (``point_data``, ``face_data``: read-only :class:`AttributeMap` of frozen arrays),
+part of their equality, hash, state and ``to_pyvista()``. The math lives in
 :mod:`formgraph.kernels`; these classes are thin, validated wrappers.
 
-- ``base``: the :class:`Geometry` base, frozen arrays, the table of storable types
+- ``base``: the :class:`Geometry` base, frozen arrays, attribute maps, the table of storable
+  types
 - ``points``: :class:`Points`
 - ``curves``: :class:`Curve`, :class:`NurbsCurve`, :class:`ParametricCurve`
 - ``surfaces``: :class:`Surface`, :class:`NurbsSurface`, :class:`ParametricSurface`
 - ``mesh``: :class:`Mesh`
+- ``field``: :class:`Field`, a signed distance function kept as its recipe
 """
 
 from __future__ import annotations
 
-from .base import STORABLE, Geometry, as_xyz, from_state, frozen_array, is_frozen, storable
+from .base import (
+    STORABLE,
+    AttributeMap,
+    Geometry,
+    as_xyz,
+    attribute_map,
+    from_state,
+    frozen_array,
+    is_frozen,
+    storable,
+)
 from .curves import Curve, NurbsCurve, ParametricCurve
+from .field import Field
 from .mesh import Mesh
 from .points import Points
 from .surfaces import NurbsSurface, ParametricSurface, Surface
 
 __all__ = [
     "STORABLE",
+    "AttributeMap",
     "Curve",
+    "Field",
     "Geometry",
     "Mesh",
     "NurbsCurve",
@@ -33,6 +50,7 @@ __all__ = [
     "Points",
     "Surface",
     "as_xyz",
+    "attribute_map",
     "from_state",
     "frozen_array",
     "is_frozen",

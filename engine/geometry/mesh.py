@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from .base import Geometry, as_xyz, frozen_array, storable
+from .base import AttributeMap, Geometry, as_xyz, attribute_map, frozen_array, storable
 
 __all__ = ["Mesh"]
 
@@ -25,6 +25,10 @@ class Mesh(Geometry):
         Vertex indices of all faces, one face after another.
     face_offsets : (n_faces + 1,) int
         Face ``i`` is ``face_indices[face_offsets[i]:face_offsets[i + 1]]``.
+    point_data : mapping name -> (n,) or (n, k) float, optional
+        Per-vertex attributes (:class:`~.base.AttributeMap`, read-only, frozen).
+    face_data : mapping name -> (n_faces,) or (n_faces, k) float, optional
+        Per-face attributes.
 
     The half-edge connectivity (:attr:`halfedges`) is built on first use, vectorized, and
     raises on non-manifold edges, bad indices and inconsistent orientation.
@@ -33,8 +37,17 @@ class Mesh(Geometry):
     vertices: np.ndarray
     face_indices: np.ndarray
     face_offsets: np.ndarray
+    point_data: AttributeMap
+    face_data: AttributeMap
 
-    def __init__(self, vertices: Any, face_indices: Any, face_offsets: Any = None):
+    def __init__(
+        self,
+        vertices: Any,
+        face_indices: Any,
+        face_offsets: Any = None,
+        point_data: Any = None,
+        face_data: Any = None,
+    ):
         v = as_xyz(vertices, "vertices")
         if face_offsets is None:  # a list of faces
             faces = [np.asarray(f, dtype=np.int64).ravel() for f in face_indices]
@@ -61,6 +74,39 @@ class Mesh(Geometry):
         object.__setattr__(self, "vertices", v)
         object.__setattr__(self, "face_indices", frozen_array(fi, np.int64))
         object.__setattr__(self, "face_offsets", frozen_array(fo, np.int64))
+        object.__setattr__(self, "point_data", attribute_map(point_data, len(v), "point attribute"))
+        object.__setattr__(
+            self, "face_data", attribute_map(face_data, len(fo) - 1, "face attribute")
+        )
+
+    @classmethod
+    def trusted(
+        cls,
+        vertices: np.ndarray,
+        face_indices: np.ndarray,
+        face_offsets: np.ndarray,
+        point_data: Any = None,
+        face_data: Any = None,
+    ) -> Mesh:
+        """A mesh of arrays that are valid by construction (e.g. copies of a valid mesh's
+        faces, shifted): frozen, but their indices not checked again, which for 10,000
+        copies would cost more than building them. Attributes are still validated."""
+        out = cls.__new__(cls)
+        v = frozen_array(vertices, np.float64)
+        fo = frozen_array(face_offsets, np.int64)
+        object.__setattr__(out, "vertices", v)
+        object.__setattr__(out, "face_indices", frozen_array(face_indices, np.int64))
+        object.__setattr__(out, "face_offsets", fo)
+        object.__setattr__(out, "point_data", attribute_map(point_data, len(v), "point attribute"))
+        object.__setattr__(
+            out, "face_data", attribute_map(face_data, len(fo) - 1, "face attribute")
+        )
+        return out
+
+    @property
+    def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(vertices, face_indices, face_offsets)``: what the kernels take."""
+        return self.vertices, self.face_indices, self.face_offsets
 
     @property
     def n_vertices(self) -> int:
@@ -102,7 +148,7 @@ class Mesh(Geometry):
         """Total face area: of the triangles we export (each face fanned from its first corner)."""
         from ..kernels.mesh import measure
 
-        return float(measure.face_areas(*self.state().values()).sum())
+        return float(measure.face_areas(*self.arrays).sum())
 
     @functools.cached_property
     def volume(self) -> float:
@@ -110,7 +156,7 @@ class Mesh(Geometry):
         mesh; only meaningful when :attr:`is_watertight`."""
         from ..kernels.mesh import measure
 
-        return float(measure.signed_volume(*self.state().values()).sum())
+        return float(measure.signed_volume(*self.arrays).sum())
 
     @functools.cached_property
     def bounds(self) -> np.ndarray:
@@ -130,24 +176,57 @@ class Mesh(Geometry):
 
     @property
     def nbytes(self) -> int:
-        return self.vertices.nbytes + self.face_indices.nbytes + self.face_offsets.nbytes
+        arrays = self.vertices.nbytes + self.face_indices.nbytes + self.face_offsets.nbytes
+        return arrays + self.point_data.nbytes + self.face_data.nbytes
 
     def __repr__(self) -> str:
-        return f"Mesh(n_vertices={self.n_vertices}, n_faces={self.n_faces})"
+        extra = "".join(
+            f", {what}={list(m)}"
+            for what, m in (("point_data", self.point_data), ("face_data", self.face_data))
+            if m
+        )
+        return f"Mesh(n_vertices={self.n_vertices}, n_faces={self.n_faces}{extra})"
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Mesh):
+            return NotImplemented
+        return self is other or (
+            all(np.array_equal(a, b) for a, b in zip(self.arrays, other.arrays, strict=True))
+            and self.point_data == other.point_data
+            and self.face_data == other.face_data
+        )
+
+    def __hash__(self) -> int:
+        return self._content_hash()
+
+    def with_data(self, point_data: Any = None, face_data: Any = None) -> Mesh:
+        """The same mesh with other attributes (None: none); the arrays are shared."""
+        return Mesh(*self.arrays, point_data=point_data, face_data=face_data)
 
     def to_pyvista(self) -> Any:
         import pyvista as pv
 
         sizes = self.face_sizes
         cells = np.insert(self.face_indices, self.face_offsets[:-1], sizes)
-        return pv.PolyData(np.array(self.vertices), faces=cells)
+        poly = pv.PolyData(np.array(self.vertices), faces=cells)
+        for name, a in self.point_data.items():
+            poly.point_data[name] = np.array(a)
+        for name, a in self.face_data.items():
+            poly.cell_data[name] = np.array(a)
+        return poly
 
     def state(self) -> dict[str, Any]:
-        return {
+        out: dict[str, Any] = {
             "vertices": self.vertices,
             "face_indices": self.face_indices,
             "face_offsets": self.face_offsets,
         }
+        # only when present: the state (and so the cache key) of a plain mesh is unchanged
+        if self.point_data:
+            out["point_data"] = self.point_data.pairs()
+        if self.face_data:
+            out["face_data"] = self.face_data.pairs()
+        return out
 
 
 def _indices(values: Any, what: str) -> np.ndarray:

@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from .base import Geometry, as_xyz, storable
+from .base import AttributeMap, Geometry, as_xyz, attribute_map, storable
 
 __all__ = ["Points"]
 
@@ -17,16 +17,26 @@ __all__ = ["Points"]
 class Points(Geometry):
     """A set of points. ``xyz`` is ``(n, 3)`` float64; ``np.asarray(points)`` gives it.
 
+    Parameters
+    ----------
+    xyz : (n, 2) or (n, 3) float
+    point_data : mapping name -> (n,) or (n, k) float, optional
+        Per-point attributes (:class:`~.base.AttributeMap`, read-only, frozen).
+
     Example
     -------
-    >>> Points([[0, 0], [1, 2]]).xyz.tolist()
-    [[0.0, 0.0, 0.0], [1.0, 2.0, 0.0]]
+    >>> p = Points([[0, 0], [1, 2]], point_data={"h": [0.5, 1.5]})
+    >>> p.xyz.tolist(), p.point_data["h"].tolist()
+    ([[0.0, 0.0, 0.0], [1.0, 2.0, 0.0]], [0.5, 1.5])
     """
 
     xyz: np.ndarray
+    point_data: AttributeMap
 
-    def __init__(self, xyz: Any):
-        object.__setattr__(self, "xyz", as_xyz(xyz))
+    def __init__(self, xyz: Any, point_data: Any = None):
+        v = as_xyz(xyz)
+        object.__setattr__(self, "xyz", v)
+        object.__setattr__(self, "point_data", attribute_map(point_data, len(v), "point attribute"))
 
     def __array__(self, dtype: Any = None, copy: Any = None) -> np.ndarray:
         return self.xyz if dtype is None else self.xyz.astype(dtype)
@@ -35,12 +45,36 @@ class Points(Geometry):
         return len(self.xyz)
 
     def __repr__(self) -> str:
-        return f"Points(n={len(self.xyz)})"
+        extra = f", point_data={list(self.point_data)}" if self.point_data else ""
+        return f"Points(n={len(self.xyz)}{extra})"
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Points):
+            return NotImplemented
+        return self is other or (
+            np.array_equal(self.xyz, other.xyz) and self.point_data == other.point_data
+        )
+
+    def __hash__(self) -> int:
+        return self._content_hash()
+
+    @property
+    def nbytes(self) -> int:
+        return self.xyz.nbytes + self.point_data.nbytes
+
+    def with_point_data(self, point_data: Any) -> Points:
+        """The same points with other attributes (the coordinates shared, not copied)."""
+        return Points(self.xyz, point_data)
 
     def to_pyvista(self) -> Any:
         import pyvista as pv
 
-        return pv.PolyData(np.array(self.xyz))
+        poly = pv.PolyData(np.array(self.xyz))
+        for name, a in self.point_data.items():
+            poly.point_data[name] = np.array(a)
+        return poly
 
     def state(self) -> dict[str, Any]:
-        return {"xyz": self.xyz}
+        if not self.point_data:  # the state (and so the cache key) of a plain point set
+            return {"xyz": self.xyz}
+        return {"xyz": self.xyz, "point_data": self.point_data.pairs()}

@@ -33,8 +33,9 @@ class Surface(Geometry):
         """Points at every (u[i], v[j]): ``(len(u), len(v), 3)``."""
         return self.evaluate(u[:, None], v[None, :])
 
-    def tessellate(self, nu: int = 32, nv: int = 32) -> Mesh:
-        """A quad mesh of ``nu x nv`` faces over the whole domain (seams closed up)."""
+    def tessellate(self, nu: int = 32, nv: int = 32, with_uv: bool = False) -> Mesh:
+        """A quad mesh of ``nu x nv`` faces over the whole domain (seams closed up);
+        ``with_uv`` adds each vertex's parameters as ``u`` and ``v`` point attributes."""
         if nu < 1 or nv < 1:
             raise ValueError(f"tessellation needs at least 1 x 1 faces, got {nu} x {nv}")
         u = np.linspace(*self.domain_u, nu + 1)
@@ -47,7 +48,14 @@ class Surface(Geometry):
         if closed_v:
             pts = pts[:, :-1]
         fi, fo = _grid.grid_faces(pts.shape[0], pts.shape[1], closed_u, closed_v)
-        return Mesh(*_grid.collapse_poles(pts, fi, fo))
+        vertices, fi, fo = _grid.collapse_poles(pts, fi, fo)
+        if not with_uv:
+            return Mesh(vertices, fi, fo)
+        from ..kernels.attributes.propagate import by_position
+
+        gu, gv = np.meshgrid(u[: pts.shape[0]], v[: pts.shape[1]], indexing="ij")
+        source = by_position(pts.reshape(-1, 3), vertices)  # a pole keeps its row's first
+        return Mesh(vertices, fi, fo, {"u": gu.reshape(-1)[source], "v": gv.reshape(-1)[source]})
 
     def to_pyvista(self) -> Any:
         return self.tessellate(64, 64).to_pyvista()

@@ -8,7 +8,6 @@ fixes a graph in one pass.
 
 from __future__ import annotations
 
-import difflib
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
@@ -24,72 +23,13 @@ from ..core.types import (
     as_list,
     describe,
     loop_item_problem,
-    number_text,
 )
+from .elements import reads_elements
 from .expr import compile_expression
-from .model import FRAMES, Expr, Input, Items, Literal, NodeDef, ParamDef, Wire
-
-
-def suggest(name: str, options: Any) -> str:
-    close = difflib.get_close_matches(name, list(options), n=1, cutoff=0.6)
-    return f" (did you mean '{close[0]}'?)" if close else ""
-
-
-def _whole(x: Any) -> bool:
-    return isinstance(x, int) and not isinstance(x, bool)
-
-
-def param_kind(p: ParamDef) -> type | None:
-    """The scalar type of a param without a declared ``type:``, read from how it is written.
-
-    A number is an ``int`` only when its default, min and max are all written as whole
-    numbers (``{default: 3, min: 0.5, max: 10}`` is a float); None for anything else.
-    """
-    if p.type is not None:
-        return None
-    d = p.default
-    if isinstance(d, (bool, str)):
-        return type(d)
-    if _whole(d):
-        return int if all(_whole(b) for b in (p.min, p.max) if b is not None) else float
-    if isinstance(d, float):
-        return float
-    return None
-
-
-def check_param_value(p: ParamDef, value: Any) -> Any:
-    """The value of param ``p`` as the graph uses it, or TypeMismatch."""
-    kind = param_kind(p)
-    if p.type is not None:
-        if value is None:
-            return None
-        out = p.type.coerce(value)
-    elif kind is not None:
-        out = PortType((Kind(kind),)).coerce(value)
-    else:
-        out = value
-    if isinstance(out, (int, float)) and not isinstance(out, bool):
-        if p.min is not None and out < p.min:
-            raise TypeMismatch(f"must be >= {number_text(p.min)}, got {number_text(out)}")
-        if p.max is not None and out > p.max:
-            raise TypeMismatch(f"must be <= {number_text(p.max)}, got {number_text(out)}")
-    return out
-
-
-def param_warnings(params: Mapping[str, ParamDef], file: str) -> list[Problem]:
-    """Params whose type was guessed where a guess could be wrong: a slider-ready number
-    (with a min or max) read as int because everything about it is written whole."""
-    out = []
-    for p in params.values():
-        if param_kind(p) is int and (p.min is not None or p.max is not None):
-            out.append(
-                Problem(
-                    Where(file, p.line),
-                    f"param '{p.name}' is read as int (its default, min and max are whole "
-                    f"numbers); write 'type: int' to confirm, or 'type: float' to allow fractions",
-                )
-            )
-    return out
+from .model import FRAMES, STEP, Expr, Input, Items, Literal, NodeDef, ParamDef, Wire
+from .order import cycle_problems, kahn_order
+from .params import check_param_value, suggest
+from .simulation import is_state_placeholder, steps_problem
 
 
 @dataclass(frozen=True)
@@ -153,7 +93,7 @@ def check_graph(g: Outline, extra: list[Problem] | None = None) -> list[Problem]
         except TypeMismatch as exc:
             problems.append(Problem(Where(file, p.line), f"param '{p.name}': default {exc}"))
 
-    for name in _kahn_order(g):  # output types upstream first (see output_type)
+    for name in kahn_order(g.nodes):  # output types upstream first (see output_type)
         spec = registry.get(g.nodes[name].type)
         if spec is not None:
             for out in spec.outputs if spec.multi_output else [None]:
@@ -177,7 +117,7 @@ def check_graph(g: Outline, extra: list[Problem] | None = None) -> list[Problem]
         problems.extend(_check_node(g, nd, spec, registry))
 
     problems.extend(_check_outputs(g, registry))
-    problems.extend(_check_cycles(g))
+    problems.extend(cycle_problems(g.nodes, g.file_label))
     return problems
 
 
@@ -370,9 +310,8 @@ def _check_node(
     repeat_problems, loop = _check_repeat(g, nd, registry)
     for message in repeat_problems:
         add(message, "repeat")
-    from .simulation import check_simulate, is_state_placeholder
 
-    simulate_problems, step = check_simulate(g, nd, spec, registry)
+    simulate_problems, step = _check_simulate(g, nd, spec, registry)
     for message, port in simulate_problems:
         add(message, port)
     loop = loop or step
@@ -407,6 +346,8 @@ def _check_input(
 ) -> list[str]:
     if isinstance(value, Wire):
         return _check_wire(g, pt, value, registry)
+    if pt.per_element and reads_elements(value, set(g.params) | ({loop.name} if loop else set())):
+        return []  # evaluated per element: its names are known when the geometry is
     if isinstance(value, Literal):
         return _check_literal(g, pt, value.value, loop)
     if isinstance(value, Expr):
@@ -495,6 +436,10 @@ def _check_literal(g: Outline, pt: PortType, value: Any, loop: _Loop | None = No
         why = safety.path_problem(value)
         if why:
             problems.append(why)
+    if not problems and pt.is_input_path and isinstance(value, str):
+        why = safety.path_problem(value, "input path", "the inputs folder")
+        if why:
+            problems.append(why)
     return problems
 
 
@@ -576,56 +521,90 @@ def _coercible(pt: PortType, item: PortType) -> bool:
     return sample is not None and not _coerce_problems(pt, sample)
 
 
-def _acyclic(g: Outline) -> bool:
-    """True when every node can be ordered after its inputs."""
-    return len(_kahn_order(g)) == len(g.nodes)
-
-
-def _kahn_order(g: Outline) -> list[str]:
-    """Kahn's algorithm: the nodes each after its inputs (those on or after a cycle left
-    out)."""
-    indegree = {n: 0 for n in g.nodes}
-    users: dict[str, list[str]] = {n: [] for n in g.nodes}
-    for nd in g.nodes.values():
-        for up in nd.upstream():
-            if up in indegree:
-                indegree[nd.name] += 1
-                users[up].append(nd.name)
-    ready = [n for n, d in indegree.items() if d == 0]
-    ordered = []
-    while ready:
-        n = ready.pop()
-        ordered.append(n)
-        for user in users[n]:
-            indegree[user] -= 1
-            if indegree[user] == 0:
-                ready.append(user)
-    return ordered
-
-
-def _check_cycles(g: Outline) -> list[Problem]:
-    if _acyclic(g):
-        return []
-    import networkx as nx  # only to name the cycles' paths; keeps `import formgraph` quick
-
-    dag = nx.DiGraph()
-    for nd in g.nodes.values():
-        dag.add_node(nd.name)
-        for up in nd.upstream():
-            if up in g.nodes:
-                dag.add_edge(up, nd.name)
-    problems = []
-    seen: set[frozenset[str]] = set()
-    for cycle in nx.simple_cycles(dag):
-        key = frozenset(cycle)
-        if key in seen:
-            continue
-        seen.add(key)
-        # start the path at the node written first in the file
-        order = list(g.nodes)
-        start = min(range(len(cycle)), key=lambda i: order.index(cycle[i]))
-        path = cycle[start:] + cycle[:start]
-        problems.append(Problem(Where(g.file_label), "cycle: " + " -> ".join(path + [path[0]])))
-        if len(problems) >= 10:
-            break
-    return problems
+def _check_simulate(
+    g: Any, nd: NodeDef, spec: NodeSpec, registry: Mapping[str, NodeSpec]
+) -> tuple[list[tuple[str, str]], Any]:
+    """Problems of a node's ``simulate:`` as (message, port), and the loop its inputs see
+    (the step index, an int), or None without a simulation."""
+    sim = nd.simulate
+    if sim is None:
+        return [], None
+    out: list[tuple[str, str]] = []
+    loop = _Loop(STEP, PortType((Kind(int),)))
+    if nd.repeat is not None:
+        out.append(
+            ("a node cannot both repeat and simulate; simulate a subgraph instead", "simulate")
+        )
+    if STEP in g.params:
+        out.append(
+            (
+                f"param '{STEP}' would be hidden by the step index of this simulation; rename it",
+                "simulate",
+            )
+        )
+    if spec.multi_output:
+        out.append(
+            (
+                f"simulate needs a node with one output (each step's output is the next "
+                f"step's state); '{nd.type}' has {', '.join(spec.outputs)}",
+                "simulate",
+            )
+        )
+    elif sim.state not in spec.inputs:
+        out.append(
+            (
+                f"'{nd.type}' has no input '{sim.state}' to take the state; its inputs are "
+                f"{', '.join(spec.inputs) or 'none'}",
+                "simulate",
+            )
+        )
+    else:
+        pt = spec.inputs[sim.state].type
+        produced = spec.output_type(None)
+        if not pt.accepts(produced):
+            out.append(
+                (
+                    f"the state input '{sim.state}' ({pt.name}) cannot take the node's own "
+                    f"output ({produced.name}), so no step could follow another",
+                    "simulate",
+                )
+            )
+        if sim.state in nd.raw and not is_state_placeholder(nd, sim.state):
+            out.append(
+                (
+                    f"input '{sim.state}' is the simulation's state (the previous step's "
+                    f"output): leave it out or write '={sim.state}'; step 0 is 'from'",
+                    sim.state,
+                )
+            )
+        for message in _check_input(g, nd, pt, sim.source, dict(registry), None):
+            out.append((f"from: {message}", "simulate"))
+    steps = sim.steps
+    if isinstance(steps, Wire):
+        out.append(
+            (
+                "steps is a count known before anything runs (an int, or an expression over "
+                f"the params), not a wire ('{steps}')",
+                "simulate",
+            )
+        )
+        return out, loop
+    value: Any = None
+    if isinstance(steps, Expr):
+        msg = _expr_names_problem(g, steps)
+        if msg:
+            out.append((f"steps: {msg}", "simulate"))
+            return out, loop
+        try:
+            value = _static_value(g, steps)
+        except _Unknown:
+            return out, loop
+        except (ValueError, TypeError, ZeroDivisionError, ArithmeticError) as exc:
+            out.append((f"steps '={steps.text}' fails with the param defaults: {exc}", "simulate"))
+            return out, loop
+    elif isinstance(steps, Literal):
+        value = steps.value
+    problem = steps_problem(value)
+    if problem:
+        out.append((problem, "simulate"))
+    return out, loop

@@ -24,6 +24,8 @@ from typing import Any
 import numpy as np
 
 from ..core.errors import ExpressionError
+from ..kernels.attributes.noise import noise as _noise
+from ..kernels.attributes.random import rand as _rand
 
 MAX_LENGTH = 4000
 MAX_NODES = 2000
@@ -78,6 +80,9 @@ FUNCTIONS: dict[str, tuple[Callable[..., Any], int | tuple[int, int | None]]] = 
     "max": (_reduce(np.maximum), (1, None)),
     "clip": (np.clip, 3),
     "where": (np.where, 3),
+    # per-element variation: a pure hash to [0, 1) and Perlin noise in [-1, 1]
+    "rand": (_rand, (1, 2)),
+    "noise": (_noise, (1, 3)),
 }
 
 _BINARY: dict[type, Callable[[Any, Any], Any]] = {

@@ -22,8 +22,9 @@ from ..core import safety
 from ..core.errors import Problem, Where
 from ..core.registry import REQUIRED, NodeSpec, Port, node_types
 from ..core.types import Kind, PortType, Range
-from .check import Outline, check_graph, output_type, param_kind
+from .check import Outline, check_graph, output_type
 from .model import NodeDef, ParamDef, Wire, parse_input
+from .params import param_kind
 from .yamlio import MAX_BYTES, Document, parse
 
 __all__ = ["Includes", "SubgraphSpec", "is_graph_type"]

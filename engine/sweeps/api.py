@@ -31,7 +31,7 @@ from typing import Any
 from ..core.errors import ParamError, Problem, Where
 from ..core.terminal import StatusLine
 from ..evaluation.graph import Graph
-from ..language.check import suggest
+from ..language.params import suggest
 from .cluster import SweepError, Targets, Totals
 from .sampling import Domain, domain, parse_spec, sample
 

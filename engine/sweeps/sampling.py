@@ -20,7 +20,7 @@ import numpy as np
 from ..core.errors import ParamError, Problem, Where
 from ..core.types import TypeMismatch
 from ..evaluation.graph import Graph
-from ..language.check import check_param_value, suggest
+from ..language.params import check_param_value, suggest
 
 __all__ = ["Domain", "domain", "param_kind", "parse_spec", "sample"]
 

@@ -19,7 +19,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from .colors import rgb
-from .exporters import check_mesh
+from .meshdata import check_mesh
 
 __all__ = ["dxf_bytes"]
 

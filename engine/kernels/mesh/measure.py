@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..io.exporters import fan_triangles
+from ..io.meshdata import fan_triangles
 
 __all__ = [
     "EdgeTable",

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..io.exporters import fan_triangles
+from ..io.meshdata import fan_triangles
 from .halfedge import build_halfedges
 from .measure import edge_table, face_areas, next_corner, signed_volume, union_find
 from .meshops import reverse_faces, triangulate

@@ -8,7 +8,7 @@ from .halfedge import build_halfedges
 from .measure import next_corner
 from .meshops import face_normals, reverse_faces
 
-__all__ = ["solidify", "vertex_normals"]
+__all__ = ["planar_rim_directions", "solidify", "vertex_normals"]
 
 MeshArrays = tuple[np.ndarray, np.ndarray, np.ndarray]
 
@@ -44,6 +44,7 @@ def solidify(
     face_offsets: np.ndarray,
     thickness: float | np.ndarray,
     offset: float = 0.0,
+    planar_rims: bool = True,
 ) -> MeshArrays:
     """A closed shell around an oriented surface: two offset copies joined along the rims.
 
@@ -66,6 +67,9 @@ def solidify(
         Wall thickness, > 0; one value per vertex for a varying wall.
     offset : float
         Where the wall sits relative to the surface, -1 .. 1.
+    planar_rims : bool
+        Keep each planar boundary loop in its plane (:func:`planar_rim_directions`): a
+        shade whose bottom rim lies on z = 0 still stands on z = 0 when thickened.
 
     Returns
     -------
@@ -94,6 +98,8 @@ def solidify(
         raise ValueError("the surface has no faces to thicken")
     he = build_halfedges(fi, fo, len(v))
     n = vertex_normals(v, fi, fo)
+    if planar_rims and he.boundary_halfedges.size:
+        n = planar_rim_directions(v, he.boundary_edges, n)
     front = v + n * (t * (1.0 + offset) / 2.0)[:, None]
     back = v - n * (t * (1.0 - offset) / 2.0)[:, None]
     nv = len(v)
@@ -103,3 +109,66 @@ def solidify(
     out_fi = np.concatenate([fi, reverse_faces(fi, fo) + nv, rims])
     out_fo = np.concatenate([fo, fo[-1] + fo[1:], 2 * fo[-1] + np.arange(4, 4 * b.size + 1, 4)])
     return np.concatenate([front, back]), out_fi, out_fo
+
+
+def planar_rim_directions(
+    vertices: np.ndarray, boundary_edges: np.ndarray, normals: np.ndarray, tol: float = 1e-6
+) -> np.ndarray:
+    """Offset directions with the vertices of planar boundary loops kept in their plane.
+
+    Each loop (a connected component of the boundary edges) gets its best-fit plane from
+    the eigenvectors of its covariance (all loops at once, a batched ``eigh``); a loop whose
+    vertices are within ``tol`` of its size from that plane is planar. Its vertices then
+    move along their normal projected into the plane, scaled by ``1 / |projection|^2`` so
+    the wall keeps its thickness measured along the surface normal. A loop whose surface
+    meets the plane at less than 30 degrees (a flat sheet lying in its own rim's plane) is
+    left alone: no in-plane move could make its wall.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+    boundary_edges : (b, 2) int
+        Boundary edges (from a half-edge structure).
+    normals : (n, 3) float
+        Unit vertex normals.
+
+    Returns
+    -------
+    (n, 3) float: ``normals`` with the rim vertices' rows replaced.
+    """
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    v = np.asarray(vertices, dtype=np.float64)
+    e = np.asarray(boundary_edges, dtype=np.int64)
+    rim = np.unique(e)
+    local = np.searchsorted(rim, e)
+    graph = coo_matrix((np.ones(len(e)), (local[:, 0], local[:, 1])), shape=(rim.size,) * 2)
+    k, loop = connected_components(graph, directed=False)
+    count = np.bincount(loop, minlength=k).astype(np.float64)
+    p = v[rim]
+    centre = np.stack([np.bincount(loop, p[:, i], k) for i in range(3)], 1) / count[:, None]
+    d = p - centre[loop]
+    cov = np.zeros((k, 3, 3))
+    for i in range(3):
+        for j in range(3):
+            cov[:, i, j] = np.bincount(loop, d[:, i] * d[:, j], k)
+    _, vecs = np.linalg.eigh(cov)
+    plane = vecs[:, :, 0]  # the normal: the direction of least spread
+    dev = np.abs(np.einsum("ij,ij->i", d, plane[loop]))
+    size = np.zeros(k)
+    np.maximum.at(size, loop, np.linalg.norm(d, axis=1))
+    worst = np.zeros(k)
+    np.maximum.at(worst, loop, dev)
+    planar = (count >= 3) & (worst <= tol * np.maximum(size, 1e-300))
+    nrm = np.asarray(normals, dtype=np.float64)[rim]
+    pn = plane[loop]
+    proj = nrm - np.einsum("ij,ij->i", nrm, pn)[:, None] * pn
+    length2 = np.einsum("ij,ij->i", proj, proj)
+    steep = length2 >= 0.25  # the surface within 60 degrees of the plane's normal
+    ok_loop = np.ones(k, dtype=bool)
+    np.logical_and.at(ok_loop, loop, steep)
+    use = planar[loop] & ok_loop[loop]
+    out = np.array(normals, dtype=np.float64)
+    out[rim[use]] = proj[use] / length2[use, None]
+    return out

@@ -23,6 +23,7 @@ from .halfedge import HalfEdges, build_halfedges
 __all__ = [
     "catmull_clark",
     "catmull_clark_counts",
+    "catmull_clark_face_parents",
     "doo_sabin",
     "doo_sabin_counts",
     "doo_sabin_weights",
@@ -31,7 +32,7 @@ __all__ = [
 
 def _as_vertices(vertices: np.ndarray) -> np.ndarray:
     v = np.asarray(vertices, dtype=np.float64)
-    if v.ndim != 2 or v.shape[1] != 3:
+    if v.ndim != 2 or v.shape[1] < 3:
         raise ValueError(f"vertices must be an (n, 3) array, got shape {v.shape}")
     if not np.isfinite(v).all():
         i = int(np.flatnonzero(~np.isfinite(v).all(axis=1))[0])
@@ -46,9 +47,9 @@ def _check_levels(levels: int) -> int:
 
 
 def _scatter(index: np.ndarray, values: np.ndarray, size: int) -> np.ndarray:
-    """Sum the rows of ``values`` (m, 3) into ``size`` bins: one bincount per coordinate."""
-    out = np.empty((size, 3))
-    for k in range(3):
+    """Sum the rows of ``values`` (m, d) into ``size`` bins: one bincount per column."""
+    out = np.empty((size, values.shape[1]))
+    for k in range(values.shape[1]):
         out[:, k] = np.bincount(index, values[:, k], minlength=size)
     return out
 
@@ -58,7 +59,7 @@ def _face_sums(vertices: np.ndarray, fi: np.ndarray, fo: np.ndarray, quads: bool
         q = fi.reshape(-1, 4)
         return vertices[q[:, 0]] + vertices[q[:, 1]] + vertices[q[:, 2]] + vertices[q[:, 3]]
     if fi.size == 0:
-        return np.zeros((0, 3))
+        return np.zeros((0, vertices.shape[1]))
     return np.add.reduceat(vertices[fi], fo[:-1], axis=0)
 
 
@@ -159,7 +160,7 @@ def _catmull_clark_step(
     # = (sum of face points + sum of edge neighbours) / n^2 + (n - 2) / n * S
     k = np.bincount(fi, minlength=n).astype(np.float64)
     ring = _scatter(fi, fp_h, n)
-    for c in range(3):  # edge neighbours: each edge adds its other end to both ends
+    for c in range(v.shape[1]):  # edge neighbours: each edge adds its other end to both ends
         ring[:, c] += np.bincount(ev[:, 0], vb[:, c], minlength=n)
         ring[:, c] += np.bincount(ev[:, 1], va[:, c], minlength=n)
     kk = np.maximum(k, 1.0)[:, None]
@@ -176,7 +177,7 @@ def _catmull_clark_step(
         s_e = np.broadcast_to(np.minimum(s_e, 1e300), se.shape)
         s_v = np.bincount(ends, np.repeat(s_e, 2), minlength=n)
         s_v /= np.maximum(n_sharp, 1)  # vertex sharpness: mean over its sharp edges
-        nb = _scatter(ends, np.stack([vb[se], va[se]], axis=1).reshape(-1, 3), n)
+        nb = _scatter(ends, np.stack([vb[se], va[se]], axis=1).reshape(-1, v.shape[1]), n)
         crease_v = n_sharp == 2
         on_boundary = np.bincount(ev[boundary_edge].ravel(), minlength=n) > 0
         s_v[on_boundary] = 1.0  # the smooth rule does not hold on a boundary
@@ -272,11 +273,16 @@ def catmull_clark(
         fractional part on the next, and is smooth afterwards; a vertex takes the mean
         sharpness of its sharp edges.
 
+    vertices may carry extra columns beyond x, y, z (point attributes): every rule is
+    linear in the vertices, so they follow exactly the same stencils (a linear attribute
+    stays linear). The face each output face lies in is
+    :func:`catmull_clark_face_parents`.
+
     Returns
     -------
     vertices : (n', 3) float64
         The original vertices' new positions first (same indices), then one edge point per
-        edge, then one face point per face.
+        edge, then one face point per face (with the extra columns, when given).
     face_indices : (4 * n_faces',) int64
     face_offsets : (n_faces' + 1,) int64
         All quads.
@@ -304,6 +310,20 @@ def catmull_clark(
     for level in range(levels):
         v, lv, sharp = _catmull_clark_step(v, lv, sharp, last=level == levels - 1)
     return v, lv.face_indices, lv.face_offsets
+
+
+def catmull_clark_face_parents(face_offsets: np.ndarray, levels: int) -> np.ndarray:
+    """The input face each output face of ``levels`` Catmull-Clark steps lies in.
+
+    Level one turns face ``f`` of ``k`` corners into ``k`` consecutive quads (one per
+    corner, in face order); each later level turns every quad into four consecutive quads.
+    """
+    fo = np.asarray(face_offsets, dtype=np.int64)
+    parents = np.arange(fo.size - 1, dtype=np.int64)
+    if _check_levels(levels) == 0:
+        return parents
+    parents = np.repeat(parents, np.diff(fo))
+    return np.repeat(parents, 4 ** (levels - 1))
 
 
 def catmull_clark_counts(
@@ -342,13 +362,16 @@ def doo_sabin_weights(k: int) -> np.ndarray:
     return a[(i[None, :] - i[:, None]) % k]
 
 
-def _doo_sabin_step(v: np.ndarray, he: HalfEdges) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _doo_sabin_step(
+    v: np.ndarray, he: HalfEdges, fvals: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
     fi, fo = he.origin, he.face_offsets
     m = fi.size
     sizes = he.face_sizes
 
     # one new point per corner (half-edge), by the weights of its face's size
-    corner = np.empty((m, 3))
+    d = v.shape[1]
+    corner = np.empty((m, d))
     for k in np.unique(sizes):
         faces = np.flatnonzero(sizes == k)
         idx = fo[faces][:, None] + np.arange(k)
@@ -358,7 +381,7 @@ def _doo_sabin_step(v: np.ndarray, he: HalfEdges) -> tuple[np.ndarray, np.ndarra
     b = he.boundary_halfedges
     nb = b.size
     a_b, z_b = v[he.origin[b]], v[he.vertex[b]]
-    chaikin = np.stack([0.75 * a_b + 0.25 * z_b, 0.25 * a_b + 0.75 * z_b], axis=1).reshape(-1, 3)
+    chaikin = np.stack([0.75 * a_b + 0.25 * z_b, 0.25 * a_b + 0.75 * z_b], axis=1).reshape(-1, d)
     c_first = np.full(m, -1, dtype=np.int64)  # new id of the Chaikin point near origin(h)
     c_first[b] = m + 2 * np.arange(nb)
 
@@ -405,12 +428,26 @@ def _doo_sabin_step(v: np.ndarray, he: HalfEdges) -> tuple[np.ndarray, np.ndarra
     all_sizes = np.concatenate(part_sizes)
     face_offsets = np.zeros(all_sizes.size + 1, dtype=np.int64)
     np.cumsum(all_sizes, out=face_offsets[1:])
-    return new_v, face_indices, face_offsets
+    new_f = None
+    if fvals is not None:
+        # F-faces keep their face's values, E-faces take the mean of the faces on their
+        # edge, V-faces the mean of the faces around their vertex
+        fh = fvals[he.face]
+        fan_sum = np.add.reduceat(fh[fans.halfedges], fans.offsets[:-1], axis=0)
+        fan_mean = fan_sum / np.maximum(fan_size, 1)[:, None]
+        new_f = np.concatenate(
+            [fvals, 0.5 * (fh[h] + fh[t]), fh[b], fan_mean[out_size > 0]], axis=0
+        )
+    return new_v, face_indices, face_offsets, new_f
 
 
 def doo_sabin(
-    vertices: np.ndarray, face_indices: np.ndarray, face_offsets: np.ndarray, levels: int = 1
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    vertices: np.ndarray,
+    face_indices: np.ndarray,
+    face_offsets: np.ndarray,
+    levels: int = 1,
+    face_values: np.ndarray | None = None,
+) -> tuple[np.ndarray, ...]:
     """Doo-Sabin subdivision of a polygon mesh (Doo & Sabin 1978).
 
     Per level, every corner ``i`` of every ``k``-sided face gets a new point
@@ -447,6 +484,11 @@ def doo_sabin(
     levels : int
         Number of subdivision steps (0 returns a copy).
 
+    vertices may carry extra columns beyond x, y, z (point attributes): they follow the
+    same weights. ``face_values`` (n_faces, c), when given, follow the faces: an F-face keeps
+    its face's values, an E-face gets the mean of the faces on its edge, a V-face the mean
+    of the faces around its vertex; they are returned fourth.
+
     Returns
     -------
     vertices : (n', 3) float64
@@ -455,6 +497,8 @@ def doo_sabin(
     face_indices : (m',) int64
     face_offsets : (n_faces' + 1,) int64
         F-faces, then E-faces (interior, then boundary), then V-faces.
+    face_values : (n_faces', c) float64
+        Only when ``face_values`` is given.
 
     Raises
     ------
@@ -464,12 +508,16 @@ def doo_sabin(
     v = _as_vertices(vertices)
     levels = _check_levels(levels)
     he = build_halfedges(face_indices, face_offsets, v.shape[0])
+    fv = (
+        None if face_values is None else np.asarray(face_values, np.float64).reshape(he.n_faces, -1)
+    )
     if levels == 0:
-        return v.copy(), np.array(he.origin), np.array(he.face_offsets)
-    v, fi, fo = _doo_sabin_step(v, he)
+        out = v.copy(), np.array(he.origin), np.array(he.face_offsets)
+        return out if fv is None else (*out, fv.copy())
+    v, fi, fo, fv = _doo_sabin_step(v, he, fv)
     for _ in range(levels - 1):
-        v, fi, fo = _doo_sabin_step(v, build_halfedges(fi, fo, v.shape[0]))
-    return v, fi, fo
+        v, fi, fo, fv = _doo_sabin_step(v, build_halfedges(fi, fo, v.shape[0]), fv)
+    return (v, fi, fo) if face_values is None else (v, fi, fo, fv)
 
 
 def doo_sabin_counts(he: HalfEdges, levels: int) -> list[tuple[int, int, int]]:

@@ -253,9 +253,9 @@ class SegmentTree:
         if self.max_pairs is not None and self.pairs > self.max_pairs:
             raise WorkLimit(
                 f"the distance queries would test more than {self.max_pairs:,} (point, segment) "
-                f"pairs: {self.n:,} input segments that criss-cross (a capsule around a run "
-                "of them holds much of the input, so every sample near the result tests many) "
-                "and a result that long for its cell; use a larger cell, fewer or cleaner "
+                f"pairs against the {self.n:,} input segments (each sample near the result "
+                "tests the segments within its reach: many when the input criss-crosses or "
+                "the distance is large next to it); use a larger cell, fewer or cleaner "
                 "curves, or a larger budget"
             )
 

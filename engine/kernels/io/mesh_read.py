@@ -1,0 +1,231 @@
+"""Mesh file readers as pure functions: the file's bytes in, flat polygon arrays out.
+
+STL (binary and ASCII), Wavefront OBJ (polygons kept, negative indices), OFF and PLY
+(ASCII, binary little- and big-endian). Each returns ``(vertices (n, 3) float64,
+face_indices (m,) int64, face_offsets (n_faces + 1,) int64)`` and raises ``ValueError``
+with a sentence for a file that is truncated, inconsistent or not of its format. Counts a
+header claims are checked against the bytes there are before anything is allocated, so a
+lying header costs nothing.
+"""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+
+from .textscan import Lines, ints_at, line_numbers, parse_floats, token_starts
+
+__all__ = ["read_obj", "read_off", "read_stl", "triangles_flat"]
+
+_STL_RECORD = np.dtype(
+    [("normal", "<f4", (3,)), ("v", "<f4", (9,)), ("attr", "<u2")], align=False
+)  # 50 bytes
+
+
+def triangles_flat(vertices: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarray, ...]:
+    """``(vertices, face_indices, face_offsets)`` of a triangle array (t, 3)."""
+    tris = np.ascontiguousarray(triangles, dtype=np.int64)
+    return vertices, tris.ravel(), np.arange(0, tris.size + 1, 3, dtype=np.int64)
+
+
+def read_stl(data: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """An STL file, binary or ASCII, as a triangle soup (three vertices per facet).
+
+    Binary is recognized by its size matching the header's triangle count (84 + 50 n
+    bytes), whatever the header's text says (many binary files start with ``solid``). The
+    facet normals are not read: a facet's winding is its orientation.
+
+    Raises
+    ------
+    ValueError
+        For a size that matches neither layout, a count that does not fit the file, or an
+        ASCII file whose numbers do not come in facets of three vertices.
+    """
+    size = len(data)
+    if size >= 84:
+        count = int.from_bytes(data[80:84], "little")
+        if 84 + 50 * count == size:
+            rec = np.frombuffer(data, dtype=_STL_RECORD, count=count, offset=84)
+            v = rec["v"].reshape(-1, 3).astype(np.float64)
+            return triangles_flat(v, np.arange(3 * count).reshape(-1, 3))
+    head = data[:512].lstrip()
+    if head[:5].lower() == b"solid" and re.search(rb"\bfacet\b|\bendsolid\b", data[:4096]):
+        return _stl_ascii(data)
+    if size < 84:
+        raise ValueError(f"the file is {size} bytes: too short for an STL (binary needs 84)")
+    raise ValueError(
+        f"the header claims {count:,} triangles ({84 + 50 * count:,} bytes) but the file is "
+        f"{size:,} bytes: truncated, padded or not an STL"
+    )
+
+
+def _stl_ascii(data: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    buf = np.frombuffer(data, dtype=np.uint8)
+    lines = Lines(buf)
+    vertex = lines.keyword(b"vertex") | _indented(lines, b"vertex")
+    n = int(vertex.sum())
+    facets = data.count(b"facet normal") or data.count(b"facet")  # 'endfacet' has no space
+    if n % 3 or (facets and 3 * data.count(b"endloop") != n):
+        raise ValueError(
+            f"the ASCII STL has {n:,} vertex lines, not three per facet: truncated or garbled"
+        )
+    text, _ = _stripped(lines, vertex, b"vertex")
+    v = parse_floats(text, 3 * n).reshape(-1, 3)
+    return triangles_flat(v, np.arange(n).reshape(-1, 3))
+
+
+def _indented(lines: Lines, word: bytes) -> np.ndarray:
+    """Lines whose first token (after leading whitespace) is ``word``."""
+    buf = lines.buf
+    first = _first_token(lines)
+    ok = first + len(word) <= lines.ends
+    for k, ch in enumerate(word):
+        ok &= buf[np.minimum(first + k, buf.size - 1)] == ch
+    return ok
+
+
+def _first_token(lines: Lines) -> np.ndarray:
+    buf = lines.buf
+    space = (buf == 32) | (buf == 9)
+    nonspace = np.flatnonzero(~space)
+    if nonspace.size == 0:
+        return lines.ends.copy()
+    at = np.searchsorted(nonspace, lines.starts)
+    return np.where(at < nonspace.size, nonspace[np.minimum(at, nonspace.size - 1)], lines.ends)
+
+
+def _stripped(lines: Lines, which: np.ndarray, word: bytes) -> tuple[np.ndarray, np.ndarray]:
+    """The chosen lines' text with their leading ``word`` (and indentation) blanked."""
+    first = _first_token(lines)[which]
+    text, starts = lines.text(which)
+    text = text.copy()
+    lead = first - lines.starts[which] + len(word)
+    width = int(lead.max()) if lead.size else 0
+    cols = np.arange(width)
+    mask = cols[None, :] < lead[:, None]
+    text[(starts[:, None] + cols[None, :])[mask]] = 32
+    return text, starts
+
+
+# --------------------------------------------------------------------------------------------
+# OBJ
+
+
+def read_obj(data: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A Wavefront OBJ file's ``v`` and ``f`` lines: polygons kept, every group and object
+    in one mesh, texture and normal references dropped.
+
+    Face indices are 1-based or negative (relative to the vertices read so far), as the
+    format says. A ``v`` line may carry more than three numbers (a weight or a colour):
+    the first three are the point.
+
+    Raises
+    ------
+    ValueError
+        For a number that is not one, a face of fewer than three vertices or an index out
+        of range, naming the line.
+    """
+    buf = np.frombuffer(data, dtype=np.uint8)
+    lines = Lines(buf)
+    is_v, is_f = lines.keyword(b"v"), lines.keyword(b"f")
+    v = _rows(lines, is_v, b"v", 3, "vertex")
+    text, starts = lines.text(is_f, skip=1)
+    tokens = token_starts(text)
+    line_of = line_numbers(starts, tokens)
+    sizes = np.bincount(line_of, minlength=starts.size)
+    f_lines = np.flatnonzero(is_f)
+    if sizes.size and sizes.min() < 3:
+        k = int(np.argmin(sizes))
+        raise ValueError(f"line {f_lines[k] + 1}: a face needs at least 3 vertices")
+    try:
+        idx, _ = ints_at(text, tokens)  # a token 'v/vt/vn' starts with its vertex index
+    except ValueError as exc:
+        raise ValueError(f"a face line has {exc}") from None
+    before = np.cumsum(is_v)[f_lines] if f_lines.size else np.zeros(0, np.int64)
+    idx = np.where(idx < 0, idx + np.repeat(before, sizes), idx - 1)
+    bad = (idx < 0) | (idx >= len(v))
+    if bad.any():
+        k = int(np.argmax(bad))
+        raise ValueError(
+            f"line {f_lines[line_of[k]] + 1}: a face refers to a vertex that does not exist "
+            f"({len(v):,} vertices)"
+        )
+    return v, idx, np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+
+
+def _rows(lines: Lines, which: np.ndarray, word: bytes, width: int, what: str) -> np.ndarray:
+    """The first ``width`` numbers of each chosen line (which must have at least that many)."""
+    text, starts = lines.text(which, skip=len(word))
+    tokens = token_starts(text)
+    counts = np.bincount(line_numbers(starts, tokens), minlength=starts.size)
+    chosen = np.flatnonzero(which)
+    if counts.size and counts.min() < width:
+        k = int(np.argmin(counts))
+        raise ValueError(f"line {chosen[k] + 1}: a {what} needs {width} numbers")
+    values = parse_floats(text, int(counts.sum()))
+    if np.all(counts == width):
+        return values.reshape(-1, width)
+    first = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    return values[first[:, None] + np.arange(width)]
+
+
+# --------------------------------------------------------------------------------------------
+# OFF
+
+
+def read_off(data: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """An OFF file: ``OFF``, then ``nv nf ne``, ``nv`` points and ``nf`` faces ``k i1 .. ik``
+    (any colour after a face's indices is ignored); ``#`` comments anywhere.
+
+    Raises
+    ------
+    ValueError
+        For a missing keyword, counts that the file cannot hold, or a bad face.
+    """
+    text = re.sub(rb"#[^\n]*", b"", data)
+    buf = np.frombuffer(text, dtype=np.uint8)
+    lines = Lines(buf)
+    blank = _first_token(lines) >= lines.ends
+    content = np.flatnonzero(~blank)
+    if content.size == 0:
+        raise ValueError("the file is empty")
+    head = bytes(buf[lines.starts[content[0]] : lines.ends[content[0]]]).split()
+    if not head or not head[0].endswith(b"OFF"):
+        raise ValueError("an OFF file starts with the keyword OFF")
+    counts = head[1:]
+    rest = content[1:]
+    if len(counts) < 2:  # the counts on their own line
+        if rest.size == 0:
+            raise ValueError("the OFF header has no vertex and face counts")
+        counts = bytes(buf[lines.starts[rest[0]] : lines.ends[rest[0]]]).split()
+        rest = rest[1:]
+    try:
+        nv, nf = int(counts[0]), int(counts[1])
+    except (ValueError, IndexError):
+        raise ValueError("the OFF counts line must hold whole numbers: nv nf ne") from None
+    if nv < 0 or nf < 0 or nv + nf > rest.size:
+        raise ValueError(
+            f"the header claims {nv:,} vertices and {nf:,} faces but the file has "
+            f"{rest.size:,} lines after it: truncated"
+        )
+    pick = np.zeros(len(lines), dtype=bool)
+    pick[rest[:nv]] = True
+    v = _rows(lines, pick, b"", 3, "vertex")
+    pick[:] = False
+    pick[rest[nv : nv + nf]] = True
+    ftext, starts = lines.text(pick)
+    tokens = token_starts(ftext)
+    line_of = line_numbers(starts, tokens)
+    per_line = np.bincount(line_of, minlength=nf)
+    values, _ = ints_at(ftext, tokens)  # every token of a face line is an integer...
+    first = np.concatenate([[0], np.cumsum(per_line)[:-1]]).astype(np.int64)
+    k = values[first] if nf else np.zeros(0, np.int64)
+    if nf and (k.min() < 3 or np.any(k + 1 > per_line)):
+        bad = int(np.argmax((k < 3) | (k + 1 > per_line)))
+        raise ValueError(f"face {bad}: a face needs a count of at least 3, then that many indices")
+    take = np.repeat(first + 1, k) + (np.arange(int(k.sum())) - np.repeat(np.cumsum(k) - k, k))
+    idx = values[take]
+    if idx.size and (idx.min() < 0 or idx.max() >= nv):
+        raise ValueError(f"a face refers to a vertex that does not exist ({nv:,} vertices)")
+    return v, idx, np.concatenate([[0], np.cumsum(k)]).astype(np.int64)

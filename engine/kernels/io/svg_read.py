@@ -1,0 +1,241 @@
+"""SVG drawings to exact NURBS curves, in millimetres with y up.
+
+The SVG itself — paths and their commands, basic shapes (``rect`` with rounded corners,
+``circle``, ``ellipse``, ``line``, ``polyline``, ``polygon``), nested transforms, CSS and
+``use`` — is read by ``svgelements``, which knows the specification's rules; every segment
+it reports, transforms applied, is then made exact here: lines degree 1, quadratic and cubic
+Béziers as they are, elliptical arcs as rational quadratics (:mod:`.chains`). Each subpath is
+one curve. Segments are taken in their element's own coordinates and its full transform is
+applied to the control points (an affine map keeps a rational Bézier exact; a skewed arc
+stays an exact ellipse), arcs converted from the endpoint form by the specification's own
+formulas rather than through a transformed ellipse's rounded axes.
+
+Units: svgelements resolves ``width="100mm"`` with a ``viewBox`` (and every other length) to
+CSS pixels at 96 per inch; a pixel is 25.4/96 mm. The y axis is flipped to point up, about
+the document's bottom edge when it has a height (so the page's lower-left corner is the
+origin), else about y = 0.
+
+A hostile file is bounded before svgelements sees it: at most :data:`MAX_ELEMENTS` tags and
+:data:`MAX_DEPTH` levels of nesting, no external entities (expat never fetches them, and
+its billion-laughs guard bounds internal ones).
+"""
+
+from __future__ import annotations
+
+import io
+import math
+import re
+from dataclasses import dataclass
+
+import numpy as np
+
+from .chains import Chain, CurveArrays, arc_pieces, bezier_piece, line_piece
+
+__all__ = ["MAX_DEPTH", "MAX_ELEMENTS", "SvgCurve", "read_svg"]
+
+MAX_ELEMENTS = 250_000
+MAX_DEPTH = 512
+PX_MM = 25.4 / 96.0
+_TAG = re.compile(rb"<(/?)([^>]*?)(/?)>")
+
+
+@dataclass(frozen=True)
+class SvgCurve:
+    curve: CurveArrays
+    layer: str  # the id (or Inkscape label) of its top-level group; "" outside any
+
+
+def _bounded(data: bytes, max_elements: int) -> None:
+    tags = data.count(b"<")
+    if tags > max_elements:
+        raise ValueError(f"the file has {tags:,} tags, over the budget of {max_elements:,}")
+    depth = deepest = 0
+    for m in _TAG.finditer(data):
+        body = m.group(2)
+        if body[:1] in (b"!", b"?"):
+            continue
+        if m.group(1):
+            depth -= 1
+        elif not m.group(3):
+            depth += 1
+            deepest = max(deepest, depth)
+    if deepest > MAX_DEPTH:
+        raise ValueError(f"elements nest {deepest:,} deep, over the budget of {MAX_DEPTH}")
+
+
+def read_svg(data: bytes, max_elements: int = MAX_ELEMENTS) -> list[SvgCurve]:
+    """Every drawn shape of an SVG file as exact NURBS arrays, one per subpath.
+
+    Raises
+    ------
+    ValueError
+        For a file over the budgets, or one svgelements cannot parse as SVG.
+    """
+    import svgelements as se
+
+    _bounded(data, max_elements)
+    try:
+        doc = se.SVG.parse(io.BytesIO(data), reify=False, ppi=96.0, on_error="raise")
+    except Exception as exc:  # svgelements raises what its XML parser raises
+        raise ValueError(f"not an SVG document ({type(exc).__name__}: {str(exc)[:100]})") from None
+    mm, declared = _mm_per_px(data, doc)
+    height = _length(getattr(doc, "height", None)) if declared else 0.0
+    flip = np.array([mm, -mm, 1.0])
+    shift = np.array([0.0, height * mm if height else 0.0, 0.0])
+    out: list[SvgCurve] = []
+    stack: list[tuple[object, str]] = [(doc, "")]
+    while stack:  # depth-first, without recursion
+        node, layer = stack.pop()
+        if isinstance(node, se.Group) or node is doc:
+            children = list(node)
+            for child in reversed(children):
+                name = layer
+                if isinstance(child, se.Group) and node is doc:
+                    name = _layer_name(child)
+                stack.append((child, name))
+            continue
+        if not isinstance(node, se.Shape):
+            continue
+        if node.values.get("visibility") == "hidden":
+            continue
+        m = node.transform  # local to document pixels: applied to the control points (exact)
+        lin = np.array([[m.a, m.c, 0.0], [m.b, m.d, 0.0], [0.0, 0.0, 1.0]], dtype=np.float64)
+        move = np.array([m.e, m.f, 0.0], dtype=np.float64)
+        for chain in _chains(se.Path(node), se):
+            cp, p, k, w = chain.curve()
+            out.append(SvgCurve(((cp @ lin.T + move) * flip + shift, p, k, w), layer))
+    return out
+
+
+_UNIT_MM = {
+    "mm": 1.0,
+    "cm": 10.0,
+    "in": 25.4,
+    "pt": 25.4 / 72,
+    "pc": 25.4 / 6,
+    "px": PX_MM,
+    "": PX_MM,
+}
+
+
+def _mm_per_px(data: bytes, doc: object) -> tuple[float, bool]:
+    """Millimetres per svgelements pixel, from the root's own width (or height) and unit;
+    and whether the root declares a height (or a view box) to flip about.
+
+    svgelements turns millimetres into pixels with a rounded inch (0.0393701 in/mm, 5e-7
+    off); a document ``width="100mm"`` must measure 100 mm, so the root's length is read
+    here and divided by the pixels svgelements made of it.
+    """
+    root = re.search(rb"<(?:\w+:)?svg\b([^>]*)>", data[: 1 << 16])
+    if root is None:
+        return PX_MM, False
+    attrs = dict(re.findall(rb'([\w:-]+)\s*=\s*["\']([^"\']*)["\']', root.group(1)))
+    declared = b"height" in attrs or b"viewBox" in attrs
+    for name in (b"width", b"height"):
+        m = re.fullmatch(rb"\s*([0-9.eE+-]+)\s*(mm|cm|in|pt|pc|px|)\s*", attrs.get(name, b""))
+        px = _length(getattr(doc, name.decode(), None))
+        if m and px:
+            try:
+                amount = float(m.group(1))
+            except ValueError:
+                continue
+            if amount > 0:
+                return amount * _UNIT_MM[m.group(2).decode()] / px, declared
+    return PX_MM, declared
+
+
+def _length(value: object) -> float:
+    try:
+        f = float(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        return 0.0
+    return f if np.isfinite(f) and f > 0 else 0.0
+
+
+def _layer_name(group: object) -> str:
+    values = getattr(group, "values", {}) or {}
+    for key, v in values.items():
+        if str(key).endswith("}label") or str(key) == "inkscape:label":
+            return str(v)
+    return str(getattr(group, "id", None) or values.get("id") or "")
+
+
+def _xyz(pt: object) -> np.ndarray:
+    return np.array([float(pt.x), float(pt.y), 0.0])  # type: ignore[attr-defined]
+
+
+def _chains(path: object, se: object) -> list[Chain]:
+    chains: list[Chain] = []
+    current = Chain()
+    start = None
+    for seg in path:  # type: ignore[attr-defined]
+        if isinstance(seg, se.Move):
+            if len(current):
+                chains.append(current)
+            current, start = Chain(), seg.end
+            continue
+        if isinstance(seg, se.Close):
+            if start is not None and seg.start is not None and len(current):
+                a, b = _xyz(seg.start), _xyz(start)
+                if np.linalg.norm(a - b) > 1e-9 * (1.0 + np.abs(b).max()):
+                    current.add(line_piece(a, b))
+                else:  # closed already, up to rounding: end exactly where it began
+                    current.pieces[-1][-1, :3] = b * current.pieces[-1][-1, 3]
+            if len(current):
+                chains.append(current)
+            current = Chain()
+            continue
+        if seg.start is None or seg.end is None:
+            continue
+        p0, p1 = _xyz(seg.start), _xyz(seg.end)
+        if isinstance(seg, se.Line):
+            if p0.tolist() != p1.tolist():
+                current.add(line_piece(p0, p1))
+        elif isinstance(seg, se.QuadraticBezier):
+            current.add(bezier_piece(np.array([p0, _xyz(seg.control), p1])))
+        elif isinstance(seg, se.CubicBezier):
+            current.add(bezier_piece(np.array([p0, _xyz(seg.control1), _xyz(seg.control2), p1])))
+        elif isinstance(seg, se.Arc):
+            current.add(_arc(seg, p0, p1))
+    if len(current):
+        chains.append(current)
+    return chains
+
+
+def _arc(seg: object, p0: np.ndarray, p1: np.ndarray) -> list[np.ndarray]:
+    """An SVG elliptical arc, from its endpoint form (radii, rotation, large-arc and sweep
+    flags) to centre form by the SVG specification's appendix (F.6.5, radii scaled up as
+    F.6.6 says when they cannot span the chord), then exact pieces."""
+    rx, ry = abs(float(seg.rx)), abs(float(seg.ry))  # type: ignore[attr-defined]
+    sweep = float(seg.sweep)  # type: ignore[attr-defined]
+    if rx == 0 or ry == 0 or sweep == 0 or p0.tolist() == p1.tolist():
+        return [line_piece(p0, p1)] if p0.tolist() != p1.tolist() else []
+    phi = float(seg.get_rotation())  # type: ignore[attr-defined]
+    large, positive = abs(sweep) > math.pi, sweep > 0
+    cos_p, sin_p = math.cos(phi), math.sin(phi)
+    dx, dy = (p0[0] - p1[0]) / 2, (p0[1] - p1[1]) / 2
+    x1, y1 = cos_p * dx + sin_p * dy, -sin_p * dx + cos_p * dy
+    scale = (x1 / rx) ** 2 + (y1 / ry) ** 2
+    if scale > 1:
+        rx, ry = rx * math.sqrt(scale), ry * math.sqrt(scale)
+    num = rx * rx * ry * ry - rx * rx * y1 * y1 - ry * ry * x1 * x1
+    den = rx * rx * y1 * y1 + ry * ry * x1 * x1
+    root = math.sqrt(max(num / den, 0.0)) * (-1 if large == positive else 1)
+    cx1, cy1 = root * rx * y1 / ry, -root * ry * x1 / rx
+    center = np.array(
+        [
+            cos_p * cx1 - sin_p * cy1 + (p0[0] + p1[0]) / 2,
+            sin_p * cx1 + cos_p * cy1 + (p0[1] + p1[1]) / 2,
+            0.0,
+        ]
+    )
+    t0 = math.atan2((y1 - cy1) / ry, (x1 - cx1) / rx)
+    t1 = math.atan2((-y1 - cy1) / ry, (-x1 - cx1) / rx)
+    delta = (t1 - t0) % (2 * math.pi)
+    if not positive:
+        delta -= 2 * math.pi
+    a = rx * np.array([cos_p, sin_p, 0.0])
+    b = ry * np.array([-sin_p, cos_p, 0.0])
+    pieces = arc_pieces(center, a, b, t0, t0 + delta)
+    pieces[0][0, :3], pieces[-1][-1, :3] = p0, p1  # the joints exactly where the path has them
+    return pieces

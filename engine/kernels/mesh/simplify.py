@@ -1,0 +1,113 @@
+"""Fewer or better triangles: quadric decimation and isotropic remeshing, through libraries.
+
+* :func:`decimate`: Garland & Heckbert's quadric error metric edge collapse ("Surface
+  simplification using quadric error metrics", SIGGRAPH 1997) as fast-simplification
+  implements it (Fast-Quadric-Mesh-Simplification, C++; the collapse order by threshold
+  sweeps, not a global heap).
+* :func:`remesh`: approximated centroidal Voronoi clustering (Valette & Chassery 2004,
+  ACVD) through pyacvd: clusters of about equal area become the new vertices, the dual of
+  the clustering the new triangles; the input is first subdivided until it has several
+  vertices per cluster, as ACVD needs.
+
+Both take and give triangles (callers triangulate polygons first) and report, never hide,
+a closed input that came out open (:class:`OpenedError`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["OpenedError", "decimate", "is_closed", "remesh"]
+
+
+class OpenedError(ValueError):
+    """A closed mesh came out with open or non-manifold edges."""
+
+
+def is_closed(triangles: np.ndarray) -> bool:
+    """Every undirected edge is used by exactly two triangles."""
+    t = np.asarray(triangles, dtype=np.int64)
+    if not len(t):
+        return False
+    e = np.sort(np.stack([t, np.roll(t, -1, axis=1)], axis=2).reshape(-1, 2), axis=1)
+    n = int(t.max()) + 1
+    _, counts = np.unique(e[:, 0] * n + e[:, 1], return_counts=True)
+    return bool((counts == 2).all())
+
+
+def _compact(v: np.ndarray, t: np.ndarray):
+    """Drop degenerate triangles (a repeated corner) and unused vertices."""
+    t = t[(t[:, 0] != t[:, 1]) & (t[:, 1] != t[:, 2]) & (t[:, 2] != t[:, 0])]
+    used = np.zeros(len(v), dtype=bool)
+    used[t] = True
+    new = np.cumsum(used) - 1
+    return v[used], new[t]
+
+
+def decimate(
+    vertices: np.ndarray, triangles: np.ndarray, target_faces: int, aggression: float = 7.0
+):
+    """Quadric-error decimation to about ``target_faces`` triangles.
+
+    Returns ``vertices (k, 3)``, ``triangles (m, 3)``; raises :class:`OpenedError` when a
+    closed input comes out open (a collapse made a non-manifold edge).
+    """
+    import fast_simplification
+
+    # writable copies: the extension refuses read-only (frozen) arrays
+    v = np.array(vertices, dtype=np.float64, order="C")
+    t = np.array(triangles, dtype=np.int64, order="C")
+    if target_faces >= len(t):
+        return v, t
+    closed = is_closed(t)
+    reduction = 1.0 - target_faces / len(t)
+    out_v, out_t = fast_simplification.simplify(v, t, target_reduction=reduction, agg=aggression)
+    out_v, out_t = _compact(np.asarray(out_v, np.float64), np.asarray(out_t, np.int64))
+    if closed and not is_closed(out_t):
+        raise OpenedError(
+            f"decimating to {len(out_t)} triangles opened the closed mesh; ask for more faces"
+        )
+    return out_v, out_t
+
+
+def cluster_count(vertices: np.ndarray, triangles: np.ndarray, edge_length: float) -> int:
+    """The vertices of an equilateral triangulation of the surface with that edge length:
+    its area over ``sqrt(3) / 2 * edge_length^2`` (the area per vertex), at least 4."""
+    v = np.asarray(vertices, dtype=np.float64)
+    t = np.asarray(triangles, dtype=np.int64)
+    area = 0.5 * np.linalg.norm(np.cross(v[t[:, 1]] - v[t[:, 0]], v[t[:, 2]] - v[t[:, 0]]), axis=1)
+    return max(4, int(round(area.sum() / (np.sqrt(3) / 2 * edge_length**2))))
+
+
+def remesh(vertices: np.ndarray, triangles: np.ndarray, clusters: int):
+    """About ``clusters`` vertices evenly spread over the surface, as triangles (ACVD)."""
+    import warnings
+
+    import pyacvd
+    import pyvista as pv
+
+    v = np.asarray(vertices, dtype=np.float64)
+    t = np.asarray(triangles, dtype=np.int64)
+    closed = is_closed(t)
+    cells = np.hstack([np.full((len(t), 1), 3), t]).ravel()
+    mesh = pv.PolyData(v, cells)
+    with warnings.catch_warnings():  # pyacvd calls a pyvista API that pyvista deprecates
+        warnings.simplefilter("ignore", DeprecationWarning)
+        clus = pyacvd.Clustering(mesh)
+        # ACVD wants several input vertices per cluster: subdivide (each level x4) to ~3
+        levels = 0
+        while len(v) * 4**levels < 3 * clusters and levels < 6:
+            levels += 1
+        if levels:
+            clus.subdivide(levels)
+        clus.cluster(clusters)
+        out = clus.create_mesh()
+    ov = np.asarray(out.points, dtype=np.float64)
+    ot = np.asarray(out.faces, dtype=np.int64).reshape(-1, 4)[:, 1:]
+    ov, ot = _compact(ov, ot)
+    if closed and not is_closed(ot):
+        raise OpenedError(
+            "remeshing opened the closed mesh (a cluster pinched the surface); use a shorter "
+            "edge_length"
+        )
+    return ov, ot

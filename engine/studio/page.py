@@ -1,0 +1,586 @@
+"""The studio's page: trame widgets bound to a :class:`~.session.StudioSession`.
+
+Left, the YAML in Monaco (trame-code) with the check's problems marked at their lines and
+listed under it; in the middle, the 3-D view (vtk.js in the browser, fed by
+:class:`~.scene.StudioScene`) over the drawing of the graph (:func:`formgraph.draw_graph`,
+coloured computed / cached / failed with times; a click on a node shows it); right, a
+control per param with its reset. The top bar holds Save, Run and the status line.
+
+Everything the page asks of the engine goes through one :class:`~.worker.Worker`; results
+come back to the event loop (``call_soon_threadsafe``) and are shown there.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import itertools
+import sys
+import time
+from typing import Any
+
+from formgraph.core.errors import Problem
+
+from .session import Control, Cooked, StudioSession, controls_of
+from .worker import Worker
+
+__all__ = ["Page"]
+
+EDIT_DELAY = 0.35  # seconds of no typing before an edit is checked and cooked
+POLL_SECONDS = 0.5  # how often the graph's files are looked at
+_names = itertools.count()
+
+CSS = """
+html, body { overflow: hidden; }
+.fg-main { display: flex; height: calc(100vh - 48px); }
+.fg-left { flex: 0 0 32%; min-width: 0; display: flex; flex-direction: column;
+  border-right: 1px solid #ddd; }
+.fg-editor { flex: 1 1 auto; min-height: 0; }
+.fg-problems { max-height: 30%; overflow: auto; font: 12px monospace; color: #b00020;
+  padding: 4px 8px; border-top: 1px solid #ddd; white-space: pre-wrap; }
+.fg-center { flex: 1 1 auto; display: flex; flex-direction: column; min-width: 0; }
+.fg-view { flex: 1 1 62%; position: relative; min-height: 0; }
+.fg-graph { flex: 0 0 38%; overflow: auto; border-top: 1px solid #ddd; background: white; }
+.fg-graph svg { cursor: pointer; max-width: 100%; height: auto; }
+.fg-right { flex: 0 0 250px; overflow-y: auto; border-left: 1px solid #ddd; padding: 6px 10px; }
+.fg-control { margin-bottom: 6px; }
+.fg-control-name { font-size: 12px; color: #333; display: flex; align-items: center;
+  justify-content: space-between; }
+.fg-status { font: 13px sans-serif; margin-left: 12px; white-space: nowrap; overflow: hidden;
+  text-overflow: ellipsis; }
+.fg-status.bad { color: #b00020; }
+"""
+
+
+def _markers(problems: list[Problem]) -> list[dict[str, Any]]:
+    return [
+        {"line": p.where.line, "message": p.message, "severity": "error"}
+        for p in problems
+        if p.where.line is not None
+    ]
+
+
+def _problem_lines(problems: list[Problem]) -> list[str]:
+    out = []
+    for p in problems:
+        where = f"line {p.where.line}: " if p.where.line is not None else ""
+        node = f"node '{p.where.node}': " if p.where.node else ""
+        out.append(f"{where}{node}{p.message}")
+    return out
+
+
+def clickable_svg(drawing: Any) -> str:
+    """The drawing's SVG with an invisible rectangle over each node box, ``data-node`` set
+    to the node's name (the page's click handler reads it)."""
+    from xml.sax.saxutils import quoteattr
+
+    boxes = []
+    rect = None
+    for shape in drawing.shapes:
+        cls = getattr(shape, "cls", "")
+        if cls == "node":
+            rect = shape
+        elif cls == "param":
+            rect = None
+        elif cls == "name" and rect is not None:
+            boxes.append((shape.text, rect))
+            rect = None
+    hits = "".join(
+        f'<rect data-node={quoteattr(name)} x="{r.x:.1f}" y="{r.y:.1f}" width="{r.w:.1f}" '
+        f'height="{r.h:.1f}" fill="transparent" stroke="none"/>'
+        for name, r in boxes
+    )
+    svg = drawing.svg
+    svg = svg[svg.index("<svg") :]  # no XML declaration inside a page
+    return svg.replace("</svg>", hits + "</svg>")
+
+
+class Page:
+    """The trame server, its layout and the wiring between the page and the session."""
+
+    def __init__(self, session: StudioSession, guard: Any):
+        from trame.app import get_server
+
+        from .scene import StudioScene, make_plotter
+
+        self.session = session
+        self.guard = guard
+        self.server = get_server(f"formgraph-studio-{next(_names)}", client_type="vue3")
+        self.state, self.ctrl = self.server.state, self.server.controller
+        self.plotter = make_plotter()
+        self.scene = StudioScene(self.plotter)
+        self.worker = Worker(self._deliver, self._worker_error)
+        session.progress = self.worker.check
+        self.loop: asyncio.AbstractEventLoop | None = None
+        self.controls: list[Control] = []
+        self._wanted: dict[str, Any] = {}  # the controls' values, as the page last set them
+        self._editor_text = ""  # the editor's text as the loop last knew it
+        self._disk_text: str | None = None  # the file's text as last read or saved
+        self._edit_timer: Any = None
+        self._framed: tuple[float, ...] | None = None  # the bounds the camera was fit to
+        self.updates = 0  # view updates sent
+        from formgraph.viewer.watch import _Watched
+
+        page = self
+
+        class DiskWatch(_Watched):
+            """The viewer's watching of a graph's files, asking the worker to reload."""
+
+            def reload(self) -> bool:
+                self.stamp = self._stamp()
+                if page.state.text != page._disk_text:  # unsaved edits: keep them
+                    page._say(
+                        f"{page.session.path.name} changed on disk; the editor keeps your "
+                        "edits (Reload takes the file's text, Save overwrites the file)",
+                        True,
+                    )
+                    return False
+                page.worker.submit("disk", page._open_disk)
+                return True
+
+        self.watch = DiskWatch(session.path, None, (), session.out_dir, session.budget, "", None)
+        self.watch.stamp = self.watch._stamp()  # the first load reads this version
+        self._init_state()
+        self._build()
+        self.ctrl.on_server_bind.add(self._bind)
+        self.ctrl.on_server_ready.add(self._ready)
+
+    # ------------------------------------------------------------------ state, layout
+
+    def _init_state(self) -> None:
+        s = self.state
+        s.trame__title = f"{self.session.path.name} - formgraph studio"
+        s.text = ""
+        s.markers = []
+        s.problems = []
+        s.status = "loading..."
+        s.status_bad = False
+        s.controls = []
+        s.params = {}
+        s.graph_svg = ""
+        s.shown = "the graph's results"
+        s.busy = False
+        s.cook_id = 0  # bumped after each picture sent (the bench waits on it)
+        s.timing = {}  # where the last request's time went (read by bench/bench_studio.py)
+
+        @s.change("text")
+        def _edited(text: str, **_: Any) -> None:
+            if text == self._editor_text:
+                return  # the text the server itself put in the editor
+            self._editor_text = text
+            if self._edit_timer is not None:
+                self._edit_timer.cancel()
+            loop = asyncio.get_event_loop()
+            self._edit_timer = loop.call_later(
+                EDIT_DELAY, lambda: self.worker.submit("text", self.session.open, text)
+            )
+
+        ctrl = self.ctrl
+        ctrl.trigger("set_param")(self._set_param)
+        ctrl.trigger("reset_param")(self._reset_param)
+        ctrl.trigger("show_node")(self._show_node)
+        ctrl.add("save")(self._save)
+        ctrl.add("run")(self._run)
+        ctrl.add("reload")(lambda: self.worker.submit("disk", self._open_disk))
+        ctrl.add("reset_all")(lambda: self.worker.submit("params", self.session.reset_params))
+        ctrl.add("show_results")(lambda: self.worker.submit("show", self.session.show, None))
+
+    def _build(self) -> None:
+        from trame.ui.vuetify3 import VAppLayout
+        from trame.widgets import client, code, html
+        from trame.widgets import vuetify3 as v
+        from trame_pyvista.widgets import PyVistaLocalView
+
+        with VAppLayout(self.server, full_height=True) as layout:
+            client.Style(CSS)
+            with v.VAppBar(density="compact", flat=True, border=True):
+                v.VAppBarTitle(
+                    f"{self.session.path.name}", style="flex: 0 0 auto; font-size: 16px;"
+                )
+                v.VBtn("Save", click=self.ctrl.save, variant="tonal", classes="ml-2", id="save")
+                v.VBtn("Run", click=self.ctrl.run, variant="tonal", classes="ml-2", id="run")
+                v.VBtn(
+                    "Reload",
+                    click=self.ctrl.reload,
+                    variant="text",
+                    classes="ml-1",
+                    id="reload",
+                    title="read the graph file again (the editor's unsaved edits are lost)",
+                )
+                html.Div(
+                    "{{ status }}",
+                    classes=("status_bad ? 'fg-status bad' : 'fg-status'",),
+                    id="status",
+                )
+                v.VSpacer()
+                html.Div("{{ JSON.stringify(timing) }}", id="timing", style="display: none")
+                v.VProgressCircular(
+                    v_show=("busy",), indeterminate=True, size=18, width=2, classes="mr-3"
+                )
+            with v.VMain():
+                with html.Div(classes="fg-main"):
+                    with html.Div(classes="fg-left"):
+                        with html.Div(classes="fg-editor", id="editor"):
+                            code.Editor(
+                                v_model=("text",),
+                                language="yaml",
+                                theme="vs",
+                                markers=("markers",),
+                                options=(
+                                    "{ minimap: { enabled: false }, fontSize: 13, "
+                                    "automaticLayout: true, scrollBeyondLastLine: false }",
+                                ),
+                            )
+                        with html.Div(
+                            classes="fg-problems", id="problems", v_show="problems.length"
+                        ):
+                            html.Div("{{ p }}", v_for="p in problems")
+                    with html.Div(classes="fg-center"):
+                        with html.Div(classes="fg-view", id="view"):
+                            self.view = PyVistaLocalView(self.plotter)
+                        with html.Div(classes="fg-graph", id="graph"):
+                            html.Div(
+                                "showing {{ shown }}",
+                                style="font: 12px sans-serif; padding: 4px 8px; color: #555;",
+                            )
+                            html.Div(
+                                v_html=("graph_svg",),
+                                click=(
+                                    "$event.target.closest('[data-node]') && "
+                                    "trigger('show_node', [$event.target.closest('[data-node]')"
+                                    ".getAttribute('data-node')])"
+                                ),
+                            )
+                    with html.Div(classes="fg-right", id="controls"):
+                        with html.Div(
+                            style="display: flex; justify-content: space-between; "
+                            "align-items: center; margin-bottom: 4px;"
+                        ):
+                            html.B("params", style="font: 13px sans-serif;")
+                            v.VBtn(
+                                "reset all",
+                                click=self.ctrl.reset_all,
+                                size="x-small",
+                                variant="text",
+                            )
+                        v.VBtn(
+                            "show results",
+                            click=self.ctrl.show_results,
+                            size="x-small",
+                            variant="text",
+                            block=True,
+                            classes="mb-2",
+                        )
+                        self._control_widgets(v, html)
+        self.layout = layout
+
+    def _control_widgets(self, v: Any, html: Any) -> None:
+        set_value = "params[c.name] = $event; trigger('set_param', [c.name, $event])"
+        with html.Div(v_for="c in controls", key="c.name", classes="fg-control"):
+            with html.Div(classes="fg-control-name"):
+                html.Span(
+                    "{{ c.name }} = {{ params[c.name] }}",
+                    title=("c.doc",),
+                )
+                v.VBtn(
+                    "reset",
+                    size="x-small",
+                    variant="text",
+                    click="trigger('reset_param', [c.name])",
+                    disabled=("params[c.name] === c.default",),
+                )
+            v.VSlider(
+                v_if="c.kind === 'slider'",
+                model_value=("params[c.name]",),
+                min=("c.min",),
+                max=("c.max",),
+                step=("c.step",),
+                density="compact",
+                hide_details=True,
+                color="primary",
+                update_modelValue=set_value,
+                classes=("'fg-slider-' + c.name",),
+            )
+            v.VTextField(
+                v_if="c.kind === 'number' || c.kind === 'text'",
+                model_value=("params[c.name]",),
+                density="compact",
+                hide_details=True,
+                variant="outlined",
+                change=(
+                    "trigger('set_param', [c.name, c.kind === 'number' ? "
+                    "Number($event.target.value) : $event.target.value])"
+                ),
+            )
+            v.VSwitch(
+                v_if="c.kind === 'toggle'",
+                model_value=("params[c.name]",),
+                density="compact",
+                hide_details=True,
+                color="primary",
+                update_modelValue=set_value,
+            )
+            v.VSelect(
+                v_if="c.kind === 'choice'",
+                model_value=("params[c.name]",),
+                items=("c.choices",),
+                density="compact",
+                hide_details=True,
+                variant="outlined",
+                update_modelValue=set_value,
+            )
+
+    # --------------------------------------------------------------------- server life
+
+    def _bind(self, wslink_server: Any) -> None:
+        wslink_server.app.middlewares.append(self.guard.middleware)
+
+    def _ready(self, **_: Any) -> None:
+        self.loop = asyncio.get_event_loop()
+        self.worker.submit("disk", self._open_disk)
+        self.loop.create_task(self._poll())
+
+    async def _poll(self) -> None:
+        while True:
+            await asyncio.sleep(POLL_SECONDS)
+            try:
+                self.watch.poll()
+            except OSError:
+                pass
+
+    def close(self) -> None:
+        self.worker.stop()
+        self.plotter.close()
+
+    # ---------------------------------------------------------------- page -> engine
+
+    def _control(self, name: str) -> Control | None:
+        return next((c for c in self.controls if c.name == name), None)
+
+    def _set_param(self, name: str, value: Any) -> None:
+        c = self._control(name)
+        if c is None:
+            return
+        value = _as_param(c, value)
+        self._wanted[name] = value
+        self.worker.submit("params", self._cook_params, dict(self._wanted))
+
+    def _cook_params(self, values: dict[str, Any]) -> Cooked:
+        return self.session.set_params(**values)
+
+    def _reset_param(self, name: str) -> None:
+        self._wanted.pop(name, None)
+        self.worker.submit("params", self._reset, name)
+
+    def _reset(self, name: str) -> Cooked:
+        return self.session.reset_params(name)
+
+    def _show_node(self, name: str) -> None:
+        self.worker.submit("show", self.session.show, [name])
+
+    def _open_disk(self) -> Cooked:
+        cooked = self.session.open()
+        cooked.message = cooked.message or ""
+        return cooked
+
+    def _save(self) -> None:
+        text = self.state.text
+        self.worker.submit("save", self._save_text, text)
+
+    def _save_text(self, text: str) -> tuple[str, str, str | None]:
+        try:
+            path = self.session.save(text)
+        except Exception as exc:  # a PathError or an OSError: said on the page
+            return ("error", f"not saved: {exc}", None)
+        return ("ok", f"saved {path.name}", text)
+
+    def _run(self) -> None:
+        self.worker.submit("run", self.session.run)
+
+    # ---------------------------------------------------------------- engine -> page
+
+    def _deliver(self, kind: str, result: Any, seconds: float) -> None:
+        """In the worker thread: what can be made away from the page's loop (the datasets
+        of the picture, the graph's drawing), then the rest on the loop."""
+        if self.loop is None:
+            return
+        t0 = time.perf_counter()
+        prepared = None
+        if isinstance(result, Cooked):
+            datasets = self.scene.prepare(result.shown) if result.ok and kind != "run" else None
+            prepared = (datasets, self._drawing(result), self._snapshot())
+        seconds += time.perf_counter() - t0
+        self.loop.call_soon_threadsafe(self._apply, kind, result, seconds, prepared)
+
+    def _snapshot(self) -> dict[str, Any]:
+        """What the page shows of the session, read in the worker thread, between two of
+        its requests (the loop must not read a session the next request is changing)."""
+        session = self.session
+        graph = session.graph
+        return {
+            "text": session.text,
+            "files": [session.path, *session.files()[1:]],
+            "controls": controls_of(graph, session.values) if graph is not None else None,
+            "values": dict(session.values),
+            "shown": session.shown_names,
+            "exports": session.exports(),
+        }
+
+    def _worker_error(self, kind: str, exc: BaseException) -> None:
+        message = f"internal error ({kind}): {type(exc).__name__}: {exc}"
+        print(message, file=sys.stderr)
+        if self.loop is not None:
+            self.loop.call_soon_threadsafe(self._say, message, True)
+
+    def _say(self, text: str, bad: bool) -> None:
+        with self.state:
+            self.state.status = text
+            self.state.status_bad = bad
+
+    def _apply(self, kind: str, result: Any, seconds: float, prepared: Any = None) -> None:
+        t0 = time.perf_counter()
+        name = self.session.path.name
+        if kind == "save":
+            status, text, saved = result
+            self.watch.stamp = self.watch._stamp()  # our own write: no reload
+            if saved is not None:
+                self._disk_text = saved
+            self._say(f"{name}: {text}", status != "ok")
+            return
+        cooked: Cooked = result
+        datasets, svg, snap = prepared if prepared is not None else (None, None, None)
+        if snap is None:
+            snap = self._snapshot()  # (a request with no Cooked result: not reached)
+        s = self.state
+        if datasets is not None:  # the picture first: its arrays are what takes longest
+            self._picture(datasets)
+        t1 = time.perf_counter()
+        with s:
+            if kind == "disk":
+                self._disk_text = snap["text"]
+                if snap["text"] != s.text:
+                    self._editor_text = s.text = snap["text"]  # the file's text, in the editor
+            if kind in ("text", "disk") and snap["files"] != self.watch.files:
+                self.watch.files = snap["files"]  # a subgraph file more or less to watch
+                self.watch.stamp = self.watch._stamp()
+            if kind == "run" and cooked.ok:
+                written = ", ".join(snap["exports"]) or "nothing to export"
+                s.status = f"{name}: ran in {_ms(cooked.seconds)}, wrote {written} into "
+                s.status += f"{self.session.out_dir}"
+                s.status_bad = False
+                if svg is not None:
+                    s.graph_svg = svg
+                return
+            s.problems = _problem_lines(cooked.problems)
+            if cooked.new_graph or not cooked.ok or kind in ("text", "disk"):
+                s.markers = _markers(cooked.problems)
+            if cooked.ok:
+                s.markers = []
+                s.problems = []
+            newer = kind == "params" and self.worker.waiting("params")
+            if (
+                snap["controls"] is not None
+                and (cooked.new_graph or kind == "params")
+                and not newer
+            ):
+                # (with a newer step waiting, the sliders keep the values the user set)
+                self.controls = snap["controls"]
+                self._wanted = dict(snap["values"])
+                s.controls = [c.as_dict() for c in self.controls]
+                s.params = {c.name: _shown_value(c.value) for c in self.controls}
+            if svg is not None:
+                s.graph_svg = svg
+            shown = snap["shown"]
+            s.shown = ", ".join(shown) if shown else "the graph's results"
+            if cooked.ok:
+                s.status = (
+                    f"{name}: {cooked.computed} computed, {cooked.cached} cached in "
+                    f"{_ms(cooked.seconds)}"
+                )
+                s.status_bad = False
+            else:
+                kept = " (the picture is the last version that worked)" if cooked.shown else ""
+                lines = _problem_lines(cooked.problems) or [cooked.message]
+                more = f" (+{len(lines) - 1} more)" if len(lines) > 1 else ""
+                s.status = f"{name}: {lines[0]}{more}{kept}"
+                s.status_bad = True
+            s.busy = not self.worker.idle()
+        t2 = time.perf_counter()
+        timing = {
+            "cook_ms": round(cooked.seconds * 1000, 2),
+            # in the worker: queue, recook, datasets and drawing prepared
+            "asked_to_done_ms": round(seconds * 1000, 2),
+            "scene_ms": round((t1 - t0) * 1000, 2),  # arrays in place + serialization
+            "state_ms": round((t2 - t1) * 1000, 2),  # status, controls, problems, drawing
+        }
+        with s:
+            s.cook_id = s.cook_id + 1
+            s.timing = timing
+
+    def _drawing(self, cooked: Cooked) -> str | None:
+        """The graph's drawing, coloured by the last evaluation (None: nothing to draw)."""
+        from formgraph.core.errors import FormgraphError
+        from formgraph.drawgraph.layout import draw_graph
+
+        graph = self.session.graph
+        if graph is None:
+            return None
+        try:
+            drawing = draw_graph(graph, stats=cooked.stats, failed=cooked.failed)
+        except FormgraphError:
+            return None
+        return clickable_svg(drawing)
+
+    def _picture(self, datasets: dict[tuple[str, str], Any]) -> None:
+        from formgraph.viewer.app import _camera_lost
+
+        from .scene import send_back_faces
+
+        added = self.scene.apply(datasets)
+        send_back_faces()
+        bounds = self.scene.bounds()
+        first = self._framed is None
+        if first:
+            self.plotter.reset_camera()
+        self.view.update()
+        if first:
+            self.view.push_camera()
+        elif added or _camera_lost(self._framed, bounds):
+            # framed again in the browser, keeping the direction the user turned it to
+            self.view.reset_camera()
+        if first or added or _camera_lost(self._framed, bounds):
+            self._framed = bounds
+        self.updates += 1
+
+
+def _as_param(c: Control, value: Any) -> Any:
+    """A control's value as the param's type reads it."""
+    if c.kind == "toggle":
+        return bool(value)
+    if c.kind in ("slider", "number"):
+        try:
+            number = float(value)
+        except (TypeError, ValueError):
+            return value  # the param's check says what was expected
+        if c.step == 1.0 and number.is_integer():
+            return int(number)
+        return number
+    if c.kind == "text" and isinstance(value, str):
+        from formgraph.language.yamlread import load_value
+
+        try:
+            return load_value(value)
+        except Exception:  # not YAML: handed on as text, the param's check speaks
+            return value
+    return value
+
+
+def _shown_value(value: Any) -> Any:
+    if hasattr(value, "value") and not isinstance(value, (int, float, str)):
+        return value.value  # an Enum
+    if isinstance(value, (int, float, str, bool)) or value is None:
+        return value
+    return repr(value)
+
+
+def _ms(seconds: float) -> str:
+    return f"{seconds * 1000:.0f} ms" if seconds < 10 else f"{seconds:.1f} s"

@@ -1,0 +1,241 @@
+"""Export for the next tool: 3MF for slicers, GLB for the web, STEP for CAD, .3dm for Rhino.
+
+Each node builds the file's bytes with a kernel (:mod:`formgraph.kernels.io.threemf`,
+``.gltf``, ``.step``, ``.rhino``) and hands them to ``ctx.write``: written atomically,
+inside the output directory, left alone when the file already holds these bytes. Each
+returns the written file's path.
+"""
+
+from __future__ import annotations
+
+from enum import Enum
+
+import numpy as np
+
+from formgraph.core.errors import InputError
+from formgraph.core.registry import Context, node
+from formgraph.core.types import OutputPath
+from formgraph.geometry import Curve, Mesh, NurbsCurve, NurbsSurface, Surface
+from formgraph.kernels.io import colors, gltf, rhino, step, threemf
+from formgraph.kernels.io.exporters import mesh_report
+from formgraph.kernels.mesh import meshops
+
+
+class Unit(str, Enum):
+    micron = "micron"
+    millimeter = "millimeter"
+    centimeter = "centimeter"
+    inch = "inch"
+    foot = "foot"
+    meter = "meter"
+
+
+def css_rgba(text: str) -> tuple[float, float, float, float]:
+    """A CSS colour (:func:`formgraph.kernels.io.colors.css_color`) as opaque 0..1 RGBA."""
+    r, g, b = colors.rgb(text)
+    return (r / 255, g / 255, b / 255, 1.0)
+
+
+def _triangles(meshes: list[Mesh], ctx: Context) -> list[tuple[np.ndarray, np.ndarray]]:
+    ctx.guard(sum(int(np.sum(m.face_sizes - 2)) for m in meshes), "triangles")
+    out = []
+    for m in meshes:
+        v, fi, fo = meshops.triangulate(
+            m.vertices, m.face_indices, m.face_offsets, max_tests=ctx.budget
+        )
+        out.append((v, fi.reshape(-1, 3)))
+    return out
+
+
+def _per_mesh(values: list | None, meshes: list[Mesh], port: str) -> list | None:
+    if values is not None and len(values) != len(meshes):
+        raise InputError(port, f"{len(values)} {port} for {len(meshes)} meshes: give one each")
+    return values
+
+
+@node("export.3mf", version=1)
+def export_3mf(
+    meshes: list[Mesh],
+    path: OutputPath,
+    names: list[str] | None = None,
+    colors: list[str] | None = None,
+    units: Unit = Unit.millimeter,
+    *,
+    ctx: Context,
+) -> str:
+    """Write meshes as a 3MF package, for slicers: one object and one build item each.
+
+    A valid 3MF core package (content types, relationships, the model with its unit);
+    polygons are triangulated (ear clipping for concave ones); each object carries its name
+    and, given ``colors``, a base material of that colour. Slicers read the unit, so a part
+    arrives at its size.
+
+    Parameters
+    ----------
+    meshes : list[Mesh]
+        The parts, one object each.
+    path : OutputPath
+        File path relative to the output directory, e.g. ``parts/plate.3mf``.
+    names : list[str] | None
+        One name per mesh (default ``mesh 1``, ``mesh 2``, ...).
+    colors : list[str] | None
+        One CSS colour per mesh (``red``, ``#ff8800``).
+    units : Unit
+        What one model unit is.
+    """
+    _per_mesh(names, meshes, "names")
+    _per_mesh(colors, meshes, "colors")
+    try:
+        rgba = [css_rgba(c) for c in colors] if colors is not None else None
+    except ValueError as exc:
+        raise InputError("colors", str(exc)) from None
+    data = threemf.write_3mf(_triangles(meshes, ctx), names=names, colors=rgba, unit=units.value)
+    return str(ctx.write(path, data))
+
+
+@node("export.gltf", version=1)
+def export_gltf(
+    meshes: list[Mesh],
+    path: OutputPath,
+    names: list[str] | None = None,
+    units: Unit = Unit.millimeter,
+    *,
+    ctx: Context,
+) -> str:
+    """Write meshes as binary glTF 2.0 (``.glb``), for the web and AR viewers.
+
+    One node and mesh each: float32 positions (with their bounds), smooth vertex normals
+    (area-weighted) and uint32 triangle indices in one binary chunk. glTF's unit is the
+    metre, so coordinates are scaled from ``units`` (a 100 mm vase is 0.1 m in the file).
+
+    Parameters
+    ----------
+    meshes : list[Mesh]
+        The meshes, one node each.
+    path : OutputPath
+        File path relative to the output directory, e.g. ``web/vase.glb``.
+    names : list[str] | None
+        One name per mesh.
+    units : Unit
+        What one model unit is.
+    """
+    _per_mesh(names, meshes, "names")
+    scale = threemf.UNITS[units.value] / 1000.0
+    data = gltf.write_glb(_triangles(meshes, ctx), names=names, scale=scale)
+    return str(ctx.write(path, data))
+
+
+def _nurbs_curves(curves: list[Curve], port: str) -> list[tuple]:
+    out = []
+    for k, c in enumerate(curves):
+        if not isinstance(c, NurbsCurve):
+            raise InputError(
+                port,
+                f"curve {k} is a {type(c).__name__}; STEP and .3dm hold NURBS exactly (make it "
+                f"one with nurbs.interpolate through its points)",
+            )
+        out.append((c.control_points, c.degree, c.knots, c.weights if c.rational else None))
+    return out
+
+
+def _nurbs_surfaces(surfaces: list[Surface], port: str) -> list[tuple]:
+    out = []
+    for k, s in enumerate(surfaces):
+        if not isinstance(s, NurbsSurface):
+            raise InputError(
+                port,
+                f"surface {k} is a {type(s).__name__}; STEP and .3dm hold NURBS exactly "
+                f"(tessellate it and pass it as a mesh)",
+            )
+        w = s.weights if s.rational else None
+        out.append((s.control_points, s.degree_u, s.degree_v, s.knots_u, s.knots_v, w))
+    return out
+
+
+@node("export.step", version=1)
+def export_step(
+    path: OutputPath,
+    curves: list[Curve] | None = None,
+    surfaces: list[Surface] | None = None,
+    meshes: list[Mesh] | None = None,
+    *,
+    ctx: Context,
+) -> str:
+    """Write exact NURBS geometry (and meshes) as STEP, ISO 10303-21 AP214, for CAD.
+
+    Surfaces become ``B_SPLINE_SURFACE_WITH_KNOTS`` (rational where weighted), each the face
+    of its own shell in a shell-based surface model, bounded by its parameter domain's edges
+    (a pole left out, a seam one edge used both ways): Fusion, SolidWorks and FreeCAD open
+    them as surface bodies. Curves become ``B_SPLINE_CURVE_WITH_KNOTS``. A closed mesh
+    becomes a faceted solid (a closed shell of planar faces), an open one an open shell.
+    Millimetres; every number its shortest round-trip decimal, so the file is exact.
+
+    Parameters
+    ----------
+    path : OutputPath
+        File path relative to the output directory, e.g. ``cad/vase.step``.
+    curves : list[Curve] | None
+        NURBS curves.
+    surfaces : list[Surface] | None
+        NURBS surfaces.
+    meshes : list[Mesh] | None
+        Meshes, as faceted solids when closed.
+    """
+    c = _nurbs_curves(curves or [], "curves")
+    s = _nurbs_surfaces(surfaces or [], "surfaces")
+    meshes = meshes or []
+    ctx.guard(
+        sum(len(x[0]) for x in c)
+        + sum(x[0].shape[0] * x[0].shape[1] for x in s)
+        + 8 * sum(m.n_faces for m in meshes),
+        "STEP entities",
+    )
+    m = [
+        (x.vertices, x.face_indices, x.face_offsets, mesh_report(*_arrays(x)).watertight)
+        for x in meshes
+    ]
+    return str(ctx.write(path, step.write_step(curves=c, surfaces=s, meshes=m)))
+
+
+@node("export.rhino", version=1)
+def export_rhino(
+    path: OutputPath,
+    curves: list[Curve] | None = None,
+    surfaces: list[Surface] | None = None,
+    meshes: list[Mesh] | None = None,
+    layers: list[str] | None = None,
+    *,
+    ctx: Context,
+) -> str:
+    """Write a Rhino ``.3dm`` file (through rhino3dm): NURBS exact, meshes as meshes.
+
+    Degree, knots and weights go across as they are (openNURBS's knot and homogeneous point
+    conventions are converted); model units are millimetres.
+
+    Parameters
+    ----------
+    path : OutputPath
+        File path relative to the output directory, e.g. ``vase.3dm``.
+    curves : list[Curve] | None
+        NURBS curves.
+    surfaces : list[Surface] | None
+        NURBS surfaces.
+    meshes : list[Mesh] | None
+        Meshes.
+    layers : list[str] | None
+        One layer name per object, curves first, then surfaces, then meshes (default: a
+        layer per kind, ``curves``, ``surfaces``, ``meshes``).
+    """
+    c = _nurbs_curves(curves or [], "curves")
+    s = _nurbs_surfaces(surfaces or [], "surfaces")
+    m = [_arrays(x) for x in meshes or []]
+    ctx.guard(sum(len(x[0]) for x in m) + sum(x[0].size for x in s), "3dm vertices")
+    try:
+        data = rhino.write_3dm(curves=c, surfaces=s, meshes=m, layers=layers)
+    except ValueError as exc:
+        raise InputError("layers" if "layers" in str(exc) else "path", str(exc)) from None
+    return str(ctx.write(path, data))
+
+
+def _arrays(m: Mesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    return m.vertices, m.face_indices, m.face_offsets

@@ -1,0 +1,166 @@
+"""Mesh processing (mesh family): smoothing, decimation, isotropic remeshing.
+
+Thin adapters over :mod:`formgraph.kernels.mesh.smooth` (sparse Laplacian and Taubin
+smoothing, boundaries held) and :mod:`formgraph.kernels.mesh.simplify` (quadric
+decimation through fast-simplification, ACVD remeshing through pyacvd). A closed input
+stays closed in every one: smoothing keeps the connectivity, and the other two check their
+result and say so if a closed mesh came out open.
+"""
+
+from __future__ import annotations
+
+from enum import Enum
+from typing import Annotated
+
+import numpy as np
+
+from formgraph.core.errors import InputError
+from formgraph.core.registry import Context, Range, node
+from formgraph.geometry import Mesh
+from formgraph.kernels.mesh import meshops
+from formgraph.kernels.mesh import simplify as ksimp
+from formgraph.kernels.mesh import smooth as ksm
+
+
+class SmoothMethod(str, Enum):
+    """How mesh.smooth moves vertices."""
+
+    taubin = "taubin"  # lambda|mu: a low-pass filter, volume kept
+    laplacian = "laplacian"  # toward the neighbours' mean: shrinks
+
+
+def _triangles(mesh: Mesh, ctx: Context) -> tuple[np.ndarray, np.ndarray]:
+    v, fi, _ = meshops.triangulate(
+        mesh.vertices, mesh.face_indices, mesh.face_offsets, max_tests=ctx.budget
+    )
+    return v, fi.reshape(-1, 3)
+
+
+def _mesh(v: np.ndarray, t: np.ndarray) -> Mesh:
+    return Mesh(v, t.reshape(-1), np.arange(0, t.size + 1, 3))
+
+
+def _signed_volume(v: np.ndarray, t: np.ndarray) -> float:
+    return float(np.einsum("ij,ij->i", v[t[:, 0]], np.cross(v[t[:, 1]], v[t[:, 2]])).sum() / 6)
+
+
+@node("mesh.smooth", version=1)
+def smooth(
+    mesh: Mesh,
+    iterations: Annotated[int, Range(min=0, max=100_000)] = 10,
+    method: SmoothMethod = SmoothMethod.taubin,
+    strength: Annotated[float, Range(min=0, max=1)] = 0.5,
+    *,
+    ctx: Context,
+) -> Mesh:
+    """Smooth a mesh: Taubin's lambda|mu (volume kept) or Laplacian (shrinks).
+
+    Each step moves every vertex toward the mean of its edge neighbours (one sparse
+    matrix product over all vertices); Taubin follows each step with a slightly larger one
+    back (mu = -(strength + 0.03)), a low-pass filter that removes noise without shrinking
+    (Taubin, SIGGRAPH 1995). Vertices on boundary or non-manifold edges are held, so open
+    outlines stay put; faces are unchanged, so a closed mesh stays closed.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        Any polygon mesh.
+    iterations : int
+        Steps (a Taubin step is a lambda and a mu pass).
+    method : SmoothMethod
+        ``taubin`` or ``laplacian``.
+    strength : float
+        Lambda, the fraction of the way to the neighbours' mean per pass, 0 .. 1.
+
+    Example
+    -------
+    ``tidy: {type: mesh.smooth, mesh: "@scan", iterations: 20}``
+    """
+    ctx.guard(mesh.n_vertices * max(iterations, 1), "vertex updates")
+    mu = -(strength + 0.03)
+    v = ksm.smooth(
+        mesh.vertices,
+        mesh.face_indices,
+        mesh.face_offsets,
+        iterations,
+        SmoothMethod(method).value,
+        strength,
+        mu,
+    )
+    return Mesh(v, mesh.face_indices, mesh.face_offsets)
+
+
+@node("mesh.decimate", version=1)
+def decimate(
+    mesh: Mesh,
+    ratio: Annotated[float | None, Range(min=0, max=1)] = None,
+    faces: Annotated[int | None, Range(min=4)] = None,
+    *,
+    ctx: Context,
+) -> Mesh:
+    """Fewer triangles, the shape kept: quadric error edge collapse (Garland & Heckbert).
+
+    Through fast-simplification (Fast-Quadric-Mesh-Simplification). Polygons are
+    triangulated first. A closed mesh stays closed, or the node says it could not.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        The mesh to simplify.
+    ratio : float | None
+        The fraction of triangles kept, 0 .. 1 (default 0.5 when ``faces`` is not given).
+    faces : int | None
+        The number of triangles wanted instead.
+    """
+    if ratio is not None and faces is not None:
+        raise InputError("faces", "give ratio or faces, not both")
+    if mesh.n_faces == 0:
+        raise InputError("mesh", "the mesh has no faces")
+    v, t = _triangles(mesh, ctx)
+    target = faces if faces is not None else int(round(len(t) * (0.5 if ratio is None else ratio)))
+    if target < 4:
+        raise InputError("ratio", f"that keeps {target} triangles; a solid needs at least 4")
+    try:
+        ov, ot = ksimp.decimate(v, t, target)
+    except ksimp.OpenedError as exc:
+        raise InputError("faces" if faces is not None else "ratio", str(exc)) from None
+    return _mesh(ov, ot)
+
+
+@node("mesh.remesh", version=1)
+def remesh(
+    mesh: Mesh,
+    edge_length: Annotated[float, Range(min=0)],
+    *,
+    ctx: Context,
+) -> Mesh:
+    """Even triangles of about ``edge_length``: isotropic remeshing by clustering (ACVD).
+
+    pyacvd's approximated centroidal Voronoi clustering (Valette & Chassery 2004) of the
+    surface into regions of equal area, whose dual is the new mesh. Chosen over a split /
+    collapse / flip / relax loop (Botsch & Kobbelt 2004) for its speed and because it keeps
+    the test solids closed; the node checks that a closed input comes out closed, and
+    outward if it went in outward.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        A triangle or polygon mesh.
+    edge_length : float
+        The target edge length, > 0.
+    """
+    if not edge_length > 0:
+        raise InputError("edge_length", f"edge_length must be > 0, got {edge_length:g}")
+    if mesh.n_faces == 0:
+        raise InputError("mesh", "the mesh has no faces")
+    v, t = _triangles(mesh, ctx)
+    clusters = ksimp.cluster_count(v, t, edge_length)
+    ctx.guard(clusters, "vertices")
+    ctx.guard(3 * max(clusters, len(v)) * 4, "subdivided vertices")
+    try:
+        ov, ot = ksimp.remesh(v, t, clusters)
+    except ksimp.OpenedError as exc:
+        raise InputError("edge_length", str(exc)) from None
+    if ksimp.is_closed(t) and np.sign(_signed_volume(ov, ot)) != np.sign(_signed_volume(v, t)):
+        ot = ot[:, ::-1]
+    return _mesh(ov, ot)

@@ -1,0 +1,290 @@
+"""export.3mf, export.gltf, export.step and export.rhino, each read back by an independent
+reader (lib3mf, trimesh and pygltflib, OpenCASCADE, rhino3dm) and by our own read nodes."""
+
+from __future__ import annotations
+
+import io
+from pathlib import Path
+
+import numpy as np
+import pytest
+import trimesh
+
+import formgraph as fg
+
+HEAD = "formgraph: 1\nnodes:\n"
+TWO = (
+    "  ball: {type: mesh.sphere, radius: 2}\n"
+    "  box: {type: mesh.box, size: [1, 2, 3], center: [5, 0, 0]}\n"
+)
+
+
+def _run(folder: Path, body: str, node: str):
+    (folder / "g.yaml").write_text(HEAD + body)
+    g = fg.load(folder / "g.yaml", out_dir=folder / "out")
+    return g, g.evaluate(node)
+
+
+def _meshes(g) -> list[fg.Mesh]:
+    return [g.evaluate("ball"), g.evaluate("box")]
+
+
+# ---------------------------------------------------------------------------------- 3MF
+
+
+def test_3mf_opens_in_lib3mf_with_names_colours_and_exact_vertices(tmp_path):
+    lib3mf = pytest.importorskip("lib3mf")
+    g, out = _run(
+        tmp_path,
+        TWO + "  x: {type: export.3mf, meshes: ['@ball', '@box'], path: p.3mf,"
+        " names: [ball, box], colors: [red, '#0080ff']}\n",
+        "x",
+    )
+    w = lib3mf.get_wrapper()
+    model = w.CreateModel()
+    reader = model.QueryReader("3mf")
+    reader.SetStrictModeActive(True)
+    reader.ReadFromFile(out)
+    assert reader.GetWarningCount() == 0
+    assert model.GetUnit() == lib3mf.ModelUnit.MilliMeter
+    objects = model.GetMeshObjects()
+    found = {}
+    while objects.MoveNext():
+        o = objects.GetCurrentMeshObject()
+        verts = np.array([list(p.Coordinates) for p in o.GetVertices()])
+        found[o.GetName()] = (verts, o.GetTriangleCount(), o.GetObjectLevelProperty())
+    items = model.GetBuildItems()
+    count = 0
+    while items.MoveNext():
+        count += 1
+    assert count == 2 and set(found) == {"ball", "box"}
+    for name, mesh in zip(("ball", "box"), _meshes(g), strict=True):
+        verts, tris, _ = found[name]
+        np.testing.assert_allclose(verts, mesh.vertices, rtol=1e-6, atol=1e-6)  # float32
+        assert tris == int(np.sum(mesh.face_sizes - 2))
+    resource, prop, has = found["box"][2]
+    assert has
+    colour = model.GetBaseMaterialGroupByID(resource).GetDisplayColor(prop)
+    assert (colour.Red, colour.Green, colour.Blue) == (0, 128, 255)
+
+
+def test_3mf_reads_back_exactly_through_read_mesh(tmp_path):
+    g, out = _run(tmp_path, TWO + "  x: {type: export.3mf, meshes: ['@ball'], path: p.3mf}\n", "x")
+    (tmp_path / "in.yaml").write_text(HEAD + "  m: {type: read.mesh, path: out/p.3mf}\n")
+    back = fg.load(tmp_path / "in.yaml").evaluate("m")
+    assert np.array_equal(back.vertices, g.evaluate("ball").vertices)  # shortest round trip
+
+
+def test_3mf_units_scale_on_reading(tmp_path):
+    g, out = _run(
+        tmp_path, TWO + "  x: {type: export.3mf, meshes: ['@box'], path: p.3mf, units: inch}\n", "x"
+    )
+    from formgraph.kernels.io.threemf import read_3mf
+
+    ((_, v, _),) = read_3mf(Path(out).read_bytes())
+    np.testing.assert_allclose(v, g.evaluate("box").vertices * 25.4)
+
+
+def test_3mf_refuses_a_colour_it_cannot_read(tmp_path):
+    with pytest.raises(fg.NodeError, match="not a colour"):
+        _run(
+            tmp_path,
+            TWO + "  x: {type: export.3mf, meshes: ['@box'], path: p.3mf, colors: [reddish]}\n",
+            "x",
+        )
+
+
+# ---------------------------------------------------------------------------------- GLB
+
+
+def test_glb_loads_in_trimesh_and_pygltflib_in_metres(tmp_path):
+    pygltflib = pytest.importorskip("pygltflib")
+    g, out = _run(
+        tmp_path, TWO + "  x: {type: export.gltf, meshes: ['@ball', '@box'], path: p.glb}\n", "x"
+    )
+    data = Path(out).read_bytes()
+    doc = pygltflib.GLTF2.load_from_bytes(data)
+    assert doc.asset.version == "2.0" and len(doc.meshes) == 2
+    scene = trimesh.load(io.BytesIO(data), file_type="glb", process=False)
+    meshes = list(scene.geometry.values())
+    for got, want in zip(meshes, _meshes(g), strict=True):
+        tris = want.face_indices.reshape(-1, 3) if np.all(want.face_sizes == 3) else None
+        np.testing.assert_allclose(got.vertices * 1000, want.vertices, rtol=1e-6, atol=1e-5)
+        if tris is not None:
+            assert np.array_equal(got.faces, tris)
+        normals = got.vertex_normals
+        np.testing.assert_allclose(np.linalg.norm(normals, axis=1), 1, atol=1e-5)
+    ball = meshes[0]
+    # a sphere's vertex normals point out along the radius
+    radial = ball.vertices / np.linalg.norm(ball.vertices, axis=1, keepdims=True)
+    assert np.min(np.sum(radial * ball.vertex_normals, axis=1)) > 0.95
+
+
+def test_glb_reads_back_through_read_mesh(tmp_path):
+    g, out = _run(tmp_path, TWO + "  x: {type: export.gltf, meshes: ['@box'], path: p.glb}\n", "x")
+    (tmp_path / "in.yaml").write_text(HEAD + "  m: {type: read.mesh, path: out/p.glb}\n")
+    back = fg.load(tmp_path / "in.yaml").evaluate("m")
+    box = g.evaluate("box")
+    assert back.n_faces == int(np.sum(box.face_sizes - 2))
+    np.testing.assert_allclose(back.vertices, box.vertices, rtol=1e-6, atol=1e-5)
+
+
+# --------------------------------------------------------------------------------- STEP
+
+VASE = """\
+  pts: {type: points.list, points: [[1.3, 0, 6], [0.8, 0, 4.5], [2.2, 0, 2.1], [0.7, 0, 0],
+    [0, 0, 0]]}
+  profile: {type: nurbs.interpolate, points: "@pts", degree: 3}
+  vase: {type: nurbs.revolve, curve: "@profile"}
+  sheet: {type: nurbs.surface, points: [[[0, 0, 0], [1, 0, 1], [2, 0, 0]],
+    [[0, 1, 1], [1, 1, 2], [2, 1, 1]], [[0, 2, 0], [1, 2, 1], [2, 2, 0]]], degree_u: 2,
+    degree_v: 2}
+  box: {type: mesh.box, size: [2, 3, 4]}
+  plane: {type: mesh.plane, size: [2, 2]}
+"""
+
+
+def _occ(path: str):
+    pytest.importorskip("OCP")
+    from OCP.IFSelect import IFSelect_RetDone
+    from OCP.STEPControl import STEPControl_Reader
+
+    reader = STEPControl_Reader()
+    assert reader.ReadFile(path) == IFSelect_RetDone
+    reader.TransferRoots()
+    return reader.OneShape()
+
+
+def _occ_items(shape, kind):
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopoDS import TopoDS
+
+    cast = {"FACE": TopoDS.Face, "EDGE": TopoDS.Edge, "SOLID": TopoDS.Solid, "SHELL": TopoDS.Shell}
+    from OCP import TopAbs
+
+    e = TopExp_Explorer(shape, getattr(TopAbs, f"TopAbs_{kind}"))
+    out = []
+    while e.More():
+        out.append(cast[kind](e.Current()))
+        e.Next()
+    return out
+
+
+def test_step_surfaces_read_by_opencascade_evaluate_the_same(tmp_path):
+    from OCP.BRep import BRep_Tool
+    from OCP.BRepCheck import BRepCheck_Analyzer
+
+    g, out = _run(
+        tmp_path,
+        VASE + "  x: {type: export.step, surfaces: ['@vase', '@sheet'], path: s.step}\n",
+        "x",
+    )
+    shape = _occ(out)
+    assert BRepCheck_Analyzer(shape).IsValid()
+    faces = _occ_items(shape, "FACE")
+    assert len(faces) == 2
+    for face, name in zip(faces, ("vase", "sheet"), strict=True):
+        ours = g.evaluate(name)
+        surf = BRep_Tool.Surface_s(face)
+        assert surf.DynamicType().Name() == "Geom_BSplineSurface"
+        assert surf.UDegree() == ours.degree_u and surf.VDegree() == ours.degree_v
+        assert surf.IsURational() or surf.IsVRational() or not ours.rational
+        u = np.linspace(ours.knots_u[0], ours.knots_u[-1], 9)
+        v = np.linspace(ours.knots_v[0], ours.knots_v[-1], 7)
+        uu, vv = np.meshgrid(u, v, indexing="ij")
+        want = ours.evaluate(uu.ravel(), vv.ravel()).reshape(9, 7, 3)
+        for i in range(9):
+            for j in range(7):
+                p = surf.Value(float(u[i]), float(v[j]))
+                np.testing.assert_allclose([p.X(), p.Y(), p.Z()], want[i, j], atol=1e-12)
+
+
+def test_step_curves_and_a_faceted_solid(tmp_path):
+    from OCP.BRep import BRep_Tool
+    from OCP.BRepGProp import BRepGProp
+    from OCP.GProp import GProp_GProps
+
+    g, out = _run(
+        tmp_path,
+        VASE + "  x: {type: export.step, curves: ['@profile'], meshes: ['@box', '@plane'],"
+        " path: m.step}\n",
+        "x",
+    )
+    shape = _occ(out)
+    (solid,) = _occ_items(shape, "SOLID")
+    props = GProp_GProps()
+    BRepGProp.VolumeProperties_s(solid, props)
+    assert props.Mass() == pytest.approx(2 * 3 * 4, rel=1e-9)
+    assert len(_occ_items(shape, "SHELL")) == 2  # the box's closed shell and the plane's
+    profile = g.evaluate("profile")
+    curves = [BRep_Tool.Curve_s(e, 0, 1) for e in _occ_items(shape, "EDGE")]
+    splines = [c for c in curves if c is not None and c.DynamicType().Name() == "Geom_BSplineCurve"]
+    assert splines, "the profile curve is not in the file"
+    t = np.linspace(profile.knots[0], profile.knots[-1], 11)
+    want = profile.evaluate(t)
+    got = np.array([[p.X(), p.Y(), p.Z()] for p in (splines[0].Value(float(x)) for x in t)])
+    np.testing.assert_allclose(got, want, atol=1e-12)
+
+
+def test_step_refuses_a_parametric_surface(tmp_path):
+    with pytest.raises(fg.NodeError, match="surface 0 is a ParametricSurface"):
+        _run(
+            tmp_path,
+            "  s: {type: surfaces.parametric, x: u, y: v, z: u * v}\n"
+            "  x: {type: export.step, surfaces: ['@s'], path: s.step}\n",
+            "x",
+        )
+
+
+# --------------------------------------------------------------------------------- .3dm
+
+
+def test_rhino_file_evaluates_the_same_in_rhino3dm(tmp_path):
+    rhino3dm = pytest.importorskip("rhino3dm")
+    g, out = _run(
+        tmp_path,
+        VASE + "  x: {type: export.rhino, curves: ['@profile'], surfaces: ['@vase'],"
+        " meshes: ['@box'], layers: [profile, body, block], path: v.3dm}\n",
+        "x",
+    )
+    model = rhino3dm.File3dm.Read(out)
+    layers = [model.Layers[k].Name for k in range(len(model.Layers))]
+    assert layers == ["profile", "body", "block"]
+    kinds = [type(o.Geometry).__name__ for o in model.Objects]
+    assert kinds == ["NurbsCurve", "NurbsSurface", "Mesh"]
+    curve, surface, mesh = (o.Geometry for o in model.Objects)
+    ours_c, ours_s = g.evaluate("profile"), g.evaluate("vase")
+    for t in np.linspace(ours_c.knots[0], ours_c.knots[-1], 9):
+        p = curve.PointAt(float(t))
+        np.testing.assert_allclose([p.X, p.Y, p.Z], ours_c.evaluate([t])[0], atol=1e-12)
+    for u in np.linspace(0, 1, 5):
+        for v in np.linspace(0, 1, 5):
+            p = surface.PointAt(float(u), float(v))
+            np.testing.assert_allclose([p.X, p.Y, p.Z], ours_s.evaluate([u], [v])[0], atol=1e-12)
+    assert surface.IsRational and len(mesh.Vertices) == g.evaluate("box").n_vertices
+
+
+def test_rhino_round_trips_through_read_rhino_exactly(tmp_path):
+    g, out = _run(
+        tmp_path,
+        VASE + "  x: {type: export.rhino, curves: ['@profile'], surfaces: ['@vase', '@sheet'],"
+        " meshes: ['@box'], path: v.3dm}\n",
+        "x",
+    )
+    (tmp_path / "in.yaml").write_text(HEAD + "  m: {type: read.rhino, path: out/v.3dm}\n")
+    back = fg.load(tmp_path / "in.yaml").evaluate("m")
+    (c,), (s1, s2), (m,) = back.curves, back.surfaces, back.meshes
+    for got, want in ((c, g.evaluate("profile")),):
+        assert np.array_equal(got.control_points, want.control_points)
+        assert np.array_equal(got.knots, want.knots) and got.degree == want.degree
+    for got, want in ((s1, g.evaluate("vase")), (s2, g.evaluate("sheet"))):
+        np.testing.assert_allclose(got.control_points, want.control_points, rtol=0, atol=1e-14)
+        assert np.array_equal(got.knots_u, want.knots_u) and np.array_equal(
+            got.knots_v, want.knots_v
+        )
+        np.testing.assert_allclose(got.weights, want.weights, rtol=0, atol=1e-15)
+    box = g.evaluate("box")
+    assert np.array_equal(m.vertices, box.vertices) and np.array_equal(
+        m.face_indices, box.face_indices
+    )
+    assert len(back.points) == 0

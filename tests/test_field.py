@@ -1,0 +1,207 @@
+"""Field nodes (nodes/field.py): the Field type, field.*, field.mesh and mesh.offset."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import trimesh
+
+import formgraph as fg
+from formgraph.core.errors import BudgetError
+from formgraph.evaluation.cache import DiskCache, digest
+from formgraph.geometry import Field
+
+
+def build(**nodes):
+    g = fg.Graph()
+    for name, (kind, inputs) in nodes.items():
+        g.add(name, kind, **inputs)
+    return g
+
+
+def tm(mesh: fg.Mesh) -> trimesh.Trimesh:
+    t = trimesh.Trimesh(mesh.vertices, mesh.face_indices.reshape(-1, 3), process=False)
+    assert mesh.is_watertight and t.is_winding_consistent and t.volume > 0
+    return t
+
+
+def test_field_is_immutable_and_keyed_by_its_recipe():
+    a = Field.sphere(1.0, [0, 0, 1])
+    with pytest.raises(AttributeError):
+        a.op = "box"  # type: ignore[misc]
+    with pytest.raises(TypeError):
+        a.args["radius"] = 2.0
+    assert not a.args["center"].flags.writeable
+    assert digest(Field.sphere(1.0, [0, 0, 1])) == digest(a)
+    assert digest(Field.sphere(1.0, [0, 0, 1.5])) != digest(a)
+    u = Field.union([a, Field.box([1, 1, 1])], smooth=0.2)
+    assert digest(u) != digest(Field.union([a, Field.box([1, 1, 1])], smooth=0.3))
+    np.testing.assert_allclose(a.evaluate([[0, 0, 3.0]]), [1.0])
+
+
+def test_bounds_come_from_construction():
+    s = Field.sphere(1.0)
+    assert np.allclose(s.bounds, [[-1, -1, -1], [1, 1, 1]])
+    assert Field.tpms("gyroid", 10, 1).bounds is None
+    cut = Field.intersection([Field.tpms("gyroid", 10, 1), s])
+    assert np.allclose(cut.bounds, s.bounds)
+    moved = Field.transform(s, np.eye(3), [5, 0, 0], 2.0)
+    assert np.allclose(moved.bounds, [[3, -2, -2], [7, 2, 2]])
+    np.testing.assert_allclose(moved.evaluate([[5, 0, 0], [9, 0, 0]]), [-2, 2])
+
+
+def test_sphere_node_meshes_to_the_sphere_volume():
+    g = build(s=("field.sphere", {"radius": 2.0}), m=("field.mesh", {"field": "@s", "cell": 0.1}))
+    m = g.evaluate("m")
+    assert tm(m).volume == pytest.approx(4 / 3 * np.pi * 8, rel=0.01)
+    assert m.euler_characteristic == 2
+
+
+def test_smooth_union_adds_material_where_shapes_meet():
+    def volume(smooth):
+        g = build(
+            a=("field.sphere", {"radius": 1.0}),
+            b=("field.sphere", {"radius": 1.0, "center": [1.5, 0, 0]}),
+            u=("field.union", {"fields": ["@a", "@b"], "smooth": smooth}),
+            m=("field.mesh", {"field": "@u", "cell": 0.08}),
+        )
+        return tm(g.evaluate("m")).volume
+
+    r, d = 1.0, 1.5
+    lens = np.pi * (4 * r + d) * (2 * r - d) ** 2 / 12
+    assert volume(0.0) == pytest.approx(2 * 4 / 3 * np.pi - lens, rel=0.01)
+    assert volume(0.6) > volume(0.0) * 1.01
+
+
+def test_difference_cuts_a_hole_of_the_right_volume():
+    g = build(
+        box=("field.box", {"size": [2, 2, 2]}),
+        hole=("field.cylinder", {"radius": 0.5, "height": 3}),
+        d=("field.difference", {"a": "@box", "b": "@hole"}),
+        m=("field.mesh", {"field": "@d", "cell": 0.05}),
+    )
+    m = g.evaluate("m")
+    assert tm(m).volume == pytest.approx(8 - np.pi * 0.25 * 2, rel=0.01)
+    assert m.euler_characteristic == 0  # a block with a hole through it: genus 1
+
+
+def test_shell_and_offset_volumes():
+    g = build(
+        s=("field.sphere", {"radius": 1.0}),
+        sh=("field.shell", {"field": "@s", "thickness": 0.2}),
+        m=("field.mesh", {"field": "@sh", "cell": 0.04}),
+        o=("field.offset", {"field": "@s", "distance": 0.5}),
+        mo=("field.mesh", {"field": "@o", "cell": 0.06}),
+    )
+    shell = g.evaluate("m")
+    assert tm(shell).volume == pytest.approx(4 / 3 * np.pi * (1.1**3 - 0.9**3), rel=0.02)
+    assert shell.euler_characteristic == 4  # two spheres
+    assert tm(g.evaluate("mo")).volume == pytest.approx(4 / 3 * np.pi * 1.5**3, rel=0.01)
+
+
+def test_tpms_needs_bounds_and_then_closes_against_them():
+    g = build(
+        t=("field.tpms", {"kind": "gyroid", "period": 5.0, "thickness": 0.6}),
+        m=("field.mesh", {"field": "@t", "cell": 0.25}),
+    )
+    with pytest.raises(fg.NodeError, match=r"input 'bounds'.*unbounded"):
+        g.evaluate("m")
+    g.add("mb", "field.mesh", field="@t", cell=0.25, bounds=[[0, 0, 0], [5, 5, 5]])
+    m = g.evaluate("mb")
+    t = tm(m)
+    assert np.allclose(t.bounds, [[0, 0, 0], [5, 5, 5]], atol=0.01)
+    with pytest.raises(fg.GraphError, match="not a valid|one of|schwarz_p"):
+        g.add("bad", "field.tpms", kind="lidinoid")
+        g.evaluate("bad")
+
+
+def test_expression_field_with_bounds_and_params():
+    g = fg.Graph()
+    g.add_param("r", 1.5)
+    g.add(
+        "e", "field.expression", value="sqrt(x*x + y*y + z*z) - r", bounds=[[-2, -2, -2], [2, 2, 2]]
+    )
+    g.add("m", "field.mesh", field="@e", cell=0.1)
+    assert tm(g.evaluate("m")).volume == pytest.approx(4 / 3 * np.pi * 1.5**3, rel=0.01)
+    assert tm(g.evaluate("m", r=1.0)).volume == pytest.approx(4 / 3 * np.pi, rel=0.01)
+    g.add("bad", "field.expression", value="1 / (x - x)", bounds=[[-1, -1, -1], [1, 1, 1]])
+    g.add("mb", "field.mesh", field="@bad", cell=0.5)
+    with pytest.raises(fg.NodeError, match="not finite"):
+        g.evaluate("mb")
+
+
+def test_transform_moves_rotates_and_scales_the_shape():
+    g = build(
+        b=("field.box", {"size": [2, 1, 1]}),
+        t=(
+            "field.transform",
+            {"field": "@b", "translate": [5, 0, 0], "rotate": [0, 0, 90], "scale": 2},
+        ),
+        m=("field.mesh", {"field": "@t", "cell": 0.1}),
+    )
+    m = tm(g.evaluate("m"))
+    assert m.volume == pytest.approx(16, rel=0.01)
+    assert np.allclose(m.bounds, [[4, -2, -1], [6, 2, 1]], atol=0.02)
+
+
+def test_from_mesh_signed_distance_matches_trimesh():
+    ref = trimesh.creation.icosphere(3)
+    ref = trimesh.Trimesh(ref.vertices * [1, 0.8, 0.6], ref.faces)
+    mesh = fg.Mesh(ref.vertices, ref.faces.reshape(-1), np.arange(0, ref.faces.size + 1, 3))
+    f = Field.from_mesh(mesh)
+    rng = np.random.default_rng(0)
+    p = rng.uniform(-1.2, 1.2, (800, 3))
+    # trimesh is positive inside
+    np.testing.assert_allclose(f.evaluate(p), -trimesh.proximity.signed_distance(ref, p), atol=1e-7)
+
+
+def test_from_mesh_keeps_an_inside_through_a_small_hole():
+    ref = trimesh.creation.icosphere(3)
+    faces = ref.faces[1:]  # one triangle missing
+    mesh = fg.Mesh(ref.vertices, faces.reshape(-1), np.arange(0, faces.size + 1, 3))
+    f = Field.from_mesh(mesh)
+    p = np.array([[0, 0, 0], [0.5, 0.1, 0.2], [1.5, 0, 0], [0, 0, -2]])
+    assert (np.sign(f.evaluate(p)) == [-1, -1, 1, 1]).all()
+
+
+def test_from_curves_makes_a_torus_of_tubes():
+    g = build(
+        c=("nurbs.circle", {"radius": 2.0}),
+        f=("field.from_curves", {"curves": ["@c"], "radius": 0.4, "samples": 256}),
+        m=("field.mesh", {"field": "@f", "cell": 0.08}),
+    )
+    m = g.evaluate("m")
+    assert tm(m).volume == pytest.approx(2 * np.pi**2 * 2.0 * 0.16, rel=0.01)
+    assert m.euler_characteristic == 0
+
+
+def test_mesh_offset_of_a_box_is_the_minkowski_sum():
+    a, d = 2.0, 0.3
+    g = build(
+        b=("mesh.box", {"size": [a, a, a]}),
+        o=("mesh.offset", {"mesh": "@b", "distance": d, "cell": 0.06}),
+    )
+    exact = a**3 + 6 * a * a * d + 3 * np.pi * a * d * d + 4 / 3 * np.pi * d**3
+    assert tm(g.evaluate("o")).volume == pytest.approx(exact, rel=0.01)
+    g.add("i", "mesh.offset", mesh="@b", distance=-0.3, cell=0.06)
+    assert tm(g.evaluate("i")).volume == pytest.approx((a - 2 * d) ** 3, rel=0.02)
+
+
+def test_budget_refuses_a_hopeless_cell_before_meshing():
+    g = build(s=("field.sphere", {"radius": 1.0}), m=("field.mesh", {"field": "@s", "cell": 1e-5}))
+    with pytest.raises(BudgetError, match="surface cells, over the budget"):
+        g.evaluate("m")
+
+
+def test_a_field_is_not_written_to_the_disk_cache_but_its_mesh_is(tmp_path):
+    g = fg.Graph(cache_dir=tmp_path)
+    g.add("s", "field.sphere", radius=1.0)
+    g.add("m", "field.mesh", field="@s", cell=0.2)
+    first = g.evaluate("m")
+    g2 = fg.Graph(cache_dir=tmp_path)
+    g2.add("s", "field.sphere", radius=1.0)
+    g2.add("m", "field.mesh", field="@s", cell=0.2)
+    again = g2.evaluate("m")
+    assert g2.stats["m"].status == "cached"
+    np.testing.assert_array_equal(first.vertices, again.vertices)
+    assert DiskCache(tmp_path).put("k" * 40, Field.sphere(1.0)) is False

@@ -1,0 +1,108 @@
+"""Mesh processing nodes (nodes/meshproc.py): mesh.smooth, mesh.decimate, mesh.remesh."""
+
+from __future__ import annotations
+
+import fast_simplification
+import numpy as np
+import pytest
+import trimesh
+
+import formgraph as fg
+from formgraph.kernels.mesh import simplify as ksimp
+from formgraph.kernels.mesh import smooth as ksm
+
+
+def as_mesh(t: trimesh.Trimesh) -> fg.Mesh:
+    return fg.Mesh(t.vertices, t.faces.reshape(-1), np.arange(0, t.faces.size + 1, 3))
+
+
+def run(node_type: str, **inputs):
+    g = fg.Graph()
+    g.add("n", node_type, **inputs)
+    return g.evaluate("n")
+
+
+def tm(m: fg.Mesh) -> trimesh.Trimesh:
+    return trimesh.Trimesh(m.vertices, m.face_indices.reshape(-1, 3), process=False)
+
+
+@pytest.fixture(scope="module")
+def noisy_sphere() -> fg.Mesh:
+    s = trimesh.creation.icosphere(4)
+    rng = np.random.default_rng(0)
+    return as_mesh(trimesh.Trimesh(s.vertices + rng.normal(0, 0.01, s.vertices.shape), s.faces))
+
+
+def radial_noise(m) -> float:
+    return float(np.std(np.linalg.norm(np.asarray(m.vertices), axis=1)))
+
+
+def test_taubin_matches_trimesh_and_keeps_the_volume(noisy_sphere):
+    ref = tm(noisy_sphere)
+    # trimesh counts passes (lambda, mu, lambda, ...): 10 passes are 5 Taubin steps
+    trimesh.smoothing.filter_taubin(ref, lamb=0.5, nu=0.5, iterations=10)
+    m = noisy_sphere
+    ours = ksm.smooth(m.vertices, m.face_indices, m.face_offsets, 5, "taubin", 0.5, -0.5)
+    np.testing.assert_allclose(ours, ref.vertices, atol=1e-12)
+    out = run("mesh.smooth", mesh=noisy_sphere, iterations=10)
+    assert radial_noise(out) < 0.5 * radial_noise(noisy_sphere)
+    assert out.volume == pytest.approx(noisy_sphere.volume, rel=0.01)
+    np.testing.assert_array_equal(out.face_indices, noisy_sphere.face_indices)
+    assert out.is_watertight
+
+
+def test_laplacian_shrinks_and_taubin_does_not(noisy_sphere):
+    lap = run("mesh.smooth", mesh=noisy_sphere, iterations=30, method="laplacian")
+    tau = run("mesh.smooth", mesh=noisy_sphere, iterations=30, method="taubin")
+    assert lap.volume < 0.97 * noisy_sphere.volume
+    assert abs(tau.volume / noisy_sphere.volume - 1) < 0.02
+
+
+def test_boundary_vertices_are_held():
+    plane = run("mesh.plane", size=[2, 2], divisions=[10, 10])
+    rng = np.random.default_rng(1)
+    v = (
+        plane.vertices
+        + np.c_[np.zeros((plane.n_vertices, 2)), rng.normal(0, 0.05, plane.n_vertices)]
+    )
+    noisy = fg.Mesh(v, plane.face_indices, plane.face_offsets)
+    out = run("mesh.smooth", mesh=noisy, iterations=20, method="laplacian")
+    edge = (np.abs(plane.vertices[:, :2]) > 0.999).any(axis=1)
+    np.testing.assert_array_equal(out.vertices[edge], noisy.vertices[edge])
+    assert np.abs(out.vertices[~edge, 2]).max() < np.abs(noisy.vertices[~edge, 2]).max()
+
+
+def test_decimate_is_fast_simplification_and_stays_closed():
+    s = trimesh.creation.icosphere(5)
+    m = as_mesh(s)
+    out = run("mesh.decimate", mesh=m, ratio=0.1)
+    v, f = fast_simplification.simplify(s.vertices, s.faces, target_reduction=0.9, agg=7.0)
+    assert out.n_faces == len(f)
+    assert out.is_watertight and tm(out).is_winding_consistent
+    assert out.volume == pytest.approx(m.volume, rel=0.01)
+    assert run("mesh.decimate", mesh=m, faces=2000).n_faces == pytest.approx(2000, abs=10)
+
+
+def test_decimate_refuses_both_targets_and_too_few_faces():
+    m = as_mesh(trimesh.creation.icosphere(2))
+    with pytest.raises(fg.NodeError, match="ratio or faces, not both"):
+        run("mesh.decimate", mesh=m, ratio=0.5, faces=100)
+    with pytest.raises(fg.NodeError, match="at least 4"):
+        run("mesh.decimate", mesh=m, ratio=0.001)
+
+
+def test_remesh_gives_even_edges_and_a_closed_outward_torus():
+    t = trimesh.creation.torus(1.0, 0.35, major_sections=48, minor_sections=24)
+    out = run("mesh.remesh", mesh=as_mesh(t), edge_length=0.15)
+    r = tm(out)
+    assert out.is_watertight and r.is_winding_consistent and r.volume > 0
+    assert out.euler_characteristic == 0
+    lengths = r.edges_unique_length
+    assert np.median(lengths) == pytest.approx(0.15, rel=0.25)
+    assert np.percentile(lengths, 95) < 2.2 * np.percentile(lengths, 5)
+    assert r.volume == pytest.approx(t.volume, rel=0.03)
+
+
+def test_is_closed_sees_an_open_edge():
+    s = trimesh.creation.icosphere(1)
+    assert ksimp.is_closed(s.faces) and not ksimp.is_closed(s.faces[1:])

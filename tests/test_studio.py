@@ -1,0 +1,655 @@
+"""The studio (formgraph.studio): its guard, its session and worker, and the page in a real
+browser (Debian's chromium driven by Playwright; those tests are skipped without them).
+
+One studio serves every browser test: started as ``formgraph serve`` in a subprocess on
+127.0.0.1 and a free port, on a copy of the spiral tube, and always stopped.
+"""
+
+from __future__ import annotations
+
+import io
+import re
+import shutil
+import subprocess
+import sys
+import threading
+import time
+import urllib.error
+import urllib.request
+from pathlib import Path
+
+import numpy as np
+import pytest
+import pyvista as pv
+
+from formgraph.core.errors import Problem, Where
+from formgraph.studio.guard import Guard, _split_host, cookie_name
+from formgraph.studio.session import StudioSession, Superseded, controls_of
+from formgraph.studio.worker import Worker
+
+GRAPHS = Path(__file__).resolve().parent.parent / "graphs"
+TUBE = GRAPHS / "spiral_tube.yaml"
+CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
+
+# --------------------------------------------------------------------------------- guard
+
+LOCAL = ("127.0.0.1", 8765)
+
+
+def _guard() -> Guard:
+    return Guard("s3cret-token")
+
+
+def test_guard_lets_the_page_through():
+    g = _guard()
+    assert g.problem("127.0.0.1:8765", LOCAL, None, False, "s3cret-token") is None
+    assert g.problem("localhost:8765", LOCAL, None, False, "s3cret-token") is None
+    ws = g.problem("127.0.0.1:8765", LOCAL, "http://127.0.0.1:8765", True, "s3cret-token")
+    assert ws is None
+
+
+@pytest.mark.parametrize(
+    "host, origin, websocket, token, why",
+    [
+        ("127.0.0.1:8765", None, False, None, "token"),
+        ("127.0.0.1:8765", None, False, "s3cret-tokem", "token"),
+        ("127.0.0.1:8765", None, False, "", "token"),
+        # DNS rebinding: a name that resolves to 127.0.0.1 but is not this server's
+        ("evil.example:8765", None, False, "s3cret-token", "Host"),
+        ("127.0.0.1:9999", None, False, "s3cret-token", "Host"),
+        ("", None, False, "s3cret-token", "Host"),
+        ("[::1", None, False, "s3cret-token", "Host"),
+        # another site's page opening a websocket, or one with no Origin at all
+        ("127.0.0.1:8765", "http://evil.example", True, "s3cret-token", "Origin"),
+        ("127.0.0.1:8765", None, True, "s3cret-token", "Origin"),
+        ("127.0.0.1:8765", "http://localhost:8765", True, "s3cret-token", "Origin"),
+        ("127.0.0.1:8765", "http://evil.example", False, "s3cret-token", "Origin"),
+    ],
+)
+def test_guard_refuses(host, origin, websocket, token, why):
+    assert why in _guard().problem(host, LOCAL, origin, websocket, token)
+
+
+def test_guard_other_addresses():
+    g = Guard("t", names=["studio.lan"])
+    assert g.problem("studio.lan:80", ("10.0.0.5", 80), None, False, "t") is None
+    assert g.problem("10.0.0.5:80", ("10.0.0.5", 80), None, False, "t") is None
+    # localhost is this machine only when the server listens on a loopback address
+    assert "Host" in g.problem("localhost:80", ("10.0.0.5", 80), None, False, "t")
+    assert g.problem("[::1]:80", ("::1", 80), None, False, "t") is None
+    assert g.problem("127.0.0.1:80", ("::ffff:127.0.0.1", 80), None, False, "t") is None
+
+
+@pytest.mark.parametrize(
+    "text, parsed",
+    [
+        ("127.0.0.1:8765", ("127.0.0.1", 8765)),
+        ("LOCALHOST", ("localhost", None)),
+        ("[::1]:80", ("::1", 80)),
+        ("::1", None),
+        ("a:b", None),
+        ("[::1]x", None),
+    ],
+)
+def test_split_host(text, parsed):
+    assert _split_host(text) == parsed
+
+
+def test_cookie_names_differ_by_port():
+    assert cookie_name(8765) != cookie_name(8766)
+
+
+# ------------------------------------------------------------------------------ session
+
+
+@pytest.fixture
+def tube(tmp_path):
+    path = tmp_path / "tube.yaml"
+    shutil.copy(TUBE, path)
+    return path
+
+
+def test_session_recooks_what_a_param_reaches(tube, tmp_path):
+    s = StudioSession(tube, out_dir=tmp_path / "out", sets=["turns=2"])
+    first = s.open()
+    assert first.ok and first.new_graph
+    assert s.values == {"turns": 2}
+    assert first.computed == len(first.stats)  # a cold start computes everything
+    [(label, mesh)] = first.shown
+    assert label == "solid" and mesh.n_faces > 10_000
+    step = s.set_params(turns=3)
+    assert step.ok
+    # turns reaches the spiral and all below it, not the circle of the section
+    assert step.stats["section"].status == "cached"
+    assert step.stats["spiral"].status == "computed"
+    assert (step.computed, step.cached) == (len(step.stats) - 1, 1)
+    assert step.shown[0][1].n_faces == mesh.n_faces
+    assert not np.array_equal(step.shown[0][1].vertices, mesh.vertices)
+
+
+def test_session_keeps_the_last_good_result(tube, tmp_path):
+    s = StudioSession(tube, out_dir=tmp_path / "out")
+    good = s.open()
+    text = tube.read_text()
+    broken = s.open(text.replace("nurbs.sweep", "nurbs.sweeep"))
+    assert not broken.ok
+    assert broken.shown is good.shown  # the picture stays the last good one
+    (problem,) = broken.problems
+    assert problem.where.line == text.splitlines().index("    type: nurbs.sweep") + 1
+    assert "did you mean 'nurbs.sweep'" in problem.message
+    assert s.graph is not None and "tube" in s.graph.nodes  # the old version still runs
+    fixed = s.open(text)
+    assert fixed.ok and fixed.computed == 0  # its cache survived the broken version
+    yaml_typo = s.open(text + "\n  oops: [\n")
+    assert not yaml_typo.ok and yaml_typo.problems[0].where.line is not None
+
+
+def test_session_refuses_a_bad_param_value(tube, tmp_path):
+    s = StudioSession(tube, out_dir=tmp_path / "out")
+    s.open()
+    bad = s.set_params(turns=99)
+    assert not bad.ok and "turns" in bad.message and "12" in bad.message
+    assert "turns" not in s.values  # left as it was
+    assert s.reset_params().ok
+
+
+def test_session_save_and_run_write_only_their_files(tube, tmp_path):
+    out = tmp_path / "out"
+    s = StudioSession(tube, out_dir=out)
+    s.open()
+    text = "# saved from the studio\n" + tube.read_text()
+    s.save(text)
+    assert tube.read_text() == text
+    assert sorted(p.name for p in tube.parent.iterdir()) == ["tube.yaml"]  # no temp file
+    ran = s.run()
+    assert ran.ok and s.exports() == ["tube.stl"]
+    assert (out / "tube.stl").stat().st_size > 10_000
+
+
+def test_session_a_failing_node_names_itself(tmp_path):
+    path = tmp_path / "g.yaml"
+    path.write_text(
+        "formgraph: 1\n"
+        "params:\n"
+        "  how: {default: value}\n"
+        "nodes:\n"
+        "  ok:\n"
+        "    type: stub.value\n"
+        "    x: 2\n"
+        "  bad:\n"
+        "    type: stub.fail\n"
+        "    x: '@ok'\n"
+        "    how: =how\n"
+    )
+    s = StudioSession(path, out_dir=tmp_path / "out")
+    cooked = s.open()
+    assert not cooked.ok and cooked.failed == ["bad"]
+    (problem,) = cooked.problems
+    assert problem.where.node == "bad" and problem.where.line == 8  # the node's line
+    assert problem.message == "(stub.fail): this node always fails"
+    assert cooked.stats["ok"].status == "computed"
+    assert s.graph is not None  # a version that checks is current: a param may fix it
+
+
+def test_controls_from_param_types(tmp_path):
+    path = tmp_path / "g.yaml"
+    path.write_text(
+        "formgraph: 1\n"
+        "params:\n"
+        "  n: {type: int, default: 3, min: 1, max: 9}\n"
+        "  r: {default: 0.5, min: 0.0, max: 2.0}\n"
+        "  free: 1.5\n"
+        "  flag: true\n"
+        "nodes:\n"
+        "  pts:\n"
+        "    type: points.circle\n"
+        "    count: =n\n"
+        "    radius: =r * free\n"
+    )
+    s = StudioSession(path, out_dir=tmp_path / "out")
+    assert s.open().ok
+    kinds = {c.name: (c.kind, c.step) for c in controls_of(s.graph, s.values)}
+    assert kinds == {
+        "n": ("slider", 1.0),
+        "r": ("slider", 0.02),
+        "free": ("number", None),
+        "flag": ("toggle", None),
+    }
+
+
+# ------------------------------------------------------------------------------- worker
+
+
+def test_worker_newest_request_supersedes_the_running_one():
+    delivered = []
+    done = threading.Event()
+    started = threading.Event()
+    release = threading.Event()
+
+    def deliver(kind, result, seconds):
+        delivered.append((kind, result))
+        if result == "third":
+            done.set()
+
+    w = Worker(deliver, lambda kind, exc: delivered.append(("error", repr(exc))))
+
+    def slow(name):
+        started.set()
+        release.wait(5)
+        w.check()  # between two nodes: a newer request of this kind stops this one
+        return name
+
+    try:
+        w.submit("params", slow, "first")
+        assert started.wait(5)
+        w.submit("params", slow, "second")  # waits, then is replaced by the third
+        w.submit("params", lambda: "third")
+        release.set()
+        assert done.wait(5)
+    finally:
+        w.stop()
+    assert delivered == [("params", "third")]
+    assert w.superseded == 2
+
+
+def test_superseded_is_not_a_formgraph_error():
+    from formgraph.core.errors import FormgraphError
+
+    assert not issubclass(Superseded, FormgraphError)
+
+
+@pytest.mark.parametrize(
+    "args, code, message",
+    [
+        (["missing.yaml"], 1, "no such graph file"),
+        (["g.yaml", "--port", "70000"], 2, "a port is 0 to 65535"),
+        (["g.yaml", "--set", "turns"], 2, "--set takes NAME=VALUE"),
+    ],
+)
+def test_serve_command_line_errors(tmp_path, capsys, args, code, message):
+    from formgraph.cli.main import main
+
+    shutil.copy(TUBE, tmp_path / "g.yaml")
+    argv = ["serve", *(str(tmp_path / a) if a.endswith(".yaml") else a for a in args)]
+    if "port" in message:  # argparse's own check of the option: exits 2
+        with pytest.raises(SystemExit) as exc:
+            main([*argv, "--no-browser"])
+        assert exc.value.code == code
+    else:
+        assert main([*argv, "--no-browser"]) == code
+    assert message in capsys.readouterr().err
+
+
+def test_import_formgraph_does_not_import_trame():
+    code = "import sys, formgraph, formgraph.studio; print(any('trame' in m for m in sys.modules))"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert out.stdout.strip() == "False", out.stderr
+
+
+# ------------------------------------------------------------------------ live server
+
+
+class Studio:
+    """``formgraph serve`` in a subprocess; ``url`` is the first line it printed."""
+
+    def __init__(self, graph: Path, out: Path):
+        self.graph = graph
+        self.out = out
+        self.proc = subprocess.Popen(
+            [
+                sys.executable,
+                "-m",
+                "formgraph.studio",
+                str(graph),
+                "--port",
+                "0",
+                "--no-browser",
+                "--out",
+                str(out),
+            ],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+            cwd=graph.parent,
+        )
+        line: list[str] = []
+        reader = threading.Thread(target=lambda: line.append(self.proc.stdout.readline()))
+        reader.start()
+        reader.join(60)
+        if not line or not line[0].startswith("http://"):
+            self.close()
+            raise RuntimeError(f"the studio did not start: {line} {self.proc.stderr.read()}")
+        self.url = line[0].strip()
+        m = re.match(r"http://([^/]+)/index\.html\?token=([\w-]+)$", self.url)
+        assert m, self.url
+        self.address, self.token = m.group(1), m.group(2)
+        self.base = f"http://{self.address}"
+
+    def close(self) -> None:
+        if self.proc.poll() is None:
+            self.proc.terminate()
+            try:
+                self.proc.wait(10)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                self.proc.wait(10)
+        for stream in (self.proc.stdout, self.proc.stderr):
+            if stream is not None:
+                stream.close()
+
+
+@pytest.fixture(scope="module")
+def studio(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("studio")
+    graph = folder / "spiral_tube.yaml"
+    shutil.copy(TUBE, graph)
+    s = Studio(graph, folder / "out")
+    try:
+        yield s
+    finally:
+        s.close()
+
+
+def _get(url: str, headers: dict[str, str] | None = None) -> tuple[int, str, dict[str, str]]:
+    req = urllib.request.Request(url, headers=headers or {})
+    try:
+        with urllib.request.urlopen(req, timeout=20) as r:
+            return r.status, r.read().decode("utf-8", "replace"), dict(r.headers)
+    except urllib.error.HTTPError as exc:
+        return exc.code, exc.read().decode("utf-8", "replace"), dict(exc.headers)
+
+
+def test_served_on_loopback_with_a_token(studio):
+    assert studio.address.startswith("127.0.0.1:")
+    assert len(studio.token) >= 40  # secrets.token_urlsafe(32)
+
+
+def test_requests_without_the_token_are_refused(studio):
+    for path in ("/", "/index.html", "/index.html?token=wrong", "/ws", "/nothing-here"):
+        status, body, headers = _get(studio.base + path)
+        assert status == 403, path
+        assert "token" in body and "<html" not in body.lower()
+        assert "Set-Cookie" not in headers
+    status, body, headers = _get(studio.url)
+    assert status == 200 and "<html" in body.lower()
+    assert studio.token in headers["Set-Cookie"] and "HttpOnly" in headers["Set-Cookie"]
+    assert headers["X-Frame-Options"] == "DENY"
+    cookie = f"{cookie_name(int(studio.address.split(':')[1]))}={studio.token}"
+    assert _get(studio.base + "/index.html", {"Cookie": cookie})[0] == 200
+
+
+def test_wrong_host_and_origin_are_refused(studio):
+    port = studio.address.split(":")[1]
+    assert _get(studio.url, {"Host": f"evil.example:{port}"})[0] == 403
+    ws = {
+        "Connection": "Upgrade",
+        "Upgrade": "websocket",
+        "Sec-WebSocket-Version": "13",
+        "Sec-WebSocket-Key": "dGhlIHNhbXBsZSBub25jZQ==",
+    }
+    ws_url = f"{studio.base}/ws?token={studio.token}"
+    status, body, _ = _get(ws_url, {**ws, "Origin": "http://evil.example"})
+    assert status == 403 and "Origin" in body
+    assert _get(ws_url, ws)[0] == 403  # no Origin at all (the page's own: the browser tests)
+
+
+# ---------------------------------------------------------------------------- browser
+
+
+@pytest.fixture(scope="module")
+def page(studio):
+    if CHROMIUM is None:
+        pytest.skip("no chromium here (apt-get install chromium; .ci/run installs it)")
+    sync_api = pytest.importorskip(
+        "playwright.sync_api", reason="playwright is not installed (pip install playwright)"
+    )
+    with sync_api.sync_playwright() as p:
+        browser = p.chromium.launch(
+            executable_path=CHROMIUM,
+            # without SwiftShader, WebGL canvases stay blank in headless chromium
+            args=["--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--no-sandbox"],
+        )
+        try:
+            pg = browser.new_page(viewport={"width": 1400, "height": 850})
+            pg.set_default_timeout(30_000)
+            pg.goto(studio.url)
+            pg.wait_for_function(
+                "document.querySelector('#status')?.innerText.includes('computed')"
+            )
+            yield pg
+        finally:
+            browser.close()
+
+
+def _canvas(pg) -> np.ndarray:
+    from PIL import Image
+
+    png = pg.locator("#view canvas").first.screenshot()
+    return np.asarray(Image.open(io.BytesIO(png)).convert("RGB")).astype(int)
+
+
+def _shows_model(img: np.ndarray) -> float:
+    """The fraction of the canvas that is not the white background."""
+    return float(np.mean(np.abs(img - 255).sum(axis=2) > 60))
+
+
+def _wait_picture(pg, before: np.ndarray, seconds: float = 20.0) -> np.ndarray:
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        img = _canvas(pg)
+        if img.shape == before.shape and np.mean(np.abs(img - before).sum(axis=2) > 60) > 0.005:
+            return img
+        time.sleep(0.2)
+    raise AssertionError("the picture did not change")
+
+
+def _status(pg) -> str:
+    return pg.inner_text("#status")
+
+
+def test_page_shows_the_model(page):
+    end = time.monotonic() + 20
+    while _shows_model(_canvas(page)) < 0.02 and time.monotonic() < end:
+        time.sleep(0.2)
+    img = _canvas(page)
+    assert _shows_model(img) > 0.02
+    # the palette's first colour (#1f77b4) is where the mesh is
+    blue = (np.abs(img - [31, 119, 180]).sum(axis=2) < 120) & (img[..., 2] > img[..., 0] + 40)
+    assert blue.mean() > 0.01
+    assert "type: nurbs.sweep" in page.inner_text("#editor").replace("\xa0", " ")
+    assert page.locator("#graph [data-node='tube']").count() == 1
+    assert re.search(r"6 computed, 0 cached", _status(page))
+
+
+def test_slider_recooks_and_redraws(page):
+    before = _canvas(page)
+    thumb = page.locator(".fg-slider-turns .v-slider-thumb")
+    thumb.focus()
+    page.keyboard.press("ArrowRight")
+    page.wait_for_function("document.querySelector('#status').innerText.includes('1 cached')")
+    after = _wait_picture(page, before)
+    assert _shows_model(after) > 0.02
+    m = re.search(r"(\d+) computed, (\d+) cached", _status(page))
+    assert m and (int(m.group(1)), int(m.group(2))) == (5, 1)  # the section circle stays
+    assert "turns = 4" in page.inner_text("#controls")
+
+
+def test_typo_shows_its_line_and_fixing_recovers(page, studio):
+    before = _canvas(page)
+    lines = studio.graph.read_text().splitlines()
+    line = lines.index("    type: nurbs.sweep") + 1
+    page.click("#editor .view-lines")
+    page.keyboard.press("Control+Home")
+    for _ in range(line - 1):
+        page.keyboard.press("ArrowDown")
+    page.keyboard.press("End")
+    page.keyboard.type("x")
+    page.wait_for_function("document.querySelector('#status').classList.contains('bad')")
+    problems = page.inner_text("#problems")
+    assert f"line {line}:" in problems and "nurbs.sweepx" in problems
+    assert "did you mean 'nurbs.sweep'" in problems
+    assert page.locator("#editor .squiggly-error").count() >= 1  # marked in the editor
+    assert "last version that worked" in _status(page)
+    assert np.mean(np.abs(_canvas(page) - before).sum(axis=2) > 60) < 0.005  # kept
+    page.keyboard.press("Backspace")
+    page.wait_for_function("!document.querySelector('#status').classList.contains('bad')")
+    assert re.search(r"\d+ computed, \d+ cached", _status(page))
+    assert not page.locator("#problems").is_visible()
+
+
+def test_save_writes_the_file(page, studio):
+    page.click("#editor .view-lines")
+    page.keyboard.press("Control+Home")
+    page.keyboard.type("# tuned in the studio\n")
+    page.click("#save")
+    page.wait_for_function("document.querySelector('#status').innerText.includes('saved')")
+    text = studio.graph.read_text()
+    assert text.startswith("# tuned in the studio\nformgraph: 1\n")
+    assert text.endswith("path: tube.stl\n")
+    assert sorted(p.name for p in studio.graph.parent.iterdir() if p.is_file()) == [
+        "spiral_tube.yaml"
+    ]
+
+
+def test_click_a_node_shows_it(page):
+    before = _canvas(page)
+    page.locator("#graph [data-node='spiral']").click()
+    page.wait_for_function("document.querySelector('#graph').innerText.includes('showing spiral')")
+    curve = _wait_picture(page, before)
+    assert _shows_model(curve) < _shows_model(before) / 2  # a thin curve, not the tube
+    page.get_by_text("show results").click()
+    page.wait_for_function("document.querySelector('#graph').innerText.includes('results')")
+    _wait_picture(page, curve)
+
+
+def test_an_edit_on_disk_reloads(page, studio):
+    text = studio.graph.read_text()
+    studio.graph.write_text(text.replace("default: 3, min: 1", "default: 2, min: 1"))
+    page.wait_for_function(
+        "document.querySelector('#editor').innerText.includes('default:\u00a02,')"
+    )
+    page.wait_for_function("document.querySelector('#status').innerText.includes('computed')")
+    assert "turns = 4" in page.inner_text("#controls")  # the control's value is kept
+    # with unsaved edits in the editor, a change on disk does not overwrite them
+    page.click("#editor .view-lines")
+    page.keyboard.press("Control+End")
+    page.keyboard.type("# not saved")
+    time.sleep(0.6)  # past the edit delay
+    studio.graph.write_text(text)
+    page.wait_for_function("document.querySelector('#status').innerText.includes('on disk')")
+    assert "# not saved" in page.inner_text("#editor").replace("\xa0", " ")
+    page.click("#reload")  # takes the file's text
+    page.wait_for_function("!document.querySelector('#editor').innerText.includes('not saved')")
+    page.wait_for_function(
+        "document.querySelector('#editor').innerText.includes('default:\u00a03,')"
+    )
+
+
+def test_run_writes_the_exports(page, studio):
+    page.click("#run")
+    page.wait_for_function("document.querySelector('#status').innerText.includes('wrote')")
+    assert "tube.stl" in _status(page)
+    stl = studio.out / "tube.stl"
+    assert stl.read_bytes()[:5] != b"solid" and stl.stat().st_size > 100_000  # binary STL
+
+
+def test_page_without_the_token_is_refused(page, studio):
+    context = page.context.browser.new_context()  # no cookie from the page's first visit
+    try:
+        other = context.new_page()
+        response = other.goto(studio.base + "/index.html")
+        assert response.status == 403
+        assert "token" in other.inner_text("body")
+        assert page.context.cookies()[0]["httpOnly"]  # the page's own visit kept its cookie
+    finally:
+        context.close()
+
+
+def test_problem_lines_locate():
+    from formgraph.studio.page import _markers, _problem_lines
+
+    problems = [Problem(Where("g.yaml", 4, "n", "x"), "bad"), Problem(Where(), "whole graph")]
+    assert _markers(problems) == [{"line": 4, "message": "bad", "severity": "error"}]
+    assert _problem_lines(problems) == ["line 4: node 'n': bad", "whole graph"]
+
+
+# ----------------------------------------------------------------------------- scene
+
+
+def _serialized_actor(actor):
+    from trame_vtk.modules.vtk.serializers import (
+        SynchronizationContext,
+        initialize_serializers,
+        serialize,
+    )
+    from trame_vtk.modules.vtk.serializers.utils import reference_id
+
+    from formgraph.studio.scene import send_back_faces
+
+    initialize_serializers()  # as trame-vtk's protocol does when it starts
+    send_back_faces()
+    return serialize(None, actor, reference_id(actor), SynchronizationContext(), 0)
+
+
+def test_back_faces_reach_the_browser(tube, tmp_path):
+    from formgraph.studio.scene import StudioScene, make_plotter
+    from formgraph.viewer.style import BACK_FACE
+
+    s = StudioSession(tube, out_dir=tmp_path / "out")
+    plotter = make_plotter()
+    try:
+        scene = StudioScene(plotter)
+        assert scene.update(s.open().shown)  # actors added
+        mesh = scene.parts[("solid", "meshes")].actors[0]
+        out = _serialized_actor(mesh)
+        calls = {name: args for name, args in out["calls"]}
+        assert "setBackfaceProperty" in calls
+        back_id = re.fullmatch(r"instance:\$\{(.+)\}", calls["setBackfaceProperty"][0])[1]
+        back = next(d for d in out["dependencies"] if d["id"] == back_id)
+        red = pv.Color(BACK_FACE).float_rgb
+        assert np.allclose(back["properties"]["diffuseColor"], red)
+        lines = scene.parts[("solid", "features")].actors[0]
+        assert "setBackfaceProperty" not in dict(_serialized_actor(lines)["calls"])
+    finally:
+        plotter.close()
+
+
+def test_a_step_changes_arrays_in_place(tube, tmp_path):
+    from formgraph.studio.scene import StudioScene, make_plotter
+
+    s = StudioSession(tube, out_dir=tmp_path / "out")
+    plotter = make_plotter()
+    try:
+        scene = StudioScene(plotter)
+        scene.update(s.open().shown)
+        part = scene.parts[("solid", "meshes")]
+        data, actors, added = part.data, list(part.actors), scene.added
+        faces = data.GetPolys().GetMTime()
+        points = data.GetPoints().GetData()
+        assert points.GetDataType() == 10  # VTK_FLOAT: half the bytes of float64
+        assert not scene.update(s.set_params(thickness=0.4).shown)  # nothing added
+        assert scene.parts[("solid", "meshes")].data is data and part.actors == actors
+        assert scene.added == added
+        # the faces did not change and were not touched: the same hash, not sent again
+        assert data.GetPolys().GetMTime() == faces
+        assert data.GetPoints().GetData() is not points  # the points did
+        assert data.bounds[5] == pytest.approx(3.4, abs=0.02)  # 3 turns up, 0.4 tube radius
+    finally:
+        plotter.close()
+
+
+def test_choice_control_for_an_enum_param():
+    import enum
+    from types import SimpleNamespace
+
+    from formgraph.core.types import Kind, PortType
+    from formgraph.language.model import ParamDef
+
+    class Ends(str, enum.Enum):
+        FLAT = "flat"
+        ROUND = "round"
+
+    p = ParamDef("ends", Ends.FLAT, PortType((Kind(Ends),)), "Ends")
+    graph = SimpleNamespace(params={"ends": Ends.FLAT}, param_defs={"ends": p})
+    (c,) = controls_of(graph, {})
+    assert (c.kind, c.value, c.choices) == ("choice", "flat", ("flat", "round"))
