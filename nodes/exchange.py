@@ -17,7 +17,7 @@ from formgraph.core.registry import Context, node
 from formgraph.core.types import OutputPath
 from formgraph.geometry import Curve, Mesh, NurbsCurve, NurbsSurface, Surface
 from formgraph.kernels.io import colors, gltf, rhino, step, threemf
-from formgraph.kernels.io.exporters import mesh_report
+from formgraph.kernels.io.meshdata import mesh_report
 from formgraph.kernels.mesh import meshops
 
 

@@ -94,3 +94,16 @@ def test_an_export_is_checked_on_every_run(tmp_path):
     g.out_dir = tmp_path / "other"  # another output folder: another key
     g.evaluate("w")
     assert (tmp_path / "other" / "a.txt").read_text() == "hello"
+
+
+def test_a_changed_input_file_is_read_again(tmp_path):
+    # A read node's key holds its file's bytes: such runs never reuse kept keys.
+    (tmp_path / "p.xyz").write_bytes(b"1 2 3\n")
+    (tmp_path / "g.yaml").write_text(
+        "formgraph: 1\nnodes:\n  p: {type: read.points, path: p.xyz}\n"
+    )
+    g = fg.load(tmp_path / "g.yaml")
+    assert g.evaluate("p").xyz.tolist() == [[1, 2, 3]]
+    assert g.evaluate("p").xyz.tolist() == [[1, 2, 3]]
+    (tmp_path / "p.xyz").write_bytes(b"4 5 6\n")
+    assert g.evaluate("p").xyz.tolist() == [[4, 5, 6]]
