@@ -109,8 +109,11 @@ def node_types() -> dict[str, NodeSpec]:
     """Every registered node type, by name (importing the node families first)."""
     import formgraph.nodes  # noqa: F401  (registers the families on import)
 
-    # Sorted once per registration (every run asks; a sweep's plan, once per variant).
-    if len(_SORTED) != len(_REGISTRY):
+    # Sorted once per change of the registry (every run asks; a sweep, once per variant);
+    # the entries are compared too, since a test may replace one in place.
+    if len(_SORTED) != len(_REGISTRY) or any(
+        _SORTED.get(k) is not v for k, v in _REGISTRY.items()
+    ):
         _SORTED.clear()
         _SORTED.update(sorted(_REGISTRY.items()))
     return dict(_SORTED)
