@@ -203,16 +203,22 @@ def _collocation_solve(
     _, _, ctrl, info = gbsv(kl, ku, ab, rhs, overwrite_ab=True, overwrite_b=True)
     if info != 0:
         raise np.linalg.LinAlgError("the collocation matrix is singular")
-    # The miss, column by column (gbsv's Fortran-ordered answer is contiguous that way).
+    # The miss, column by column (gbsv's Fortran-ordered answer is contiguous that way),
+    # over the diagonals that hold entries (a collocation row has p + 1 of the 2 p + 1).
     cols = np.asarray(ctrl).T
     miss = np.array(flat.T, order="C")
+    scratch = np.empty_like(miss)
     for o in range(-kl, ku + 1):  # diagonal j - i = o
         d = band[ku - o]
+        if not d.any():
+            continue
         if o >= 0:
-            miss[:, : n - o] -= d[o:] * cols[:, o:]
+            t = np.multiply(d[o:], cols[:, o:], out=scratch[:, : n - o])
+            miss[:, : n - o] -= t
         else:
-            miss[:, -o:] -= d[: n + o] * cols[:, : n + o]
-    return np.ascontiguousarray(ctrl), float(np.abs(miss).max(initial=0.0))
+            t = np.multiply(d[: n + o], cols[:, : n + o], out=scratch[:, : n + o])
+            miss[:, -o:] -= t
+    return np.ascontiguousarray(ctrl), float(max(miss.max(initial=0.0), -miss.min(initial=0.0)))
 
 
 def _collocation_rows(p: int, knots: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
