@@ -17,7 +17,7 @@ from formgraph.core.errors import InputError
 from formgraph.core.registry import Context, node
 from formgraph.core.types import PerElement, SameAs
 from formgraph.geometry import Mesh, Points
-from formgraph.language.elements import ElementValue, element_env
+from formgraph.language.elements import VARIABLES, ElementValue, element_env
 
 
 class Domain(str, Enum):
@@ -53,7 +53,9 @@ def set_attribute(
     name : str
         The attribute's name (letters, digits and _), e.g. ``color``, ``height``.
     value : float | list[float]
-        A number, a vector, an expression or a list of them (see above).
+        A number, a vector, or per-element expressions: one ("=z / 10"), or a list with
+        one per component (["=x", 0, "=rand(i)"]), over x y z, nx ny nz, i, count, the
+        element's attributes and the params.
     domain : Domain
         ``point`` (points, or a mesh's vertices) or ``face`` (a mesh's faces).
 
@@ -64,6 +66,10 @@ def set_attribute(
     """
     if not isinstance(name, str) or not name.isidentifier() or name.startswith("_"):
         raise InputError("name", f"{name!r} is not a name: letters, digits and _, not first _")
+    if name in VARIABLES:
+        raise InputError(
+            "name", f"{name!r} is a variable of per-element expressions; choose another name"
+        )
     domain = Domain(domain)
     if domain is Domain.face and not isinstance(geometry, Mesh):
         raise InputError("domain", "a point set has no faces; use domain: point")
@@ -74,7 +80,7 @@ def set_attribute(
     ctx.guard(count, "elements")
     what = "faces" if domain is Domain.face else "points"
     if isinstance(value, ElementValue):
-        env = element_env(geometry, domain.value)
+        env = element_env(geometry, domain.value, value.names)
         try:
             values: Any = value.evaluate(env, count, what)
         except ValueError as exc:

@@ -47,6 +47,12 @@ def _triangles(meshes: list[Mesh], ctx: Context) -> list[tuple[np.ndarray, np.nd
     return out
 
 
+def _vertex_colour(mesh: Mesh) -> np.ndarray | None:
+    """A mesh's ``color`` point attribute when it is RGB or RGBA (0..1), else None."""
+    c = mesh.point_data.get("color")
+    return c if c is not None and c.ndim == 2 and c.shape[1] in (3, 4) else None
+
+
 def _per_mesh(values: list | None, meshes: list[Mesh], port: str) -> list | None:
     if values is not None and len(values) != len(meshes):
         raise InputError(port, f"{len(values)} {port} for {len(meshes)} meshes: give one each")
@@ -105,7 +111,8 @@ def export_gltf(
     """Write meshes as binary glTF 2.0 (``.glb``), for the web and AR viewers.
 
     One node and mesh each: float32 positions (with their bounds), smooth vertex normals
-    (area-weighted) and uint32 triangle indices in one binary chunk. glTF's unit is the
+    (area-weighted) and uint32 triangle indices in one binary chunk; a ``color`` point
+    attribute (RGB or RGBA in 0..1) becomes the vertex colours ``COLOR_0``. glTF's unit is the
     metre, so coordinates are scaled from ``units`` (a 100 mm vase is 0.1 m in the file).
 
     Parameters
@@ -121,7 +128,8 @@ def export_gltf(
     """
     _per_mesh(names, meshes, "names")
     scale = threemf.UNITS[units.value] / 1000.0
-    data = gltf.write_glb(_triangles(meshes, ctx), names=names, scale=scale)
+    colors = [_vertex_colour(m) for m in meshes]  # a ``color`` point attribute: COLOR_0
+    data = gltf.write_glb(_triangles(meshes, ctx), names=names, scale=scale, colors=colors)
     return str(ctx.write(path, data))
 
 

@@ -179,11 +179,24 @@ def _per_point(points: Points, **inputs: Any) -> dict[str, Any]:
     env = None
     for port, value in inputs.items():
         if isinstance(value, ElementValue):
-            env = element_env(points) if env is None else env
+            env = element_env(points, "point", value.names) if env is None else env
             try:
                 out[port] = value.evaluate(env, len(points), "points")
             except ValueError as exc:
                 raise InputError(port, str(exc)) from None
+            a = out[port]
+            vector = a.ndim == 2 and a.shape[1] == 3
+            if not vector and (port != "scale" or a.ndim != 1):
+                want = "[x, y, z]" if port == "align" else "[rx, ry, rz]"
+                example = '"=normal"' if port == "align" else '[0, 0, "=360 * rand(i)"]'
+                if port == "scale":
+                    want, example = "one factor or [sx, sy, sz]", '"=0.5 + rand(i)"'
+                got = a.shape[1] if a.ndim == 2 else 1
+                raise InputError(
+                    port,
+                    f"{value.text} gives {got} number(s) per point; {port} needs {want} per "
+                    f"point, e.g. {example}",
+                )
     return out
 
 
@@ -324,7 +337,7 @@ class Samples(NamedTuple):
     normals: list[Vec3]
 
 
-@node("geometry.sample_surface", version=1)
+@node("geometry.sample_surface", version=2)
 def sample_surface(
     surface: Surface,
     u: Annotated[int, Range(min=1)] = 8,
@@ -337,8 +350,8 @@ def sample_surface(
     Cell (i, j) is centred at parameters ``u0 + (i + 1/2) (u1 - u0) / u`` and likewise in
     v; points run along v first (row i holds v points). The points carry ``normal``,
     ``u`` and ``v`` point attributes (so ``align: "=normal"`` works). Normals are ``S_u x S_v``
-    normalized: exact derivatives on a NURBS surface (The NURBS Book A3.6), central
-    differences on a parametric one.
+    normalized: exact derivatives on a NURBS surface (The NURBS Book A3.6) and on a
+    parametric one (its expressions differentiated; central differences only for noise).
 
     Parameters
     ----------
@@ -355,13 +368,7 @@ def sample_surface(
     vv = v0 + (np.arange(v) + 0.5) * (v1 - v0) / v
     gu, gv = (a.reshape(-1) for a in np.meshgrid(uu, vv, indexing="ij"))
     xyz = np.asarray(surface.evaluate(gu, gv), dtype=np.float64).reshape(-1, 3)
-    if isinstance(surface, NurbsSurface):
-        normals = np.asarray(surface.normals(gu, gv), dtype=np.float64).reshape(-1, 3)
-    else:
-        hu, hv = (u1 - u0) * 1e-5, (v1 - v0) * 1e-5
-        su = (surface.evaluate(gu + hu, gv) - surface.evaluate(gu - hu, gv)) / (2 * hu)
-        sv = (surface.evaluate(gu, gv + hv) - surface.evaluate(gu, gv - hv)) / (2 * hv)
-        normals = np.cross(su, sv)
+    normals = np.asarray(surface.normals(gu, gv), dtype=np.float64).reshape(-1, 3)
     length = np.linalg.norm(normals, axis=1, keepdims=True)
     if (length <= 1e-300).any():
         ctx.warn("the surface is degenerate at some samples; their normal is +z")

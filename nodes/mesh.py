@@ -57,7 +57,7 @@ def from_faces(vertices: Points, faces: Faces) -> Mesh:
     Parameters
     ----------
     vertices : Points
-        The vertex positions; [x, y] gets z = 0.
+        The vertex positions; [x, y] gets z = 0. Their point attributes become the mesh's.
     faces : list[list[int]]
         One list of 0-based vertex indices per face.
 
@@ -71,7 +71,7 @@ def from_faces(vertices: Points, faces: Faces) -> Mesh:
         v, fi, fo = meshops.validate_faces(vertices.xyz, fi, fo)
     except ValueError as exc:
         raise InputError("faces", str(exc)) from None
-    return Mesh(v, fi, fo)
+    return Mesh(v, fi, fo, vertices.point_data)  # the points' attributes on the vertices
 
 
 @node("mesh.box", version=1)

@@ -137,10 +137,10 @@ def remesh(
     """Even triangles of about ``edge_length``: isotropic remeshing by clustering (ACVD).
 
     pyacvd's approximated centroidal Voronoi clustering (Valette & Chassery 2004) of the
-    surface into regions of equal area, whose dual is the new mesh. Chosen over a split /
-    collapse / flip / relax loop (Botsch & Kobbelt 2004) for its speed and because it keeps
-    the test solids closed; the node checks that a closed input comes out closed, and
-    outward if it went in outward.
+    surface into regions of equal area, whose dual is the new mesh (taken instead of a
+    split / collapse / flip / relax loop after Botsch & Kobbelt 2004, which is not
+    written here). The node checks that a closed input comes out closed, and outward if it
+    went in outward.
 
     Parameters
     ----------

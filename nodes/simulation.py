@@ -19,6 +19,14 @@ from formgraph.geometry import Curve, Mesh, NurbsCurve
 from formgraph.kernels.curves import growth as kg
 from formgraph.kernels.mesh import relax as kr
 
+#: the point attribute that carries a relaxation's velocities from one step to the next
+VELOCITY = "relax_velocity"
+
+#: what one point of a growth step costs against the element budget: its neighbour pairs
+#: and the arrays over them (about 50 numbers a point); the default budget allows a step of
+#: a million points, a few seconds
+GROWTH_POINT_ELEMENTS = 50
+
 
 def _polygon(curve: Curve, spacing: float, port: str) -> tuple[np.ndarray, bool]:
     """A curve's vertices (the control polygon of a polyline, else points about
@@ -49,7 +57,7 @@ def grow(
     curve: Curve,
     split: Annotated[float, Range(min=1e-9)] = 1.0,
     repulsion: Annotated[float, Range(min=0)] = 0.5,
-    radius: Annotated[float, Range(min=1e-9)] | None = None,
+    radius: Annotated[float | None, Range(min=1e-9)] = None,
     bounds: Curve | None = None,
     jitter: Annotated[float, Range(min=0)] = 0.3,
     seed: int = 0,
@@ -99,7 +107,8 @@ def grow(
         fence, _ = _polygon(bounds, 0.5 * split, "bounds")
     edges = np.diff(np.vstack([p, p[:1]]) if closed else p, axis=0)
     pieces = np.ceil(np.linalg.norm(edges[:, :2], axis=1) / split).sum()
-    ctx.guard(2 * max(pieces, len(p)), "points")  # a step at most doubles a divided edge
+    # a step at most doubles a divided edge, and each point costs its neighbour pairs
+    ctx.guard(GROWTH_POINT_ELEMENTS * 2 * max(pieces, len(p)), "elements (growing points)")
     mixed = zlib.crc32(np.ascontiguousarray(p[:, :2]).tobytes())
     try:
         out = kg.grow_step(
@@ -113,7 +122,9 @@ def grow(
             seed=int(np.random.SeedSequence([abs(seed), mixed]).generate_state(1)[0]),
         )
     except ValueError as exc:
-        raise InputError("bounds" if "bounds" in str(exc) else "curve", str(exc)) from None
+        message = str(exc)
+        port = "radius" if "search radius" in message else "curve"
+        raise InputError("bounds" if "bounds" in message else port, message) from None
     xyz = np.c_[out, np.full(len(out), p[0, 2])]
     return NurbsCurve.polyline(xyz, closed=closed)
 
@@ -122,7 +133,7 @@ def grow(
 def relax(
     mesh: Mesh,
     anchors: list[int] | None = None,
-    rest_length: Annotated[float, Range(min=1e-12)] | None = None,
+    rest_length: Annotated[float | None, Range(min=1e-12)] = None,
     stiffness: Annotated[float, Range(min=0)] = 1.0,
     load: Vec3 = (0.0, 0.0, 0.0),
     pressure: float = 0.0,
@@ -130,6 +141,7 @@ def relax(
     rest_scale: Annotated[float, Range(min=1e-6)] = 1.0,
     anchor_boundary: bool = False,
     iterations: Annotated[int, Range(min=1, max=10_000)] = 10,
+    momentum: bool = True,
     *,
     ctx: Context,
 ) -> Mesh:
@@ -138,10 +150,11 @@ def relax(
     Dynamic relaxation with kinetic damping (Barnes 1999): each vertex gets a fictitious
     mass from its springs' stiffness and a velocity that integrates the out-of-balance
     force; the velocities are zeroed at each peak of kinetic energy. A step runs
-    ``iterations`` of these from rest. Loads hang a net (turned upside down, a vault in
-    pure compression); pressure inflates a closed mesh along its area-weighted vertex
-    normals. Anchors do not move at all. Use with ``simulate:``; with the defaults a few
-    hundred steps bring a small net to rest.
+    ``iterations`` of these; with ``momentum`` the velocities ride along to the next step
+    as the point attribute ``relax_velocity``, so the steps are one motion. Loads hang a
+    net (turned upside down, a vault in pure compression); pressure inflates a closed mesh
+    along its area-weighted vertex normals. Anchors do not move at all. Use with
+    ``simulate:``; with the defaults a few hundred steps bring a small net to rest.
 
     Parameters
     ----------
@@ -168,15 +181,29 @@ def relax(
         Also hold every vertex of the mesh's boundary (a vault's springing line).
     iterations : int
         Relaxation iterations per step.
+    momentum : bool
+        Carry the velocities to the next step (the ``relax_velocity`` point attribute);
+        off, every step starts at rest.
     """
     v = np.asarray(mesh.vertices)
     n = len(v)
-    edges = mesh.edge_table.vertices
     ref = mesh if reference is None else reference
+    same = ref is mesh or (
+        ref.n_vertices == n
+        and ref.face_offsets.shape == mesh.face_offsets.shape
+        and (
+            ref.face_indices is mesh.face_indices
+            or np.array_equal(ref.face_indices, mesh.face_indices)
+        )
+        and np.array_equal(ref.face_offsets, mesh.face_offsets)
+    )
+    # the reference is the same object every step: its edge table is built once
+    table = ref.edge_table if same else mesh.edge_table
+    edges = table.vertices
     if rest_length is not None:
         rest = np.full(len(edges), float(rest_length))
     else:
-        if ref.n_vertices != n or not np.array_equal(ref.face_indices, mesh.face_indices):
+        if not same:
             raise InputError("reference", "reference must have the mesh's faces (the same net)")
         rv = np.asarray(ref.vertices)
         rest = rest_scale * np.linalg.norm(rv[edges[:, 1]] - rv[edges[:, 0]], axis=1)
@@ -187,7 +214,6 @@ def relax(
         bad = next(a for a in fixed if not -n <= a < n)
         raise InputError("anchors", f"anchor {bad} is not a vertex (the mesh has {n})")
     if anchor_boundary:
-        table = mesh.edge_table
         fixed += np.unique(table.vertices[table.counts == 1]).tolist()
     ctx.guard(iterations * (n + len(edges)), "spring updates")
     triangles = kr.fan_triangles(mesh.face_indices, mesh.face_offsets) if pressure else None
@@ -201,7 +227,11 @@ def relax(
         triangles=triangles,
         anchors=np.asarray(fixed, dtype=np.int64),
     )
-    x, _ = kr.relax(v, net, steps=iterations)
-    if not np.isfinite(x).all():
+    velocity = mesh.point_data.get(VELOCITY) if momentum else None
+    if velocity is not None and np.shape(velocity) != (n, 3):
+        velocity = None  # not ours: start at rest
+    x, velocity = kr.relax(v, net, steps=iterations, velocity=velocity)
+    if not (np.isfinite(x).all() and np.isfinite(velocity).all()):
         raise InputError("stiffness", "the relaxation diverged: the loads are too large")
-    return Mesh(x, mesh.face_indices, mesh.face_offsets)
+    point_data = mesh.point_data.with_(VELOCITY, velocity) if momentum else mesh.point_data
+    return Mesh.trusted(x, mesh.face_indices, mesh.face_offsets, point_data, mesh.face_data)

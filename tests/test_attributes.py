@@ -319,3 +319,84 @@ def test_ply_writes_colours_and_attributes_that_trimesh_and_meshio_read(tmp_path
     assert [f for f, _ in faces] == [list(f) for f in Mesh(v, fi, fo).faces]
     plain = trimesh.load(io.BytesIO(ply_binary(*box().arrays)), file_type="ply", process=False)
     assert len(plain.vertices) == 8
+
+
+def test_curves_copy_to_points_per_point_and_sample_surface_attributes():
+    g = fg.Graph()
+    g.add("wall", "surfaces.parametric", x="v", y="0.5 * sin(v)", z="u", u=[0, 2], v=[0, 6])
+    g.add("spots", "geometry.sample_surface", surface="@wall", u=2, v=5)
+    g.add("ring", "nurbs.circle", radius=0.2)
+    g.add(
+        "rings",
+        "curves.copy_to_points",
+        curve="@ring",
+        points="@spots.points",
+        align="=normal",
+        scale="=1 + i",
+    )
+    spots = g.evaluate("spots")
+    pts = spots.points
+    np.testing.assert_array_equal(pts.point_data["normal"], np.asarray(spots.normals))
+    assert pts.point_data["u"].shape == (10,) and pts.point_data["v"].max() < 6
+    rings = g.evaluate("rings")
+    for k, ring in enumerate(rings):
+        p = ring.sample(64)
+        r = np.linalg.norm(p - pts.xyz[k], axis=1)
+        np.testing.assert_allclose(r, 0.2 * (1 + k), rtol=1e-9)
+        # the ring's plane is normal to the surface normal there
+        np.testing.assert_allclose((p - pts.xyz[k]) @ pts.point_data["normal"][k], 0, atol=1e-9)
+
+
+def test_per_element_values_are_checked(tmp_path):
+    g = load_text(
+        tmp_path,
+        """
+formgraph: 1
+nodes:
+  p: {type: points.grid, nx: 2, ny: 2}
+  inf: {type: attr.set, geometry: "@p", name: h, value: "=1 / (x * 0)"}
+  deep: {type: mesh.copy_to_points, mesh: "@b", points: "@p", rotate: "=x"}
+  b: {type: mesh.box}
+""",
+    )
+    with pytest.raises(fg.NodeError, match="not finite at element 0"):
+        g.evaluate("inf")
+    with pytest.raises(fg.NodeError, match="input 'rotate'"):
+        g.evaluate("deep")  # one number per point where a vector per point is needed
+    with pytest.raises(fg.NodeError, match=r"rotate needs \[rx, ry, rz\] per point"):
+        g.evaluate("deep")
+
+
+def test_from_faces_takes_the_points_attributes():
+    pts = Points([[0, 0], [1, 0], [1, 1], [0, 1]], {"w": [1.0, 2.0, 3.0, 4.0]})
+    out = run("mesh.from_faces", pts, "vertices", faces=[[0, 1, 2, 3]])
+    assert out.point_data["w"].tolist() == [1, 2, 3, 4]
+
+
+def test_per_element_expressions_in_a_repeat_read_the_loop_name(tmp_path):
+    text = """
+formgraph: 1
+nodes:
+  p: {type: points.grid, nx: 3, ny: 1}
+  s: {type: attr.set, repeat: {k: 3}, geometry: "@p", name: h, value: "=x * k + rand(i, k)"}
+"""
+    out = load_text(tmp_path, text).evaluate("s")
+    x, i = np.asarray(out[0].xyz)[:, 0], np.arange(3.0)
+    for k, value in enumerate(out):
+        np.testing.assert_array_equal(value.point_data["h"], x * k + rand(i, k))
+
+
+def test_glb_writes_the_color_attribute_as_color_0(tmp_path):
+    sphere = trimesh.creation.icosphere(2)
+    m = Mesh(sphere.vertices, sphere.faces.reshape(-1), np.arange(0, sphere.faces.size + 1, 3))
+    z = m.vertices[:, 2]
+    colour = np.column_stack([(z + 1) / 2, np.full_like(z, 0.25), 1 - (z + 1) / 2])
+    g = fg.Graph()
+    g.add_param("m", type="Mesh")
+    g.add("w", "export.gltf", meshes=["=m"], path="colours.glb")
+    g.out_dir = tmp_path
+    path = g.evaluate("w", m=m.with_data({"color": colour}))
+    scene = trimesh.load(path, process=False)
+    back = next(iter(scene.geometry.values()))
+    assert len(back.vertices) == m.n_vertices
+    np.testing.assert_allclose(back.visual.vertex_colors[:, :3] / 255.0, colour, atol=1 / 255)

@@ -16,7 +16,7 @@ import formgraph as fg
 from formgraph.cli.main import main
 from formgraph.drawgraph.layout import MARKS, draw_graph, node_marks
 from formgraph.drawgraph.shapes import Text, text_width
-from formgraph.language.model import wires_of
+from formgraph.language.model import Literal, wires_of
 
 ROOT = Path(__file__).resolve().parents[1]
 GRAPHS = sorted((ROOT / "graphs").glob("*.yaml"))
@@ -32,13 +32,17 @@ def by_class(root: ET.Element, tag: str, cls: str) -> list[ET.Element]:
 
 
 def wire_count(g: fg.Graph) -> int:
-    """Wires as authored: every @node reference in every input and repeat: source."""
+    """Wires as authored: every @node reference in every input, repeat: source and
+    simulate: from (a simulation's state input is drawn as its 'from')."""
     count = 0
     for n in g.nodes:
         nd = g._nodes[n]  # noqa: SLF001
         count += sum(len(wires_of(v)) for v in nd.inputs.values())
         if nd.repeat is not None:
             count += len(wires_of(nd.repeat.source))
+        if nd.simulate is not None:
+            count += len(wires_of(nd.simulate.source)) + len(wires_of(nd.simulate.steps))
+            count -= len(wires_of(nd.inputs.get(nd.simulate.state, None) or Literal(0)))
     return count
 
 

@@ -10,7 +10,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from formgraph.core.errors import ExpressionError
-from formgraph.language.expr import Bound, compile_expression
+from formgraph.language.bound import Bound
+from formgraph.language.expr import compile_expression
 
 
 @pytest.mark.parametrize(

@@ -205,3 +205,11 @@ def test_a_field_is_not_written_to_the_disk_cache_but_its_mesh_is(tmp_path):
     assert g2.stats["m"].status == "cached"
     np.testing.assert_array_equal(first.vertices, again.vertices)
     assert DiskCache(tmp_path).put("k" * 40, Field.sphere(1.0)) is False
+
+
+def test_a_field_previews_as_a_mesh_and_a_tpms_in_two_periods():
+    preview = Field.sphere(1.0).display_mesh()
+    assert preview.is_watertight and tm(preview).volume == pytest.approx(4 / 3 * np.pi, rel=0.02)
+    g = Field.tpms("schwarz_p", 4.0, 0.5).display_mesh()
+    assert np.allclose(g.bounds, [[0, 0, 0], [8, 8, 8]], atol=0.2) and g.is_watertight
+    assert Field.expression(lambda x, y, z: x).display_mesh() is None

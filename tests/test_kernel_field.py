@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import trimesh
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from formgraph.kernels.field import meshdist, mesher, sdf
@@ -36,7 +36,9 @@ def test_root_finding_beats_linear_interpolation_on_a_curved_field():
     f = lambda p: (p * p).sum(axis=1) - 1.0  # noqa: E731
     lin, _ = mesher.mesh_field(f, [-1] * 3, [1] * 3, 0.2, lipschitz=3.0, root_steps=0)
     exact, _ = mesher.mesh_field(f, [-1] * 3, [1] * 3, 0.2, lipschitz=3.0)
-    assert np.abs(f(exact)).max() < 1e-3 * np.abs(f(lin)).max()
+    assert np.median(np.abs(f(exact))) < 1e-3 * np.median(np.abs(f(lin)))
+    # at worst a vertex is held END_GAP of its edge off a corner that is on the surface
+    assert np.abs(f(exact)).max() <= 3.0 * mesher.END_GAP * 0.2 * 1.001
 
 
 def test_rounded_box_volume_closed_form():
@@ -173,6 +175,7 @@ def test_a_field_that_is_not_finite_is_refused():
     ),
     st.floats(0, 0.6),
 )
+@example(spheres=[(0.0, 0.0, 0.0, 0.5), (0.0, 0.0, 0.75, 0.5)], k=0.0)  # a kink on edges
 def test_random_smooth_blends_are_closed_outward_and_even_euler(spheres, k):
     def f(p):
         out = None
@@ -243,3 +246,18 @@ def test_winding_number_is_one_inside_zero_outside_and_near_exact():
     exact = (2 * np.arctan2(num, den)).sum(axis=1) / (4 * np.pi)
     assert np.abs(w - exact).max() < 0.05
     assert ((w > 0.5) == m.contains(p)).all()
+
+
+def test_pseudonormal_sign_on_a_closed_mesh_agrees_with_the_winding_number():
+    m = trimesh.creation.annulus(0.4, 1.0, 0.6, sections=32)  # concave edges and corners
+    rng = np.random.default_rng(6)
+    p = np.concatenate(
+        [rng.uniform(-1.2, 1.2, (1500, 3)), m.vertices + rng.normal(0, 1e-3, m.vertices.shape)]
+    )
+    signed = meshdist.SignedDistance(m.vertices, m.faces)
+    assert signed.closed
+    d = signed(p)
+    w = meshdist.WindingNumber(m.triangles)(p)
+    assert ((d < 0) == (w > 0.5)).all()
+    np.testing.assert_allclose(np.abs(d), meshdist.Nearest(m.triangles).distance(p))
+    assert not meshdist.SignedDistance(m.vertices, m.faces[1:]).closed

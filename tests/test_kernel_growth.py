@@ -151,3 +151,45 @@ def test_a_seed_outside_its_bounds_is_refused() -> None:
 def test_bad_parameters_are_refused(kwargs: dict, match: str) -> None:
     with pytest.raises(ValueError, match=match):
         growth.grow_step(ring(10), True, **kwargs)
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    st.integers(0, 2**32 - 1),
+    st.floats(0.0, 3.0),
+    st.floats(0.0, 5.0),
+    st.floats(0.0, 1.0),
+    st.floats(0.0, 1.0),
+    st.booleans(),
+    st.integers(5, 60),
+)
+def test_any_parameters_keep_any_star_shaped_seed_simple(
+    seed: int,
+    repulsion: float,
+    jitter: float,
+    attraction: float,
+    alignment: float,
+    closed: bool,
+    n: int,
+) -> None:
+    rng = np.random.default_rng(seed)
+    t = np.sort(rng.uniform(0.0, 2.0 * np.pi, n))
+    t = t[np.concatenate([[True], np.diff(t) > 1e-3])]
+    r = rng.uniform(1.0, 6.0, len(t))
+    p = np.c_[r * np.cos(t), r * np.sin(t)]  # star-shaped about the origin: simple
+    if len(p) < 3:
+        return
+    line = shapely.LinearRing if closed else shapely.LineString
+    for step in range(12):
+        p = growth.grow_step(
+            p,
+            closed,
+            split=1.0,
+            radius=2.0,
+            repulsion=repulsion,
+            attraction=attraction,
+            alignment=alignment,
+            jitter=jitter,
+            seed=seed + step,
+        )
+        assert line(p).is_simple, step

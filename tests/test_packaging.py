@@ -116,7 +116,17 @@ def test_no_import_circles_between_modules():
     assert not cycles, "import circles: " + "; ".join(" -> ".join(c + c[:1]) for c in cycles[:5])
 
 
-ROOMS = ["kernels", "geometry", "core", "language", "evaluation", "drawgraph", "sweeps", "cli"]
+ROOMS = [
+    "kernels",
+    "geometry",
+    "core",
+    "language",
+    "evaluation",
+    "drawgraph",
+    "sweeps",
+    "studio",
+    "cli",
+]
 
 
 @pytest.mark.parametrize("low", range(len(ROOMS)), ids=ROOMS)

@@ -289,7 +289,7 @@ nodes:
 
 
 def test_set_fills_geometry_params_from_files(tmp_path):
-    from formgraph.cli.options import parse_sets
+    from formgraph.language.params import parse_sets
 
     trimesh.creation.box().export(tmp_path / "scan.stl")
     (tmp_path / "o.svg").write_bytes(
@@ -314,7 +314,7 @@ def test_set_fills_geometry_params_from_files(tmp_path):
 
 
 def test_set_a_missing_or_bad_file_says_which_param(tmp_path):
-    from formgraph.cli.options import parse_sets
+    from formgraph.language.params import parse_sets
 
     (tmp_path / "g.yaml").write_text(PARAMS)
     g = fg.load(tmp_path / "g.yaml")

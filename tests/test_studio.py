@@ -191,6 +191,61 @@ def test_session_a_failing_node_names_itself(tmp_path):
     assert s.graph is not None  # a version that checks is current: a param may fix it
 
 
+def test_session_watches_its_subgraph_files(tmp_path):
+    (tmp_path / "part.yaml").write_text(
+        "formgraph: 1\n"
+        "params:\n"
+        "  r: {default: 1.0}\n"
+        "outputs:\n"
+        "  pts: '@pts'\n"
+        "nodes:\n"
+        "  pts:\n"
+        "    type: points.circle\n"
+        "    count: 6\n"
+        "    radius: =r\n"
+    )
+    main = tmp_path / "main.yaml"
+    main.write_text("formgraph: 1\nnodes:\n  ring:\n    type: part.yaml\n    r: 2.0\n")
+    s = StudioSession(main, out_dir=tmp_path / "out")
+    assert s.open().ok
+    assert [p.name for p in s.files()] == ["main.yaml", "part.yaml"]
+    # a broken part is still watched, so that fixing it reloads
+    (tmp_path / "part.yaml").write_text("formgraph: 1\nnodes:\n  pts:\n    type: nope\n")
+    assert not s.open().ok
+    assert [p.name for p in s.files()] == ["main.yaml", "part.yaml"]
+
+
+def test_session_watches_and_rereads_its_input_files(tmp_path):
+    (tmp_path / "pts.csv").write_text("x,y,z\n0,0,0\n1,0,0\n")
+    main = tmp_path / "main.yaml"
+    main.write_text("formgraph: 1\nnodes:\n  pts:\n    type: read.points\n    path: pts.csv\n")
+    s = StudioSession(main, out_dir=tmp_path / "out")
+    first = s.open()
+    assert first.ok and len(first.shown[0][1]) == 2
+    assert [p.name for p in s.files()] == ["main.yaml", "pts.csv"]
+    (tmp_path / "pts.csv").write_text("x,y,z\n0,0,0\n1,0,0\n2,0,0\n")
+    again = s.cook()  # the input's bytes are in its key: a recook reads it again
+    assert again.ok and len(again.shown[0][1]) == 3 and again.computed == 1
+
+
+def test_node_warnings_are_located(tmp_path):
+    path = tmp_path / "g.yaml"
+    path.write_text(
+        "formgraph: 1\n"
+        "nodes:\n"
+        "  box: {type: mesh.box}\n"
+        "  smooth:\n"
+        "    type: mesh.catmull_clark\n"
+        "    mesh: '@box'\n"
+        "    sharpness: 2\n"
+    )
+    cooked = StudioSession(path, out_dir=tmp_path / "out").open()
+    assert cooked.ok
+    (w,) = cooked.warnings
+    assert (w.where.node, w.where.line) == ("smooth", 4)
+    assert "sharpness has no effect without crease_angle" in w.message
+
+
 def test_controls_from_param_types(tmp_path):
     path = tmp_path / "g.yaml"
     path.write_text(
@@ -458,20 +513,24 @@ def test_page_shows_the_model(page):
     assert blue.mean() > 0.01
     assert "type: nurbs.sweep" in page.inner_text("#editor").replace("\xa0", " ")
     assert page.locator("#graph [data-node='tube']").count() == 1
-    assert re.search(r"6 computed, 0 cached", _status(page))
+    assert re.search(r"\d+ computed, \d+ cached in", _status(page))
+
+
+def _turns(pg) -> int:
+    return int(re.search(r"turns = (\d+)", pg.inner_text("#controls")).group(1))
 
 
 def test_slider_recooks_and_redraws(page):
-    before = _canvas(page)
+    before, turns = _canvas(page), _turns(page)
     thumb = page.locator(".fg-slider-turns .v-slider-thumb")
     thumb.focus()
-    page.keyboard.press("ArrowRight")
+    page.keyboard.press("ArrowRight" if turns < 12 else "ArrowLeft")
     page.wait_for_function("document.querySelector('#status').innerText.includes('1 cached')")
     after = _wait_picture(page, before)
     assert _shows_model(after) > 0.02
     m = re.search(r"(\d+) computed, (\d+) cached", _status(page))
     assert m and (int(m.group(1)), int(m.group(2))) == (5, 1)  # the section circle stays
-    assert "turns = 4" in page.inner_text("#controls")
+    assert _turns(page) == (turns + 1 if turns < 12 else turns - 1)
 
 
 def test_typo_shows_its_line_and_fixing_recovers(page, studio):
@@ -523,13 +582,21 @@ def test_click_a_node_shows_it(page):
 
 
 def test_an_edit_on_disk_reloads(page, studio):
-    text = studio.graph.read_text()
+    # turns set by its control (whatever ran before on this page): a reload keeps it
+    before, turns = _status(page), _turns(page)
+    page.locator(".fg-slider-turns .v-slider-thumb").focus()
+    page.keyboard.press("ArrowRight" if turns < 12 else "ArrowLeft")
+    page.wait_for_function(f"document.querySelector('#status').innerText != {before!r}")
+    page.wait_for_function(
+        f"!document.querySelector('#controls').innerText.includes('turns = {turns}\\n')"
+    )
+    text, turns = studio.graph.read_text(), _turns(page)
     studio.graph.write_text(text.replace("default: 3, min: 1", "default: 2, min: 1"))
     page.wait_for_function(
         "document.querySelector('#editor').innerText.includes('default:\u00a02,')"
     )
     page.wait_for_function("document.querySelector('#status').innerText.includes('computed')")
-    assert "turns = 4" in page.inner_text("#controls")  # the control's value is kept
+    assert _turns(page) == turns  # the control's value is kept
     # with unsaved edits in the editor, a change on disk does not overwrite them
     page.click("#editor .view-lines")
     page.keyboard.press("Control+End")
@@ -653,3 +720,36 @@ def test_choice_control_for_an_enum_param():
     graph = SimpleNamespace(params={"ends": Ends.FLAT}, param_defs={"ends": p})
     (c,) = controls_of(graph, {})
     assert (c.kind, c.value, c.choices) == ("choice", "flat", ("flat", "round"))
+    assert c.as_dict()["default"] == "flat" and type(c.as_dict()["default"]) is str
+
+
+def test_colour_by_an_attribute(tmp_path):
+    from formgraph.studio.scene import StudioScene, make_plotter
+
+    path = tmp_path / "g.yaml"
+    path.write_text(
+        "formgraph: 1\n"
+        "params:\n"
+        "  k: {default: 1.0, min: 0.5, max: 4.0}\n"
+        "nodes:\n"
+        "  box: {type: mesh.box, size: [1, 1, 2]}\n"
+        "  tall: {type: attr.set, geometry: '@box', name: tall, value: '=k * z'}\n"
+    )
+    s = StudioSession(path, out_dir=tmp_path / "out")
+    shown = s.open().shown
+    plotter = make_plotter()
+    try:
+        scene = StudioScene(plotter)
+        plain = scene.prepare(shown)
+        assert plain.attributes == ["tall"] and plain.color_by is None
+        assert "tall" not in plain.parts[("tall", "meshes")].point_data  # not sent undrawn
+        scene.apply(plain)
+        assert scene.apply(scene.prepare(shown, "tall"))  # coloured: actors made again
+        mapper = scene.parts[("tall", "meshes")].actors[0].GetMapper()
+        assert mapper.GetScalarVisibility() and mapper.GetArrayName() == "tall"
+        assert mapper.GetScalarRange() == pytest.approx((-1.0, 1.0))
+        assert not scene.apply(scene.prepare(s.set_params(k=3.0).shown, "tall"))
+        assert mapper.GetScalarRange() == pytest.approx((-3.0, 3.0))  # follows the values
+        assert scene.prepare(shown, "nope").color_by is None  # no such attribute: by node
+    finally:
+        plotter.close()

@@ -67,6 +67,8 @@ def _check_target(graph: Graph, registry: dict[str, Any], target: str) -> None:
     if base not in graph.nodes:
         raise GraphError(Problem(where, f"no node '{target}'{suggest(target, graph.nodes)}"))
     spec = registry[graph.nodes[base]]
+    if output == "frames" and graph._nodes[base].simulate is not None:
+        return  # every step's output, drawn together
     if not spec.multi_output or output not in spec.outputs:
         outputs = ", ".join(spec.outputs) if spec.multi_output else "only one, unnamed"
         raise GraphError(
@@ -233,7 +235,10 @@ class Session:
             value = outs[base]
             if t != base:
                 output = t[len(base) + 1 :]
-                value = getattr(value, output)
+                if output == "frames" and self.graph._nodes[base].simulate is not None:
+                    value = self.graph.frames(base, **self.params)  # from the caches
+                else:
+                    value = getattr(value, output)
             shown.append((t, value))
         return shown
 

@@ -12,7 +12,16 @@ from typing import Any
 
 import numpy as np
 
-from formgraph.geometry import Curve, Geometry, Mesh, NurbsCurve, NurbsSurface, Points, Surface
+from formgraph.geometry import (
+    Curve,
+    Field,
+    Geometry,
+    Mesh,
+    NurbsCurve,
+    NurbsSurface,
+    Points,
+    Surface,
+)
 
 from .style import shaded
 
@@ -119,6 +128,8 @@ def datasets_of(items: Sequence[Geometry]) -> dict[str, Any]:
     curves = [g for g in items if isinstance(g, Curve)]
     surfaces = [g for g in items if isinstance(g, Surface)]
     meshes = [g for g in items if isinstance(g, Mesh) and g.n_faces]
+    previews = [g.display_mesh() for g in items if isinstance(g, Field)]  # fields: a preview
+    meshes += [m for m in previews if m is not None and m.n_faces]
     surface_data = _merge([s.tessellate(*_surface_resolution(s)).to_pyvista() for s in surfaces])
     mesh_data = _merge([m.to_pyvista() for m in meshes])
     out: dict[str, Any] = {

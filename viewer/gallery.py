@@ -51,7 +51,8 @@ def render_gallery(
             try:
                 # exports are never drawn, but a graph must not write outside a scratch folder
                 g = load(path, out_dir=scratch)
-                screenshot(g, image, size=size)
+                # a mesh with a ``color`` attribute is drawn in its own colours
+                screenshot(g, image, size=size, color="color")
             except FormgraphError as exc:
                 entries.append(Entry(path.stem, path, image, error=str(exc)))
                 continue

@@ -124,8 +124,10 @@ class Watcher(_Watched):
         edges: bool | None = None,
         camera: Camera | None = None,
         inputs_dir: str | os.PathLike[str] | None = None,
+        color: str | None = None,
     ):
         super().__init__(path, node, sets, out_dir, budget, layout, edges, camera, inputs_dir)
+        self.color = color
         self.plotter = plotter
         self.session: Session | None = None
         self.reloads = 0
@@ -141,7 +143,7 @@ class Watcher(_Watched):
         Returns True when the new version is drawn; False when it is broken, in which case
         its error is shown in the window and on stderr and the last good geometry stays.
         """
-        from formgraph.cli.main import UsageError
+        from formgraph.core.errors import UsageError
 
         self.stamp = self._stamp()
         self.reloads += 1
@@ -157,6 +159,7 @@ class Watcher(_Watched):
                     layout=self.layout,
                     edges=self.edges,
                     camera=self.camera,
+                    color=self.color,
                 )
                 self.session.add_keys()
                 self.session.scene.set_error(None)  # an error left by a broken start
@@ -202,6 +205,7 @@ def watch(
     edges: bool | None = None,
     camera: Camera | None = None,
     inputs_dir: str | os.PathLike[str] | None = None,
+    color: str | None = None,
 ) -> Watcher:
     """Open a window on ``graph_path`` that redraws whenever the file is saved.
 
@@ -211,7 +215,7 @@ def watch(
     """
     for item in sets:
         if "=" not in item:
-            from formgraph.cli.main import UsageError
+            from formgraph.core.errors import UsageError
 
             raise UsageError(f"--set takes NAME=VALUE, got {item!r}")
     from .entry import make_plotter, view_count
@@ -237,6 +241,7 @@ def watch(
         edges=edges,
         camera=camera,
         inputs_dir=inputs_dir,
+        color=color,
     )
     watcher.reload()
     plotter.add_timer_event(
@@ -311,8 +316,10 @@ class ScreenshotWatcher(_Watched):
         out: Any = None,
         err: Any = None,
         inputs_dir: str | os.PathLike[str] | None = None,
+        color: str | None = None,
     ):
         super().__init__(path, node, sets, out_dir, budget, layout, edges, camera, inputs_dir)
+        self.color = color
         self.screenshot = Path(screenshot)
         self.size = size
         self.out = out if out is not None else sys.stdout
@@ -323,7 +330,7 @@ class ScreenshotWatcher(_Watched):
 
     def reload(self) -> bool:
         """Load, evaluate and render the file once; True when a new PNG was written."""
-        from formgraph.cli.main import UsageError
+        from formgraph.core.errors import UsageError
 
         from .entry import make_plotter
 
@@ -346,6 +353,7 @@ class ScreenshotWatcher(_Watched):
                     layout=self.layout,
                     edges=self.edges,
                     camera=self.camera,
+                    color=self.color,
                 )
                 self.screenshot.parent.mkdir(parents=True, exist_ok=True)
                 tmp = self.screenshot.with_name(f".{self.screenshot.name}.{os.getpid()}.tmp.png")

@@ -302,6 +302,7 @@ def cmd_watch(args: argparse.Namespace) -> int:
         layout=args.layout,
         edges=edges,
         camera=camera_arg(args),
+        color=args.color,
     )
     if args.screenshot:
         viewer.ScreenshotWatcher(args.graph, args.screenshot, nodes, **options).run(

@@ -60,4 +60,5 @@ def cmd_serve(args: argparse.Namespace) -> int:
         out_dir=args.out,
         sets=args.set,
         budget=args.budget,
+        inputs_dir=args.inputs,
     )

@@ -105,3 +105,7 @@ class InputError(ValueError):
     def __init__(self, port: str, message: str):
         self.port = port
         super().__init__(message)
+
+
+class UsageError(Exception):
+    """A command line that does not make sense (exit code 2); not a problem of a graph."""

@@ -196,6 +196,41 @@ def _count(elements: int | float) -> str:
     return f"about 10^{int(math.log10(elements))}"  # exact for ints of any size
 
 
+RUN_FACTOR = 4
+"""A run may hold this many budgets of elements at once (what its nodes made so far and the
+one about to be made): each node alone stays under the budget, the run under four."""
+
+
+class Estimate(Exception):
+    """Raised by :meth:`Context.guard` of a probing context: what the node would make."""
+
+    def __init__(self, elements: int | float):
+        super().__init__(elements)
+        self.elements = elements
+
+
+@dataclass
+class RunTally:
+    """The elements a run's nodes were allowed so far, against :data:`RUN_FACTOR` budgets."""
+
+    budget: int
+    total: float = 0
+
+    @property
+    def limit(self) -> int:
+        return RUN_FACTOR * self.budget
+
+    def charge(self, elements: int | float, what: str) -> None:
+        if self.total + elements > self.limit:
+            raise BudgetError(
+                f"would make {_count(elements)} {what} while the run already holds about "
+                f"{_count(self.total)} elements from earlier nodes: together over "
+                f"{RUN_FACTOR} x the budget of {self.budget:,} ({self.limit:,}), what one run "
+                "may hold at once; raise it with budget= or --budget if you mean it"
+            )
+        self.total += elements
+
+
 @dataclass
 class Context:
     """What a running node may use besides its inputs: budget, output directory, warnings.
@@ -209,9 +244,16 @@ class Context:
     warnings: list[str] = field(default_factory=list)
     written: list[Path] = field(default_factory=list)
     inputs: Callable[[str], tuple[Path, bytes]] | None = None  # input path -> (file, bytes)
+    tally: RunTally | None = None  # the run's total (None: this node alone)
+    probe: bool = False  # only asking what the node would make: guard raises Estimate
 
     def guard(self, elements: int | float, what: str = "elements") -> None:
-        """Refuse, before allocating, an output of more than the element budget."""
+        """Refuse, before allocating, an output of more than the element budget, or one
+        that would bring the run past :data:`RUN_FACTOR` budgets in all."""
+        if self.probe:
+            raise Estimate(elements)
+        if self.tally is not None and elements <= self.budget:
+            self.tally.charge(elements, what)
         if elements > self.budget:
             count = _count(elements)
             raise BudgetError(

@@ -329,7 +329,6 @@ def _running(pid: int) -> bool:
     return True
 
 
-
 def read_input(path: str | os.PathLike[str], max_bytes: int = MAX_INPUT_BYTES) -> bytes:
     """The bytes of an input file (:func:`read_regular`), its refusal a :class:`PathError`
     saying why in a sentence ("does not exist", "is a FIFO (named pipe), not a regular file",

@@ -393,6 +393,8 @@ def draw_graph(
         elif st is not None:
             box.status = st.status
             where = f" ({st.source})" if getattr(st, "source", "") in ("disk",) else ""
+            if getattr(st, "items", None) is not None:  # a repeat's items, a simulation's steps
+                where += f" {st.computed_items}/{st.items} {getattr(st, 'unit', 'items')}"
             box.status_text = f"{st.status}{where} {_seconds(st.seconds)}"
         elif ran:
             box.status = "not run"

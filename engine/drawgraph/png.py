@@ -14,11 +14,36 @@ from typing import Any
 
 import numpy as np
 
+from ..core.errors import BudgetError
 from .shapes import Circle, Rect, Shape, Text, Wire
 
-__all__ = ["rasterize"]
+__all__ = ["MAX_PIXELS", "MAX_SIDE", "MIN_SCALE", "fitted_scale", "rasterize"]
 
 SUPERSAMPLE = 2
+MAX_PIXELS = 40_000_000  # of the PNG (the canvas is SUPERSAMPLE^2 times that): ~160 MB RGB
+MAX_SIDE = 32_000  # pixels a side: what image viewers and browsers still open
+MIN_SCALE = 0.5  # pixels per drawing unit below which the text (12 units) cannot be read
+
+
+def fitted_scale(width: float, height: float, scale: float) -> float:
+    """``scale``, lowered until a ``width`` x ``height`` page fits the canvas budget.
+
+    Raises
+    ------
+    BudgetError
+        When even :data:`MIN_SCALE` pixels per unit would not fit: the graph is too large
+        for one picture (the SVG has no such limit).
+    """
+    w, h = max(width, 1e-9), max(height, 1e-9)
+    fit = min(scale, MAX_SIDE / w, MAX_SIDE / h, float(np.sqrt(MAX_PIXELS / (w * h))))
+    if fit < MIN_SCALE:
+        raise BudgetError(
+            f"the drawing is {w:,.0f} x {h:,.0f} units: as a PNG it would be "
+            f"{w * scale:,.0f} x {h * scale:,.0f} pixels, over the budget of "
+            f"{MAX_PIXELS:,} pixels ({MAX_SIDE:,} a side) even at {MIN_SCALE:g} pixels a "
+            "unit; write it as .svg, or draw fewer nodes"
+        )
+    return fit
 
 
 @lru_cache(maxsize=32)
@@ -52,10 +77,11 @@ def _dashes(points: np.ndarray, on: float, off: float) -> list[np.ndarray]:
 
 
 def rasterize(shapes: list[Shape], width: float, height: float, scale: float = 2.0) -> bytes:
-    """PNG bytes of ``shapes`` on a white ``width`` x ``height`` page, ``scale`` pixels per unit."""
+    """PNG bytes of ``shapes`` on a white ``width`` x ``height`` page, ``scale`` pixels per
+    unit -- fewer when the page would not fit the canvas budget (:func:`fitted_scale`)."""
     from PIL import Image, ImageDraw
 
-    k = scale * SUPERSAMPLE
+    k = fitted_scale(width, height, scale) * SUPERSAMPLE
     size = (max(1, int(np.ceil(width * k))), max(1, int(np.ceil(height * k))))
     img = Image.new("RGB", size, "white")
     draw = ImageDraw.Draw(img)

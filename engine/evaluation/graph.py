@@ -15,8 +15,6 @@ from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from ..core import safety
 from ..core.errors import (
     CycleError,
@@ -34,6 +32,7 @@ from ..language.params import check_param_value
 from ..language.subgraph import Includes, SubgraphSpec, is_graph_type
 from ..language.yamlio import MAX_BYTES, MAX_DEPTH, dump, parse
 from . import cache as _cache
+from .arguments import check_budgets, nesting, node_names, plain
 from .plans import Plans
 from .run import NodeStat, Step, _Run
 
@@ -64,7 +63,7 @@ def load(
     """
     if not isinstance(path, (str, os.PathLike)):
         raise GraphError(f"load() takes the path of a graph file, got {describe(path)}")
-    _check_budgets(budget, memory_bytes)
+    check_budgets(budget, memory_bytes)
     path = Path(path)
     try:
         text = safety.read_regular(path, max_bytes=MAX_BYTES).decode("utf-8")
@@ -104,7 +103,7 @@ class Graph(Plans):
         file: str | None = None,
         inputs_dir: str | os.PathLike[str] | None = None,
     ):
-        _check_budgets(budget, memory_bytes)
+        check_budgets(budget, memory_bytes)
         self.file = file
         self.description = description
         self.out_dir = Path(out_dir)
@@ -296,7 +295,7 @@ class Graph(Plans):
             if b is not None and (isinstance(b, bool) or not isinstance(b, (int, float))):
                 raise ParamError(f"param '{name}': {bound} must be a number, got {describe(b)}")
         long_form = any(x is not None for x in (min, max, type)) or bool(doc)
-        default = _plain(default, f"param '{name}'")
+        default = plain(default, f"param '{name}'")
         p = ParamDef(name, default, None, type, min, max, doc, None, long_form)
         if type is not None:
             if not isinstance(type, str):
@@ -316,7 +315,7 @@ class Graph(Plans):
             bad = name if not isinstance(name, str) else type
             raise GraphError(f"add() takes a {what} (a string), got {describe(bad)}")
         self._nodes[name] = NodeDef.make(
-            name, type, {k: _plain(v, f"input '{k}' of '{name}'") for k, v in inputs.items()}
+            name, type, {k: plain(v, f"input '{k}' of '{name}'") for k, v in inputs.items()}
         )
         self._checked = False
 
@@ -342,7 +341,7 @@ class Graph(Plans):
     def set_input(self, node: str, port: str, value: Any) -> None:
         """Change one input of a node as authored (a literal, wire or expression)."""
         nd = self._nodes[node]
-        value = _plain(value, f"input '{port}' of '{node}'")
+        value = plain(value, f"input '{port}' of '{node}'")
         if port == "repeat":  # not an input: the node's loop
             nd.set_repeat(value)
             self._checked = False
@@ -392,7 +391,7 @@ class Graph(Plans):
                     )
                 )
                 continue
-            if _nesting(value) > MAX_DEPTH:
+            if nesting(value) > MAX_DEPTH:
                 problems.append(
                     Problem(
                         Where(self.file_label, p.line),
@@ -428,23 +427,54 @@ class Graph(Plans):
     def evaluate(self, nodes: str | Iterable[str], **params: Any) -> Any:
         """Evaluate one node (returns its output) or several (returns a dict by name).
 
-        Keyword arguments override params for this call only.
+        A name may pick one output of a node with several, ``"a.ring"``, as the wire
+        ``@a.ring`` does. Keyword arguments override params for this call only.
         """
         if not self._checked:
             self.check()
         values = dict(self._values)
         values.update(self._checked_params(params))
-        names = _node_names(nodes)
-        for n in names:
-            if n not in self._nodes:
-                from ..language.params import suggest
-
-                raise GraphError(f"{self.file_label}: no node '{n}'{suggest(n, self._nodes)}")
+        names = node_names(nodes)
+        picks = {n: self._output_of(n) for n in names}
         run = _Run(self, values)
         self.stats = run.stats
-        run.run(names)
-        outs = {n: run.results[n] for n in names}
+        run.run(list(dict.fromkeys(node for node, _ in picks.values())))
+        outs = {
+            n: run.results[node] if output is None else getattr(run.results[node], output)
+            for n, (node, output) in picks.items()
+        }
         return outs[names[0]] if isinstance(nodes, str) else outs
+
+    def _output_of(self, name: str) -> tuple[str, str | None]:
+        """(node, output) of ``name``: a node, or ``node.output`` as a wire spells it."""
+        from ..language.params import suggest
+
+        if name in self._nodes:
+            return name, None
+        node, _, output = name.rpartition(".")
+        if node in self._nodes:
+            spec = self.node_types().get(self._nodes[node].type)
+            if spec is not None and spec.multi_output and output in spec.outputs:
+                return node, output
+            if spec is not None:
+                outs = ", ".join(f"{node}.{o}" for o in spec.outputs) if spec.multi_output else ""
+                raise GraphError(
+                    f"{self.file_label}: node '{node}' ({spec.name}) has no output '{output}'"
+                    + (f"; its outputs are {outs}" if outs else "; it has one output")
+                )
+        raise GraphError(f"{self.file_label}: no node '{name}'{suggest(name, self._nodes)}")
+
+    def frames(self, node: str, **params: Any) -> list[Any]:
+        """Every step's output of simulated node ``node``, in order (``@node.frames``)."""
+        nd = self._nodes.get(node)
+        if nd is None or nd.simulate is None:
+            raise GraphError(f"{self.file_label}: '{node}' is not a simulated node (simulate:)")
+        if not self._checked:
+            self.check()
+        run = _Run(self, {**self._values, **self._checked_params(params)})
+        self.stats = run.stats
+        run.run([node])
+        return run.frames_of(node)
 
     def sinks(self) -> list[str]:
         """Nodes nothing else reads from (exports, usually), in author order."""
@@ -503,65 +533,3 @@ class Graph(Plans):
 
     def __repr__(self) -> str:
         return f"Graph({self.file_label!r}, {len(self._nodes)} nodes, params={self._values})"
-
-
-def _node_names(nodes: Any) -> list[str]:
-    """The names asked for by ``evaluate(nodes)``: one name or an iterable of names."""
-    if isinstance(nodes, str):
-        return [nodes]
-    names = None
-    if isinstance(nodes, Iterable) and not isinstance(nodes, (bytes, dict)):
-        names = list(nodes)
-    if names is None or not all(isinstance(n, str) for n in names):
-        raise GraphError(
-            f"evaluate() takes a node name or a list of node names, got {describe(nodes)}"
-        )
-    return names
-
-
-def _check_budgets(budget: Any, memory_bytes: Any) -> None:
-    for what, value, least in (("budget", budget, 1), ("memory_bytes", memory_bytes, 0)):
-        if isinstance(value, bool) or not isinstance(value, int) or value < least:
-            raise GraphError(
-                f"{what} must be a whole number of {'elements' if what == 'budget' else 'bytes'}"
-                f" (at least {least}), got {describe(value)}"
-            )
-
-
-def _nesting(value: Any) -> int:
-    """How deeply lists, tuples and dicts nest in ``value``, without recursion."""
-    deepest, stack = 0, [(value, 0)]
-    while stack:
-        v, d = stack.pop()
-        if isinstance(v, (list, tuple, dict)):
-            if d + 1 > MAX_DEPTH:
-                return d + 1  # deep enough to refuse: no need to walk the rest
-            deepest = max(deepest, d + 1)
-            stack.extend((c, d + 1) for c in (v.values() if isinstance(v, dict) else v))
-        elif isinstance(v, np.ndarray):
-            deepest = max(deepest, d + v.ndim)
-    return deepest
-
-
-def _plain(value: Any, what: str = "a value", depth: int = 0) -> Any:
-    """Inputs given from Python as the YAML they save to: tuples and arrays become lists,
-    numpy numbers Python numbers (geometry objects stay as they are).
-
-    Raises
-    ------
-    GraphError
-        For a value nested deeper than a graph file may be.
-    """
-    if depth > MAX_DEPTH:
-        raise GraphError(f"{what} is nested more than {MAX_DEPTH} levels deep")
-    if isinstance(value, np.ndarray):
-        if value.ndim > MAX_DEPTH:
-            raise GraphError(f"{what} is nested more than {MAX_DEPTH} levels deep")
-        return value.tolist()
-    if isinstance(value, np.generic):
-        return value.item()
-    if isinstance(value, (list, tuple)):
-        return [_plain(v, what, depth + 1) for v in value]
-    if isinstance(value, dict):
-        return {k: _plain(v, what, depth + 1) for k, v in value.items()}
-    return value

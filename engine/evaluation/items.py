@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from ..core.errors import BudgetError, ExpressionError, GraphError, NodeError, Problem
-from ..core.registry import NodeSpec
+from ..core.registry import NodeSpec, _count
 from ..core.types import loop_item_problem
 from ..geometry import Points
 from ..language.model import Expr, Input, Items, Literal, NodeDef, Wire, wires_of
@@ -34,6 +34,7 @@ from .stats import NodeStat
 # allow as elements (50 million) would run for hours: the default budget allows 50,000
 # items, about ten seconds of the cheapest node.
 ITEM_ELEMENTS = 1000
+PROBES = 8  # items of a repeat asked what they would make before any runs
 
 __all__ = [
     "ITEM_ELEMENTS",
@@ -98,10 +99,11 @@ def _check_count(loop: str, where: Any, count: int, budget: int, scale: int = 1)
                 Problem(
                     where,
                     f"repeat '{loop}' would run {runs}, over the budget of "
-                    f"{budget:,} (each item is a node run and counts as {ITEM_ELEMENTS:,} "
-                    f"elements, so at most {budget // ITEM_ELEMENTS:,} items; raise it with "
+                    f"{budget:,} elements: each item is a node run and counts as "
+                    f"{ITEM_ELEMENTS:,} elements, so {_count(total * ITEM_ELEMENTS)} in all, "
+                    f"and at most {budget // ITEM_ELEMENTS:,} items fit; raise it with "
                     "budget= or --budget if you mean it, or place copies with "
-                    "mesh.copy_to_points)",
+                    "mesh.copy_to_points",
                 )
             ]
         )
@@ -133,6 +135,7 @@ class LanguageRun:
         src = r.source
         where = self.where(name, "repeat")
         for w in wires_of(src):  # the count is known only from the value
+            self.precheck_source(name, r.name, w.node, where)
             self.fetch(w.node)
         if isinstance(src, Wire):
             value = self.resolve(name, "repeat", src)
@@ -265,6 +268,7 @@ class LanguageRun:
             if not reads_loop(v, loop, spec.inputs[port].type)
         }
         base = self.inputs(name, nd, spec, None, skip=set(nd.inputs) - set(static))
+        self.precheck_items(name, nd, spec, items, found, base, static)
         seconds = 0.0
         size = 0
         warnings: list[str] = []
@@ -297,6 +301,77 @@ class LanguageRun:
             "computed", seconds, size, warnings, items=len(items), computed_items=computed
         )
         return self.assemble(spec, [found[k] for k in range(len(items))])
+
+    def precheck_source(self, name: str, loop: str, source: str, where: Any) -> None:
+        """Refuse a repeat over a wire whose source would make too many items, before the
+        source is computed: asked what it would make (up to its budget check), one item
+        per element it makes (a point of Points, an item of a list)."""
+        if source in self.results:
+            return
+        nd = self.g._nodes[source]
+        spec = self.registry.get(nd.type)
+        if spec is None or nd.repeat is not None or nd.simulate is not None:
+            return
+        if any(u not in self.results for u in nd.upstream()):
+            return  # its inputs are not known yet: the count check after it holds
+        est = self.estimate(source, spec, self.inputs(source, nd, spec, None))
+        if est is None or est * ITEM_ELEMENTS * self.scale <= self.g.budget:
+            return
+        raise BudgetError(
+            [
+                Problem(
+                    where,
+                    f"repeat '{loop}' would run about {_count(est)} items, one per element "
+                    f"'{source}' makes: each item is a node run and counts as "
+                    f"{ITEM_ELEMENTS:,} elements, so {_count(est * ITEM_ELEMENTS * self.scale)}"
+                    f" in all, over the budget of {self.g.budget:,}, and at most "
+                    f"{self.g.budget // ITEM_ELEMENTS:,} items fit (refused before '{source}' "
+                    "runs)",
+                )
+            ]
+        )
+
+    def precheck_items(
+        self,
+        name: str,
+        nd: NodeDef,
+        spec: NodeSpec,
+        items: list[Any],
+        found: dict[int, Any],
+        base: dict[str, Any],
+        static: dict[str, Any],
+    ) -> None:
+        """Refuse a repeat whose items together would make more than the budget, before any
+        runs: a few items (evenly spread) are asked what they would make (run up to their
+        budget check only), and their mean times the items still to compute is the total."""
+        assert nd.repeat is not None
+        pending = [k for k in range(len(items)) if k not in found]
+        if len(pending) < 2:
+            return  # one item is checked by its own guard
+        sample = sorted({pending[int(i)] for i in np.linspace(0, len(pending) - 1, PROBES)})
+        sizes = []
+        for k in sample:
+            env = dict(self.values)
+            env[nd.repeat.name] = items[k]
+            kwargs = dict(base)
+            kwargs.update(self.inputs(name, nd, spec, env, only=set(nd.inputs) - set(static)))
+            est = self.estimate(name, spec, kwargs)
+            if est is None:
+                return  # it makes no budget check: each item's own run is all we know
+            sizes.append(est)
+        per = float(np.mean(sizes))
+        total = per * len(pending)
+        if total > self.g.budget:
+            raise BudgetError(
+                [
+                    Problem(
+                        self.where(name, "repeat"),
+                        f"repeat '{nd.repeat.name}' would run {len(pending):,} items of about "
+                        f"{_count(per)} elements each, {_count(total)} in all, over the budget "
+                        f"of {self.g.budget:,} (raise it with budget= or --budget if you mean it)",
+                    )
+                ]
+            )
 
     def run_subgraph(
         self,

@@ -34,13 +34,14 @@ from ..core.errors import (
     Problem,
     Where,
 )
-from ..core.registry import Context, NodeSpec, node_types
+from ..core.registry import Context, Estimate, NodeSpec, RunTally, node_types
 from ..core.types import Entries, TypeMismatch
 from ..language.elements import bind_elements, reads_elements
 from ..language.model import FRAMES, STEP, Expr, Input, Items, Literal, NodeDef, Wire, wires_of
 from ..language.subgraph import SubgraphSpec
 from . import cache as _cache
 from .items import LanguageRun, file_stamp, input_names, reads_loop
+from .replay import Replay
 from .simulation import SimulationRun
 from .stats import NodeStat, Step
 
@@ -71,7 +72,7 @@ class GraphView(Protocol):
     def _child(self, spec: SubgraphSpec) -> GraphView: ...
 
 
-class _Run(LanguageRun, SimulationRun):
+class _Run(LanguageRun, SimulationRun, Replay):
     """One evaluation call: memoized keys, identities and values, and the run record."""
 
     def __init__(
@@ -108,6 +109,7 @@ class _Run(LanguageRun, SimulationRun):
                 g._pure_root = (str(g.out_dir), self.out_path)
         self.out_dir = str(self.out_path)
         self.total = 0
+        self.tally = RunTally(g.budget)  # what this run's nodes hold together
         self.started: set[str] = set()  # nodes that began computing, for the progress line
         self.quiet = False  # inside run(): numpy's warnings are silenced once, not per node
         # node -> input path -> (file, bytes): read once when keyed, handed to the node
@@ -142,6 +144,9 @@ class _Run(LanguageRun, SimulationRun):
             if r is not None and not wires_of(r.source):
                 self.repeat_items(n)
                 self.precheck_nested(n)
+            elif r is not None:  # over a wire: what its source would make, before it runs
+                for w in wires_of(r.source):
+                    self.precheck_source(n, r.name, w.node, self.where(n, "repeat"))
             if self.g._nodes[n].simulate is not None:
                 self.step_count(n)
         for n in order:
@@ -158,60 +163,6 @@ class _Run(LanguageRun, SimulationRun):
         self.input_files.clear()  # the bytes of inputs whose nodes came from a cache
         if replayed is None:
             self.remember(targets, order)
-
-    # Keys kept per graph version: a run of the same targets with the same params on the
-    # unchanged graph (every change clears `_replay`) whose upstream identities are all
-    # still what they were has the same keys, so the order and the keys of the last such run
-    # are reused instead of rebuilding every key's text (2 ms for 200 nodes; the check of
-    # the identities is a dict look-up a node). Only plain runs: no plan (pure), no wired
-    # subgraph params (tokens), no repeated or simulated nodes (their items and steps are
-    # found with their keys), no input files (their bytes are in the keys).
-    _REPLAYS = 8  # target lists remembered per graph
-
-    def _replay_state(self, order: list[str]) -> tuple | None:
-        if self.pure or self.tokens:
-            return None
-        try:
-            values = _cache.key_text(self.values)
-        except (TypeError, ValueError):
-            return None
-        specs = tuple(self.registry.get(self.g._nodes[n].type) for n in order)
-        return values, self.out_dir, specs
-
-    def replay(self, targets: list[str]) -> list[str] | None:
-        memo = self.g._replay.get(tuple(targets))
-        if memo is None:
-            return None
-        order, state, keys, identities = memo
-        if self._replay_state(order) != state:
-            return None
-        ident = self.g._identity
-        for key, identity in identities.items():
-            if ident.get(key) != identity:
-                return None
-        self.keys.update(keys)
-        return order
-
-    def remember(self, targets: list[str], order: list[str]) -> None:
-        if getattr(self, "keyed_files", False):  # an input file may change between runs
-            return
-        nodes = self.g._nodes
-        if any(nodes[n].repeat is not None or nodes[n].simulate is not None for n in order):
-            return
-        state = self._replay_state(order)
-        if state is None:
-            return
-        keys = {n: self.keys[n] for n in order if n in self.keys}
-        if len(keys) != len(order):
-            return
-        ident = self.g._identity
-        identities = {k: ident[k] for k in keys.values() if k in ident}
-        if len(identities) != len(set(keys.values())):
-            return
-        memo = self.g._replay
-        if len(memo) >= self._REPLAYS:
-            memo.pop(next(iter(memo)))
-        memo[tuple(targets)] = (order, state, keys, identities)
 
     def identity(self, name: str) -> str:
         # identity of the value that flows out of a node: its key, or an earlier identical
@@ -479,6 +430,21 @@ class _Run(LanguageRun, SimulationRun):
                 raise GraphError([Problem(self.where(name, port), str(exc))]) from None
         return kwargs
 
+    def estimate(self, name: str, spec: NodeSpec, kwargs: dict[str, Any]) -> float | None:
+        """What node ``name`` would make on ``kwargs``, by running it only to its first
+        budget check (``Context.guard``); None when it makes no such check."""
+        if not spec.wants_context or isinstance(spec, SubgraphSpec):
+            return None
+        ctx = Context(name, self.out_path, self.g.budget, [], probe=True)
+        try:
+            with contextlib.nullcontext() if self.quiet else _quiet_numpy():
+                spec.func(**{**kwargs, "ctx": ctx})
+        except Estimate as est:
+            return float(est.elements)
+        except Exception:  # the real call reports it, located
+            return None
+        return None
+
     def call(
         self,
         name: str,
@@ -496,6 +462,7 @@ class _Run(LanguageRun, SimulationRun):
                 self.g.budget,
                 warnings,
                 inputs=lambda relpath: self.read_input(name, relpath),
+                tally=self.tally,
             )
         if self.g.progress is not None:  # counted as it goes: linear in the graph's size
             self.g.progress(name, len(self.started) - (name in self.started), self.total)
@@ -577,7 +544,8 @@ class _Run(LanguageRun, SimulationRun):
     def bind_expression(
         self, name: str, port: str, pt: Any, text: Any, env: dict[str, Any] | None = None
     ) -> Any:
-        from ..language.expr import Bound, compile_expression
+        from ..language.bound import Bound
+        from ..language.expr import compile_expression
 
         values = self.values if env is None else env
         allowed = set(values) | set(pt.variables)

@@ -168,6 +168,8 @@ class SimulationRun:
             hit, value, _ = self.lookup(key, spec)
             if not hit:
                 if state is None:
+                    for u in dict.fromkeys(nd.upstream()):
+                        self.fetch(u)
                     state = self.start_value(name, nd, spec)
                 value = stepper.step(k, state)
             out.append(value)
@@ -215,13 +217,17 @@ class _Stepper:
             for port, v in nd.inputs.items()
             if port != state and reads_loop(v, STEP, spec.inputs[port].type)
         }
-        self.base = run.inputs(name, nd, spec, None, skip=self.varying | {state})
+        self.base: dict[str, Any] | None = None  # resolved at the first step that runs
         self.seconds = 0.0
         self.warnings: list[str] = []
         self.computed = 0
 
     def step(self, k: int, state: Any) -> Any:
         run, name, nd, spec = self.run, self.name, self.nd, self.spec
+        if self.base is None:
+            for u in dict.fromkeys(nd.upstream()):  # a frame recomputed late needs them
+                run.fetch(u)
+            self.base = run.inputs(name, nd, spec, None, skip=self.varying | {nd.simulate.state})
         env = dict(run.values)
         env[STEP] = k
         kwargs = dict(self.base)

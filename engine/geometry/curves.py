@@ -155,7 +155,8 @@ class ParametricCurve(Curve):
     """A curve given by expressions ``x(t), y(t), z(t)`` over ``domain``.
 
     ``fx, fy, fz`` are callables taking ``t=array``; ``samples`` is how finely it is drawn
-    and sampled by default. Derivatives are central finite differences.
+    and sampled by default. Derivatives are exact for expressions (forward-mode
+    differentiation of their syntax tree), central differences for other callables.
     """
 
     fx: Callable[..., Any]
@@ -181,14 +182,31 @@ class ParametricCurve(Curve):
         return xyz[0] if scalar else xyz
 
     def derivative(self, t: Any, order: int = 1) -> np.ndarray:
+        """The first or second derivative, exact: the expressions are differentiated
+        (forward mode over their syntax tree); by central differences only for what has no
+        derivative there (``noise``) or callables that are not expressions."""
+        if order not in (1, 2):
+            raise ValueError(f"derivative order {order} is not supported on a parametric curve")
+        exact = self._exact(t, order)
+        if exact is not None:
+            return exact
         t0, t1 = self.domain
         h = (t1 - t0) * 1e-5
         tt = np.clip(np.asarray(t, dtype=np.float64), t0 + order * h, t1 - order * h)
         if order == 1:
             return (self.evaluate(tt + h) - self.evaluate(tt - h)) / (2 * h)
-        if order == 2:
-            return (self.evaluate(tt + h) - 2 * self.evaluate(tt) + self.evaluate(tt - h)) / h**2
-        raise ValueError(f"derivative order {order} is not supported on a parametric curve")
+        return (self.evaluate(tt + h) - 2 * self.evaluate(tt) + self.evaluate(tt - h)) / h**2
+
+    def _exact(self, t: Any, order: int) -> np.ndarray | None:
+        fs = (self.fx, self.fy, self.fz)
+        if not all(hasattr(f, "taylor") for f in fs):
+            return None
+        tt = np.asarray(t, dtype=np.float64)
+        try:
+            cols = [f.taylor("t", t=tt)[order] for f in fs]  # type: ignore[attr-defined]
+        except ValueError:  # NotDifferentiable
+            return None
+        return np.stack([np.broadcast_to(c, tt.shape) for c in cols], axis=-1)
 
     def display_points(self) -> np.ndarray:
         return self.sample(max(2, self.samples))

@@ -130,16 +130,29 @@ class Field(Geometry):
     def __repr__(self) -> str:
         return f"Field({self.op}{', bounded' if self.bounds is not None else ''})"
 
-    def to_pyvista(self) -> Any:
-        """The zero set meshed at 1/64 of the bounds' largest side (bounded fields only)."""
-        if self.bounds is None:
-            raise ValueError("an unbounded field has no shape to show; mesh it with bounds")
+    def display_mesh(self) -> Any:
+        """A preview Mesh: the zero set at 1/64 of the bounds' largest side; an unbounded
+        TPMS in a cube of two periods; None for other unbounded fields."""
         from ..kernels.field.mesher import mesh_field
         from .mesh import Mesh
 
-        cell = float((self.bounds[1] - self.bounds[0]).max()) / 64 or 1.0
-        v, t = mesh_field(self.evaluate, self.bounds[0], self.bounds[1], cell, self.lipschitz)
-        return Mesh(v, t.reshape(-1), np.arange(0, 3 * len(t) + 1, 3)).to_pyvista()
+        field = self
+        if self.bounds is None and self.op == "tpms":
+            side = 2.0 * self.args["period"]
+            field = Field.intersection([self, Field.box([side] * 3, [side / 2] * 3)])
+        if field.bounds is None:
+            return None
+        lo, hi = field.bounds
+        cell = float((hi - lo).max()) / 64 or 1.0
+        v, t = mesh_field(field.evaluate, lo, hi, cell, field.lipschitz)
+        return Mesh(v, t.reshape(-1), np.arange(0, 3 * len(t) + 1, 3))
+
+    def to_pyvista(self) -> Any:
+        """The preview mesh (:meth:`display_mesh`) as pyvista PolyData."""
+        preview = self.display_mesh()
+        if preview is None:
+            raise ValueError("an unbounded field has no shape to show; mesh it with bounds")
+        return preview.to_pyvista()
 
     # ------------------------------------------------------------------ constructors
 
@@ -305,13 +318,10 @@ def _from_mesh(field: Field, p: np.ndarray) -> np.ndarray:
     from ..kernels.field import meshdist
 
     cache = field._cache
-    if "nearest" not in cache:
+    if "signed" not in cache:
         mesh = field.args["mesh"]
-        tri = mesh.vertices[_triangles(mesh)]
-        cache["nearest"] = meshdist.Nearest(tri)
-        cache["winding"] = meshdist.WindingNumber(tri)
-    d = cache["nearest"].distance(p)
-    return np.where(cache["winding"](p) > 0.5, -d, d)
+        cache["signed"] = meshdist.SignedDistance(mesh.vertices, _triangles(mesh))
+    return cache["signed"](p)
 
 
 def _triangles(mesh: Any) -> np.ndarray:

@@ -180,6 +180,29 @@ class ParametricSurface(Surface):
             )
         return xyz
 
+    def partials(self, u: Any, v: Any) -> tuple[np.ndarray, np.ndarray]:
+        """``S_u`` and ``S_v`` at (u, v): exact for expressions (forward-mode differentiation
+        of their syntax tree), central differences otherwise (``noise``, plain callables)."""
+        uu, vv = np.broadcast_arrays(np.asarray(u, np.float64), np.asarray(v, np.float64))
+        fs = (self.fx, self.fy, self.fz)
+        if all(hasattr(f, "taylor") for f in fs):
+            try:
+                su = [f.taylor("u", u=uu, v=vv)[1] for f in fs]  # type: ignore[attr-defined]
+                sv = [f.taylor("v", u=uu, v=vv)[1] for f in fs]  # type: ignore[attr-defined]
+                return np.stack(su, axis=-1), np.stack(sv, axis=-1)
+            except ValueError:  # NotDifferentiable: differences below
+                pass
+        (u0, u1), (v0, v1) = self.domain_u, self.domain_v
+        hu, hv = (u1 - u0) * 1e-5, (v1 - v0) * 1e-5
+        su_fd = (self.evaluate(uu + hu, vv) - self.evaluate(uu - hu, vv)) / (2 * hu)
+        sv_fd = (self.evaluate(uu, vv + hv) - self.evaluate(uu, vv - hv)) / (2 * hv)
+        return su_fd, sv_fd
+
+    def normals(self, u: Any, v: Any) -> np.ndarray:
+        """``S_u x S_v`` at (u, v), not normalized (as NurbsSurface.normals)."""
+        su, sv = self.partials(u, v)
+        return np.cross(su, sv)
+
     def __repr__(self) -> str:
         return f"ParametricSurface(u={self.domain_u}, v={self.domain_v})"
 

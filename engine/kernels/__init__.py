@@ -7,5 +7,6 @@ benchmarked alone. One package per family, mirroring ``nodes/``:
 - ``curves``: Bezier and Catmull-Rom splines, polyline subdivision, resampling, offset;
 - ``mesh``: half-edges, subdivision, mesh operations, structured grids;
 - ``offset``: distance fields, marching squares, loop clean-up and refinement;
+- ``field``: signed distance functions, mesh distances, adaptive meshing of zero sets;
 - ``io``: STL, OBJ, PLY, SVG, PDF and DXF writers and their number formatting.
 """

@@ -26,6 +26,7 @@ from ..core.types import (
 )
 from .elements import reads_elements
 from .expr import compile_expression
+from .inference import expression_ports_take_text, infer_fed
 from .model import FRAMES, STEP, Expr, Input, Items, Literal, NodeDef, ParamDef, Wire
 from .order import cycle_problems, kahn_order
 from .params import check_param_value, suggest
@@ -70,6 +71,7 @@ def check_graph(g: Outline, extra: list[Problem] | None = None) -> list[Problem]
 
     from .expr import CONSTANTS, FUNCTIONS
 
+    infer_fed(g, registry)
     for p in g.params.values():
         if not p.name.isidentifier() or p.name.startswith("_"):
             problems.append(
@@ -101,6 +103,8 @@ def check_graph(g: Outline, extra: list[Problem] | None = None) -> list[Problem]
 
     for nd in g.nodes.values():
         spec = registry.get(nd.type)
+        if spec is not None:
+            expression_ports_take_text(g, nd, spec)
         if spec is None:
             if nd.type.endswith((".yaml", ".yml")):
                 continue  # a graph file: its problems come from reading it
@@ -316,7 +320,13 @@ def _check_node(
         add(message, port)
     loop = loop or step
     for port in nd.raw:
-        if port not in spec.inputs:
+        if port not in spec.inputs and nd.raw[port] is None and " " in str(port):
+            add(
+                f"the text {port!r} became an input of its own, because inside {{...}} a "
+                "', ' ends a value: put text that holds ', ' in quotes",
+                port,
+            )
+        elif port not in spec.inputs:
             add(
                 f"'{nd.type}' has no input '{port}'{suggest(port, spec.inputs)}; its inputs are "
                 f"{', '.join(spec.inputs) or 'none'}",

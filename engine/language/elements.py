@@ -22,10 +22,10 @@ from typing import Any
 
 import numpy as np
 
-from .expr import Bound
+from .bound import Bound
 from .model import Expr, Input, Items, Literal
 
-__all__ = ["ElementValue", "bind_elements", "element_env", "reads_elements"]
+__all__ = ["VARIABLES", "ElementValue", "bind_elements", "element_env", "reads_elements"]
 
 VARIABLES = ("x", "y", "z", "nx", "ny", "nz", "i", "count")
 
@@ -54,7 +54,7 @@ class ElementValue:
     Attributes
     ----------
     parts : tuple
-        :class:`~formgraph.language.expr.Bound` expressions and plain numbers.
+        :class:`~formgraph.language.bound.Bound` expressions and plain numbers.
     vector : bool
         Whether it was written as a list (``[0, 0, "=360 * rand(i)"]``).
     """
@@ -94,7 +94,7 @@ class ElementValue:
                     f"attribute of the {what} (attributes: {have})"
                 )
         cols = []
-        for p in self.parts:
+        for j, p in enumerate(self.parts):
             if isinstance(p, Bound):
                 with np.errstate(all="ignore"):
                     v = np.asarray(p.compiled(p.params, **env), dtype=np.float64)
@@ -104,6 +104,11 @@ class ElementValue:
                 if v.ndim > 1 or (v.ndim == 1 and self.vector):
                     raise ValueError(f"{self.text} gives an array of shape {v.shape}")
                 v = np.broadcast_to(v, (count,) + v.shape)
+            if self.vector and v.ndim != 1:
+                raise ValueError(
+                    f"component {j} of {self.text} gives {v.shape[1:]} values per element; "
+                    f"each component must be one number per element"
+                )
             cols.append(v)
         out = np.stack(cols, axis=1) if self.vector else cols[0]
         if out.ndim > 2:
@@ -127,39 +132,47 @@ def bind_elements(value: Input, params: Mapping[str, Any]) -> ElementValue:
     return ElementValue((bind(value),), False)
 
 
-def element_env(geometry: Any, domain: str = "point") -> dict[str, Any]:
+def element_env(
+    geometry: Any, domain: str = "point", names: set[str] | None = None
+) -> dict[str, Any]:
     """The names a per-element expression reads for the points (``domain="point"``) or
     faces (``"face"``) of a Points or a Mesh: coordinates, normals (a ``normal``
-    attribute, else a mesh's vertex or face normals), index, count, attributes."""
+    attribute, else a mesh's vertex or face normals), index, count, attributes.
+
+    ``names``: the names the expressions read, if known; a mesh's normals are then only
+    computed when ``nx``, ``ny`` or ``nz`` is among them."""
     from ..geometry import Mesh
 
+    want_normals = names is None or bool({"nx", "ny", "nz"} & names)
     if domain == "face":
         from ..kernels.mesh import meshops
 
         xyz = _face_centres(geometry)
         data = geometry.face_data
         normals = data.get("normal")
-        if normals is None:
+        if normals is None and want_normals:
             normals = meshops.face_normals(*geometry.arrays)
     else:
         xyz = geometry.vertices if isinstance(geometry, Mesh) else geometry.xyz
         data = geometry.point_data
         normals = data.get("normal")
-        if normals is None and isinstance(geometry, Mesh) and geometry.n_faces:
+        if normals is None and want_normals and isinstance(geometry, Mesh) and geometry.n_faces:
             from ..kernels.mesh.solidify import vertex_normals
 
             normals = vertex_normals(*geometry.arrays)
     n = len(xyz)
-    env: dict[str, Any] = {
-        "x": xyz[:, 0],
-        "y": xyz[:, 1],
-        "z": xyz[:, 2],
-        "i": np.arange(n, dtype=np.float64),
-        "count": float(n),
-    }
+    env: dict[str, Any] = dict(data)  # the variables below win over a same-named attribute
+    env.update(
+        {
+            "x": xyz[:, 0],
+            "y": xyz[:, 1],
+            "z": xyz[:, 2],
+            "i": np.arange(n, dtype=np.float64),
+            "count": float(n),
+        }
+    )
     if normals is not None and np.shape(normals) == (n, 3):
         env.update(nx=normals[:, 0], ny=normals[:, 1], nz=normals[:, 2])
-    env.update(data)
     return env
 
 

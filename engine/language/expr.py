@@ -143,28 +143,6 @@ class Compiled:
         return self.text.strip().isidentifier() and self.text.strip() not in CONSTANTS
 
 
-@dataclass(frozen=True)
-class Bound:
-    """An expression with its graph params bound; nodes call it with their own variables.
-
-    Example
-    -------
-    >>> x = Bound(compile_expression("r * cos(t)"), {"r": 2.0})
-    >>> float(x(t=0.0))
-    2.0
-    """
-
-    compiled: Compiled
-    params: Mapping[str, Any]
-
-    @property
-    def text(self) -> str:
-        return self.compiled.text
-
-    def __call__(self, **variables: Any) -> Any:
-        return self.compiled(self.params, **variables)
-
-
 def compile_expression(text: str, allowed: set[str] | frozenset[str] | None = None) -> Compiled:
     """Compile ``text`` into a :class:`Compiled` closure tree.
 

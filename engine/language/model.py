@@ -226,6 +226,9 @@ class ParamDef:
     doc: str = ""
     line: int | None = None
     long_form: bool = False
+    # what the ports its expressions feed ask for (set by the check): a whole-number param
+    # that feeds only float ports is a float, so ``--set r=2.5`` works on ``r: 2``
+    fed: type | None = field(default=None, compare=False)
 
     def to_yaml(self) -> Any:
         if not self.long_form:

@@ -4,14 +4,19 @@ range, the warnings about guessed types, and "did you mean" for names."""
 from __future__ import annotations
 
 import difflib
-from collections.abc import Mapping
+import struct
+import zlib
+from collections.abc import Mapping, Sequence
 from typing import Any
 
-from ..core.errors import Problem, Where
+import yaml
+
+from ..core.errors import GraphError, Problem, UsageError, Where
+from ..core.registry import DEFAULT_BUDGET
 from ..core.types import Kind, PortType, TypeMismatch, number_text
 from .model import ParamDef
 
-__all__ = ["check_param_value", "param_kind", "param_warnings", "suggest"]
+__all__ = ["check_param_value", "param_kind", "param_warnings", "parse_sets", "suggest"]
 
 
 def suggest(name: str, options: Any) -> str:
@@ -27,7 +32,9 @@ def param_kind(p: ParamDef) -> type | None:
     """The scalar type of a param without a declared ``type:``, read from how it is written.
 
     A number is an ``int`` only when its default, min and max are all written as whole
-    numbers (``{default: 3, min: 0.5, max: 10}`` is a float); None for anything else.
+    numbers (``{default: 3, min: 0.5, max: 10}`` is a float) and it feeds no port that
+    asks for a float only (``r: 2`` feeding a radius is a float: ``p.fed``, set by the
+    check's ``infer_fed``); None for anything else.
     """
     if p.type is not None:
         return None
@@ -35,7 +42,8 @@ def param_kind(p: ParamDef) -> type | None:
     if isinstance(d, (bool, str)):
         return type(d)
     if _whole(d):
-        return int if all(_whole(b) for b in (p.min, p.max) if b is not None) else float
+        whole = all(_whole(b) for b in (p.min, p.max) if b is not None)
+        return int if whole and p.fed is not float else float
     if isinstance(d, float):
         return float
     return None
@@ -74,3 +82,105 @@ def param_warnings(params: Mapping[str, ParamDef], file: str) -> list[Problem]:
                 )
             )
     return out
+
+
+def parse_sets(graph: Any, items: Sequence[str]) -> dict[str, Any]:
+    """``NAME=VALUE`` pairs parsed by each param's type (YAML scalars, lists allowed)."""
+    out: dict[str, Any] = {}
+    defs = graph.param_defs
+    for item in items:
+        name, sep, text = item.partition("=")
+        name = name.strip()
+        if not sep or not name:
+            raise UsageError(f"--set takes NAME=VALUE, got {item!r} (node names go before --set)")
+        if name not in defs:
+            raise GraphError(
+                f"--set {name}: unknown param{suggest(name, defs)}; params are "
+                f"{', '.join(defs) or 'none'}"
+            )
+        from .yamlread import load_value
+
+        kind = param_kind(defs[name])
+        declared = defs[name].type
+        if declared is not None and declared.is_geometry:
+            out[name] = file_value(name, declared, text)
+            continue
+        if kind is str:
+            value: Any = text
+        elif kind in (int, float):
+            value = _number(text)
+            if kind is float and isinstance(value, int):
+                value = float(value)
+        else:
+            try:
+                value = load_value(text)  # YAML 1.2 numbers, as in the graph file
+            except (yaml.YAMLError, ValueError, TypeError, RecursionError) as exc:
+                shown = text if len(text) <= 40 else text[:37] + "..."
+                why = getattr(exc, "problem", None) or exc
+                raise UsageError(f"--set {name}: cannot read {shown!r}: {why}") from None
+        out[name] = value
+    return out
+
+
+def file_value(name: str, declared: Any, text: str) -> Any:
+    """The geometry a ``--set NAME=FILE`` names, read as the ``read.*`` node would read it.
+
+    The path is the user's own (relative to the working directory, not confined: a graph
+    from elsewhere cannot choose it), opened as a regular file under the input size cap.
+
+    Raises
+    ------
+    GraphError
+        A file that cannot be read, or whose content does not fit the param's type.
+    """
+    from pathlib import Path
+
+    from ..core import safety
+    from ..core.errors import PathError
+    from ..geometry import Mesh, NurbsCurve, Points
+    from ..kernels.io import readers
+
+    kind = declared.kinds[0]
+    base, many = kind.base, kind.is_list
+    try:
+        data = safety.read_input(Path(text).expanduser())
+    except PathError as exc:
+        raise GraphError(f"--set {name}: {exc}") from None
+    try:
+        if base is Mesh and not many:
+            return Mesh(*readers.mesh_arrays(text, data))
+        if base is Points and not many:
+            ext = readers.extension(text, readers.POINT_FORMATS)
+            return Points(readers.POINT_FORMATS[ext](data))
+        if base.__name__ in ("Curve", "NurbsCurve"):
+            ext = readers.extension(text, readers.CURVE_FORMATS)
+            found, _ = readers.CURVE_FORMATS[ext](data, DEFAULT_BUDGET)
+            curves = [NurbsCurve(*c.curve) for c in found]
+            if many:
+                return curves
+            if len(curves) != 1:
+                raise ValueError(
+                    f"it holds {len(curves)} curves; a Curve param takes one (declare the "
+                    f"param list[Curve] for all of them)"
+                )
+            return curves[0]
+    except (ValueError, IndexError, KeyError, TypeError, OverflowError, RecursionError,
+            struct.error, zlib.error) as exc:  # fmt: skip
+        raise GraphError(f"--set {name}: cannot read {text!r}: {exc}") from None
+    raise GraphError(
+        f"--set {name}: a {declared.name} param is not read from a file (Mesh, Points, Curve "
+        f"and list[Curve] are)"
+    )
+
+
+def _number(text: str) -> Any:
+    """A number as people type it: 3, -2.5, 1e3, 0x10 (YAML 1.1 would read 1e3 as text)."""
+    for parse in (int, float):
+        try:
+            return parse(text.strip().replace("_", ""))
+        except ValueError:
+            pass
+    try:
+        return int(text.strip(), 0)
+    except ValueError:
+        return text  # the param's check then says what was expected

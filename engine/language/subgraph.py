@@ -54,7 +54,7 @@ def _run_elsewhere(**kwargs: Any) -> Any:  # pragma: no cover - the graph runs s
 def _param_port(p: ParamDef) -> Port:
     rng = Range(p.min, p.max) if (p.min is not None or p.max is not None) else None
     if p.type is not None:
-        t = PortType(p.type.kinds, optional=p.default is not None)
+        t = PortType(p.type.kinds, range=rng)  # the default fills it: not None-able
         return Port(p.name, t, REQUIRED if p.default is None else p.default, p.doc)
     base: Any = param_kind(p) or Any  # an int only when written whole throughout
     return Port(p.name, PortType((Kind(base),), range=rng), p.default, p.doc)

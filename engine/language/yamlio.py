@@ -253,6 +253,15 @@ def _param(
     if not isinstance(value, dict):
         return ParamDef(name, value, line=line)
     unknown = set(value) - {"default", "min", "max", "doc", "type"}
+    stray = sorted(str(k) for k in unknown if value[k] is None and " " in str(k))
+    if stray:  # {doc: degrees, bottom to top}: the ", " ended the text
+        problem(
+            f"param '{name}': the text {stray[0]!r} became a key of its own, because inside "
+            "{...} a ', ' ends a value: put text that holds ', ' in quotes "
+            f'(doc: "..., {stray[0]}")',
+            line,
+        )
+        unknown -= set(stray)
     if unknown:
         problem(
             f"param '{name}': unknown key(s) {', '.join(sorted(map(str, unknown)))} "

@@ -7,7 +7,8 @@
   engine (no trame here);
 - :mod:`.worker`: the thread that runs the session's requests, newest first;
 - :mod:`.scene`: node values as vtk actors the browser draws, updated in place;
-- :mod:`.page`: the trame page (editor, 3-D view, graph drawing, controls, status);
+- :mod:`.page`: the trame page's state and wiring (requests out, results shown);
+- :mod:`.layout`: its widgets (editor, 3-D view, graph drawing, controls, status);
 - :mod:`.guard`: the token, Host and Origin checks in front of every request;
 - :mod:`.app`: :func:`serve`.
 

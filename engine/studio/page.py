@@ -1,10 +1,11 @@
-"""The studio's page: trame widgets bound to a :class:`~.session.StudioSession`.
+"""The studio's page: a trame server whose state shows a :class:`~.session.StudioSession`.
 
-Left, the YAML in Monaco (trame-code) with the check's problems marked at their lines and
-listed under it; in the middle, the 3-D view (vtk.js in the browser, fed by
-:class:`~.scene.StudioScene`) over the drawing of the graph (:func:`formgraph.draw_graph`,
-coloured computed / cached / failed with times; a click on a node shows it); right, a
-control per param with its reset. The top bar holds Save, Run and the status line.
+Its widgets (:mod:`.layout`): left, the YAML in Monaco (trame-code) with the check's
+problems marked at their lines and listed under it; in the middle, the 3-D view (vtk.js in
+the browser, fed by :class:`~.scene.StudioScene`) over the drawing of the graph
+(:func:`formgraph.draw_graph`, coloured computed / cached / failed with times; a click on a
+node shows it); right, a control per param with its reset. The top bar holds Save, Run,
+Reload and the status line.
 
 Everything the page asks of the engine goes through one :class:`~.worker.Worker`; results
 come back to the event loop (``call_soon_threadsafe``) and are shown there.
@@ -20,7 +21,8 @@ from typing import Any
 
 from formgraph.core.errors import Problem
 
-from .session import Control, Cooked, StudioSession, controls_of
+from .layout import build
+from .session import Control, Cooked, StudioSession, controls_of, plain
 from .worker import Worker
 
 __all__ = ["Page"]
@@ -29,31 +31,10 @@ EDIT_DELAY = 0.35  # seconds of no typing before an edit is checked and cooked
 POLL_SECONDS = 0.5  # how often the graph's files are looked at
 _names = itertools.count()
 
-CSS = """
-html, body { overflow: hidden; }
-.fg-main { display: flex; height: calc(100vh - 48px); }
-.fg-left { flex: 0 0 32%; min-width: 0; display: flex; flex-direction: column;
-  border-right: 1px solid #ddd; }
-.fg-editor { flex: 1 1 auto; min-height: 0; }
-.fg-problems { max-height: 30%; overflow: auto; font: 12px monospace; color: #b00020;
-  padding: 4px 8px; border-top: 1px solid #ddd; white-space: pre-wrap; }
-.fg-center { flex: 1 1 auto; display: flex; flex-direction: column; min-width: 0; }
-.fg-view { flex: 1 1 62%; position: relative; min-height: 0; }
-.fg-graph { flex: 0 0 38%; overflow: auto; border-top: 1px solid #ddd; background: white; }
-.fg-graph svg { cursor: pointer; max-width: 100%; height: auto; }
-.fg-right { flex: 0 0 250px; overflow-y: auto; border-left: 1px solid #ddd; padding: 6px 10px; }
-.fg-control { margin-bottom: 6px; }
-.fg-control-name { font-size: 12px; color: #333; display: flex; align-items: center;
-  justify-content: space-between; }
-.fg-status { font: 13px sans-serif; margin-left: 12px; white-space: nowrap; overflow: hidden;
-  text-overflow: ellipsis; }
-.fg-status.bad { color: #b00020; }
-"""
 
-
-def _markers(problems: list[Problem]) -> list[dict[str, Any]]:
+def _markers(problems: list[Problem], severity: str = "error") -> list[dict[str, Any]]:
     return [
-        {"line": p.where.line, "message": p.message, "severity": "error"}
+        {"line": p.where.line, "message": p.message, "severity": severity}
         for p in problems
         if p.where.line is not None
     ]
@@ -66,32 +47,6 @@ def _problem_lines(problems: list[Problem]) -> list[str]:
         node = f"node '{p.where.node}': " if p.where.node else ""
         out.append(f"{where}{node}{p.message}")
     return out
-
-
-def clickable_svg(drawing: Any) -> str:
-    """The drawing's SVG with an invisible rectangle over each node box, ``data-node`` set
-    to the node's name (the page's click handler reads it)."""
-    from xml.sax.saxutils import quoteattr
-
-    boxes = []
-    rect = None
-    for shape in drawing.shapes:
-        cls = getattr(shape, "cls", "")
-        if cls == "node":
-            rect = shape
-        elif cls == "param":
-            rect = None
-        elif cls == "name" and rect is not None:
-            boxes.append((shape.text, rect))
-            rect = None
-    hits = "".join(
-        f'<rect data-node={quoteattr(name)} x="{r.x:.1f}" y="{r.y:.1f}" width="{r.w:.1f}" '
-        f'height="{r.h:.1f}" fill="transparent" stroke="none"/>'
-        for name, r in boxes
-    )
-    svg = drawing.svg
-    svg = svg[svg.index("<svg") :]  # no XML declaration inside a page
-    return svg.replace("</svg>", hits + "</svg>")
 
 
 class Page:
@@ -115,6 +70,7 @@ class Page:
         self._wanted: dict[str, Any] = {}  # the controls' values, as the page last set them
         self._editor_text = ""  # the editor's text as the loop last knew it
         self._disk_text: str | None = None  # the file's text as last read or saved
+        self._color_by: str | None = None  # the attribute the page colours by
         self._edit_timer: Any = None
         self._framed: tuple[float, ...] | None = None  # the bounds the camera was fit to
         self.updates = 0  # view updates sent
@@ -126,21 +82,25 @@ class Page:
             """The viewer's watching of a graph's files, asking the worker to reload."""
 
             def reload(self) -> bool:
-                self.stamp = self._stamp()
-                if page.state.text != page._disk_text:  # unsaved edits: keep them
-                    page._say(
-                        f"{page.session.path.name} changed on disk; the editor keeps your "
-                        "edits (Reload takes the file's text, Save overwrites the file)",
-                        True,
-                    )
-                    return False
-                page.worker.submit("disk", page._open_disk)
-                return True
+                old, self.stamp = self.stamp, self._stamp()
+                own = old is None or self.stamp is None or old[0] != self.stamp[0]
+                if page.state.text == page._disk_text:
+                    page.worker.submit("disk", page._open_disk)
+                    return True
+                if not own:  # a part or an input changed: the editor's version again
+                    page.worker.submit("text", page.session.open, page.state.text)
+                    return True
+                page._say(  # the graph file itself, under unsaved edits: keep them
+                    f"{page.session.path.name} changed on disk; the editor keeps your "
+                    "edits (Reload takes the file's text, Save overwrites the file)",
+                    True,
+                )
+                return False
 
         self.watch = DiskWatch(session.path, None, (), session.out_dir, session.budget, "", None)
         self.watch.stamp = self.watch._stamp()  # the first load reads this version
         self._init_state()
-        self._build()
+        self.layout, self.view = build(self)
         self.ctrl.on_server_bind.add(self._bind)
         self.ctrl.on_server_ready.add(self._ready)
 
@@ -161,6 +121,8 @@ class Page:
         s.busy = False
         s.cook_id = 0  # bumped after each picture sent (the bench waits on it)
         s.timing = {}  # where the last request's time went (read by bench/bench_studio.py)
+        s.attributes = []  # the attributes of what is shown, to colour by
+        s.color_by = "none"
 
         @s.change("text")
         def _edited(text: str, **_: Any) -> None:
@@ -178,156 +140,12 @@ class Page:
         ctrl.trigger("set_param")(self._set_param)
         ctrl.trigger("reset_param")(self._reset_param)
         ctrl.trigger("show_node")(self._show_node)
+        ctrl.trigger("colour_by")(self._colour_by)
         ctrl.add("save")(self._save)
         ctrl.add("run")(self._run)
         ctrl.add("reload")(lambda: self.worker.submit("disk", self._open_disk))
         ctrl.add("reset_all")(lambda: self.worker.submit("params", self.session.reset_params))
         ctrl.add("show_results")(lambda: self.worker.submit("show", self.session.show, None))
-
-    def _build(self) -> None:
-        from trame.ui.vuetify3 import VAppLayout
-        from trame.widgets import client, code, html
-        from trame.widgets import vuetify3 as v
-        from trame_pyvista.widgets import PyVistaLocalView
-
-        with VAppLayout(self.server, full_height=True) as layout:
-            client.Style(CSS)
-            with v.VAppBar(density="compact", flat=True, border=True):
-                v.VAppBarTitle(
-                    f"{self.session.path.name}", style="flex: 0 0 auto; font-size: 16px;"
-                )
-                v.VBtn("Save", click=self.ctrl.save, variant="tonal", classes="ml-2", id="save")
-                v.VBtn("Run", click=self.ctrl.run, variant="tonal", classes="ml-2", id="run")
-                v.VBtn(
-                    "Reload",
-                    click=self.ctrl.reload,
-                    variant="text",
-                    classes="ml-1",
-                    id="reload",
-                    title="read the graph file again (the editor's unsaved edits are lost)",
-                )
-                html.Div(
-                    "{{ status }}",
-                    classes=("status_bad ? 'fg-status bad' : 'fg-status'",),
-                    id="status",
-                )
-                v.VSpacer()
-                html.Div("{{ JSON.stringify(timing) }}", id="timing", style="display: none")
-                v.VProgressCircular(
-                    v_show=("busy",), indeterminate=True, size=18, width=2, classes="mr-3"
-                )
-            with v.VMain():
-                with html.Div(classes="fg-main"):
-                    with html.Div(classes="fg-left"):
-                        with html.Div(classes="fg-editor", id="editor"):
-                            code.Editor(
-                                v_model=("text",),
-                                language="yaml",
-                                theme="vs",
-                                markers=("markers",),
-                                options=(
-                                    "{ minimap: { enabled: false }, fontSize: 13, "
-                                    "automaticLayout: true, scrollBeyondLastLine: false }",
-                                ),
-                            )
-                        with html.Div(
-                            classes="fg-problems", id="problems", v_show="problems.length"
-                        ):
-                            html.Div("{{ p }}", v_for="p in problems")
-                    with html.Div(classes="fg-center"):
-                        with html.Div(classes="fg-view", id="view"):
-                            self.view = PyVistaLocalView(self.plotter)
-                        with html.Div(classes="fg-graph", id="graph"):
-                            html.Div(
-                                "showing {{ shown }}",
-                                style="font: 12px sans-serif; padding: 4px 8px; color: #555;",
-                            )
-                            html.Div(
-                                v_html=("graph_svg",),
-                                click=(
-                                    "$event.target.closest('[data-node]') && "
-                                    "trigger('show_node', [$event.target.closest('[data-node]')"
-                                    ".getAttribute('data-node')])"
-                                ),
-                            )
-                    with html.Div(classes="fg-right", id="controls"):
-                        with html.Div(
-                            style="display: flex; justify-content: space-between; "
-                            "align-items: center; margin-bottom: 4px;"
-                        ):
-                            html.B("params", style="font: 13px sans-serif;")
-                            v.VBtn(
-                                "reset all",
-                                click=self.ctrl.reset_all,
-                                size="x-small",
-                                variant="text",
-                            )
-                        v.VBtn(
-                            "show results",
-                            click=self.ctrl.show_results,
-                            size="x-small",
-                            variant="text",
-                            block=True,
-                            classes="mb-2",
-                        )
-                        self._control_widgets(v, html)
-        self.layout = layout
-
-    def _control_widgets(self, v: Any, html: Any) -> None:
-        set_value = "params[c.name] = $event; trigger('set_param', [c.name, $event])"
-        with html.Div(v_for="c in controls", key="c.name", classes="fg-control"):
-            with html.Div(classes="fg-control-name"):
-                html.Span(
-                    "{{ c.name }} = {{ params[c.name] }}",
-                    title=("c.doc",),
-                )
-                v.VBtn(
-                    "reset",
-                    size="x-small",
-                    variant="text",
-                    click="trigger('reset_param', [c.name])",
-                    disabled=("params[c.name] === c.default",),
-                )
-            v.VSlider(
-                v_if="c.kind === 'slider'",
-                model_value=("params[c.name]",),
-                min=("c.min",),
-                max=("c.max",),
-                step=("c.step",),
-                density="compact",
-                hide_details=True,
-                color="primary",
-                update_modelValue=set_value,
-                classes=("'fg-slider-' + c.name",),
-            )
-            v.VTextField(
-                v_if="c.kind === 'number' || c.kind === 'text'",
-                model_value=("params[c.name]",),
-                density="compact",
-                hide_details=True,
-                variant="outlined",
-                change=(
-                    "trigger('set_param', [c.name, c.kind === 'number' ? "
-                    "Number($event.target.value) : $event.target.value])"
-                ),
-            )
-            v.VSwitch(
-                v_if="c.kind === 'toggle'",
-                model_value=("params[c.name]",),
-                density="compact",
-                hide_details=True,
-                color="primary",
-                update_modelValue=set_value,
-            )
-            v.VSelect(
-                v_if="c.kind === 'choice'",
-                model_value=("params[c.name]",),
-                items=("c.choices",),
-                density="compact",
-                hide_details=True,
-                variant="outlined",
-                update_modelValue=set_value,
-            )
 
     # --------------------------------------------------------------------- server life
 
@@ -374,13 +192,16 @@ class Page:
     def _reset(self, name: str) -> Cooked:
         return self.session.reset_params(name)
 
+    def _colour_by(self, name: str | None) -> None:
+        """Colour by an attribute (``"none"``: by node), drawn again from the last result."""
+        self._color_by = None if name in (None, "", "none") else str(name)
+        self.worker.submit("show", lambda: self.session.last)
+
     def _show_node(self, name: str) -> None:
         self.worker.submit("show", self.session.show, [name])
 
     def _open_disk(self) -> Cooked:
-        cooked = self.session.open()
-        cooked.message = cooked.message or ""
-        return cooked
+        return self.session.open()  # the file's text
 
     def _save(self) -> None:
         text = self.state.text
@@ -406,7 +227,9 @@ class Page:
         t0 = time.perf_counter()
         prepared = None
         if isinstance(result, Cooked):
-            datasets = self.scene.prepare(result.shown) if result.ok and kind != "run" else None
+            datasets = None
+            if result.ok and kind != "run":
+                datasets = self.scene.prepare(result.shown, self._color_by)
             prepared = (datasets, self._drawing(result), self._snapshot())
         seconds += time.perf_counter() - t0
         self.loop.call_soon_threadsafe(self._apply, kind, result, seconds, prepared)
@@ -453,6 +276,9 @@ class Page:
         s = self.state
         if datasets is not None:  # the picture first: its arrays are what takes longest
             self._picture(datasets)
+            with s:
+                s.attributes = datasets.attributes
+                s.color_by = datasets.color_by or "none"
         t1 = time.perf_counter()
         with s:
             if kind == "disk":
@@ -473,9 +299,9 @@ class Page:
             s.problems = _problem_lines(cooked.problems)
             if cooked.new_graph or not cooked.ok or kind in ("text", "disk"):
                 s.markers = _markers(cooked.problems)
-            if cooked.ok:
-                s.markers = []
-                s.problems = []
+            if cooked.ok:  # what is left to say: the nodes' warnings
+                s.markers = _markers(cooked.warnings, "warning")
+                s.problems = [f"warning: {p}" for p in _problem_lines(cooked.warnings)]
             newer = kind == "params" and self.worker.waiting("params")
             if (
                 snap["controls"] is not None
@@ -486,15 +312,17 @@ class Page:
                 self.controls = snap["controls"]
                 self._wanted = dict(snap["values"])
                 s.controls = [c.as_dict() for c in self.controls]
-                s.params = {c.name: _shown_value(c.value) for c in self.controls}
+                s.params = {c.name: plain(c.value) for c in self.controls}
             if svg is not None:
                 s.graph_svg = svg
             shown = snap["shown"]
             s.shown = ", ".join(shown) if shown else "the graph's results"
             if cooked.ok:
+                n = len(cooked.warnings)
+                warned = f", {n} warning{'s' if n != 1 else ''}" if n else ""
                 s.status = (
                     f"{name}: {cooked.computed} computed, {cooked.cached} cached in "
-                    f"{_ms(cooked.seconds)}"
+                    f"{_ms(cooked.seconds)}{warned}"
                 )
                 s.status_bad = False
             else:
@@ -521,6 +349,8 @@ class Page:
         from formgraph.core.errors import FormgraphError
         from formgraph.drawgraph.layout import draw_graph
 
+        from .layout import clickable_svg
+
         graph = self.session.graph
         if graph is None:
             return None
@@ -530,7 +360,7 @@ class Page:
             return None
         return clickable_svg(drawing)
 
-    def _picture(self, datasets: dict[tuple[str, str], Any]) -> None:
+    def _picture(self, datasets: Any) -> None:
         from formgraph.viewer.app import _camera_lost
 
         from .scene import send_back_faces
@@ -540,7 +370,7 @@ class Page:
         bounds = self.scene.bounds()
         first = self._framed is None
         if first:
-            self.plotter.reset_camera()
+            self.plotter.reset_camera(render=False)  # a render would send the scene
         self.view.update()
         if first:
             self.view.push_camera()
@@ -572,14 +402,6 @@ def _as_param(c: Control, value: Any) -> Any:
         except Exception:  # not YAML: handed on as text, the param's check speaks
             return value
     return value
-
-
-def _shown_value(value: Any) -> Any:
-    if hasattr(value, "value") and not isinstance(value, (int, float, str)):
-        return value.value  # an Enum
-    if isinstance(value, (int, float, str, bool)) or value is None:
-        return value
-    return repr(value)
 
 
 def _ms(seconds: float) -> str:

@@ -20,12 +20,14 @@ from typing import Any
 
 import numpy as np
 
-from formgraph.viewer.scene import datasets_of, expand, geometry_items
+from formgraph.viewer.datasets import colour_by, datasets_of, expand, geometry_items
 from formgraph.viewer.style import BACKGROUND, PALETTE, apply_material, mix, style
 
-__all__ = ["StudioScene", "make_plotter", "send_back_faces"]
+__all__ = ["Prepared", "StudioScene", "make_plotter", "send_back_faces"]
 
 DRAWN = ("meshes", "surfaces", "features", "curves", "points")  # control overlays left out
+COLOURED = ("meshes", "surfaces", "points")  # what an attribute colours (as in the viewer)
+INTERNAL = {"Normals", "vtkOriginalPointIds", "vtkOriginalCellIds", "TCoords"}
 
 
 def send_back_faces() -> None:
@@ -70,6 +72,15 @@ def make_plotter() -> Any:
 
 
 @dataclass
+class Prepared:
+    """What :meth:`StudioScene.prepare` makes (in the worker thread) for :meth:`apply`."""
+
+    parts: dict[tuple[str, str], Any]
+    attributes: list[str]  # the attributes there are to colour by
+    color_by: str | None = None
+
+
+@dataclass
 class _Part:
     data: Any
     actors: list[Any] = field(default_factory=list)
@@ -89,6 +100,7 @@ class StudioScene:
         self.parts: dict[tuple[str, str], _Part] = {}
         self.colors: dict[str, str] = {}
         self.added = 0  # actors added so far (a slider step should add none)
+        self.color_by: str | None = None  # the attribute the actors are coloured by
 
     def color_of(self, label: str) -> str:
         if label not in self.colors:
@@ -96,40 +108,57 @@ class StudioScene:
         return self.colors[label]
 
     @staticmethod
-    def prepare(shown: Iterable[tuple[str, Any]]) -> dict[tuple[str, str], Any]:
+    def prepare(shown: Iterable[tuple[str, Any]], color_by: str | None = None) -> Prepared:
         """The datasets to draw for ``(label, value)`` pairs, by ``(label, kind)``.
 
         The costly half of an update (tessellating surfaces, normals, feature edges) and
         touching no actor, so the worker thread does it while the page stays responsive.
+        Only the arrays drawn are kept: the normals, and the attribute ``color_by``.
         """
-        out = {}
+        parts = {}
+        names: set[str] = set()
         for label, value in (p for lv in shown for p in expand(*lv)):
             data = datasets_of(geometry_items(value))
             for kind in DRAWN:
                 if kind in data:
-                    out[(label, kind)] = _lean(data[kind])
-        return out
+                    names.update(_attributes(data[kind]))
+                    parts[(label, kind)] = _lean(data[kind], color_by)
+        return Prepared(parts, sorted(names), color_by if color_by in names else None)
 
-    def update(self, shown: Iterable[tuple[str, Any]]) -> bool:
+    def update(self, shown: Iterable[tuple[str, Any]], color_by: str | None = None) -> bool:
         """Draw ``(label, value)`` pairs; True when actors were added or removed."""
-        return self.apply(self.prepare(shown))
+        return self.apply(self.prepare(shown, color_by))
 
-    def apply(self, prepared: dict[tuple[str, str], Any]) -> bool:
+    def apply(self, prepared: Prepared) -> bool:
         """Put prepared datasets in place (see :meth:`prepare`); True when actors were
-        added or removed (a step that only changes geometry adds none)."""
+        added or removed (a step that only changes geometry adds none; a new colouring
+        adds them all again)."""
         changed = False
-        for key, new in prepared.items():
+        if prepared.color_by != self.color_by:
+            self.clear()
+            self.color_by = prepared.color_by
+            changed = True
+        for key, new in prepared.parts.items():
             part = self.parts.get(key)
             if part is None:
                 self.parts[key] = self._add(*key, new)
                 changed = True
             else:
                 _copy_into(part.data, new)
-        for key in [k for k in self.parts if k not in prepared]:
+                self._rescale(part)
+        for key in [k for k in self.parts if k not in prepared.parts]:
             for actor in self.parts.pop(key).actors:
                 self.plotter.remove_actor(actor, render=False)
             changed = True
         return changed
+
+    def clear(self) -> None:
+        for part in self.parts.values():
+            for actor in part.actors:
+                self.plotter.remove_actor(actor, render=False)
+        self.parts.clear()
+        if self.plotter.scalar_bars:
+            self.plotter.scalar_bars.clear()
 
     def _add(self, label: str, kind: str, data: Any) -> _Part:
         color = self.color_of(label)
@@ -139,12 +168,30 @@ class StudioScene:
             kw = style(kind, color)
             kw.pop("render_points_as_spheres", None)
             kw.pop("render_lines_as_tubes", None)
+            if kind in COLOURED:
+                kw.update(colour_by(data, self.color_by))
         part = _Part(data)
-        actor = self.plotter.add_mesh(data, reset_camera=False, **kw)
+        actor = self.plotter.add_mesh(data, reset_camera=False, render=False, **kw)
         apply_material(actor, kind)  # Phong, and the back faces in BACK_FACE
         part.actors.append(actor)
         self.added += len(part.actors)
         return part
+
+    def _rescale(self, part: _Part) -> None:
+        """The colour range follows the attribute's values as a slider changes them."""
+        name = self.color_by
+        if name is None or name == "color":
+            return
+        data = part.data
+        values = data.point_data.get(name) if name in data.point_data else data.cell_data.get(name)
+        if values is None or not len(values):
+            return
+        values = np.asarray(values, dtype=np.float64)
+        if values.ndim == 2:
+            values = np.linalg.norm(values, axis=1)
+        lo, hi = float(np.nanmin(values)), float(np.nanmax(values))
+        for actor in part.actors:
+            actor.GetMapper().SetScalarRange(lo, hi if hi > lo else lo + 1.0)
 
     def bounds(self) -> tuple[float, ...] | None:
         boxes = [np.asarray(p.data.bounds).reshape(3, 2) for p in self.parts.values()]
@@ -156,15 +203,26 @@ class StudioScene:
         return tuple(float(x) for x in np.column_stack([lo, hi]).ravel())
 
 
-def _lean(data: Any) -> Any:
-    """``data`` with float32 points and normals: what vtk.js draws with anyway, and half
-    the bytes of float64 for every step sent to the browser."""
+def _attributes(data: Any) -> list[str]:
+    """The point and cell attributes of ``data`` one could colour by."""
+    names = [*data.point_data.keys(), *data.cell_data.keys()]
+    return [n for n in names if n not in INTERNAL and not n.startswith(("vtk", "pyvista"))]
+
+
+def _lean(data: Any, keep: str | None = None) -> Any:
+    """``data`` with only the arrays drawn (the normals, and the attribute ``keep``), in
+    float32: what vtk.js draws with anyway, and half the bytes of float64 for every step
+    sent to the browser."""
     if data.points.dtype != np.float32:
         data.points = data.points.astype(np.float32)
-    for name in list(data.point_data.keys()):
-        arr = data.point_data[name]
-        if arr.dtype == np.float64:
-            data.point_data[name] = arr.astype(np.float32)
+    for attrs in (data.point_data, data.cell_data):
+        for name in list(attrs.keys()):
+            if name not in ("Normals", keep):
+                attrs.remove(name)
+                continue
+            arr = attrs[name]
+            if arr.dtype == np.float64:
+                attrs[name] = arr.astype(np.float32)
     if "Normals" in data.point_data.keys():
         data.point_data.active_normals_name = "Normals"
     return data
@@ -183,12 +241,13 @@ def _copy_into(target: Any, new: Any) -> None:
         a, b = getattr(target, cells), getattr(new, cells)
         if len(a) != len(b) or not np.array_equal(a, b):
             setattr(target, cells, b)
-    old_names = set(target.point_data.keys())
-    for name in new.point_data.keys():
-        arr = new.point_data[name]
-        if name not in old_names or not np.array_equal(target.point_data[name], arr):
-            target.point_data[name] = arr
-    for name in old_names - set(new.point_data.keys()):
-        target.point_data.remove(name)
+    for mine, theirs in ((target.point_data, new.point_data), (target.cell_data, new.cell_data)):
+        old_names = set(mine.keys())
+        for name in theirs.keys():
+            arr = theirs[name]
+            if name not in old_names or not np.array_equal(mine[name], arr):
+                mine[name] = arr
+        for name in old_names - set(theirs.keys()):
+            mine.remove(name)
     if "Normals" in new.point_data.keys():
         target.point_data.active_normals_name = "Normals"

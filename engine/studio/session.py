@@ -26,7 +26,7 @@ from formgraph.core.safety import write_atomic
 from formgraph.evaluation.graph import Graph
 from formgraph.language.yamlio import MAX_BYTES
 
-__all__ = ["Control", "Cooked", "StudioSession", "Superseded", "controls_of"]
+__all__ = ["Control", "Cooked", "StudioSession", "Superseded", "controls_of", "plain"]
 
 
 class Superseded(Exception):
@@ -48,16 +48,31 @@ class Control:
     doc: str = ""
 
     def as_dict(self) -> dict[str, Any]:
+        """The control as the page's state holds it (JSON: an Enum as its value)."""
         return {
             "name": self.name,
             "kind": self.kind,
-            "default": self.default,
+            "default": plain(self.default),
             "min": self.min,
             "max": self.max,
             "step": self.step,
             "choices": list(self.choices),
             "doc": self.doc,
         }
+
+
+def plain(value: Any) -> Any:
+    """``value`` as JSON can carry it: an Enum as its value, a tuple as a list, anything
+    else that is not a number, string, bool, list or None as its repr."""
+    import enum
+
+    if isinstance(value, enum.Enum):
+        return value.value
+    if isinstance(value, (list, tuple)):
+        return [plain(v) for v in value]
+    if value is None or isinstance(value, (bool, int, float, str)):
+        return value
+    return repr(value)
 
 
 def controls_of(graph: Graph, values: dict[str, Any]) -> list[Control]:
@@ -68,7 +83,7 @@ def controls_of(graph: Graph, values: dict[str, Any]) -> list[Control]:
     type) a list of its options; anything else (a vector, a list, a string) a text field
     holding its YAML.
     """
-    from formgraph.language.check import param_kind
+    from formgraph.language.params import param_kind
 
     out = []
     current = {**graph.params, **values}
@@ -127,6 +142,7 @@ class Cooked:
     failed: list[str] = field(default_factory=list)
     message: str = ""
     new_graph: bool = False  # a new version of the graph (controls and drawing may change)
+    warnings: list[Problem] = field(default_factory=list)  # the nodes' warnings, located
 
     @property
     def computed(self) -> int:
@@ -150,6 +166,8 @@ class StudioSession:
         ``NAME=VALUE`` params from the command line, the controls' starting values.
     budget : int
         The element budget per node, as for :func:`formgraph.load`.
+    inputs_dir : str or path, optional
+        The folder the read nodes read from (default: the graph file's), as ``--inputs``.
     """
 
     def __init__(
@@ -159,8 +177,10 @@ class StudioSession:
         out_dir: str | os.PathLike[str] = "out",
         sets: Sequence[str] = (),
         budget: int = DEFAULT_BUDGET,
+        inputs_dir: str | os.PathLike[str] | None = None,
     ):
         self.path = Path(path)
+        self.inputs_dir = inputs_dir
         self.out_dir = Path(out_dir)
         self.sets = list(sets)
         self.budget = budget
@@ -203,7 +223,11 @@ class StudioSession:
         self.text = text
         try:
             graph = Graph.from_text(
-                text, file=str(self.path), out_dir=self.out_dir, budget=self.budget
+                text,
+                file=str(self.path),
+                out_dir=self.out_dir,
+                budget=self.budget,
+                inputs_dir=self.inputs_dir,
             )
         except GraphError as exc:
             self._files = list(getattr(exc, "files", None) or [self.path])
@@ -223,7 +247,8 @@ class StudioSession:
         return cooked
 
     def _start_values(self, graph: Graph) -> dict[str, Any] | Cooked:
-        from formgraph.cli.options import UsageError, parse_sets
+        from formgraph.core.errors import UsageError
+        from formgraph.language.params import parse_sets
 
         try:
             return parse_sets(graph, self.sets)
@@ -233,7 +258,7 @@ class StudioSession:
 
     def _kept_values(self, graph: Graph) -> dict[str, Any]:
         from formgraph.core.types import TypeMismatch
-        from formgraph.language.check import check_param_value
+        from formgraph.language.params import check_param_value
 
         kept = {}
         for name, value in self.values.items():
@@ -248,7 +273,8 @@ class StudioSession:
         return kept
 
     def files(self) -> list[Path]:
-        """The files the last version read: its own and its subgraph files (to watch)."""
+        """The files the last version read: its own, its subgraph files and the files its
+        read nodes name (what to watch)."""
         return list(self._files)
 
     # ------------------------------------------------------------------------ cook
@@ -319,7 +345,7 @@ class StudioSession:
             if t != base:
                 value = getattr(value, t[len(base) + 1 :])
             shown.append((t, value))
-        self.last = Cooked(True, shown, dict(graph.stats), seconds)
+        self.last = Cooked(True, shown, dict(graph.stats), seconds, warnings=_warnings(graph))
         return self.last
 
     def _failed(self, problems: Sequence[Problem], message: str, failed=()) -> Cooked:
@@ -368,6 +394,17 @@ class StudioSession:
                 if isinstance(path, str):
                     out.append(path)
         return out
+
+
+def _warnings(graph: Graph) -> list[Problem]:
+    """The last evaluation's node warnings (an open mesh, a value clamped), each at its
+    node's line."""
+    out = []
+    for name, st in graph.stats.items():
+        node = graph._nodes.get(name)  # the authored node: its line
+        where = Where(graph.file, getattr(node, "line", None), name)
+        out.extend(Problem(where, w) for w in st.warnings)
+    return out
 
 
 def _base(graph: Graph, target: str) -> str:

@@ -227,6 +227,103 @@ def build(
 
 
 @contextlib.contextmanager
+def _workers_ignore_interrupts() -> Iterator[None]:
+    """Start worker processes with Ctrl-C ignored (an ignored signal stays ignored across
+    their exec, where a handler or a blocked mask would not).
+
+    A terminal sends Ctrl-C to the whole process group: the workers would each die with a
+    ``KeyboardInterrupt`` traceback, mid-import or mid-task, while the client is already
+    stopping the sweep and closing the cluster, which ends them in order. Only the client
+    hears Ctrl-C; while the workers start (a second or two) it is ignored there too.
+    """
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+HANDSHAKE_SECONDS = 10.0
+_HANDSHAKE_BYTES = 1 << 16  # a scheduler's greeting is some 60 bytes
+
+
+def probe_scheduler(address: str, timeout: float | None = None) -> None:
+    """Check that a Dask scheduler listens at ``address`` before a client trusts it.
+
+    A Dask scheduler greets every connection at once with a small handshake (an 8-byte
+    length, then msgpack frames holding its Python version and pickle protocol).
+    ``distributed`` itself waits for it without a time limit and allocates whatever length
+    the peer announces, so a port that accepts and stays silent would hang the sweep and
+    one that sends junk could ask for exabytes. Here the greeting must come within
+    ``timeout`` seconds (:data:`HANDSHAKE_SECONDS`), be under 64 KiB and read as Dask's.
+    Addresses other than TCP (``tls://``, ``inproc://``) are left to ``distributed``.
+
+    Raises
+    ------
+    SweepError
+        No connection, no greeting in time, or a peer that is not a Dask scheduler.
+    """
+    import socket
+    import struct
+
+    import msgpack
+    from distributed.comm.addressing import parse_address, parse_host_port
+    from distributed.protocol.utils import unpack_frames
+
+    try:
+        scheme, loc = parse_address(address)
+        if scheme != "tcp":
+            return
+        host, port = parse_host_port(loc)
+    except (ValueError, TypeError) as exc:
+        raise SweepError(f"{address!r} is not a scheduler address ({exc})") from None
+    timeout = HANDSHAKE_SECONDS if timeout is None else timeout
+    deadline = time.monotonic() + timeout
+
+    def receive(sock: Any, n: int) -> bytes:
+        data = bytearray()
+        while len(data) < n:
+            left = deadline - time.monotonic()
+            if left <= 0:
+                raise TimeoutError
+            sock.settimeout(left)
+            chunk = sock.recv(n - len(data))
+            if not chunk:
+                raise ConnectionError("it closed the connection")
+            data += chunk
+        return bytes(data)
+
+    try:
+        with socket.create_connection((host, port), timeout=timeout) as sock:
+            (size,) = struct.unpack("<Q", receive(sock, 8))
+            if not 0 < size <= _HANDSHAKE_BYTES:
+                raise ValueError(f"it announced a first message of {size:,} bytes")
+            frames = unpack_frames(receive(sock, size))
+            info = msgpack.loads(frames[0], raw=False) if frames else None
+            if not (isinstance(info, dict) and "python" in info and "pickle-protocol" in info):
+                raise ValueError("its first message is not Dask's handshake")
+    except TimeoutError:
+        raise SweepError(
+            f"the peer at {address} accepted the connection but sent no Dask handshake "
+            f"within {timeout:g} s: it is not a Dask scheduler, or not answering"
+        ) from None
+    except OSError as exc:
+        raise SweepError(f"cannot reach the Dask scheduler at {address}: {exc}") from None
+    except ValueError as exc:  # ours above, and msgpack's on junk
+        raise SweepError(f"the peer at {address} is not a Dask scheduler ({exc})") from None
+    except Exception as exc:  # junk: struct, msgpack or frame errors of any kind
+        raise SweepError(
+            f"the peer at {address} is not a Dask scheduler ({one_line(exc)})"
+        ) from None
+
+
+@contextlib.contextmanager
 def connect(client: Any, workers: int | None) -> Iterator[Any]:
     """A Dask client: the one given, one for a scheduler address, or an embedded cluster.
 
@@ -240,6 +337,7 @@ def connect(client: Any, workers: int | None) -> Iterator[Any]:
         yield client
         return
     if isinstance(client, str):
+        probe_scheduler(client)
         try:
             c = Client(client, timeout="10s")
         except (OSError, TimeoutError) as exc:
@@ -255,7 +353,10 @@ def connect(client: Any, workers: int | None) -> Iterator[Any]:
     # distributed sets MALLOC_TRIM_THRESHOLD_ in workers to hand memory back early; for
     # numpy kernels whose temporaries are megabytes that costs a page-fault storm (the spiral
     # tube builds 1.4x slower), and a sweep's workers end with the sweep anyway
-    with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}):
+    with (
+        dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}),
+        _workers_ignore_interrupts(),
+    ):
         cluster = LocalCluster(
             n_workers=n,
             threads_per_worker=1,

@@ -10,14 +10,16 @@ dependents finish at once with the same error and the sweep goes on.
 from __future__ import annotations
 
 import importlib
+import sys
 import tempfile
 import time
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ..core.errors import FormgraphError
+from ..core.errors import FormgraphError, FormgraphWarning
 from ..evaluation.cache import default_cache_dir, key_of
 from ..evaluation.graph import Graph, Step
 
@@ -72,8 +74,36 @@ class RowResult:
 _GRAPHS: dict[str, Graph] = {}
 
 
+def _one_line_warnings() -> None:
+    """In a Dask worker, print our warnings as one line each, as the command line does.
+
+    Python's default shows a warning as ``file:line: Category: message`` plus the source
+    line, and the file is Dask's (``dask/_task_spec.py``, the frame that called the node),
+    so a sweep's terminal filled with Dask internals. Other warnings keep their format.
+    """
+    if getattr(warnings.showwarning, "_formgraph", False):
+        return
+    try:
+        from distributed import get_worker
+
+        get_worker()
+    except (ImportError, ValueError):
+        return  # not in a worker: the caller's own warning display stays
+    shown = warnings.showwarning
+
+    def show(message, category, filename, lineno, file=None, line=None):  # type: ignore[no-untyped-def]
+        if issubclass(category, FormgraphWarning):
+            print(f"formgraph: warning: {message}", file=file or sys.stderr)
+            return
+        shown(message, category, filename, lineno, file, line)
+
+    show._formgraph = True  # type: ignore[attr-defined]
+    warnings.showwarning = show
+
+
 def _graph(bp: Blueprint) -> Graph:
     """The worker's graph for a blueprint, built once per process."""
+    _one_line_warnings()
     g = _GRAPHS.get(bp.token)
     if g is None:
         for module in bp.modules:

@@ -65,8 +65,10 @@ def graph_file(tmp_path):
         "  waist: {default: 3, min: 0.5, max: 10}\n"
         "  height: {default: 20, min: 1, max: 100}\n"
         "  n: {default: 8, min: 3, max: 64, type: int}\n"
+        "  sides: {default: 6, min: 3, max: 12}\n"
         "nodes:\n"
         "  c: {type: points.circle, count: '=n', radius: '=waist * height'}\n"
+        "  d: {type: points.circle, count: '=sides'}\n"
     )
     return p
 
@@ -82,8 +84,10 @@ def test_cli_refuses_a_budget_below_one(graph_file, budget, capsys):
 def test_a_param_is_int_only_when_everything_about_it_is_whole(graph_file):
     g = fg.load(graph_file)
     assert g.evaluate("c", waist=1.5).xyz[0, 0] == pytest.approx(30.0)
-    with pytest.raises(fg.ParamError, match=r"param 'height': expected int, got float 1.5"):
-        g.evaluate("c", height=1.5)
+    # whole throughout, but it feeds only a radius (a float port): a float
+    assert g.evaluate("c", height=1.5).xyz[0, 0] == pytest.approx(4.5)
+    with pytest.raises(fg.ParamError, match=r"param 'sides': expected int, got float 1.5"):
+        g.evaluate("d", sides=1.5)
 
 
 def test_set_takes_several_values(graph_file, tmp_path, capsys):
@@ -114,8 +118,9 @@ def test_set_says_where_node_names_go(graph_file, capsys):
 def test_check_warns_when_it_guesses_int(graph_file, capsys):
     assert cli.main(["check", str(graph_file)]) == 0
     err = capsys.readouterr().err
-    assert "g.yaml:4: warning: param 'height' is read as int" in err
-    assert "'waist'" not in err and "'n'" not in err  # a float, and a declared int
+    assert "g.yaml:6: warning: param 'sides' is read as int" in err
+    # floats (one fed to a float port), and a declared int
+    assert "'waist'" not in err and "'height'" not in err and "'n'" not in err
 
 
 OPEN_BOX = {"vertices": [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], "faces": [[0, 1, 2, 3]]}

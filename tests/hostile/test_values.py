@@ -170,7 +170,11 @@ def test_values_read_from_the_disk_cache_are_frozen(tmp_path):
 
 
 def test_a_huge_integer_param_in_an_expression_is_located():
-    text = "formgraph: 1\nparams:\n  n: 2\nnodes:\n  c: {type: nurbs.circle, radius: '=n * 2'}\n"
+    # declared int: a whole number feeding only a float port would be read as a float
+    text = (
+        "formgraph: 1\nparams:\n  n: {type: int, default: 2}\nnodes:\n"
+        "  c: {type: nurbs.circle, radius: '=n * 2'}\n"
+    )
     g = fg.Graph.from_text(text, file="h.yaml")
     with pytest.raises(fg.GraphError, match=r"h.yaml:5: node 'c', input 'radius': .*too large"):
         g.evaluate("c", n=10**400)

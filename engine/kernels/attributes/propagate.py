@@ -197,7 +197,7 @@ def split_columns(
         k = int(np.prod(a.shape[1:], dtype=np.int64))
         out[name] = stacked[:, at : at + k].reshape((m,) + a.shape[1:])
         at += k
-    return np.ascontiguousarray(stacked[:, :3]), out
+    return stacked[:, :3], out  # views: the Mesh copies each once, into frozen buffers
 
 
 def by_position(source: np.ndarray, target: np.ndarray) -> np.ndarray:

@@ -5,7 +5,8 @@ One step (:func:`grow_step`) moves every vertex by the sum of
 - attraction: a spring along each edge toward half the split length;
 - alignment: a pull toward the midpoint of its two neighbours (Laplacian smoothing);
 - repulsion: a push away from every non-adjacent vertex nearer than ``radius``, falling off
-  linearly to zero at ``radius`` (and from the edges of ``bounds``, when given);
+  linearly to zero at ``radius`` (and from ``bounds``, when given, sampled at least every
+  ``split``);
 - jitter: an optional random push (seeded; the same on every run), which breaks the
   symmetry of a regular seed;
 
@@ -80,12 +81,21 @@ def pairs_within(points: np.ndarray, r: float) -> tuple[np.ndarray, np.ndarray]:
         ``r`` is not positive, or so small against the points' extent that the grid would
         need more than 2**30 cells a side.
     """
-    p = np.asarray(points, dtype=np.float64)[:, :2]
+    i, j, _, _, _ = _pairs(np.asarray(points, dtype=np.float64), r)
+    return i, j
+
+
+def _pairs(
+    points: np.ndarray, r: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`pairs_within`, with each pair's p[i] - p[j] (x and y) and distance."""
+    p = points[:, :2]
     n = len(p)
     if not r > 0:
         raise ValueError(f"the search radius must be > 0, got {r}")
     if n < 2:
-        return np.zeros(0, np.int64), np.zeros(0, np.int64)
+        e, f = np.zeros(0, np.int64), np.zeros(0)
+        return e, e, f, f, f
     lo = p.min(axis=0)
     span = (p.max(axis=0) - lo) / r
     if not (span < _MAX_CELLS).all():
@@ -98,28 +108,38 @@ def pairs_within(points: np.ndarray, r: float) -> tuple[np.ndarray, np.ndarray]:
     key = (cell[:, 0] + 1) * ny + (cell[:, 1] + 1)
     order = np.argsort(key, kind="stable")
     sk = key[order]
-    sp = p[order]
+    sx, sy = p[order, 0], p[order, 1]
     pos = np.arange(n, dtype=np.int64)
-    # half the neighbourhood: the rest of the own cell, then cells (+1, -1), (+1, 0),
-    # (+1, +1) and (0, +1); every unordered pair of neighbouring cells is visited once
-    starts = [pos + 1]
-    ends = [np.searchsorted(sk, sk, side="right")]
-    for off in (ny - 1, ny, ny + 1, 1):
-        t = sk + off
-        starts.append(np.searchsorted(sk, t, side="left"))
-        ends.append(np.searchsorted(sk, t, side="right"))
-    start = np.concatenate(starts)
-    counts = np.concatenate(ends) - start
-    np.maximum(counts, 0, out=counts)
+    # half the neighbourhood, as two runs of the sorted keys: the rest of the own cell
+    # with the cell above it (y + 1), and the three cells of the next column (x + 1,
+    # y - 1 .. y + 1); every unordered pair of neighbouring cells is visited once
+    start = np.concatenate([pos + 1, np.searchsorted(sk, sk + (ny - 1), side="left")])
+    end = np.concatenate(
+        [
+            np.searchsorted(sk, sk + 1, side="right"),
+            np.searchsorted(sk, sk + (ny + 1), side="right"),
+        ]
+    )
+    counts = np.maximum(end - start, 0)
     total = int(counts.sum())
     if total == 0:
-        return np.zeros(0, np.int64), np.zeros(0, np.int64)
-    a = np.repeat(np.tile(pos, 5), counts)
+        e, f = np.zeros(0, np.int64), np.zeros(0)
+        return e, e, f, f, f
+    a = np.repeat(np.concatenate([pos, pos]), counts)
     b = np.repeat(start - (np.cumsum(counts) - counts), counts) + np.arange(total)
-    dv = sp[a] - sp[b]
-    near = np.einsum("ij,ij->i", dv, dv) < r * r
-    a, b = order[a[near]], order[b[near]]
-    return np.minimum(a, b), np.maximum(a, b)
+    dx, dy = sx[a] - sx[b], sy[a] - sy[b]
+    d2 = dx * dx + dy * dy
+    near = d2 < r * r
+    a, b, dx, dy = order[a[near]], order[b[near]], dx[near], dy[near]
+    flip = a > b  # i < j, and the vectors follow
+    sign = np.where(flip, -1.0, 1.0)
+    return (
+        np.where(flip, b, a),
+        np.where(flip, a, b),
+        dx * sign,
+        dy * sign,
+        np.sqrt(d2[near]),
+    )
 
 
 def divide_long_edges(points: np.ndarray, closed: bool, split: float) -> np.ndarray:
@@ -222,7 +242,7 @@ def grow_step(
     bounds : (k, 2) float, optional
         A closed simple polygon the curve starts and stays inside (its edges also repel).
     jitter : float
-        A random push of up to about ``jitter * split`` per vertex, from ``seed``.
+        A random push of up to ``jitter * split / 2`` along each axis, from ``seed``.
     seed : int
 
     Returns
@@ -280,13 +300,12 @@ def grow_step(
     ring = np.roll(fence, -1, axis=0) - fence
     longest = max(float(length.max()), float(np.sqrt((ring * ring).sum(1)).max(initial=0.0)))
     reach = min(radius, split)
-    i, j = pairs_within(everything, max(radius, reach + longest))
+    i, j, dx, dy, dist = _pairs(everything, max(radius, reach + longest))
     gap = j - i
     # the fence's own pairs never matter; neighbours along the curve are handled apart
     apart = (i < n) & ((j >= n) | ((gap != 1) & ~(closed & (gap == n - 1))))
-    i, j = i[apart], j[apart]
-    dv = everything[i] - everything[j]
-    dist = np.sqrt(np.einsum("ij,ij->i", dv, dv))
+    i, j, dist = i[apart], j[apart], dist[apart]
+    dv = np.stack([dx[apart], dy[apart]], axis=1)
 
     repel = (dist < radius) & (dist > 0)
     w = 0.5 * repulsion * (radius - dist[repel]) / dist[repel]
@@ -366,9 +385,9 @@ def _limit(
     ua = np.concatenate([ia, ja[on_curve], va, va])
     keep = f >= 0
     u, f, ub, ua = u[keep], f[keep], ub[keep], ua[keep]
-    delta = _point_edge_distances(
-        pts[:, 0][u], pts[:, 1][u], a[:, 0][f], a[:, 1][f], b[:, 0][f], b[:, 1][f]
-    )
+    # contiguous columns: gathers from a strided column view are several times slower
+    px, py, ax, ay, bx, by = (np.ascontiguousarray(c) for c in (*pts.T, *a.T, *b.T))
+    delta = _point_edge_distances(px[u], py[u], ax[f], ay[f], bx[f], by[f])
     if (delta <= 0).any():
         x = int(np.argmax(delta <= 0))
         what = "its bounds" if f[x] >= m or u[x] >= n else "itself"

@@ -5,7 +5,7 @@
   nearest of the three edges), degenerate triangles included.
 * :class:`Nearest`: the distance from many points to the nearest of many primitives
   (triangles or segments), exact, by a bounding-box hierarchy over the primitives in
-  Morton order (a linear BVH: leaves of 8, nodes of 8), traversed for all points at once:
+  Morton order (a linear BVH: leaves of 2, nodes of 8), traversed for all points at once:
   the primitive with the nearest centre (scipy's cKDTree) gives each point an upper
   bound, then every (point, node) pair whose box is nearer than that bound is opened,
   level by level, down to the exact distances.
@@ -43,7 +43,7 @@ def point_segment_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.nd
     return np.linalg.norm(p - (a + t[..., None] * ab), axis=-1)
 
 
-def _triangle_coefficients(d1, d2, aa, ab, bb):
+def _triangle_coefficients(d1, d2, aa, ab, bb, region: bool = False):
     """(v, w) of the point ``a + v (b - a) + w (c - a)`` of a triangle nearest to ``p``.
 
     Ericson, "Real-Time Collision Detection", 5.1.5: the Voronoi region of ``p`` (vertex,
@@ -73,6 +73,8 @@ def _triangle_coefficients(d1, d2, aa, ab, bb):
     ]
     v = np.select(regions, [0.0, 1.0, t_ab, 0.0, 0.0, 1.0 - t_bc], fv)
     w = np.select(regions, [0.0, 0.0, 0.0, 1.0, t_ac, t_bc], fw)
+    if region:  # 0 a, 1 b, 2 edge ab, 3 c, 4 edge ac, 5 edge bc, 6 the face
+        return v, w, np.select(regions, [0, 1, 2, 3, 4, 5], 6)
     return v, w
 
 
@@ -101,7 +103,7 @@ class _Hierarchy:
     (``lo``, ``hi``); ``order`` maps sorted positions to the caller's primitive indices.
     """
 
-    LEAF = 8
+    LEAF = 2  # small leaves: tight boxes prune far more pairs than they add (1.7x vs 8)
     FAN = 8
 
     def __init__(self, corners: np.ndarray):
@@ -192,11 +194,16 @@ class Nearest:
 
     def distance(self, points: np.ndarray) -> np.ndarray:
         """(n,) unsigned distances from ``points`` (n, 3) to the nearest primitive."""
+        return self.nearest(points)[0]
+
+    def nearest(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(n,) distances and (n,) the nearest primitive of each point (in ``tree`` order)."""
         p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
-        out = np.empty(len(p))
+        dist = np.empty(len(p))
+        prim = np.empty(len(p), dtype=np.int64)
         for s in range(0, len(p), CHUNK):
-            out[s : s + CHUNK] = self._chunk(p[s : s + CHUNK])
-        return out
+            dist[s : s + CHUNK], prim[s : s + CHUNK] = self._chunk(p[s : s + CHUNK])
+        return dist, prim
 
     def _chunk(self, p: np.ndarray) -> np.ndarray:
         tree = self.tree
@@ -214,8 +221,79 @@ class Nearest:
             if level:
                 pi, node = tree.children(level, node, pi)
         ip, prim = tree.leaf_items(node, pi)
-        np.minimum.at(ub, ip, self._exact(p[ip], prim))
-        return ub
+        d = self._exact(p[ip], prim)
+        # the best pair per point, the first guess included
+        ip = np.concatenate([np.arange(len(p)), ip])
+        prim = np.concatenate([near, prim])
+        d = np.concatenate([ub, d])
+        order = np.lexsort((d, ip))
+        first = order[np.r_[True, ip[order][1:] != ip[order][:-1]]]
+        return d[first], prim[first]
+
+
+class SignedDistance:
+    """Signed distance to a triangle mesh (``vertices`` (n, 3), ``triangles`` (m, 3)).
+
+    The distance is :class:`Nearest`'s. The sign: on a closed mesh (every edge on two
+    triangles), the angle-weighted pseudonormal of the nearest feature (face, edge or
+    vertex: Baerentzen & Aanaes, "Signed distance computation using the angle weighted
+    pseudonormal", 2005), exact and cheap; on an open mesh or a soup, the generalized
+    winding number (:class:`WindingNumber`), which still has an inside where small holes
+    leave the mesh slightly open.
+    """
+
+    def __init__(self, vertices: np.ndarray, triangles: np.ndarray):
+        v = np.asarray(vertices, dtype=np.float64)
+        t = np.asarray(triangles, dtype=np.int64)
+        self.nearest = Nearest(v[t])
+        t = t[self.nearest.tree.order]  # the tree's order from here on
+        e = np.sort(np.stack([t, np.roll(t, -1, axis=1)], axis=2).reshape(-1, 2), axis=1)
+        keys, edge, uses = np.unique(
+            e[:, 0] * len(v) + e[:, 1], return_inverse=True, return_counts=True
+        )
+        self.closed = bool((uses == 2).all())
+        self.winding = None if self.closed else WindingNumber(v[t])
+        if not self.closed:
+            return
+        from ..mesh.solidify import vertex_normals
+
+        fn = np.cross(v[t[:, 1]] - v[t[:, 0]], v[t[:, 2]] - v[t[:, 0]])
+        fn /= np.maximum(np.linalg.norm(fn, axis=1, keepdims=True), 1e-300)
+        edge = edge.reshape(-1, 3)  # edges ab, bc, ca of each triangle
+        en = np.stack(
+            [np.bincount(edge.ravel(), np.repeat(fn[:, k], 3), len(keys)) for k in range(3)], 1
+        )
+        vn = vertex_normals(v, t.reshape(-1), np.arange(0, t.size + 1, 3))
+        # per triangle, by region code: a, b, ab, c, ac, bc, face
+        self.normals = np.stack(
+            [
+                vn[t[:, 0]],
+                vn[t[:, 1]],
+                en[edge[:, 0]],
+                vn[t[:, 2]],
+                en[edge[:, 2]],
+                en[edge[:, 1]],
+                fn,
+            ],
+            axis=1,
+        )
+
+    def __call__(self, points: np.ndarray) -> np.ndarray:
+        p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+        d, prim = self.nearest.nearest(p)
+        if not self.closed:
+            return np.where(self.winding(p) > 0.5, -d, d)
+        nr = self.nearest
+        ap = p - nr.a[prim]
+        e1, e2 = nr.e1[prim], nr.e2[prim]
+        v, w, region = _triangle_coefficients(
+            _dot(e1, ap), _dot(e2, ap), nr.aa[prim], nr.ab[prim], nr.bb[prim], region=True
+        )
+        ok = np.isfinite(v) & np.isfinite(w)
+        v, w = np.where(ok, v, 0.0), np.where(ok, w, 0.0)
+        away = ap - v[:, None] * e1 - w[:, None] * e2
+        side = _dot(away, self.normals[prim, region])
+        return np.where(side < 0, -d, d)
 
 
 class WindingNumber:

@@ -104,6 +104,13 @@ TET_CORNERS, TRI_TABLE = _tables()  # (6, 4) cube corners; (6, 16, 2, 3, 2)
 # ---------------------------------------------------------------------------- the grid
 
 
+GRID_SHIFT = np.array([0.1234567, 0.2345678, 0.3456789]) * 0.5
+# a vertex stays this fraction of its edge off either end, so vertices never coincide, not
+# even as the float32 coordinates of an STL (at 2,000 cells from the origin an ulp of
+# float32 is 1e-4 of a cell)
+END_GAP = 5e-4
+
+
 def plan_grid(lo: np.ndarray, hi: np.ndarray, cell: float, coarse: int = 16):
     """The finest grid over ``[lo, hi]`` (padded by a cell) and its octree depth.
 
@@ -116,7 +123,9 @@ def plan_grid(lo: np.ndarray, hi: np.ndarray, cell: float, coarse: int = 16):
     levels = max(0, int(np.ceil(np.log2(max(n.max() / coarse, 1.0)))))
     blocks = -(-n // (1 << levels))
     size = blocks * (1 << levels)
-    origin = (lo + hi) / 2.0 - size * cell / 2.0  # centre the grid on the box
+    # centre the grid on the box, shifted by a generic fraction of a cell: the planes of
+    # boxes and cuts at round coordinates then never pass exactly through grid corners
+    origin = (lo + hi) / 2.0 - size * cell / 2.0 + cell * GRID_SHIFT
     return origin, levels, blocks
 
 
@@ -196,12 +205,13 @@ def mesh_field(
     corner = corner[mixed]
     ins = ins[mixed]
     # per tetrahedron: its sign case and up to two triangles of (corner, direction) edges
-    tc = ins[:, TET_CORNERS]  # (m, 6, 4)
-    case = (tc * (1 << np.arange(4))).sum(axis=2)  # (m, 6)
-    table = TRI_TABLE[np.arange(6)[None, :], case]  # (m, 6, 2, 3, 2)
-    keep = table[:, :, :, 0, 0] >= 0  # (m, 6, 2)
-    cell_of = np.nonzero(keep)[0]
-    tri = table[keep]  # (t, 3, 2): local start corner, direction index
+    bits = ins.astype(np.int8)
+    case = sum(bits[:, TET_CORNERS[:, k]] << k for k in range(4))  # (m, 6)
+    cell_of, tet = np.nonzero((case != 0) & (case != 15))  # the tetrahedra the surface cuts
+    table = TRI_TABLE[tet, case[cell_of, tet]]  # (c, 2, 3, 2)
+    second = table[:, 1, 0, 0] >= 0  # a quad: two triangles
+    tri = np.concatenate([table[:, 0], table[second, 1]])  # (t, 3, 2): start corner, direction
+    cell_of = np.concatenate([cell_of, cell_of[second]])
     start = corner[cell_of[:, None], tri[..., 0]]  # (t, 3) corner numbers
     end = corner[cell_of[:, None], tri[..., 0] + tri[..., 1] + 1]  # bit codes add: s & d = 0
     # one vertex per (start corner, direction): a perfect hash, no sort
@@ -224,14 +234,14 @@ def mesh_field(
 def _roots(f: Fn, pa, pb, fa, fb, steps: int, cell: float) -> np.ndarray:
     """Points where ``f`` changes sign on segments ``pa -> pb`` (Illinois regula falsi).
 
-    ``fa`` and ``fb`` have opposite signs (one is < 0, the other >= 0). Points are kept a
-    hair off the ends so two edges meeting at a corner that is exactly zero give distinct
-    (if coincident-looking) vertices, never a NaN.
+    ``fa`` and ``fb`` have opposite signs (one is < 0, the other >= 0). Points are kept
+    ``END_GAP`` off the ends, so edges meeting at a corner on the surface give distinct
+    vertices (and no triangle collapses to a point in a file of float32 coordinates).
     """
     lo_t = np.zeros(len(pa))
     hi_t = np.ones(len(pa))
     flo, fhi = fa.copy(), fb.copy()
-    t = np.clip(flo / (flo - fhi), 1e-6, 1 - 1e-6)
+    t = np.clip(flo / (flo - fhi), END_GAP, 1 - END_GAP)
     tol = 1e-4 * cell
     idx = np.arange(len(pa))
     side = np.zeros(len(pa), dtype=np.int8)  # which end was kept last (Illinois)
@@ -256,7 +266,18 @@ def _roots(f: Fn, pa, pb, fa, fb, steps: int, cell: float) -> np.ndarray:
             break
         den = flo[idx] - fhi[idx]
         frac = np.divide(flo[idx], den, out=np.full(len(idx), 0.5), where=den != 0)
-        t[idx] = np.clip(lo_t[idx] + frac * (hi_t[idx] - lo_t[idx]), 1e-6, 1 - 1e-6)
+        t[idx] = np.clip(lo_t[idx] + frac * (hi_t[idx] - lo_t[idx]), END_GAP, 1 - END_GAP)
+    # what regula falsi left (a kink of a sharp union on the edge converges only linearly):
+    # bisection of the bracket, which halves it every step whatever the field's shape
+    for _ in range(16 if steps else 0):
+        if not len(idx):
+            break
+        t[idx] = np.clip((lo_t[idx] + hi_t[idx]) / 2.0, END_GAP, 1 - END_GAP)
+        fp = _check(f(pa[idx] + t[idx, None] * (pb[idx] - pa[idx])))
+        low = (fp < 0) == (flo[idx] < 0)
+        lo_t[idx[low]], flo[idx[low]] = t[idx[low]], fp[low]
+        hi_t[idx[~low]], fhi[idx[~low]] = t[idx[~low]], fp[~low]
+        idx = idx[np.abs(fp) > tol]
     return pa + t[:, None] * (pb - pa)
 
 
@@ -275,8 +296,9 @@ def _number_corners(cells: np.ndarray, n: np.ndarray, max_cells: int):
     """
     nb = n // BRICK + 1
     cc = (cells[:, None, :] + CORNERS[None, :, :]).reshape(-1, 3)
-    brick = (cc // BRICK) @ np.array([nb[1] * nb[2], nb[2], 1], dtype=np.int64)
-    place = (cc % BRICK) @ np.array([BRICK * BRICK, BRICK, 1], dtype=np.int64)
+    x, y, z = cc[:, 0], cc[:, 1], cc[:, 2]  # (integer matmul has no fast path in numpy)
+    brick = ((x >> 3) * nb[1] + (y >> 3)) * nb[2] + (z >> 3)
+    place = ((x & 7) << 6) | ((y & 7) << 3) | (z & 7)
     marked = np.zeros(int(np.prod(nb)), dtype=bool)
     marked[brick] = True
     n_slots = int(marked.sum())

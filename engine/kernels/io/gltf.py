@@ -58,6 +58,7 @@ def write_glb(
     *,
     names: Sequence[str] | None = None,
     scale: float = 1e-3,
+    colors: Sequence[np.ndarray | None] | None = None,
 ) -> bytes:
     """A binary glTF 2.0 file of triangle meshes.
 
@@ -65,6 +66,9 @@ def write_glb(
     ----------
     meshes : sequence of (vertices (n, 3) float, triangles (t, 3) int)
     names : sequence of str, optional
+    colors : sequence of (n, 3) or (n, 4) float in 0..1 or None, optional
+        Vertex colours per mesh, written as ``COLOR_0`` (float RGB or RGBA, linear as
+        glTF defines it).
     scale : float
         Metres per model unit (glTF's unit is the metre; 1e-3 for millimetres).
 
@@ -104,12 +108,18 @@ def write_glb(
         position = add((v * scale).astype("<f4"), 34962, 5126, "VEC3", True)
         normal = add(vertex_normals(v, tris).astype("<f4"), 34962, 5126, "VEC3", False)
         indices = add(tris.astype("<u4").ravel(), 34963, 5125, "SCALAR", False)
+        attributes = {"POSITION": position, "NORMAL": normal}
+        colour = None if colors is None else colors[k]
+        if colour is not None:
+            c = np.clip(np.asarray(colour, dtype=np.float64).reshape(len(v), -1), 0.0, 1.0)
+            kind = "VEC4" if c.shape[1] == 4 else "VEC3"
+            attributes["COLOR_0"] = add(c.astype("<f4"), 34962, 5126, kind, False)
         gmeshes.append(
             {
                 "name": names[k],
                 "primitives": [
                     {
-                        "attributes": {"POSITION": position, "NORMAL": normal},
+                        "attributes": attributes,
                         "indices": indices,
                         "mode": 4,
                     }

@@ -190,10 +190,13 @@ def relax(
     v = np.zeros_like(x) if velocity is None else np.array(velocity, dtype=np.float64)
     fixed = ~net.free
     energy = np.inf
+    floor = None
     for _ in range(int(steps)):
         f, stiff = forces(x, net)
+        if floor is None:
+            floor = _floor(net, stiff)
         # the fictitious mass: the largest stable step of a vertex's springs with dt = 1
-        mass = stiff + _floor(net, stiff)
+        mass = stiff + floor
         v += f / mass[:, None]
         v[fixed] = 0.0
         e = float(np.einsum("ij,ij,i->", v, v, mass))

@@ -29,10 +29,13 @@ def is_closed(triangles: np.ndarray) -> bool:
     t = np.asarray(triangles, dtype=np.int64)
     if not len(t):
         return False
-    e = np.sort(np.stack([t, np.roll(t, -1, axis=1)], axis=2).reshape(-1, 2), axis=1)
+    a, b = t.reshape(-1), t[:, [1, 2, 0]].reshape(-1)
     n = int(t.max()) + 1
-    _, counts = np.unique(e[:, 0] * n + e[:, 1], return_counts=True)
-    return bool((counts == 2).all())
+    k = np.sort(np.minimum(a, b) * n + np.maximum(a, b))
+    # every key exactly twice: equal in pairs, and each pair unlike the next
+    if k.size % 2 or not (k[0::2] == k[1::2]).all():
+        return False
+    return bool((k[2::2] != k[1:-1:2]).all())
 
 
 def _compact(v: np.ndarray, t: np.ndarray):
@@ -42,6 +45,23 @@ def _compact(v: np.ndarray, t: np.ndarray):
     used[t] = True
     new = np.cumsum(used) - 1
     return v[used], new[t]
+
+
+def _collapse_zero_edges(v: np.ndarray, t: np.ndarray):
+    """Finish the collapses the library left undone: an edge whose two ends are at one
+    point (as float32) is merged into its lower end, its two triangles dropped."""
+    key = v.astype(np.float32)
+    for _ in range(8):  # chains of such edges shorten by one link a pass
+        e = np.stack([t, np.roll(t, -1, axis=1)], axis=2).reshape(-1, 2)
+        zero = (key[e[:, 0]] == key[e[:, 1]]).all(axis=1) & (e[:, 0] != e[:, 1])
+        if not zero.any():
+            break
+        lo, hi = e[zero].min(axis=1), e[zero].max(axis=1)
+        target = np.arange(len(v))
+        np.minimum.at(target, hi, lo)
+        t = target[t]
+        t = t[(t[:, 0] != t[:, 1]) & (t[:, 1] != t[:, 2]) & (t[:, 2] != t[:, 0])]
+    return _compact(v, t)
 
 
 def decimate(
@@ -62,10 +82,19 @@ def decimate(
     closed = is_closed(t)
     reduction = 1.0 - target_faces / len(t)
     out_v, out_t = fast_simplification.simplify(v, t, target_reduction=reduction, agg=aggression)
-    out_v, out_t = _compact(np.asarray(out_v, np.float64), np.asarray(out_t, np.int64))
+    out_v, out_t = _collapse_zero_edges(np.asarray(out_v, np.float64), np.asarray(out_t, np.int64))
     if closed and not is_closed(out_t):
         raise OpenedError(
             f"decimating to {len(out_t)} triangles opened the closed mesh; ask for more faces"
+        )
+    pinched = len(out_v) - len(np.unique(out_v.astype(np.float32), axis=0))
+    if closed and pinched:
+        # two vertices at one point (as float32, an STL's precision): closed by its
+        # indices, but a file of coordinates welds them into a non-manifold vertex
+        raise OpenedError(
+            f"decimating to {len(out_t)} triangles pinched the surface at {pinched} "
+            f"point{'s' if pinched > 1 else ''} (two vertices at one position); ask for more "
+            "faces"
         )
     return out_v, out_t
 

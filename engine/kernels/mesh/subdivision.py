@@ -48,10 +48,11 @@ def _check_levels(levels: int) -> int:
 
 def _scatter(index: np.ndarray, values: np.ndarray, size: int) -> np.ndarray:
     """Sum the rows of ``values`` (m, d) into ``size`` bins: one bincount per column."""
-    out = np.empty((size, values.shape[1]))
+    columns = np.ascontiguousarray(values.T)  # bincount reads each column contiguously
+    out = np.empty((values.shape[1], size))
     for k in range(values.shape[1]):
-        out[:, k] = np.bincount(index, values[:, k], minlength=size)
-    return out
+        out[k] = np.bincount(index, columns[k], minlength=size)
+    return out.T
 
 
 def _face_sums(vertices: np.ndarray, fi: np.ndarray, fo: np.ndarray, quads: bool) -> np.ndarray:
@@ -160,9 +161,11 @@ def _catmull_clark_step(
     # = (sum of face points + sum of edge neighbours) / n^2 + (n - 2) / n * S
     k = np.bincount(fi, minlength=n).astype(np.float64)
     ring = _scatter(fi, fp_h, n)
+    e0, e1 = np.ascontiguousarray(ev[:, 0]), np.ascontiguousarray(ev[:, 1])
+    vbt, vat = np.ascontiguousarray(vb.T), np.ascontiguousarray(va.T)
     for c in range(v.shape[1]):  # edge neighbours: each edge adds its other end to both ends
-        ring[:, c] += np.bincount(ev[:, 0], vb[:, c], minlength=n)
-        ring[:, c] += np.bincount(ev[:, 1], va[:, c], minlength=n)
+        ring[:, c] += np.bincount(e0, vbt[c], minlength=n)
+        ring[:, c] += np.bincount(e1, vat[c], minlength=n)
     kk = np.maximum(k, 1.0)[:, None]
     vp = ring / kk**2 + (kk - 2.0) / kk * v
     # sharp rules: a vertex on two sharp edges (boundary or crease) follows the cubic

@@ -1,0 +1,77 @@
+"""Exact parametric lengths: the 100-turn helix's arc length through ``curves.measure``
+(forward-mode derivatives of the expressions, adaptive Gauss-Legendre to 1e-12) against
+scipy's ``integrate.quad`` on the hand-written speed, both to their tolerance; the error of
+each against 200 pi sqrt(1.01) is in the note; and a damped wiggle whose speed varies,
+against quad on its hand-written speed.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from formgraph.geometry import ParametricCurve
+from formgraph.kernels.curves import measure as kmeasure
+from formgraph.kernels.curves.adaptive import refine_breaks
+from formgraph.language.expr import Bound, compile_expression
+
+TURNS = 100
+EXACT = 2 * math.pi * TURNS * math.sqrt(1.01)
+
+
+def _wiggle() -> ParametricCurve:
+    texts = ("t", "sin(40 * t) * exp(-t)", "t**2 / 3")
+    fx, fy, fz = (Bound(compile_expression(t), {}) for t in texts)
+    return ParametricCurve(fx, fy, fz, (0.0, 3.0), 256)
+
+
+def wiggle_scipy() -> float:
+    from scipy.integrate import quad
+
+    def speed(t: float) -> float:
+        dy = 40 * math.cos(40 * t) * math.exp(-t) - math.sin(40 * t) * math.exp(-t)
+        return math.sqrt(1 + dy * dy + (2 * t / 3) ** 2)
+
+    return quad(speed, 0, 3, limit=5000, epsabs=0, epsrel=1e-12)[0]
+
+
+def _helix() -> ParametricCurve:
+    fx, fy, fz = (Bound(compile_expression(t), {}) for t in ("cos(t)", "sin(t)", "t / 10"))
+    return ParametricCurve(fx, fy, fz, (0.0, 2 * math.pi * TURNS), 256)
+
+
+def ours(curve: ParametricCurve) -> float:
+    breaks = np.linspace(*curve.domain, 257)
+    breaks = refine_breaks(lambda t: np.linalg.norm(curve.derivative(t), axis=1), breaks)
+    return kmeasure.length_and_area(curve.evaluate, curve.derivative, breaks, False)[0]
+
+
+def with_scipy() -> float:
+    from scipy.integrate import quad
+
+    def speed(t: float) -> float:
+        return math.sqrt(math.sin(t) ** 2 + math.cos(t) ** 2 + 0.01)
+
+    return quad(speed, 0, 2 * math.pi * TURNS, limit=5000, epsabs=0, epsrel=1e-12)[0]
+
+
+def run(table) -> None:
+    curve = _helix()
+    case = f"helix length, {TURNS} turns, to 1e-12"
+    err = abs(ours(curve) - EXACT) / EXACT
+    table.time(case, "formgraph", lambda: ours(curve), repeat=3, note=f"rel. error {err:.1e}")
+    try:
+        ref = abs(with_scipy() - EXACT) / EXACT
+    except ImportError:
+        ref = float("nan")
+    table.time(case, "scipy quad", with_scipy, repeat=3, note=f"rel. error {ref:.1e}")
+    wiggle = _wiggle()
+    case = "damped sin(40 t) wiggle length, to 1e-12"
+    try:
+        ref_len = wiggle_scipy()
+        note = f"differs from quad by {abs(ours(wiggle) - ref_len) / ref_len:.1e}"
+    except ImportError:
+        note = ""
+    table.time(case, "formgraph", lambda: ours(wiggle), repeat=3, note=note)
+    table.time(case, "scipy quad", wiggle_scipy, repeat=3)

@@ -1,0 +1,221 @@
+"""The studio page's widgets: the editor, the 3-D view, the graph's drawing, the controls.
+
+Built once with trame's vuetify3 widgets; everything that changes is state (``text``,
+``markers``, ``problems``, ``graph_svg``, ``controls``, ``params``, ``status``), set by
+:class:`~.page.Page`. The graph's drawing is our SVG with an invisible rectangle over each
+node, named by ``data-node``, which a click sends to the server.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+__all__ = ["CSS", "build", "clickable_svg"]
+
+CSS = """
+html, body { overflow: hidden; }
+.fg-main { display: flex; height: calc(100vh - 48px); }
+.fg-left { flex: 0 0 32%; min-width: 0; display: flex; flex-direction: column;
+  border-right: 1px solid #ddd; }
+.fg-editor { flex: 1 1 auto; min-height: 0; }
+.fg-problems { max-height: 30%; overflow: auto; font: 12px monospace; color: #b00020;
+  padding: 4px 8px; border-top: 1px solid #ddd; white-space: pre-wrap; }
+.fg-center { flex: 1 1 auto; display: flex; flex-direction: column; min-width: 0; }
+.fg-view { flex: 1 1 62%; position: relative; min-height: 0; }
+.fg-graph { flex: 0 0 38%; overflow: auto; border-top: 1px solid #ddd; background: white; }
+.fg-graph svg { cursor: pointer; max-width: 100%; height: auto; }
+.fg-right { flex: 0 0 250px; overflow-y: auto; border-left: 1px solid #ddd; padding: 6px 10px; }
+.fg-control { margin-bottom: 6px; }
+.fg-control-name { font-size: 12px; color: #333; display: flex; align-items: center;
+  justify-content: space-between; }
+.fg-status { font: 13px sans-serif; margin-left: 12px; white-space: nowrap; overflow: hidden;
+  text-overflow: ellipsis; }
+.fg-status.bad { color: #b00020; }
+"""
+
+
+def clickable_svg(drawing: Any) -> str:
+    """The drawing's SVG with an invisible rectangle over each node box, ``data-node`` set
+    to the node's name (the page's click handler reads it)."""
+    from xml.sax.saxutils import quoteattr
+
+    boxes = []
+    rect = None
+    for shape in drawing.shapes:
+        cls = getattr(shape, "cls", "")
+        if cls == "node":
+            rect = shape
+        elif cls == "param":
+            rect = None
+        elif cls == "name" and rect is not None:
+            boxes.append((shape.text, rect))
+            rect = None
+    hits = "".join(
+        f'<rect data-node={quoteattr(name)} x="{r.x:.1f}" y="{r.y:.1f}" width="{r.w:.1f}" '
+        f'height="{r.h:.1f}" fill="transparent" stroke="none"/>'
+        for name, r in boxes
+    )
+    svg = drawing.svg
+    svg = svg[svg.index("<svg") :]  # no XML declaration inside a page
+    return svg.replace("</svg>", hits + "</svg>")
+
+
+def build(page: Any) -> tuple[Any, Any]:
+    """The page's widgets, bound to ``page``'s state and controller: (layout, 3-D view)."""
+    from trame.ui.vuetify3 import VAppLayout
+    from trame.widgets import client, code, html
+    from trame.widgets import vuetify3 as v
+    from trame_pyvista.widgets import PyVistaLocalView
+
+    with VAppLayout(page.server, full_height=True) as layout:
+        client.Style(CSS)
+        with v.VAppBar(density="compact", flat=True, border=True):
+            v.VAppBarTitle(f"{page.session.path.name}", style="flex: 0 0 auto; font-size: 16px;")
+            v.VBtn("Save", click=page.ctrl.save, variant="tonal", classes="ml-2", id="save")
+            v.VBtn("Run", click=page.ctrl.run, variant="tonal", classes="ml-2", id="run")
+            v.VBtn(
+                "Reload",
+                click=page.ctrl.reload,
+                variant="text",
+                classes="ml-1",
+                id="reload",
+                title="read the graph file again (the editor's unsaved edits are lost)",
+            )
+            html.Div(
+                "{{ status }}",
+                classes=("status_bad ? 'fg-status bad' : 'fg-status'",),
+                id="status",
+            )
+            v.VSpacer()
+            html.Div("{{ JSON.stringify(timing) }}", id="timing", style="display: none")
+            v.VProgressCircular(
+                v_show=("busy",), indeterminate=True, size=18, width=2, classes="mr-3"
+            )
+        with v.VMain():
+            with html.Div(classes="fg-main"):
+                with html.Div(classes="fg-left"):
+                    with html.Div(classes="fg-editor", id="editor"):
+                        code.Editor(
+                            v_model=("text",),
+                            language="yaml",
+                            theme="vs",
+                            markers=("markers",),
+                            options=(
+                                "{ minimap: { enabled: false }, fontSize: 13, "
+                                "automaticLayout: true, scrollBeyondLastLine: false }",
+                            ),
+                        )
+                    with html.Div(classes="fg-problems", id="problems", v_show="problems.length"):
+                        html.Div(
+                            "{{ p }}",
+                            v_for="p in problems",
+                            style=("p.startsWith('warning') ? 'color: #8a5a00' : ''",),
+                        )
+                with html.Div(classes="fg-center"):
+                    with html.Div(classes="fg-view", id="view"):
+                        view = PyVistaLocalView(page.plotter)
+                    with html.Div(classes="fg-graph", id="graph"):
+                        html.Div(
+                            "showing {{ shown }}",
+                            style="font: 12px sans-serif; padding: 4px 8px; color: #555;",
+                        )
+                        html.Div(
+                            v_html=("graph_svg",),
+                            click=(
+                                "$event.target.closest('[data-node]') && "
+                                "trigger('show_node', [$event.target.closest('[data-node]')"
+                                ".getAttribute('data-node')])"
+                            ),
+                        )
+                with html.Div(classes="fg-right", id="controls"):
+                    with html.Div(
+                        style="display: flex; justify-content: space-between; "
+                        "align-items: center; margin-bottom: 4px;"
+                    ):
+                        html.B("params", style="font: 13px sans-serif;")
+                        v.VBtn(
+                            "reset all",
+                            click=page.ctrl.reset_all,
+                            size="x-small",
+                            variant="text",
+                        )
+                    v.VBtn(
+                        "show results",
+                        click=page.ctrl.show_results,
+                        size="x-small",
+                        variant="text",
+                        block=True,
+                        classes="mb-2",
+                    )
+                    v.VSelect(
+                        v_show=("attributes.length",),
+                        label="colour by",
+                        items=("['none', ...attributes]",),
+                        model_value=("color_by",),
+                        update_modelValue="color_by = $event; trigger('colour_by', [$event])",
+                        density="compact",
+                        hide_details=True,
+                        variant="outlined",
+                        classes="mb-3",
+                        id="colour-by",
+                    )
+                    _control_widgets(v, html)
+    return layout, view
+
+
+def _control_widgets(v: Any, html: Any) -> None:
+    """A control per param (``controls`` in the state), with its reset."""
+    set_value = "params[c.name] = $event; trigger('set_param', [c.name, $event])"
+    with html.Div(v_for="c in controls", key="c.name", classes="fg-control"):
+        with html.Div(classes="fg-control-name"):
+            html.Span(
+                "{{ c.name }} = {{ params[c.name] }}",
+                title=("c.doc",),
+            )
+            v.VBtn(
+                "reset",
+                size="x-small",
+                variant="text",
+                click="trigger('reset_param', [c.name])",
+                disabled=("params[c.name] === c.default",),
+            )
+        v.VSlider(
+            v_if="c.kind === 'slider'",
+            model_value=("params[c.name]",),
+            min=("c.min",),
+            max=("c.max",),
+            step=("c.step",),
+            density="compact",
+            hide_details=True,
+            color="primary",
+            update_modelValue=set_value,
+            classes=("'fg-slider-' + c.name",),
+        )
+        v.VTextField(
+            v_if="c.kind === 'number' || c.kind === 'text'",
+            model_value=("params[c.name]",),
+            density="compact",
+            hide_details=True,
+            variant="outlined",
+            change=(
+                "trigger('set_param', [c.name, c.kind === 'number' ? "
+                "Number($event.target.value) : $event.target.value])"
+            ),
+        )
+        v.VSwitch(
+            v_if="c.kind === 'toggle'",
+            model_value=("params[c.name]",),
+            density="compact",
+            hide_details=True,
+            color="primary",
+            update_modelValue=set_value,
+        )
+        v.VSelect(
+            v_if="c.kind === 'choice'",
+            model_value=("params[c.name]",),
+            items=("c.choices",),
+            density="compact",
+            hide_details=True,
+            variant="outlined",
+            update_modelValue=set_value,
+        )

@@ -1,0 +1,90 @@
+"""Hostile fields: unbounded, non-finite, oversized and degenerate inputs to field.* and
+mesh.offset give a located error (never a numpy traceback, a hang or a huge allocation)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import formgraph as fg
+from formgraph.core.errors import BudgetError
+
+
+def graph(**nodes):
+    g = fg.Graph()
+    for name, (kind, inputs) in nodes.items():
+        g.add(name, kind, **inputs)
+    return g
+
+
+def test_an_expression_that_reads_attributes_is_refused_at_load():
+    with pytest.raises(fg.GraphError, match="__class__|not allowed|attribute"):
+        g = graph(
+            e=("field.expression", {"value": "x.__class__", "bounds": [[0, 0, 0], [1, 1, 1]]})
+        )
+        g.evaluate("e")
+
+
+def test_a_field_infinite_everywhere_is_a_node_error():
+    g = graph(
+        e=("field.expression", {"value": "log(0 * x)", "bounds": [[0, 0, 0], [1, 1, 1]]}),
+        m=("field.mesh", {"field": "@e", "cell": 0.25}),
+    )
+    with pytest.raises(fg.NodeError, match="not finite"):
+        g.evaluate("m")
+
+
+def test_bounds_that_are_not_a_box_are_refused():
+    g = graph(
+        s=("field.sphere", {"radius": 1}),
+        m=("field.mesh", {"field": "@s", "bounds": [[1, 1, 1], [0, 0, 0]]}),
+    )
+    with pytest.raises(fg.NodeError, match="x0 < x1"):
+        g.evaluate("m")
+
+
+def test_a_tiny_cell_over_a_huge_box_fails_before_allocating():
+    g = graph(
+        t=("field.tpms", {"period": 1.0, "thickness": 0.1}),
+        m=("field.mesh", {"field": "@t", "cell": 1e-3, "bounds": [[0, 0, 0], [1e3, 1e3, 1e3]]}),
+    )
+    with pytest.raises(BudgetError, match="over the budget"):
+        g.evaluate("m")
+
+
+def test_a_hopeless_lipschitz_field_is_still_bounded_by_the_budget():
+    # a field claiming no slope keeps every cell at every level: counted, then refused
+    g = graph(
+        e=(
+            "field.expression",
+            {
+                "value": "sin(1000 * x) * 0.001",
+                "bounds": [[-1, -1, -1], [1, 1, 1]],
+                "lipschitz": 1e6,
+            },
+        ),
+        m=("field.mesh", {"field": "@e", "cell": 0.002}),
+    )
+    with pytest.raises(BudgetError):
+        g.evaluate("m")
+
+
+def test_tpms_walls_thicker_than_half_a_period_are_refused():
+    g = graph(t=("field.tpms", {"period": 2.0, "thickness": 1.5}))
+    with pytest.raises(fg.NodeError, match="half the period"):
+        g.evaluate("t")
+
+
+def test_the_offset_of_a_mesh_without_area_is_a_closed_tube():
+    flat = fg.Mesh(np.array([[0, 0, 0], [1, 0, 0], [2, 0, 0.0]]), [[0, 1, 2]])  # no area
+    g = fg.Graph()
+    g.add_param("m", type="Mesh")
+    g.add("o", "mesh.offset", mesh="=m", distance=0.1, cell=0.05)
+    out = g.evaluate("o", m=flat)  # a tube round a segment: closed, outward
+    assert out.is_watertight and out.volume > 0
+
+
+def test_a_field_evaluated_at_2d_points_says_what_it_needs():
+    f = fg.geometry.Field.sphere(1.0)
+    with pytest.raises(ValueError, match=r"\(n, 3\)"):
+        f.evaluate(np.zeros((4, 2)))

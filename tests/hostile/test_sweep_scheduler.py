@@ -1,0 +1,96 @@
+"""sweep --scheduler at something that is not a Dask scheduler: a sentence within the
+handshake's time limit, never a hang or an allocation the peer chose."""
+
+from __future__ import annotations
+
+import socket
+import struct
+import threading
+import time
+
+import pytest
+
+import formgraph as fg
+from formgraph.cli import main as cli
+from formgraph.sweeps import cluster
+from formgraph.sweeps.api import sweep
+
+GRAPH = "formgraph: 1\nparams:\n  r: 1.0\nnodes:\n  c: {type: nurbs.circle, radius: '=r'}\n"
+
+
+class _Peer:
+    """A loopback server that accepts and then answers with ``reply`` (None: silence)."""
+
+    def __init__(self, reply: bytes | None):
+        self.server = socket.create_server(("127.0.0.1", 0))
+        self.port = self.server.getsockname()[1]
+        self.reply = reply
+        self.conns: list[socket.socket] = []
+        self.thread = threading.Thread(target=self._serve, daemon=True)
+        self.thread.start()
+
+    def _serve(self) -> None:
+        self.server.settimeout(30)
+        try:
+            while True:
+                conn, _ = self.server.accept()
+                self.conns.append(conn)  # kept open: a silent peer holds the line
+                if self.reply is not None:
+                    conn.sendall(self.reply)
+        except OSError:
+            return
+
+    def close(self) -> None:
+        self.server.close()
+        for c in self.conns:
+            c.close()
+
+
+@pytest.fixture
+def peer(request, monkeypatch):
+    monkeypatch.setattr(cluster, "HANDSHAKE_SECONDS", 1.0)
+    p = _Peer(request.param)
+    yield p
+    p.close()
+
+
+JUNK = struct.pack("<Q", 3 * 2**60) + b"\x00" * 64  # asks for 3 EiB
+NOT_DASK = struct.pack("<Q", 16) + b"GET / HTTP/1.1\r\n"
+
+
+@pytest.mark.parametrize(
+    ("peer", "message"),
+    [
+        (None, "sent no Dask handshake within 1 s"),
+        (JUNK, "is not a Dask scheduler (it announced a first message of"),
+        (NOT_DASK, "is not a Dask scheduler"),
+        (b"", "is not a Dask scheduler"),  # accepts, says nothing, stays open: silent too
+    ],
+    indirect=["peer"],
+)
+def test_a_peer_that_is_not_a_scheduler_is_refused_in_time(tmp_path, peer, message):
+    g = fg.Graph.from_text(GRAPH, file="g.yaml")
+    t0 = time.monotonic()
+    with pytest.raises(cluster.SweepError) as info:
+        sweep(g, {"r": "1,2"}, client=f"tcp://127.0.0.1:{peer.port}", cache_dir=None)
+    assert time.monotonic() - t0 < 8
+    text = str(info.value)
+    assert (message in text) or (peer.reply == b"" and "no Dask handshake" in text), text
+
+
+@pytest.mark.parametrize("peer", [JUNK], indirect=True)
+def test_the_cli_says_it_in_one_line(tmp_path, peer, capsys):
+    (tmp_path / "g.yaml").write_text(GRAPH)
+    address = f"tcp://127.0.0.1:{peer.port}"
+    code = cli.main(["sweep", str(tmp_path / "g.yaml"), "--vary", "r=1,2", "--scheduler", address])
+    err = capsys.readouterr().err
+    assert code == 1 and "not a Dask scheduler" in err and "MemoryError" not in err
+    assert "internal error" not in err and len(err.strip().splitlines()) == 1
+
+
+def test_nobody_listening_is_a_sentence():
+    s = socket.create_server(("127.0.0.1", 0))
+    port = s.getsockname()[1]
+    s.close()
+    with pytest.raises(cluster.SweepError, match="cannot reach the Dask scheduler"):
+        cluster.probe_scheduler(f"tcp://127.0.0.1:{port}", timeout=1)
