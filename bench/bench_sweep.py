@@ -9,29 +9,54 @@
 
 The embedded cluster (what ``fg.sweep`` starts when given no client) is started before
 timing, its start-up reported apart, and closed after.
+
+Under ``BENCH_CLOCK=cpu`` both sides are CPU seconds: the loop's process, and for the sweep
+this process plus every worker process of the cluster (read from the operating system
+before and after: a sweep's work is done in the workers, so this process's own CPU time
+alone would flatter it).
 """
 
 from __future__ import annotations
 
+import os
 import time
 from pathlib import Path
 
 import formgraph as fg
 
 ROOT = Path(__file__).resolve().parents[1]
+CPU = os.environ.get("BENCH_CLOCK", "wall") == "cpu"
+
+
+def _clock() -> float:
+    """Wall seconds, or under BENCH_CLOCK=cpu the CPU seconds of this process and of its
+    children (the cluster's nanny and worker processes)."""
+    if not CPU:
+        return time.perf_counter()
+    import psutil
+
+    me = psutil.Process()
+    total = time.process_time()
+    for child in me.children(recursive=True):
+        try:
+            t = child.cpu_times()
+            total += t.user + t.system
+        except psutil.Error:  # a process that ended meanwhile
+            pass
+    return total
 
 
 def _loop(g: fg.Graph, node: str, variants: list[dict]) -> float:
-    t0 = time.perf_counter()
+    t0 = _clock()
     for v in variants:
         g.evaluate(node, **v)
-    return time.perf_counter() - t0
+    return _clock() - t0
 
 
 def _sweep(g: fg.Graph, vary: dict, client) -> tuple[float, fg.Sweep]:
-    t0 = time.perf_counter()
+    t0 = _clock()
     s = fg.sweep(g, vary, client=client, cache_dir=None)
-    seconds = time.perf_counter() - t0
+    seconds = _clock() - t0
     assert s.failed == 0, s.rows[0]["error"] if s.rows else ""
     return seconds, s
 
@@ -78,7 +103,7 @@ def run(table) -> None:
             case,
             "formgraph",
             ours / len(variants),
-            f"target < 5 ms; whole sweep {ours:.2f} s on 2 workers",
+            f"whole sweep {ours:.2f} s on 2 workers" + (" (CPU, workers included)" if CPU else ""),
         )
         table.add(case, "plain g.evaluate loop", loop / len(variants), "one process")
     finally:

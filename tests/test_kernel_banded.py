@@ -178,3 +178,18 @@ def test_averaged_knots_by_running_sums_match_the_definition():
         inner = [u[j : j + p].mean() for j in range(1, len(u) - p)]
         np.testing.assert_allclose(knots[p + 1 : -p - 1], inner, atol=1e-14)
         assert (np.diff(knots) >= 0).all()
+
+
+def test_open_fit_without_scipys_private_collocation(monkeypatch):
+    # The band comes from scipy's own (not public) collocation routine; without it the
+    # public make_interp_spline does the same fit.
+    rng = np.random.default_rng(9)
+    pts = np.cumsum(rng.normal(size=(400, 3)), axis=0)
+    cp, _, knots, _ = K.interpolate(pts, 3)
+    monkeypatch.setattr(fit, "_scipy_coloc", lambda: None)
+    cp2, _, _, _ = K.interpolate(pts, 3)
+    np.testing.assert_allclose(cp2, cp, atol=1e-9 * np.abs(pts).max())
+    u = K.interpolation_parameters(pts)
+    np.testing.assert_allclose(
+        K.curve_evaluate(cp, 3, knots, None, u), pts, atol=1e-9 * np.abs(pts).max()
+    )

@@ -547,3 +547,66 @@ def test_fast_solid_check_agrees_with_the_report(seed, which):
     if which == "soup":
         fi, fo = kr.drop_collapsed(fi, fo, 6)
     assert km.is_closed_oriented(fi, fo, len(v)) == km.solid_report(fi, fo, len(v)).is_solid
+
+
+def test_packed_and_hashed_cell_keys_find_the_same_pairs(monkeypatch):
+    # Cell numbers that fit 21 bits an axis take the packed-key path; forcing the hashed
+    # one must give the same close pairs (and so the same weld).
+    from formgraph.kernels.mesh import repair
+
+    rng = np.random.default_rng(4)
+    base = rng.uniform(-1, 1, (3000, 3))
+    near = base[rng.integers(0, 3000, 2000)] + rng.normal(scale=3e-4, size=(2000, 3))
+    v = np.concatenate([base, near])
+    packed = repair._close_pairs(v, 1e-3)
+    monkeypatch.setattr(repair, "_PACKED", 0)
+    hashed = repair._close_pairs(v, 1e-3)
+
+    def canon(ij):
+        i, j = np.minimum(*ij), np.maximum(*ij)
+        return sorted(zip(i.tolist(), j.tolist(), strict=True))
+
+    assert canon(packed) == canon(hashed)
+    d = np.linalg.norm(v[:, None] - v[None], axis=2)
+    brute = np.argwhere(np.triu(d <= 1e-3, k=1))
+    assert canon(packed) == sorted(map(tuple, brute.tolist()))
+
+
+def test_triangle_face_vectors_match_the_polygon_formula():
+    from formgraph.kernels.mesh import measure
+
+    rng = np.random.default_rng(6)
+    v = rng.normal(size=(50, 3)) + 1e3  # far from the origin
+    tri = rng.integers(0, 50, (200, 3))
+    fast = measure.face_vectors(v, tri.ravel(), np.arange(0, 601, 3))
+    # The same triangles among one quad: the general Newell path.
+    fi = np.r_[tri.ravel(), [0, 1, 2, 3]]
+    general = measure.face_vectors(v, fi, np.r_[np.arange(0, 601, 3), 604])[:-1]
+    np.testing.assert_allclose(fast, general, rtol=1e-9, atol=1e-9)
+    a, b, c = v[tri[:, 0]], v[tri[:, 1]], v[tri[:, 2]]
+    np.testing.assert_allclose(fast, np.cross(b - a, c - a), rtol=1e-9, atol=1e-9)
+
+
+def test_triangle_signed_volumes_match_the_fan_formula():
+    from formgraph.kernels.mesh import measure
+
+    rng = np.random.default_rng(7)
+    v = rng.normal(size=(40, 3))
+    tri = rng.integers(0, 40, (100, 3))
+    fo = np.arange(0, 301, 3)
+    origins = rng.normal(size=(100, 3))
+    for origin in (None, origins[0], origins):
+        fast = measure.signed_volume(v, tri.ravel(), fo, origin)
+        # the general path: the same triangles plus one quad, which is dropped after
+        general = measure.signed_volume(
+            v,
+            np.r_[tri.ravel(), [0, 1, 2, 3]],
+            np.r_[fo, 304],
+            None
+            if origin is None
+            else (np.r_[origins, [[0, 0, 0]]] if origin.ndim == 2 else origin),
+        )[:-1]
+        if origin is None:  # the default origins differ (the quad's corners are in the box)
+            assert np.sum(fast) == pytest.approx(np.sum(general), abs=1e-9)
+        else:
+            np.testing.assert_allclose(fast, general, rtol=1e-9, atol=1e-12)

@@ -84,6 +84,7 @@ class NodeSpec:
 
 
 _REGISTRY: dict[str, NodeSpec] = {}
+_SORTED: dict[str, NodeSpec] = {}  # _REGISTRY in name order, rebuilt after a registration
 
 
 def node(name: str, *, version: int = 1) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
@@ -98,6 +99,7 @@ def node(name: str, *, version: int = 1) -> Callable[[Callable[..., Any]], Calla
         if name in _REGISTRY and _REGISTRY[name].func.__qualname__ != func.__qualname__:
             raise ValueError(f"node type {name!r} is registered twice")
         _REGISTRY[name] = _spec_from_function(name, version, func)
+        _SORTED.clear()
         return func
 
     return register
@@ -107,7 +109,12 @@ def node_types() -> dict[str, NodeSpec]:
     """Every registered node type, by name (importing the node families first)."""
     import formgraph.nodes  # noqa: F401  (registers the families on import)
 
-    return dict(sorted(_REGISTRY.items()))
+    # Sorted once per change of the registry (every run asks; a sweep, once per variant);
+    # the entries are compared too, since a test may replace one in place.
+    if len(_SORTED) != len(_REGISTRY) or any(_SORTED.get(k) is not v for k, v in _REGISTRY.items()):
+        _SORTED.clear()
+        _SORTED.update(sorted(_REGISTRY.items()))
+    return dict(_SORTED)
 
 
 def _spec_from_function(name: str, version: int, func: Callable[..., Any]) -> NodeSpec:

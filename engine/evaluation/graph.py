@@ -11,7 +11,6 @@ cached). Outputs are hashed only for that comparison, never on a cold run.
 from __future__ import annotations
 
 import os
-import time
 from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
@@ -34,6 +33,7 @@ from ..language.subgraph import Includes, SubgraphSpec, is_graph_type
 from ..language.yamlio import MAX_BYTES, MAX_DEPTH, dump, parse
 from . import cache as _cache
 from .arguments import check_budgets, nesting, node_names, plain
+from .plans import Plans
 from .run import NodeStat, Step, _Run
 
 __all__ = ["Graph", "NodeStat", "Step", "load"]
@@ -81,7 +81,7 @@ def load(
     )
 
 
-class Graph:
+class Graph(Plans):
     """A formgraph graph. Build it in code with :meth:`add` or read one with :func:`load`.
 
     Example
@@ -126,9 +126,25 @@ class Graph:
         self._subgraphs: dict[str, SubgraphSpec] = {}  # graph-file node types -> specs
         self._includes: Includes | None = None
         self._children: dict[Any, Graph] = {}  # subgraph path -> its graph, caches shared
+        self._replay: dict[tuple[str, ...], Any] = {}  # targets -> last run's keys (run.py)
+        self._pure_root: tuple[str, Path] | None = None  # out_dir -> its root, for plans
+        self._step_params: tuple[str, dict[str, Any]] | None = None  # compute_step's last
         self._checked = False
         self.stats: dict[str, NodeStat] = {}
         self.progress: Progress | None = None
+
+    @property
+    def _checked(self) -> bool:
+        """Whether the graph as it stands was checked. Every change sets it False, which
+        also forgets the keys kept from the last runs (they were of the graph before)."""
+        return self.__checked
+
+    @_checked.setter
+    def _checked(self, value: bool) -> None:
+        self.__checked = value
+        if not value:
+            self._replay.clear()
+            self._step_params = None
 
     # ----------------------------------------------------------------------- building
 
@@ -362,6 +378,7 @@ class Graph:
     def set(self, **params: Any) -> None:
         """Change param values for later evaluations."""
         self._values.update(self._checked_params(params))
+        self._step_params = None
 
     def _checked_params(self, params: dict[str, Any]) -> dict[str, Any]:
         problems = []
@@ -473,94 +490,6 @@ class Graph:
     def evaluate_all(self, **params: Any) -> dict[str, Any]:
         """Evaluate every sink (so every export writes its file)."""
         return self.evaluate(self.sinks(), **params)
-
-    # ------------------------------------------------------------------ plans (sweeps)
-
-    def plan(self, targets: str | Iterable[str], **params: Any) -> list[Step]:
-        """The nodes that ``targets`` need, in evaluation order, each with its cache key.
-
-        Keys are those of a cold evaluation with these params: they depend only on what goes
-        into each node (no early cutoff, which needs earlier outputs), so a sweep can key
-        every variant's nodes before anything runs and share the nodes whose keys agree.
-        Nothing is evaluated (except the inputs a repeat count is read from).
-        """
-        if not self._checked:
-            self.check()
-        values = dict(self._values)
-        values.update(self._checked_params(params))
-        run = _Run(self, values, pure=True)
-        names = [targets] if isinstance(targets, str) else list(targets)
-        steps = []
-        for n in self._order(names):
-            up = tuple(dict.fromkeys(self._nodes[n].upstream()))
-            export = run.registry[self._nodes[n].type].is_export
-            steps.append(Step(n, run.key(n), up, export, tuple(run.keys[u] for u in up)))
-        return steps
-
-    def compute_step(
-        self,
-        step: Step,
-        inputs: dict[str, Any],
-        *,
-        out_dir: str | os.PathLike[str] | None = None,
-        **params: Any,
-    ) -> tuple[Any, NodeStat]:
-        """Node ``step.name``'s output from its inputs' outputs, through the caches.
-
-        ``step`` comes from :meth:`plan` with the same params; ``inputs`` maps each of
-        ``step.upstream`` to its output. A value cached under ``step.key`` is returned as it
-        is; a computed one is cached under it. Exports always run, writing into ``out_dir``
-        (default :attr:`out_dir`).
-
-        Raises
-        ------
-        NodeError, GraphError
-            As :meth:`evaluate` does for the node.
-        """
-        values = dict(self._values)
-        values.update(self._checked_params(params))
-        run = _Run(self, values, pure=True)
-        if out_dir is not None:
-            run.out_path = Path(out_dir).resolve()
-            run.out_dir = str(run.out_path)
-        run.keys.update(zip(step.upstream, step.upstream_keys, strict=True))
-        run.results.update(inputs)
-        nd = self._nodes[step.name]
-        spec = run.registry[nd.type]
-        if nd.repeat is None and nd.simulate is None:
-            run.keys[step.name] = step.key
-        else:
-            run.key(step.name)  # its items' keys (the count may come from an input)
-        t0 = time.perf_counter()
-        if not spec.is_export:
-            if nd.repeat is not None:
-                hit, value, source = run.lookup_items(step.name, spec)
-            elif nd.simulate is not None:
-                hit, value, source = run.lookup_steps(step.name, spec)
-            else:
-                hit, value, source = run.lookup(step.key, spec)
-            if hit:
-                return value, NodeStat("cached", time.perf_counter() - t0, source=source)
-        if nd.repeat is not None:
-            value = run.compute_items(step.name, nd, spec)
-        elif nd.simulate is not None:
-            value = run.compute_steps(step.name, nd, spec)
-        else:
-            value = run.compute(step.name, nd, spec)
-        return value, run.stats[step.name]
-
-    def cached(self, step: Step) -> tuple[bool, Any]:
-        """(True, output) when a cache holds planned ``step``'s output, else (False, None).
-
-        Exports (their file may be gone) and repeated nodes are never answered this way.
-        """
-        nd = self._nodes[step.name]
-        run = _Run(self, dict(self._values), pure=True)
-        spec = run.registry[nd.type]
-        if spec.is_export or nd.repeat is not None or nd.simulate is not None:
-            return False, None
-        hit, value, _ = run.lookup(step.key, spec)
-        return hit, value
 
     def upstream(self, name: str) -> list[str]:
         """All ancestors of ``name`` and itself, in evaluation order."""

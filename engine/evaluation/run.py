@@ -42,6 +42,7 @@ from ..language.model import FRAMES, STEP, Expr, Input, Items, Literal, NodeDef,
 from ..language.subgraph import SubgraphSpec
 from . import cache as _cache
 from .items import LanguageRun, file_stamp, input_names, reads_loop
+from .replay import Replay
 from .simulation import SimulationRun
 from .stats import NodeStat, Step
 
@@ -65,13 +66,14 @@ class GraphView(Protocol):
     _digests: dict[str, str]  # key -> content digest of the value
     _written: dict[str, Any]  # key of an export -> (size, mtime) of the file it wrote
     _last: dict[str, tuple[str, str]]  # node -> (key, identity) of its last value
+    _replay: dict[tuple[str, ...], Any]  # targets -> the keys of the last run (_Run.replay)
 
     def _order(self, targets: Any) -> list[str]: ...
 
     def _child(self, spec: SubgraphSpec) -> GraphView: ...
 
 
-class _Run(LanguageRun, SimulationRun):
+class _Run(LanguageRun, SimulationRun, Replay):
     """One evaluation call: memoized keys, identities and values, and the run record."""
 
     def __init__(
@@ -93,10 +95,19 @@ class _Run(LanguageRun, SimulationRun):
         self.inner: dict[str, dict[str, NodeStat]] = {}  # subgraph node -> its run's stats
         self.results: dict[str, Any] = {}
         self.stats: dict[str, NodeStat] = {}
-        try:
-            self.out_path = safety.output_root(g.out_dir)
-        except PathError:  # only an export needs it: each says why, at its own line
-            self.out_path = Path(os.path.abspath(g.out_dir))
+        memo = getattr(g, "_pure_root", None) if pure else None
+        if memo is not None and memo[0] == str(g.out_dir):
+            # A plan or a step keys with the folder's name only (a sweep plans every variant
+            # and runs every step through one: one look at the file system, not thousands);
+            # an export still checks where it writes.
+            self.out_path = memo[1]
+        else:
+            try:
+                self.out_path = safety.output_root(g.out_dir)
+            except PathError:  # only an export needs it: each says why, at its own line
+                self.out_path = Path(os.path.abspath(g.out_dir))
+            if pure:
+                g._pure_root = (str(g.out_dir), self.out_path)
         self.out_dir = str(self.out_path)
         self.total = 0
         self.tally = RunTally(g.budget)  # what this run's nodes hold together
@@ -126,7 +137,8 @@ class _Run(LanguageRun, SimulationRun):
                 self.quiet = False
 
     def _run(self, targets: list[str]) -> None:
-        order = self.g._order(targets)
+        replayed = self.replay(targets)
+        order = self.g._order(targets) if replayed is None else replayed
         self.total = len(order)
         for n in order:  # the budget applies to every count known before anything runs
             r = self.g._nodes[n].repeat
@@ -150,6 +162,8 @@ class _Run(LanguageRun, SimulationRun):
         for t in targets:
             self.fetch(t)
         self.input_files.clear()  # the bytes of inputs whose nodes came from a cache
+        if replayed is None:
+            self.remember(targets, order)
 
     def identity(self, name: str) -> str:
         # identity of the value that flows out of a node: its key, or an earlier identical
@@ -240,6 +254,7 @@ class _Run(LanguageRun, SimulationRun):
             if len(self.g._input_digests) > 10_000:
                 self.g._input_digests.clear()
             self.g._input_digests[str(path)] = (stamp, digest)
+        self.keyed_files = True  # keys that hold file bytes: never replayed (_Run.remember)
         return {"path": relpath, "bytes": digest}
 
     def read_input(self, name: str, relpath: str) -> tuple[Path, bytes]:

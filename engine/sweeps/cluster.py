@@ -172,8 +172,8 @@ def build(
     users: dict[str, int] = {}  # node key -> how many distinct rows need it
     cached: set[str] = set()
     totals = Totals(variants=len(variants))
-    for index, params in variants:
-        steps = g.plan(names, **params)
+    planned = g.plans(names, [params for _, params in variants])
+    for (index, params), steps in zip(variants, planned, strict=True):
         totals.naive += len(steps)
         by_name = {s.name: s for s in steps}
         row_key = "row-" + key_of(

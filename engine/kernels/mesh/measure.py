@@ -177,11 +177,29 @@ def face_vectors(
     fo = np.asarray(face_offsets, dtype=np.int64)
     if fo.size < 2:
         return np.zeros((0, 3))
+    n_faces = fo.size - 1
+    if fi.size == 3 * n_faces and fo[-1] == fi.size and (np.diff(fo) == 3).all():
+        return _triangle_vectors(v, fi.reshape(-1, 3))
     # about the first corner of each face, for conditioning far from the origin
     base = np.repeat(v[fi[fo[:-1]]], np.diff(fo), axis=0)
     p = v[fi] - base
     q = v[fi[next_corner(fo)]] - base
     return np.add.reduceat(np.cross(p, q), fo[:-1], axis=0)
+
+
+def _triangle_vectors(v: np.ndarray, tri: np.ndarray) -> np.ndarray:
+    """Newell vectors of triangles: ``(b - a) x (c - a)``, the same as the polygon formula
+    for three corners, on one contiguous array per coordinate (no per-corner repeat, no
+    reduceat, no (m, 3) cross product with its short last axis)."""
+    cols = [np.ascontiguousarray(v[:, k]) for k in range(3)]
+    a = [np.take(c, tri[:, 0]) for c in cols]
+    e1 = [np.take(c, tri[:, 1]) - ak for c, ak in zip(cols, a, strict=True)]
+    e2 = [np.take(c, tri[:, 2]) - ak for c, ak in zip(cols, a, strict=True)]
+    out = np.empty((tri.shape[0], 3))
+    out[:, 0] = e1[1] * e2[2] - e1[2] * e2[1]
+    out[:, 1] = e1[2] * e2[0] - e1[0] * e2[2]
+    out[:, 2] = e1[0] * e2[1] - e1[1] * e2[0]
+    return out
 
 
 def face_areas(
@@ -201,6 +219,10 @@ def face_areas(
     if fo.size < 2:
         return np.zeros(0)
     sizes = np.diff(fo)
+    if fi.size == 3 * sizes.size and fo[-1] == fi.size and (sizes == 3).all():
+        n = _triangle_vectors(v, fi.reshape(-1, 3))  # a triangle is its own fan
+        x, y, z = n[:, 0], n[:, 1], n[:, 2]
+        return 0.5 * np.sqrt(x * x + y * y + z * z)
     base = np.repeat(v[fi[fo[:-1]]], sizes, axis=0)
     cross = np.cross(v[fi] - base, v[fi[next_corner(fo)]] - base)  # fan triangles, doubled
     newell = np.add.reduceat(cross, fo[:-1], axis=0)
@@ -231,6 +253,15 @@ def signed_volume(
         used = v[fi]
         origin = 0.5 * (used.min(axis=0) + used.max(axis=0))
     origin = np.asarray(origin, dtype=np.float64)
+    if fi.size == 3 * n_faces and fo[-1] == fi.size and (np.diff(fo) == 3).all():
+        # Triangles: one cone each, on contiguous coordinate columns (no fan, no bincount).
+        tri = fi.reshape(-1, 3)
+        o = [origin[:, k] if origin.ndim == 2 else origin[k] for k in range(3)]
+        cols = [np.ascontiguousarray(v[:, k]) for k in range(3)]
+        p = [[np.take(cols[k], tri[:, c]) - o[k] for k in range(3)] for c in range(3)]
+        (x0, y0, z0), (x1, y1, z1), (x2, y2, z2) = p
+        det = x0 * (y1 * z2 - z1 * y2) + y0 * (z1 * x2 - x1 * z2) + z0 * (x1 * y2 - y1 * x2)
+        return det / 6.0
     tris = fan_triangles(fi, fo)
     face = np.repeat(np.arange(n_faces), np.diff(fo) - 2)
     o = origin[face] if origin.ndim == 2 else origin

@@ -72,6 +72,8 @@ def _close_pairs(v: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
             "along an axis would pass 2^62); 0 merges exact duplicates only"
         )
     q = np.ascontiguousarray(qf.astype(np.int64))
+    if qf.max(initial=0.0) < _PACKED - 2:
+        return _close_pairs_packed(v, q, tol)
     for salt in (0, 0x9E3779B97F4A7C15, 0x2545F4914F6CDD1D):
         h = _cell_hash(q, salt)
         order = np.argsort(h, kind="stable")
@@ -128,6 +130,73 @@ def _close_pairs(v: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
     j = np.concatenate(jj) if jj else np.zeros(0, np.int64)
     # compared in units of tol: tol * tol underflows for a tiny tolerance
     with np.errstate(over="ignore"):
+        d = (v[i] - v[j]) / tol
+        close = np.einsum("ij,ij->i", d, d) <= 1.0
+    return i[close], j[close]
+
+
+_PACKED = 1 << 21  # cell numbers below this per axis pack into one int64 key (3 x 21 bits)
+_NEIGHBOURS = [(dx, dy, dz) for dx in (-1, 0, 1) for dy in (-1, 0, 1) for dz in (-1, 0, 1)][13:]
+
+
+def _close_pairs_packed(v: np.ndarray, q: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
+    """`_close_pairs` where the cell numbers fit 21 bits an axis (a tolerance above about
+    1e-6 of the extent): each cell is one int64 key ``(x + 1) << 42 | (y + 1) << 21 | z + 1``,
+    so a neighbour's key is the cell's plus a constant. The cells sorted once, every
+    neighbour look-up is then a search of sorted keys in sorted keys (no hashing, no
+    collision check, and cache-friendly: the searches walk both arrays in order)."""
+    key = ((q[:, 0] + 1) << 42) | ((q[:, 1] + 1) << 21) | (q[:, 2] + 1)
+    order = np.argsort(key, kind="stable")
+    ks = key[order]
+    new_cell = np.empty(ks.size, dtype=bool)
+    new_cell[0] = True
+    np.not_equal(ks[1:], ks[:-1], out=new_cell[1:])
+    starts = np.flatnonzero(new_cell)
+    cells = ks[starts]
+    counts = np.diff(np.r_[starts, len(v)])
+    found = []
+    for dx, dy, dz in _NEIGHBOURS:
+        shift = (dx << 42) + (dy << 21) + dz
+        if shift == 0:
+            hit = np.flatnonzero(counts > 1)
+            found.append((True, hit, hit))
+            continue
+        target = cells + shift  # sorted, as cells are
+        pos = np.minimum(np.searchsorted(cells, target), cells.size - 1)
+        hit = np.flatnonzero(cells[pos] == target)
+        found.append((False, hit, pos[hit]))
+    return _pairs_within(v, tol, order, starts, counts, found)
+
+
+def _pairs_within(v, tol, order, starts, counts, found):
+    """The point pairs of the cell pairs ``found`` (same cell, cells a, cells b) closer than
+    ``tol``, after the count of pairs to compare is checked against ``MAX_PAIRS``."""
+    total = 0
+    for same, ca, cb in found:
+        na, nb = counts[ca], counts[cb]
+        total += int(np.sum(na * (nb - 1) // 2 if same else na * nb))
+    if total > MAX_PAIRS:
+        raise ValueError(
+            f"weld tolerance {tol:g} is too coarse for this mesh: {total:,} vertex pairs fall "
+            f"within a cell of each other (limit {MAX_PAIRS:,}); use a smaller tolerance"
+        )
+    start = np.r_[starts, len(v)]
+    ii, jj = [], []
+    for same, ca, cb in found:
+        if ca.size == 0:
+            continue
+        na, nb = counts[ca], counts[cb]
+        pairs = na * nb
+        owner = np.repeat(np.arange(ca.size), pairs)
+        k = np.arange(owner.size) - np.repeat(np.cumsum(pairs) - pairs, pairs)
+        i = order[start[ca][owner] + k // nb[owner]]
+        j = order[start[cb][owner] + k % nb[owner]]
+        keep = i < j if same else i != j
+        ii.append(i[keep])
+        jj.append(j[keep])
+    i = np.concatenate(ii) if ii else np.zeros(0, np.int64)
+    j = np.concatenate(jj) if jj else np.zeros(0, np.int64)
+    with np.errstate(over="ignore"):  # compared in units of tol: tol * tol may underflow
         d = (v[i] - v[j]) / tol
         close = np.einsum("ij,ij->i", d, d) <= 1.0
     return i[close], j[close]

@@ -157,12 +157,12 @@ def banded_entries(n: int, width: int, rhs: int, cyclic: bool = False) -> int:
     values (twice: the sparse matrix of the residual check copies them), the right-hand
     sides, the solution, its correction and the residual; a closed system solves
     ``rhs + width`` right-hand sides and keeps its border's copies too (measured with
-    tracemalloc at a million points, cubic, 3 columns: 25 numbers a point open, 53
-    closed; charged: 40 and 70).
+    tracemalloc at a million points, cubic, 3 columns: 35 numbers a point open, 53
+    closed; charged: 48 and 70).
     """
     if cyclic:
         return int(n) * (7 * width + 6 * (rhs + width))
-    return int(n) * (7 * width + 4 * rhs)
+    return int(n) * (9 * width + 4 * rhs)
 
 
 def _solve_cyclic(cols: np.ndarray, vals: np.ndarray, f: np.ndarray) -> np.ndarray:

@@ -144,27 +144,81 @@ def fit_columns(
 
 
 def _fit_open(flat: np.ndarray, params: np.ndarray, p: int, knots: np.ndarray) -> np.ndarray:
-    """Open interpolation: scipy's compiled collocation and LAPACK banded solve
-    (``make_interp_spline`` on our knots), checked by how far the curve misses the data at
-    the parameters; where it misses by more than 1e-10 of the data's size (a nearly
-    singular system) or scipy refuses, the rows' own solve decides (refinement, a dense
-    solve when small, or a clear error)."""
-    from scipy.interpolate import make_interp_spline
-
+    """Open interpolation: scipy's compiled collocation and LAPACK's banded LU
+    (``gbsv``, partial pivoting), checked by how far the curve misses the data at the
+    parameters; where it misses by more than 1e-10 of the data's size (a nearly singular
+    system) or the solve refuses, the rows' own solve decides (refinement, a dense solve
+    when small, or a clear error)."""
     k = flat.shape[0]
     if k > 4 * (p + 1) and np.isfinite(flat).all():
         try:
             with np.errstate(all="ignore"):
-                spline = make_interp_spline(params, flat, k=p, t=knots, check_finite=False)
-                ctrl = np.asarray(spline.c)
-                miss = np.abs(spline(params) - flat).max(initial=0.0)
+                ctrl, miss = _collocation_solve(flat, params, p, knots)
             scale = float(np.abs(flat).max(initial=0.0))
             if np.isfinite(ctrl).all() and miss <= 1e-10 * max(scale, 1e-300):
                 return ctrl
-        except (ValueError, np.linalg.LinAlgError):
-            pass
+        except (ValueError, TypeError, AttributeError, np.linalg.LinAlgError):
+            pass  # (scipy's internals moved, or it refused: the rows' solve decides)
     cols, rows = _collocation_rows(p, knots, params)
     return solve_banded_rows(cols, rows, flat)
+
+
+def _scipy_coloc():
+    """scipy's compiled collocation into band storage, if this scipy has it (else None)."""
+    try:
+        from scipy.interpolate import _dierckx
+
+        return _dierckx._coloc
+    except (ImportError, AttributeError):
+        return None
+
+
+def _collocation_solve(
+    flat: np.ndarray, params: np.ndarray, p: int, knots: np.ndarray
+) -> tuple[np.ndarray, float]:
+    """The interpolating coefficients and the largest miss at the parameters.
+
+    What ``make_interp_spline`` does (scipy's compiled collocation into LAPACK band storage,
+    then ``gbsv``), with the band kept so the miss is one pass over its ``2 p + 1``
+    diagonals rather than an evaluation of the curve. The collocation routine is scipy's
+    own, not public (``_dierckx._coloc`` since 1.15): where it is missing, the public
+    ``make_interp_spline`` and an evaluation do the same.
+    """
+    coloc = _scipy_coloc()
+    if coloc is None:
+        from scipy.interpolate import make_interp_spline
+
+        spline = make_interp_spline(params, flat, k=p, t=knots, check_finite=False)
+        ctrl = np.asarray(spline.c)
+        return ctrl, float(np.abs(spline(params) - flat).max(initial=0.0))
+    from scipy.linalg import get_lapack_funcs
+
+    n = flat.shape[0]
+    kl = ku = p
+    ab = np.zeros((2 * kl + ku + 1, n), dtype=np.float64, order="F")
+    coloc(np.ascontiguousarray(params), np.ascontiguousarray(knots), p, ab.T, 0)
+    band = ab[kl:].copy()  # band[ku + i - j, j] = A[i, j]
+    rhs = np.array(flat, dtype=np.float64, order="F")
+    (gbsv,) = get_lapack_funcs(("gbsv",), (ab, rhs))
+    _, _, ctrl, info = gbsv(kl, ku, ab, rhs, overwrite_ab=True, overwrite_b=True)
+    if info != 0:
+        raise np.linalg.LinAlgError("the collocation matrix is singular")
+    # The miss, column by column (gbsv's Fortran-ordered answer is contiguous that way),
+    # over the diagonals that hold entries (a collocation row has p + 1 of the 2 p + 1).
+    cols = np.asarray(ctrl).T
+    miss = np.array(flat.T, order="C")
+    scratch = np.empty_like(miss)
+    for o in range(-kl, ku + 1):  # diagonal j - i = o
+        d = band[ku - o]
+        if not d.any():
+            continue
+        if o >= 0:
+            t = np.multiply(d[o:], cols[:, o:], out=scratch[:, : n - o])
+            miss[:, : n - o] -= t
+        else:
+            t = np.multiply(d[: n + o], cols[:, : n + o], out=scratch[:, : n + o])
+            miss[:, -o:] -= t
+    return np.ascontiguousarray(ctrl), float(max(miss.max(initial=0.0), -miss.min(initial=0.0)))
 
 
 def _collocation_rows(p: int, knots: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
