@@ -233,6 +233,7 @@ class _Run(LanguageRun, SimulationRun, Replay):
         """
         if not isinstance(relpath, str):
             return relpath  # the check or the node says what is wrong with it
+        self.keyed_files = True  # keys that hold file bytes: never replayed (_Run.remember)
         here = self.where(name, port)
         try:
             path = safety.resolve_input(self.g.input_root, relpath, self.g.input_base)
@@ -254,7 +255,6 @@ class _Run(LanguageRun, SimulationRun, Replay):
             if len(self.g._input_digests) > 10_000:
                 self.g._input_digests.clear()
             self.g._input_digests[str(path)] = (stamp, digest)
-        self.keyed_files = True  # keys that hold file bytes: never replayed (_Run.remember)
         return {"path": relpath, "bytes": digest}
 
     def read_input(self, name: str, relpath: str) -> tuple[Path, bytes]:

@@ -232,7 +232,7 @@ class StudioSession:
         except GraphError as exc:
             self._files = list(getattr(exc, "files", None) or [self.path])
             return self._failed(exc.problems, str(exc))
-        self._files = list(graph.files) or [self.path]
+        self._files = [*(graph.files or [self.path]), *graph.input_files]
         if self.memory is not None:
             graph.memory = self.memory  # a new version recomputes only what it reaches
         first = self.graph is None
