@@ -17,6 +17,8 @@ import numpy as np
 from formgraph.core.errors import InputError
 from formgraph.core.registry import Context, Range, node
 from formgraph.geometry import Mesh
+from formgraph.kernels.attributes import propagate as carry
+from formgraph.kernels.attributes.propagate import SAME
 from formgraph.kernels.mesh import meshops
 from formgraph.kernels.mesh import simplify as ksimp
 from formgraph.kernels.mesh import smooth as ksm
@@ -44,7 +46,7 @@ def _signed_volume(v: np.ndarray, t: np.ndarray) -> float:
     return float(np.einsum("ij,ij->i", v[t[:, 0]], np.cross(v[t[:, 1]], v[t[:, 2]])).sum() / 6)
 
 
-@node("mesh.smooth", version=1)
+@node("mesh.smooth", version=2)
 def smooth(
     mesh: Mesh,
     iterations: Annotated[int, Range(min=0, max=100_000)] = 10,
@@ -87,7 +89,8 @@ def smooth(
         strength,
         mu,
     )
-    return Mesh(v, mesh.face_indices, mesh.face_offsets)
+    # the same vertices and faces, moved: every attribute stays with its element
+    return Mesh(v, mesh.face_indices, mesh.face_offsets, **carry.carried(mesh, SAME, SAME))
 
 
 @node("mesh.decimate", version=1)

@@ -106,3 +106,16 @@ def test_remesh_gives_even_edges_and_a_closed_outward_torus():
 def test_is_closed_sees_an_open_edge():
     s = trimesh.creation.icosphere(1)
     assert ksimp.is_closed(s.faces) and not ksimp.is_closed(s.faces[1:])
+
+
+def test_smooth_keeps_point_and_face_attributes():
+    g = fg.Graph()
+    g.add("s", "mesh.sphere", radius=1, segments=16)
+    g.add("h", "attr.set", geometry="@s", name="h", value="=z")
+    g.add("f", "attr.set", geometry="@h", name="side", value="=x > 0", domain="face")
+    g.add("m", "mesh.smooth", mesh="@f", iterations=5)
+    before, after = g.evaluate(["f", "m"]).values()
+    # the attributes stay with their vertices and faces (values as they were set)
+    assert np.array_equal(after.point_data["h"], before.point_data["h"])
+    assert np.array_equal(after.face_data["side"], before.face_data["side"])
+    assert not np.array_equal(after.vertices, before.vertices)
