@@ -266,13 +266,17 @@ def star_polygons(draw):
     return np.c_[np.array(radii) * np.cos(angles), np.array(radii) * np.sin(angles)]
 
 
-# Derandomized: the same examples every run (random seeds find rare thin-neck cases where
-# the result is cut or two far-apart stretches of a loop cross; see docs/family-offset.md).
-@settings(
-    max_examples=25, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow]
-)
-@given(star_polygons(), st.floats(-0.25, 0.3).filter(lambda d: abs(d) > 0.02))
-def test_random_polygons_match_shapely(polygon, d):
+def _seeded_star(seed: int) -> tuple[np.ndarray, float]:
+    """A random star polygon and distance from ``seed``, drawn as :func:`star_polygons` draws."""
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(3, 25))
+    radii, gaps = rng.uniform(0.3, 1.0, n), rng.uniform(0.2, 1.0, n)
+    angles = 2 * np.pi * np.cumsum(gaps) / np.sum(gaps)
+    d = float(rng.uniform(-0.25, 0.3))
+    return np.c_[radii * np.cos(angles), radii * np.sin(angles)], d if abs(d) > 0.02 else 0.1
+
+
+def _matches_shapely(polygon: np.ndarray, d: float) -> None:
     loops = offset_polylines([polygon], [True], d)
     # Every loop is a simple ring, islands counter-clockwise and holes clockwise.
     assert all(shapely.Polygon(loop).is_valid for loop in loops)
@@ -284,6 +288,48 @@ def test_random_polygons_match_shapely(polygon, d):
     # tolerance (so a sliver at most that thin along the whole boundary).
     size = extent(polygon)
     assert ours.symmetric_difference(reference).area <= 1e-3 * size * reference.length + 1e-9
+
+
+# Seeded, not drawn by hypothesis: the derandomized draw turned out to depend on what ran
+# before it in the process, and random draws find rare thin-neck cases where two far-apart
+# stretches of an inward loop cross (see docs/family-offset.md and the xfail below).
+@pytest.mark.parametrize("seed", range(40))
+def test_random_polygons_match_shapely(seed):
+    _matches_shapely(*_seeded_star(seed))
+
+
+# Two such cases (found by hypothesis, 21-corner stars at d = -0.17): the inward offset of
+# a deep notch keeps a loop that crosses itself. Known and open; strict, so a fix shows.
+_THIN_NECK = np.array(
+    [
+        [9.28367933e-01, 3.71662456e-01],
+        [7.23734038e-01, 6.90079011e-01],
+        [1.55780630e-01, 3.41111998e-01],
+        [2.35758936e-01, 9.71811568e-01],
+        [-4.75819158e-02, 9.98867339e-01],
+        [-1.42314838e-01, 9.89821442e-01],
+        [-1.87500000e-01, 3.24759526e-01],
+        [-7.86053095e-01, 6.18158986e-01],
+        [-9.59492974e-01, 2.81732557e-01],
+        [-9.95471923e-01, -9.50560433e-02],
+        [-8.88835449e-01, -4.58226522e-01],
+        [-6.54860734e-01, -7.55749574e-01],
+        [-3.27067963e-01, -9.45000819e-01],
+        [4.75819158e-02, -9.98867339e-01],
+        [4.15415013e-01, -9.09631995e-01],
+        [5.80056910e-01, -8.14575952e-01],
+        [7.23734038e-01, -6.90079011e-01],
+        [8.41253533e-01, -5.40640817e-01],
+        [9.28367933e-01, -3.71662456e-01],
+        [9.81928697e-01, -1.89251244e-01],
+        [1.00000000e00, -2.44929360e-16],
+    ]
+)
+
+
+@pytest.mark.xfail(strict=True, reason="inward offset of a deep notch: a loop crosses itself")
+def test_thin_neck_star_matches_shapely():
+    _matches_shapely(_THIN_NECK, -0.171875)
 
 
 # A random star (found by fuzzing) whose inward offset keeps a narrow spike: a corner
