@@ -73,6 +73,8 @@ def polygon(
     radius: Annotated[float, Range(min=0)],
     center: Vec3 = (0.0, 0.0, 0.0),
     angle: float = 0.0,
+    *,
+    ctx: Context,
 ) -> NurbsCurve:
     """A regular polygon, closed, counter-clockwise, its corners on a circle of ``radius``.
 
@@ -91,6 +93,7 @@ def polygon(
     -------
     ``hex: {type: curves.polygon, sides: 6, radius: 5}``
     """
+    ctx.guard(sides, "corners")
     port = "sides" if sides < 3 else "radius"
     corners = _kernel(port, kshapes.regular_polygon, sides, radius, center, angle)
     return NurbsCurve.polyline(corners, closed=True)
