@@ -26,6 +26,35 @@ def _svg(body: str) -> bytes:
     ).encode()
 
 
+# ---------------------------------------------------------------------------- DXF MINSERT
+
+
+def test_a_minsert_grid_over_the_budget_is_refused_before_expanding(tmp_path):
+    ezdxf = pytest.importorskip("ezdxf")
+    doc = ezdxf.new()
+    doc.blocks.new("B").add_line((0, 0), (1, 1))
+    doc.modelspace().add_blockref("B", (0, 0)).grid(size=(100_000, 100_000), spacing=(1, 1))
+    doc.saveas(tmp_path / "a.dxf")
+    # was: 10^10 copies expanded one virtual entity at a time (hung)
+    with pytest.raises(
+        fg.NodeError,
+        match=r"node 'c', input 'path'.*a MINSERT of "
+        r"10,000,000,000 copies expands to more than 1,000,000 entities",
+    ):
+        _read(tmp_path, "a.dxf", (tmp_path / "a.dxf").read_bytes())
+
+
+def test_a_small_minsert_grid_still_expands(tmp_path):
+    ezdxf = pytest.importorskip("ezdxf")
+    doc = ezdxf.new(units=4)  # millimetres
+    doc.blocks.new("B").add_line((0, 0), (1, 0))
+    doc.modelspace().add_blockref("B", (0, 0)).grid(size=(2, 3), spacing=(10, 20))
+    doc.saveas(tmp_path / "a.dxf")
+    curves = _read(tmp_path, "a.dxf", (tmp_path / "a.dxf").read_bytes())
+    starts = sorted(tuple(c.control_points[0][:2]) for c in curves)
+    assert starts == [(x, y) for x in (0.0, 20.0, 40.0) for y in (0.0, 10.0)]
+
+
 # ---------------------------------------------------------------------------- cutting counts
 
 
