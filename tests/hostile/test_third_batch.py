@@ -6,9 +6,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import formgraph as fg
+from formgraph.kernels.io import svg_read
 
 HEAD = "formgraph: 1\nnodes:\n"
 
@@ -24,6 +26,63 @@ def _svg(body: str) -> bytes:
         '<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="100mm" '
         f'viewBox="0 0 100 100">{body}</svg>'
     ).encode()
+
+
+# ---------------------------------------------------------------------------- SVG use
+
+
+@pytest.mark.parametrize(
+    "body",
+    [
+        '<g id="a"><use href="#a"/><path d="M0 0 L1 1"/></g>',
+        '<defs><g id="a"><use href="#b"/></g><g id="b"><use href="#a"/></g></defs><use href="#a"/>',
+    ],
+    ids=["itself", "a cycle"],
+)
+def test_a_use_that_contains_itself_is_refused_by_name(tmp_path, body):
+    # was: "not an SVG document (RecursionError: maximum recursion depth exceeded ...)"
+    with pytest.raises(
+        fg.NodeError,
+        match=r"g.yaml:3: node 'c', input 'path'.*'use' refers "
+        r"to an element that contains it \(id 'a'\)",
+    ):
+        _read(tmp_path, "a.svg", _svg(body))
+
+
+def test_uses_that_double_per_level_are_refused_before_expanding(tmp_path):
+    # was: svgelements expanded 2^40 copies (a 3 KB file hung)
+    levels = "".join(
+        f'<g id="p{i + 1}"><use href="#p{i}"/><use href="#p{i}"/></g>' for i in range(40)
+    )
+    body = f'<defs><path id="p0" d="M0 0 L1 1"/>{levels}</defs><use href="#p40"/>'
+    with pytest.raises(
+        fg.NodeError,
+        match=r"'use' references expand to more than 250,000 "
+        r"elements, over the budget",
+    ):
+        _read(tmp_path, "a.svg", _svg(body))
+
+
+def test_a_use_draws_its_copy_where_it_is_placed(tmp_path):
+    # was: nothing (a Use is not a Group, so the walk skipped it): an empty drawing
+    body = (
+        '<defs><path id="p0" d="M0 0 L1 1"/></defs><use href="#p0"/>'
+        '<g transform="translate(5 0)"><use href="#p0" x="3"/></g>'
+    )
+    curves = _read(tmp_path, "a.svg", _svg(body))
+    starts = sorted(c.control_points[0][0] for c in curves)
+    np.testing.assert_allclose(starts, [0.0, 8.0], atol=1e-9)
+    for c in curves:  # the copy's own segment, a unit diagonal, flipped to y up
+        np.testing.assert_allclose(np.diff(c.control_points, axis=0), [[1.0, -1.0, 0.0]], atol=1e-9)
+
+
+def test_a_path_of_millions_of_numbers_is_refused_before_parsing(tmp_path, monkeypatch):
+    # was: 3,000,000 "L1 1" segments (15 MB) ran past 25 s in svgelements' Python parser;
+    # the budget is lowered here so the case stays small
+    monkeypatch.setattr(svg_read, "MAX_NUMBERS", 1_000, raising=False)
+    body = '<path d="M0 0 ' + "L1 1 " * 600 + '"/>'
+    with pytest.raises(fg.NodeError, match=r"holds 1,2\d\d numbers .*over the budget of 1,000"):
+        _read(tmp_path, "a.svg", _svg(body))
 
 
 # ---------------------------------------------------------------------------- DXF MINSERT
