@@ -25,9 +25,10 @@ import numpy as np
 
 from .chains import Chain, CurveArrays, arc_pieces, bulge_arc, line_piece
 
-__all__ = ["DxfCurve", "MAX_DEPTH", "read_dxf"]
+__all__ = ["DxfCurve", "MAX_DEPTH", "MAX_ENTITIES", "read_dxf"]
 
 MAX_DEPTH = 16
+MAX_ENTITIES = 1_000_000  # entities expanded one by one in Python: about 30 s of them
 UNITS_MM = {1: 25.4, 2: 304.8, 4: 1.0, 5: 10.0, 6: 1000.0, 8: 25.4e-6, 9: 0.0254,
             10: 914.4, 13: 1e-3, 14: 100.0}  # fmt: skip
 
@@ -38,7 +39,7 @@ class DxfCurve:
     layer: str
 
 
-def read_dxf(data: bytes, max_entities: int = 1_000_000) -> tuple[list[DxfCurve], Counter]:
+def read_dxf(data: bytes, max_entities: int = MAX_ENTITIES) -> tuple[list[DxfCurve], Counter]:
     """Every curve entity of a DXF file's model space (blocks expanded) as NURBS arrays,
     and a count of the entity types passed over (text, hatches, points, ...).
 
@@ -77,6 +78,14 @@ def read_dxf(data: bytes, max_entities: int = 1_000_000) -> tuple[list[DxfCurve]
         if kind == "INSERT":
             if depth >= MAX_DEPTH:
                 raise ValueError(f"blocks nest deeper than {MAX_DEPTH} levels")
+            copies = max(1, int(e.dxf.get("row_count", 1))) * max(
+                1, int(e.dxf.get("column_count", 1))
+            )
+            if count + copies > max_entities:  # a MINSERT's grid, refused before it expands
+                raise ValueError(
+                    f"a MINSERT of {copies:,} copies expands to more than {max_entities:,} "
+                    f"entities, over the budget"
+                )
             stack.append((_expand(e), here, depth + 1))
             continue
         try:

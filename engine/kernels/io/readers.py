@@ -11,7 +11,7 @@ from pathlib import PurePath
 
 import numpy as np
 
-from .dxf_read import read_dxf
+from .dxf_read import MAX_ENTITIES, read_dxf
 from .gltf import read_gltf
 from .mesh_read import read_obj, read_off, read_stl
 from .ply_read import point_data, read_ply
@@ -61,7 +61,7 @@ MESH_FORMATS = {  # data -> (vertices, face_indices, face_offsets, point attribu
 
 CURVE_FORMATS = {  # (data, element budget) -> (curves with a .curve and a .layer, skipped)
     ".svg": lambda data, budget: read_svg(data, min(MAX_ELEMENTS, budget)),
-    ".dxf": lambda data, budget: read_dxf(data, budget),
+    ".dxf": lambda data, budget: read_dxf(data, min(MAX_ENTITIES, budget)),
 }
 
 

@@ -16,8 +16,9 @@ the document's bottom edge when it has a height (so the page's lower-left corner
 origin), else about y = 0.
 
 A hostile file is bounded before svgelements sees it: at most :data:`MAX_ELEMENTS` tags and
-:data:`MAX_DEPTH` levels of nesting, no external entities (expat never fetches them, and
-its billion-laughs guard bounds internal ones).
+:data:`MAX_DEPTH` levels of nesting, :data:`MAX_NUMBERS` numbers, ``use`` references
+neither cyclic nor expanding past the tag budget, no external entities (expat never fetches
+them, and its billion-laughs guard bounds internal ones).
 """
 
 from __future__ import annotations
@@ -32,10 +33,12 @@ import numpy as np
 
 from .chains import Chain, CurveArrays, arc_pieces, bezier_piece, line_piece
 
-__all__ = ["MAX_DEPTH", "MAX_ELEMENTS", "SvgCurve", "read_svg"]
+__all__ = ["MAX_DEPTH", "MAX_ELEMENTS", "MAX_NUMBERS", "SvgCurve", "read_svg"]
 
 MAX_ELEMENTS = 250_000
 MAX_DEPTH = 512
+MAX_NUMBERS = 2_000_000  # svgelements parses a path's numbers in Python: about 20 s of them
+_NUMBER = re.compile(rb"[0-9]+(?:\.[0-9]*)?|\.[0-9]+")
 PX_MM = 25.4 / 96.0
 _TAG = re.compile(rb"<(/?)([^>]*?)(/?)>")
 
@@ -62,6 +65,69 @@ def _bounded(data: bytes, max_elements: int) -> None:
             deepest = max(deepest, depth)
     if deepest > MAX_DEPTH:
         raise ValueError(f"elements nest {deepest:,} deep, over the budget of {MAX_DEPTH}")
+    numbers = len(_NUMBER.findall(data))
+    if numbers > MAX_NUMBERS:
+        raise ValueError(
+            f"the file holds {numbers:,} numbers (path coordinates), over the budget of "
+            f"{MAX_NUMBERS:,}"
+        )
+    if b"<use" in data or b":use" in data:
+        _bounded_uses(data, max_elements)
+
+
+def _bounded_uses(data: bytes, max_elements: int) -> None:
+    """Refuse ``use`` references that form a cycle or expand past the tag budget (a use of
+    a group of two uses of ... doubles per level), before svgelements expands them."""
+    import xml.etree.ElementTree as ET
+
+    try:
+        root = ET.fromstring(data)
+    except ET.ParseError:
+        return  # svgelements reports it
+    ids: dict[str, ET.Element] = {}
+    for el in root.iter():
+        if el.get("id"):
+            ids.setdefault(el.get("id"), el)
+
+    def ref(el: ET.Element) -> ET.Element | None:
+        if not el.tag.endswith("use"):
+            return None
+        href = el.get("href") or el.get("{http://www.w3.org/1999/xlink}href") or ""
+        return ids.get(href[1:]) if href.startswith("#") else None
+
+    size: dict[int, int] = {}  # expanded element count, by id(element)
+    on_path: set[int] = set()
+    stack: list[tuple[ET.Element, bool]] = [(root, False)]
+    while stack:  # post-order, without recursion
+        el, done = stack.pop()
+        key = id(el)
+        if done:
+            on_path.discard(key)
+            n = 1 + sum(size[id(c)] for c in el)
+            target = ref(el)
+            if target is not None:
+                n += size[id(target)]
+            if n > max_elements:
+                raise ValueError(
+                    f"'use' references expand to more than {max_elements:,} elements, over "
+                    f"the budget"
+                )
+            size[key] = n
+            continue
+        if key in size:
+            continue
+        if key in on_path:
+            raise ValueError(f"a 'use' refers to an element that contains it (id {el.get('id')!r})")
+        on_path.add(key)
+        stack.append((el, True))
+        target = ref(el)
+        for c in (*el, *(() if target is None else (target,))):
+            if id(c) in on_path:
+                raise ValueError(
+                    f"a 'use' refers to an element that contains it (id {c.get('id')!r})"
+                )
+            if id(c) not in size:
+                stack.append((c, False))
 
 
 def read_svg(data: bytes, max_elements: int = MAX_ELEMENTS) -> tuple[list[SvgCurve], Counter]:
@@ -90,7 +156,7 @@ def read_svg(data: bytes, max_elements: int = MAX_ELEMENTS) -> tuple[list[SvgCur
     stack: list[tuple[object, str, bool]] = [(doc, "", False)]
     while stack:  # depth-first, without recursion
         node, layer, marked = stack.pop()
-        if isinstance(node, se.Group) or node is doc:
+        if isinstance(node, (se.Group, se.Use)) or node is doc:  # a use holds its copy
             for child in reversed(list(node)):
                 name, mark = layer, marked
                 if isinstance(child, se.Group):
