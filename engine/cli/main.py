@@ -167,18 +167,24 @@ def _describe(value: Any) -> str:
     return repr(value)
 
 
-def cmd_run(args: argparse.Namespace) -> int:
+def _load_with_cache(args: argparse.Namespace) -> Any:
+    """The graph a command names, with the disk cache unless ``--no-cache``."""
     from ..evaluation.cache import default_cache_dir
     from ..evaluation.graph import load
 
     cache_dir = None if args.no_cache else (args.cache_dir or default_cache_dir())
-    g = load(
+    return load(
         args.graph,
         out_dir=args.out,
         cache_dir=cache_dir,
         budget=args.budget,
         inputs_dir=args.inputs,
     )
+
+
+def cmd_run(args: argparse.Namespace) -> int:
+
+    g = _load_with_cache(args)
     params = parse_sets(g, args.set)
     progress = _ProgressLine(sys.stderr)
     g.progress = progress
@@ -318,20 +324,11 @@ def cmd_graph(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from ..drawgraph.layout import draw_graph, failed_nodes
-    from ..evaluation.cache import default_cache_dir
-    from ..evaluation.graph import load
 
     output = args.output or f"{Path(args.graph).stem}.svg"
     if output != "-" and Path(output).suffix.lower() not in (".svg", ".png"):
         raise UsageError(f"-o {output}: the drawing is written as .svg or .png")
-    cache_dir = None if args.no_cache else (args.cache_dir or default_cache_dir())
-    g = load(
-        args.graph,
-        out_dir=args.out,
-        cache_dir=cache_dir,
-        budget=args.budget,
-        inputs_dir=args.inputs,
-    )
+    g = _load_with_cache(args)
     g.set(**parse_sets(g, args.set))  # the param boxes show the values used
     failure: FormgraphError | None = None
     if args.run:
