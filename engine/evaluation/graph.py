@@ -130,6 +130,7 @@ class Graph(Plans):
         self._pure_root: tuple[str, Path] | None = None  # out_dir -> its root, for plans
         self._step_params: tuple[str, dict[str, Any]] | None = None  # compute_step's last
         self._checked = False
+        self._source: tuple[str, str] | None = None  # (text read, its to_yaml()) from_text
         self.stats: dict[str, NodeStat] = {}
         self.progress: Progress | None = None
 
@@ -160,6 +161,7 @@ class Graph(Plans):
         g._parse_problems = doc.problems
         g.outputs = doc.outputs
         g._output_lines = doc.output_lines
+        g._source = (text, g.to_yaml())
         if check:
             try:
                 g.check()
@@ -520,6 +522,14 @@ class Graph(Plans):
 
     def to_yaml(self) -> str:
         return dump(self.description, self._params, self._nodes, self.outputs)
+
+    def source_text(self) -> str:
+        """Text that rebuilds this graph: the text it was read from while nothing has
+        changed since (so its line numbers stay the file's), else :meth:`to_yaml`."""
+        text = self.to_yaml()
+        if self._source is not None and self._source[1] == text:
+            return self._source[0]
+        return text
 
     def save(self, path: str | os.PathLike[str]) -> None:
         """Write the graph as YAML (author order kept); ``load`` reads back an equal graph."""

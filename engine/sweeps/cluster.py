@@ -118,7 +118,7 @@ def blueprint(g: Graph, cache_dir: str | None, worker_cache: bool) -> Blueprint:
         if not module.startswith("formgraph."):
             modules.add(module)
     try:
-        text = g.to_yaml()
+        text = g.source_text()  # the file's own lines, for workers' messages
     except Exception as exc:  # yaml's RepresenterError for a geometry typed in as an input
         raise SweepError(
             f"{g.file_label}: the graph cannot be sent to Dask workers as YAML ({exc}); pass "

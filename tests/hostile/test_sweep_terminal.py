@@ -52,13 +52,15 @@ def test_ctrl_c_reaches_the_client_only(tmp_path):
 
 def test_a_worker_warning_is_one_line_of_ours(tmp_path):
     (tmp_path / "g.yaml").write_text(
-        "formgraph: 1\nparams:\n  s: 1.0\nnodes:\n"
+        "formgraph: 1\n# a comment, so the file's lines are not the re-written YAML's\n\n"
+        "params:\n  s: 1.0\nnodes:\n"
         "  m: {type: mesh.from_faces, vertices: [[0, 0, 0], ['=s', 0, 0], [0, 1, 0]], "
-        "faces: [[0, 1, 2]]}\n  q: {type: mesh.measure, mesh: '@m'}\n"
+        "faces: [[0, 1, 2]]}\n\n  # measured\n  q: {type: mesh.measure, mesh: '@m'}\n"
     )
     p = _sweep(tmp_path, "g.yaml", "--vary", "s=1,2", "--measure", "q.area", "--no-cache")
     out, err = p.communicate(timeout=180)
     assert p.returncode == 0, err
     lines = [x for x in err.splitlines() if x.strip()]
     assert lines and all(x.startswith("formgraph: warning: ") for x in lines), err
+    assert "g.yaml:10: node 'q'" in err, err  # the file's own line, not the re-written text's
     assert "not watertight" in err and "_task_spec" not in err and "FormgraphWarning" not in err
