@@ -120,6 +120,25 @@ nodes:
     assert again == first and again.point_data["h"].tolist() == first.point_data["h"].tolist()
 
 
+def test_a_new_rand_hash_leaves_results_cached_with_the_old_one_unused(tmp_path, monkeypatch):
+    from formgraph.evaluation import run as run_mod
+
+    text = """
+formgraph: 1
+nodes:
+  b: {type: mesh.box}
+  s: {type: attr.set, geometry: "@b", name: h, value: "=rand(i)"}
+"""
+    load_text(tmp_path, text, cache_dir=tmp_path / "cache").evaluate("s")
+    g = load_text(tmp_path, text, cache_dir=tmp_path / "cache")
+    g.evaluate("s")
+    assert g.stats["s"].status != "computed"
+    monkeypatch.setattr(run_mod, "FUNCTIONS_VERSION", run_mod.FUNCTIONS_VERSION + "-next")
+    g = load_text(tmp_path, text, cache_dir=tmp_path / "cache")
+    g.evaluate("s")
+    assert g.stats["s"].status == "computed"
+
+
 # ---------------------------------------------------------------------- propagation
 
 

@@ -16,35 +16,29 @@ from scipy import stats
 
 from formgraph.kernels.attributes import noise as noise_mod
 from formgraph.kernels.attributes.noise import PERMUTATION, noise, raw_noise
-from formgraph.kernels.attributes.random import hash32, rand
+from formgraph.kernels.attributes.random import mix64, rand
 
 # --- pure-Python references ------------------------------------------------------------
 
 
-def lowbias32(x: int) -> int:
-    """Chris Wellons' lowbias32, written from its published definition."""
-    x ^= x >> 16
-    x = (x * 0x7FEB352D) & 0xFFFFFFFF
-    x ^= x >> 15
-    x = (x * 0x846CA68B) & 0xFFFFFFFF
-    x ^= x >> 16
-    return x
+MASK = (1 << 64) - 1
 
 
-def words(v: float) -> tuple[int, int]:
-    lo, hi = struct.unpack("<II", struct.pack("<d", v + 0.0))
-    return lo, hi
+def mix13(z: int) -> int:
+    """SplitMix64's finalizer (Stafford's Mix13), written from its published definition."""
+    z = ((z ^ (z >> 30)) * 0xBF58476D1CE4E5B9) & MASK
+    z = ((z ^ (z >> 27)) * 0x94D049BB133111EB) & MASK
+    return z ^ (z >> 31)
+
+
+def bits(v: float) -> int:
+    return struct.unpack("<Q", struct.pack("<d", v + 0.0))[0]
 
 
 def rand_reference(key: float, seed: float = 0.0) -> float:
-    slo, shi = words(seed)
-    s1 = lowbias32(lowbias32(slo ^ 0x9E3779B9) ^ shi)
-    s2 = lowbias32(lowbias32(shi ^ 0x85EBCA6B) ^ slo)
-    lo, hi = words(key)
-    a = lowbias32(lowbias32(lo ^ s1) ^ hi)
-    b = lowbias32(lowbias32(hi ^ s2) ^ lo)
-    bits = ((a >> 12) | 0x3FF00000) << 32 | b
-    return struct.unpack("<d", struct.pack("<Q", bits))[0] - 1.0
+    stream = mix13((bits(seed) + 0x9E3779B97F4A7C15) & MASK)
+    top52 = mix13(bits(key) ^ stream) >> 12
+    return struct.unpack("<d", struct.pack("<Q", 0x3FF0000000000000 | top52))[0] - 1.0
 
 
 _P = list(PERMUTATION) * 2
@@ -90,9 +84,16 @@ def perlin_reference(x: float, y: float, z: float) -> float:
 # --- rand ------------------------------------------------------------------------------
 
 
-def test_hash32_is_lowbias32():
-    x = np.random.default_rng(0).integers(0, 2**32, 500, dtype=np.uint64).astype(np.uint32)
-    assert hash32(x).tolist() == [lowbias32(int(v)) for v in x]
+def test_mix64_is_splitmix64s_finalizer():
+    x = np.random.default_rng(0).integers(0, 2**64, 500, dtype=np.uint64)
+    assert mix64(x).tolist() == [mix13(int(v)) for v in x]
+    # SplitMix64 seeded with 0: its first outputs, as published with the algorithm
+    state = np.uint64(0x9E3779B97F4A7C15) * np.arange(1, 4, dtype=np.uint64)
+    assert [hex(int(v)) for v in mix64(state)] == [
+        "0xe220a8397b1dcdaf",
+        "0x6e789e6aa1b965f4",
+        "0x6c45d188009454f",
+    ]
 
 
 @settings(max_examples=60, deadline=None)

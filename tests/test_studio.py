@@ -633,6 +633,54 @@ def test_page_without_the_token_is_refused(page, studio):
         context.close()
 
 
+HANG = """\
+formgraph: 1
+params:
+  steps: {type: int, default: 12, min: 0, max: 40}
+  weight: {default: 0.05, choices: [0.02, 0.05, 0.3], doc: load on each vertex}
+nodes:
+  net: {type: mesh.plane, size: [10, 10], divisions: [12, 12]}
+  hang:
+    type: mesh.relax
+    simulate: {state: mesh, from: "@net", steps: "=steps"}
+    reference: "@net"
+    anchors: [0, 12, 156, 168]
+    load: [0, 0, "=-weight"]
+    stiffness: 3.0
+  print: {type: export.stl, mesh: "@hang", path: hang.stl}
+"""
+
+
+def test_frames_and_choices_on_the_page(page, studio):
+    """A shown simulated node gets a frame scrubber (steps from the cache, nothing
+    recooked); a param with choices a list to pick from."""
+    tube = studio.graph.read_text()
+    before = _canvas(page)
+    studio.graph.write_text(HANG)
+    page.wait_for_function("document.querySelector('#editor').innerText.includes('mesh.relax')")
+    page.wait_for_function("document.querySelector('#status').innerText.includes('computed')")
+    page.wait_for_function("document.querySelector('#frames').innerText.includes('of 12')")
+    last = _wait_picture(page, before)
+    assert "frame 12 of 12" in page.inner_text("#frames")
+    page.locator(".fg-frame-slider .v-slider-thumb").focus()
+    page.keyboard.press("Home")
+    page.wait_for_function("document.querySelector('#status').innerText.includes('frame 1 of')")
+    assert "nothing recooked" in _status(page) and "frame 1 of 12" in page.inner_text("#frames")
+    first = _wait_picture(page, last)  # step 1 has barely sagged
+    page.keyboard.press("End")
+    page.wait_for_function("document.querySelector('#status').innerText.includes('frame 12 of')")
+    _wait_picture(page, first)
+    page.locator(".fg-choice-weight").click()
+    page.locator(".v-overlay .v-list-item", has_text="0.3").click()
+    page.wait_for_function("document.querySelector('#status').innerText.includes('cached')")
+    m = re.search(r"(\d+) computed, (\d+) cached", _status(page))
+    assert m and (int(m.group(1)), int(m.group(2))) == (1, 1)  # the steps; the net cached
+    assert "weight = 0.3" in page.inner_text("#controls")
+    studio.graph.write_text(tube)
+    page.wait_for_function("document.querySelector('#editor').innerText.includes('nurbs.sweep')")
+    page.wait_for_function("document.querySelector('#frames').offsetParent === null")
+
+
 def test_problem_lines_locate():
     from formgraph.studio.page import _markers, _problem_lines
 
@@ -722,6 +770,27 @@ def test_choice_control_for_an_enum_param():
     (c,) = controls_of(graph, {})
     assert (c.kind, c.value, c.choices) == ("choice", "flat", ("flat", "round"))
     assert c.as_dict()["default"] == "flat" and type(c.as_dict()["default"]) is str
+
+
+def test_choice_control_from_yaml_and_frames_from_the_cache(tmp_path):
+    path = tmp_path / "hang.yaml"
+    path.write_text(HANG)
+    session = StudioSession(path, out_dir=tmp_path / "out")
+    cooked = session.open()
+    assert cooked.ok and cooked.frames == 12
+    c = {c.name: c for c in controls_of(session.graph, session.values)}["weight"]
+    assert (c.kind, c.value, c.choices) == ("choice", 0.05, (0.02, 0.05, 0.3))
+    steps = session.graph.frames("hang")  # the reference: every step, as the API gives it
+    for k in (1, 5, 12):
+        f = session.frame(k)
+        assert f.frame == k and f.frames == 12
+        ((label, mesh),) = f.shown
+        assert label == "hang" and np.array_equal(mesh.vertices, steps[k - 1].vertices)
+    assert session.frame(99).frame == 12 and session.frame(-3).frame == 1
+    assert session.frame(1).shown[0][1].vertices[:, 2].min() > steps[-1].vertices[:, 2].min()
+    # a cook of a node that is not simulated: no frames
+    assert session.show(["net"]).frames == 0
+    assert session.frame(3).frame is None
 
 
 def test_colour_by_an_attribute(tmp_path):

@@ -11,7 +11,7 @@ cached). Outputs are hashed only for that comparison, never on a cold run.
 from __future__ import annotations
 
 import os
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -30,7 +30,7 @@ from ..language.check import Outline, check_graph
 from ..language.model import NodeDef, ParamDef, parse_input
 from ..language.params import check_param_value
 from ..language.subgraph import Includes, SubgraphSpec, is_graph_type
-from ..language.yamlio import MAX_BYTES, MAX_DEPTH, dump, parse
+from ..language.yamlio import MAX_BYTES, MAX_DEPTH, dump, parse, read_choices
 from . import cache as _cache
 from .arguments import check_budgets, nesting, node_names, plain
 from .plans import Plans
@@ -295,16 +295,24 @@ class Graph(Plans):
         max: float | None = None,
         doc: str = "",
         type: str | None = None,
+        choices: Sequence[Any] | None = None,
     ) -> None:
-        """Declare a graph param (``type`` names a geometry type for a Python input slot)."""
+        """Declare a graph param (``type`` names a geometry type for a Python input slot;
+        ``choices`` the only values it takes)."""
         if not isinstance(name, str):
             raise ParamError(f"add_param() takes a param name (a string), got {describe(name)}")
         for bound, b in (("min", min), ("max", max)):
             if b is not None and (isinstance(b, bool) or not isinstance(b, (int, float))):
                 raise ParamError(f"param '{name}': {bound} must be a number, got {describe(b)}")
-        long_form = any(x is not None for x in (min, max, type)) or bool(doc)
+        long_form = any(x is not None for x in (min, max, type, choices)) or bool(doc)
         default = plain(default, f"param '{name}'")
-        p = ParamDef(name, default, None, type, min, max, doc, None, long_form)
+        if choices is not None:
+
+            def refuse(message: str, _line: Any) -> None:
+                raise ParamError(message)
+
+            choices = read_choices(name, plain(list(choices), f"param '{name}'"), refuse, None)
+        p = ParamDef(name, default, None, type, min, max, doc, None, long_form, choices)
         if type is not None:
             if not isinstance(type, str):
                 raise ParamError(f"param '{name}': type must be a name such as 'Mesh'")

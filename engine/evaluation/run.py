@@ -38,6 +38,7 @@ from ..core.errors import (
 from ..core.registry import Context, Estimate, NodeSpec, RunTally, node_types
 from ..core.types import Entries, TypeMismatch
 from ..language.elements import bind_elements, reads_elements
+from ..language.expr import FUNCTIONS_VERSION
 from ..language.model import FRAMES, STEP, Expr, Input, Items, Literal, NodeDef, Wire, wires_of
 from ..language.subgraph import SubgraphSpec
 from . import cache as _cache
@@ -177,7 +178,12 @@ class _Run(LanguageRun, SimulationRun, Replay):
             return self.keys[name]
         nd = self.g._nodes[name]
         spec = self.registry[nd.type]
-        parts: dict[str, Any] = {"type": nd.type, "version": spec.version, "inputs": {}}
+        parts: dict[str, Any] = {
+            "type": nd.type,
+            "version": spec.version,
+            "functions": FUNCTIONS_VERSION,  # what rand returns: a new hash, new keys
+            "inputs": {},
+        }
         digest = getattr(spec, "digest", None)
         if digest is not None:  # a subgraph: its file tree's content
             parts["file"] = digest

@@ -154,6 +154,11 @@ def json_schema() -> dict[str, Any]:
             "max": {"type": "number"},
             "doc": {"type": "string"},
             "type": {"type": "string"},
+            "choices": {
+                "type": "array",
+                "minItems": 1,
+                "items": {"type": ["number", "string", "boolean"]},
+            },
         },
         "additionalProperties": False,
     }

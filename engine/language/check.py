@@ -94,6 +94,11 @@ def check_graph(g: Outline, extra: list[Problem] | None = None) -> list[Problem]
             check_param_value(p, p.default)
         except TypeMismatch as exc:
             problems.append(Problem(Where(file, p.line), f"param '{p.name}': default {exc}"))
+        for c in p.choices or ():
+            try:
+                check_param_value(p, c)
+            except TypeMismatch as exc:
+                problems.append(Problem(Where(file, p.line), f"param '{p.name}': choice {exc}"))
 
     for name in kahn_order(g.nodes):  # output types upstream first (see output_type)
         spec = registry.get(g.nodes[name].type)

@@ -25,8 +25,12 @@ import numpy as np
 
 from ..core.errors import ExpressionError
 from ..kernels.attributes.noise import noise as _noise
+from ..kernels.attributes.random import VERSION as _RAND_VERSION
 from ..kernels.attributes.random import rand as _rand
 
+# What the built-in functions return is part of every node's cache key: a kernel whose
+# values change bumps its VERSION, so no result cached with the old numbers is used again.
+FUNCTIONS_VERSION = f"rand{_RAND_VERSION}"
 MAX_LENGTH = 4000
 MAX_NODES = 2000
 MAX_DEPTH = 64

@@ -226,6 +226,7 @@ class ParamDef:
     doc: str = ""
     line: int | None = None
     long_form: bool = False
+    choices: tuple[Any, ...] | None = None  # the only values it takes (a choice control)
     # what the ports its expressions feed ask for (set by the check): a whole-number param
     # that feeds only float ports is a float, so ``--set r=2.5`` works on ``r: 2``
     fed: type | None = field(default=None, compare=False)
@@ -242,6 +243,8 @@ class ParamDef:
             out["min"] = self.min
         if self.max is not None:
             out["max"] = self.max
+        if self.choices is not None:
+            out["choices"] = list(self.choices)
         if self.doc:
             out["doc"] = self.doc
         return out

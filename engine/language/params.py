@@ -60,12 +60,28 @@ def check_param_value(p: ParamDef, value: Any) -> Any:
         out = PortType((Kind(kind),)).coerce(value)
     else:
         out = value
+    if p.choices is not None and not _among(out, p.choices):
+        shown = ", ".join(repr(c) for c in p.choices)
+        hint = suggest(str(out), [str(c) for c in p.choices]) if isinstance(out, str) else ""
+        raise TypeMismatch(f"must be one of {shown}, got {out!r}{hint}")
     if isinstance(out, (int, float)) and not isinstance(out, bool):
         if p.min is not None and out < p.min:
             raise TypeMismatch(f"must be >= {number_text(p.min)}, got {number_text(out)}")
         if p.max is not None and out > p.max:
             raise TypeMismatch(f"must be <= {number_text(p.max)}, got {number_text(out)}")
     return out
+
+
+def _among(value: Any, choices: tuple[Any, ...]) -> bool:
+    """``value`` is one of ``choices`` (a number equal to a number choice counts: 2 is 2.0;
+    True is not 1)."""
+    for c in choices:
+        if isinstance(c, bool) or isinstance(value, bool):
+            if isinstance(c, bool) and isinstance(value, bool) and c == value:
+                return True
+        elif c == value and isinstance(c, str) == isinstance(value, str):
+            return True
+    return False
 
 
 def param_warnings(params: Mapping[str, ParamDef], file: str) -> list[Problem]:

@@ -252,7 +252,7 @@ def _param(
     value = _value(node, problem, None, None, bulk)
     if not isinstance(value, dict):
         return ParamDef(name, value, line=line)
-    unknown = set(value) - {"default", "min", "max", "doc", "type"}
+    unknown = set(value) - {"default", "min", "max", "doc", "type", "choices"}
     stray = sorted(str(k) for k in unknown if value[k] is None and " " in str(k))
     if stray:  # {doc: degrees, bottom to top}: the ", " ended the text
         problem(
@@ -265,7 +265,7 @@ def _param(
     if unknown:
         problem(
             f"param '{name}': unknown key(s) {', '.join(sorted(map(str, unknown)))} "
-            f"(expected default, min, max, doc, type)",
+            f"(expected default, min, max, doc, type, choices)",
             line,
         )
     p = ParamDef(
@@ -279,6 +279,8 @@ def _param(
             problem(f"param '{name}': {bound} must be a finite number, got {b!r}", line)
         else:
             setattr(p, bound, b)
+    if "choices" in value:
+        p.choices = read_choices(name, value["choices"], problem, line)
     if "type" in value:
         p.type_name = str(value["type"])
         try:
@@ -288,6 +290,23 @@ def _param(
     elif "default" not in value:
         problem(f"param '{name}' needs a default (or a type, for geometry given from Python)", line)
     return p
+
+
+def read_choices(name: str, raw: Any, problem: Any, line: int | None) -> tuple[Any, ...] | None:
+    """A param's ``choices:``: a non-empty list of distinct numbers, texts or booleans."""
+    if not isinstance(raw, list) or not raw:
+        problem(f"param '{name}': choices must be a non-empty list, got {raw!r}", line)
+        return None
+    seen: list[Any] = []
+    for c in raw:
+        if not isinstance(c, (str, int, float, bool)):
+            problem(f"param '{name}': a choice is a number, a text or true/false, got {c!r}", line)
+            return None
+        if any(type(c) is type(s) and c == s for s in seen):
+            problem(f"param '{name}': the choice {c!r} is listed twice", line)
+            return None
+        seen.append(c)
+    return tuple(seen)
 
 
 def dump(

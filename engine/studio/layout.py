@@ -147,6 +147,23 @@ def build(page: Any) -> tuple[Any, Any]:
                         block=True,
                         classes="mb-2",
                     )
+                    with html.Div(v_show=("frames_n > 0",), classes="fg-control", id="frames"):
+                        html.Div(
+                            "frame {{ frame_k }} of {{ frames_n }}",
+                            classes="fg-control-name",
+                            title="the steps of the shown simulated node, from the cache",
+                        )
+                        v.VSlider(
+                            model_value=("frame_k",),
+                            min=1,
+                            max=("frames_n",),
+                            step=1,
+                            density="compact",
+                            hide_details=True,
+                            color="secondary",
+                            update_modelValue="frame_k = $event; trigger('show_frame', [$event])",
+                            classes="fg-frame-slider",
+                        )
                     v.VSelect(
                         v_show=("attributes.length",),
                         label="colour by",
@@ -218,4 +235,5 @@ def _control_widgets(v: Any, html: Any) -> None:
             hide_details=True,
             variant="outlined",
             update_modelValue=set_value,
+            classes=("'fg-choice-' + c.name",),
         )

@@ -123,6 +123,8 @@ class Page:
         s.timing = {}  # where the last request's time went (read by bench/bench_studio.py)
         s.attributes = []  # the attributes of what is shown, to colour by
         s.color_by = "none"
+        s.frames_n = 0  # the steps of the shown simulated nodes (0: no frame scrubber)
+        s.frame_k = 0  # the step the scrubber shows
 
         @s.change("text")
         def _edited(text: str, **_: Any) -> None:
@@ -141,6 +143,7 @@ class Page:
         ctrl.trigger("reset_param")(self._reset_param)
         ctrl.trigger("show_node")(self._show_node)
         ctrl.trigger("colour_by")(self._colour_by)
+        ctrl.trigger("show_frame")(self._show_frame)
         ctrl.add("save")(self._save)
         ctrl.add("run")(self._run)
         ctrl.add("reload")(lambda: self.worker.submit("disk", self._open_disk))
@@ -197,6 +200,14 @@ class Page:
         self._color_by = None if name in (None, "", "none") else str(name)
         self.worker.submit("show", lambda: self.session.last)
 
+    def _show_frame(self, k: Any) -> None:
+        """Show step ``k`` of the shown simulated nodes, from the caches (no recook)."""
+        try:
+            k = int(k)
+        except (TypeError, ValueError):
+            return
+        self.worker.submit("frame", self.session.frame, k)
+
     def _show_node(self, name: str) -> None:
         self.worker.submit("show", self.session.show, [name])
 
@@ -230,7 +241,8 @@ class Page:
             datasets = None
             if result.ok and kind != "run":
                 datasets = self.scene.prepare(result.shown, self._color_by)
-            prepared = (datasets, self._drawing(result), self._snapshot())
+            svg = self._drawing(result) if kind != "frame" else None  # the graph is as it was
+            prepared = (datasets, svg, self._snapshot())
         seconds += time.perf_counter() - t0
         self.loop.call_soon_threadsafe(self._apply, kind, result, seconds, prepared)
 
@@ -244,7 +256,7 @@ class Page:
             "files": [session.path, *session.files()[1:]],
             "controls": controls_of(graph, session.values) if graph is not None else None,
             "values": dict(session.values),
-            "shown": session.shown_names,
+            "shown_text": ", ".join(session.shown_names or ()) or "the graph's results",
             "exports": session.exports(),
         }
 
@@ -280,6 +292,18 @@ class Page:
                 s.attributes = datasets.attributes
                 s.color_by = datasets.color_by or "none"
         t1 = time.perf_counter()
+        if kind == "frame":
+            with s:
+                if cooked.frame is not None:
+                    s.frame_k = cooked.frame
+                    s.status = (
+                        f"{name}: frame {cooked.frame} of {cooked.frames}, from the cache in "
+                        f"{_ms(cooked.seconds)} (nothing recooked)"
+                    )
+                    s.status_bad = False
+                s.busy = not self.worker.idle()
+                s.cook_id = s.cook_id + 1
+            return
         with s:
             if kind == "disk":
                 self._disk_text = snap["text"]
@@ -315,8 +339,10 @@ class Page:
                 s.params = {c.name: plain(c.value) for c in self.controls}
             if svg is not None:
                 s.graph_svg = svg
-            shown = snap["shown"]
-            s.shown = ", ".join(shown) if shown else "the graph's results"
+            s.shown = snap["shown_text"]
+            if cooked.ok:
+                s.frames_n = cooked.frames
+                s.frame_k = cooked.frames  # a new cook shows the last step
             if cooked.ok:
                 n = len(cooked.warnings)
                 warned = f", {n} warning{'s' if n != 1 else ''}" if n else ""

@@ -44,7 +44,7 @@ class Control:
     min: float | None = None
     max: float | None = None
     step: float | None = None
-    choices: tuple[str, ...] = ()
+    choices: tuple[Any, ...] = ()  # a choice's options: texts, numbers or booleans
     doc: str = ""
 
     def as_dict(self) -> dict[str, Any]:
@@ -56,7 +56,7 @@ class Control:
             "min": self.min,
             "max": self.max,
             "step": self.step,
-            "choices": list(self.choices),
+            "choices": [plain(c) for c in self.choices],
             "doc": self.doc,
         }
 
@@ -78,10 +78,10 @@ def plain(value: Any) -> Any:
 def controls_of(graph: Graph, values: dict[str, Any]) -> list[Control]:
     """A control per param of ``graph``, chosen from its type, min and max.
 
-    A number with both a min and a max is a slider (whole steps for an int), any other
-    number a number field, a bool a toggle, a param whose type is a choice (an Enum port
-    type) a list of its options; anything else (a vector, a list, a string) a text field
-    holding its YAML.
+    A param declared with ``choices:`` (or whose type is an Enum port type) is a list of its
+    options; otherwise a number with both a min and a max is a slider (whole steps for an
+    int), any other number a number field, a bool a toggle, and anything else (a vector, a
+    list, a string) a text field holding its YAML.
     """
     from formgraph.language.params import param_kind
 
@@ -93,7 +93,9 @@ def controls_of(graph: Graph, values: dict[str, Any]) -> list[Control]:
         enum = p.type.enum if p.type is not None else None
         kind = param_kind(p)
         integer = kind is int or (p.type is not None and p.type.name == "int")
-        if enum is not None:
+        if p.choices is not None:
+            out.append(Control(name, "choice", value, default, choices=p.choices, doc=p.doc))
+        elif enum is not None:
             choices = tuple(str(m.value) for m in enum)
             shown = value.value if hasattr(value, "value") else value
             out.append(Control(name, "choice", shown, default, choices=choices, doc=p.doc))
@@ -143,6 +145,8 @@ class Cooked:
     message: str = ""
     new_graph: bool = False  # a new version of the graph (controls and drawing may change)
     warnings: list[Problem] = field(default_factory=list)  # the nodes' warnings, located
+    frames: int = 0  # the steps of the shown simulated nodes (0: none is shown)
+    frame: int | None = None  # the step shown (a frame request), 1 .. frames
 
     @property
     def computed(self) -> int:
@@ -193,6 +197,7 @@ class StudioSession:
         self.memory: Any = None  # the cache handed on from version to version
         self.progress: Callable[[str, int, int], None] | None = None
         self._files: list[Path] = [self.path]
+        self._frames: dict[str, list[Any]] = {}  # simulated node -> its steps (this cook's)
 
     # ------------------------------------------------------------------------ text
 
@@ -345,8 +350,47 @@ class StudioSession:
             if t != base:
                 value = getattr(value, t[len(base) + 1 :])
             shown.append((t, value))
-        self.last = Cooked(True, shown, dict(graph.stats), seconds, warnings=_warnings(graph))
+        self._frames = {}
+        frames = max((graph.stats[b].items for b in self._simulated(targets)), default=0)
+        self.last = Cooked(
+            True, shown, dict(graph.stats), seconds, warnings=_warnings(graph), frames=frames
+        )
         return self.last
+
+    def _simulated(self, targets: Sequence[str]) -> list[str]:
+        """The shown targets that are simulated nodes themselves (not their ``.frames``)."""
+        graph = self.graph
+        assert graph is not None
+        nodes = graph._nodes
+        return [t for t in targets if t in nodes and nodes[t].simulate is not None]
+
+    def frame(self, k: int) -> Cooked:
+        """The last cook's picture with each shown simulated node at its step ``k`` (1 ..
+        steps, clipped), taken from the caches: nothing upstream recooks, and a step the
+        memory cache let go is recomputed from the one before."""
+        last, graph = self.last, self.graph
+        if graph is None or not last.ok or not last.frames:
+            return last
+        t0 = time.perf_counter()
+        k = min(max(int(k), 1), last.frames)
+        shown = []
+        for label, value in last.shown:
+            if label in self._simulated([label]):
+                if label not in self._frames:
+                    graph.progress = self.progress
+                    try:
+                        self._frames[label] = graph.frames(label, **self.values)
+                    finally:
+                        graph.progress = None
+                steps = self._frames[label]
+                if steps:
+                    value = steps[min(k, len(steps)) - 1]
+            shown.append((label, value))
+        seconds = time.perf_counter() - t0
+        return Cooked(
+            True, shown, dict(graph.stats), seconds, frames=last.frames, frame=k,
+            warnings=last.warnings,
+        )  # fmt: skip
 
     def _failed(self, problems: Sequence[Problem], message: str, failed=()) -> Cooked:
         return Cooked(
