@@ -19,6 +19,7 @@ from formgraph.core.errors import InputError
 from formgraph.core.registry import Context, Range, node
 from formgraph.core.types import Expression, Variables, Vec3
 from formgraph.geometry import Curve, Field, Mesh, NurbsCurve
+from formgraph.kernels.attributes import propagate as carry
 from formgraph.kernels.field import mesher
 from formgraph.kernels.mesh.meshops import rotation_matrix
 
@@ -453,7 +454,7 @@ def mesh(
     return mesh_of(field, cell, bounds, ctx)
 
 
-@node("mesh.offset", version=1)
+@node("mesh.offset", version=2)
 def mesh_offset(
     mesh: Mesh,
     distance: float,
@@ -466,7 +467,9 @@ def mesh_offset(
     The mesh's signed distance field (``field.from_mesh``: exact distance, winding-number
     sign) less ``distance``, meshed adaptively (``field.mesh``): robust for any closed
     input, self-intersecting or not; convex edges come out rounded (a Minkowski sum with a
-    ball), concave ones sharp up to the cell.
+    ball), concave ones sharp up to the cell. Point attributes are interpolated at each new
+    vertex's closest point of the input (the foot of its offset), face attributes come from
+    the input face nearest each new face's centroid.
 
     Parameters
     ----------
@@ -485,4 +488,7 @@ def mesh_offset(
     if distance < 0 and -distance * 2 >= size:
         ctx.warn(f"an inward offset of {-distance:g} may remove the whole mesh")
     f = Field.offset(Field.from_mesh(mesh), float(distance))
-    return mesh_of(f, cell, None, ctx, port="mesh")
+    out = mesh_of(f, cell, None, ctx, port="mesh")
+    # attributes from the input's closest point (the offset's foot), faces' from the nearest
+    faces = (out.face_indices, out.face_offsets)
+    return Mesh(out.vertices, *faces, **carry.onto(mesh, out.vertices, faces, max_tests=ctx.budget))

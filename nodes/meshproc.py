@@ -4,7 +4,8 @@ Thin adapters over :mod:`formgraph.kernels.mesh.smooth` (sparse Laplacian and Ta
 smoothing, boundaries held) and :mod:`formgraph.kernels.mesh.simplify` (quadric
 decimation through fast-simplification, ACVD remeshing through pyacvd). A closed input
 stays closed in every one: smoothing keeps the connectivity, and the other two check their
-result and say so if a closed mesh came out open.
+result and say so if a closed mesh came out open. Smoothing keeps every attribute with its
+element; the other two take them from the input's closest point (``propagate.onto``).
 """
 
 from __future__ import annotations
@@ -38,8 +39,11 @@ def _triangles(mesh: Mesh, ctx: Context) -> tuple[np.ndarray, np.ndarray]:
     return v, fi.reshape(-1, 3)
 
 
-def _mesh(v: np.ndarray, t: np.ndarray) -> Mesh:
-    return Mesh(v, t.reshape(-1), np.arange(0, t.size + 1, 3))
+def _remade(source: Mesh, t: np.ndarray, v: np.ndarray, out: np.ndarray) -> Mesh:
+    """Triangles ``out`` over ``v``, carrying ``source``'s attributes (``t``: its own
+    triangles): from the closest point of the input, by ``propagate.onto``."""
+    fi, fo = out.reshape(-1), np.arange(0, out.size + 1, 3)
+    return Mesh(v, fi, fo, **carry.onto(source, v, (fi, fo), t))
 
 
 def _signed_volume(v: np.ndarray, t: np.ndarray) -> float:
@@ -93,7 +97,7 @@ def smooth(
     return Mesh(v, mesh.face_indices, mesh.face_offsets, **carry.carried(mesh, SAME, SAME))
 
 
-@node("mesh.decimate", version=1)
+@node("mesh.decimate", version=2)
 def decimate(
     mesh: Mesh,
     ratio: Annotated[float | None, Range(min=0, max=1)] = None,
@@ -104,7 +108,10 @@ def decimate(
     """Fewer triangles, the shape kept: quadric error edge collapse (Garland & Heckbert).
 
     Through fast-simplification (Fast-Quadric-Mesh-Simplification). Polygons are
-    triangulated first. A closed mesh stays closed, or the node says it could not.
+    triangulated first. A closed mesh stays closed, or the node says it could not. Point
+    attributes are interpolated at each new vertex's closest point of the input (its
+    triangle's barycentric weights); face attributes come from the input face nearest
+    each new face's centroid.
 
     Parameters
     ----------
@@ -127,10 +134,10 @@ def decimate(
         ov, ot = ksimp.decimate(v, t, target)
     except ksimp.OpenedError as exc:
         raise InputError("faces" if faces is not None else "ratio", str(exc)) from None
-    return _mesh(ov, ot)
+    return _remade(mesh, t, ov, ot)
 
 
-@node("mesh.remesh", version=1)
+@node("mesh.remesh", version=2)
 def remesh(
     mesh: Mesh,
     edge_length: Annotated[float, Range(min=0)],
@@ -143,7 +150,8 @@ def remesh(
     surface into regions of equal area, whose dual is the new mesh (taken instead of a
     split / collapse / flip / relax loop after Botsch & Kobbelt 2004, which is not
     written here). The node checks that a closed input comes out closed, and outward if it
-    went in outward.
+    went in outward. Attributes as in ``mesh.decimate``: a point's from the input's closest
+    point, a face's from the input face nearest its centroid.
 
     Parameters
     ----------
@@ -166,4 +174,4 @@ def remesh(
         raise InputError("edge_length", str(exc)) from None
     if ksimp.is_closed(t) and np.sign(_signed_volume(ov, ot)) != np.sign(_signed_volume(v, t)):
         ot = ot[:, ::-1]
-    return _mesh(ov, ot)
+    return _remade(mesh, t, ov, ot)

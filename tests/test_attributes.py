@@ -269,6 +269,70 @@ def test_booleans_interpolate_point_attributes_and_keep_face_sources():
         assert on_b[from_b].all() and on_a[~from_b].all()
 
 
+def _sphere_with_attributes() -> tuple[trimesh.Trimesh, Mesh]:
+    tm = trimesh.creation.icosphere(subdivisions=3, radius=1.0)
+    m = linear(Mesh(tm.vertices, tm.faces.reshape(-1), np.arange(0, tm.faces.size + 1, 3)))
+    v = m.vertices
+    point = {**m.point_data, "k": np.full(len(v), 0.37), "color": (v + 1) / 2}
+    return tm, m.with_data(point, {"id": np.arange(m.n_faces, dtype=float)})
+
+
+@pytest.mark.parametrize(
+    ("node_type", "inputs"),
+    [
+        ("mesh.decimate", {"ratio": 0.3}),
+        ("mesh.remesh", {"edge_length": 0.25}),
+        ("mesh.offset", {"distance": 0.1, "cell": 0.15}),
+        ("mesh.offset", {"distance": -0.2, "cell": 0.15}),
+    ],
+)
+def test_remade_surfaces_take_attributes_from_the_closest_point_of_the_input(node_type, inputs):
+    tm, m = _sphere_with_attributes()
+    out = run(node_type, m, **inputs)
+    assert set(out.point_data) == {"h", "k", "color"} and set(out.face_data) == {"id"}
+    assert out.point_data["color"].shape == (out.n_vertices, 3)
+    assert np.all(out.point_data["k"] == 0.37)  # a constant stays exact
+    # a linear attribute: its value at each new vertex's closest point of the input, by
+    # trimesh's own closest-point query
+    q, dist, _ = trimesh.proximity.closest_point(tm, out.vertices)
+    h_at_q = 2 * q[:, 0] - 3 * q[:, 1] + 0.5 * q[:, 2] + 1
+    np.testing.assert_allclose(out.point_data["h"], h_at_q, rtol=0, atol=1e-9)
+    # so within |grad h| * distance of the linear function at the vertex itself
+    assert linear_error(out) <= np.sqrt(2**2 + 3**2 + 0.5**2) * dist.max() + 1e-9
+    np.testing.assert_allclose(out.point_data["color"], (q + 1) / 2, rtol=0, atol=1e-9)
+    # each new face: the input face nearest its centroid (any of a tie)
+    c = np.add.reduceat(out.vertices[out.face_indices], out.face_offsets[:-1]) / 3
+    ids = out.face_data["id"].astype(int)
+    assert np.array_equal(ids, out.face_data["id"])
+    got = np.linalg.norm(trimesh.triangles.closest_point(tm.triangles[ids], c) - c, axis=1)
+    best = trimesh.proximity.closest_point(tm, c)[1]
+    np.testing.assert_allclose(got, best, rtol=0, atol=1e-12)
+
+
+def test_remade_surfaces_of_polygons_take_the_nearest_polygon_and_nothing_without():
+    m = linear(box((2, 2, 2)))  # six quads
+    m = m.with_data(m.point_data, {"side": np.arange(6.0)})
+    out = run("mesh.offset", m, distance=0.3, cell=0.2)
+    tri = meshops.triangulate(m.vertices, m.face_indices, m.face_offsets)[1].reshape(-1, 3)
+    corners = m.vertices[tri]  # two triangles per side, in face order
+    q = trimesh.proximity.closest_point(trimesh.Trimesh(m.vertices, tri), out.vertices)[0]
+    np.testing.assert_allclose(
+        out.point_data["h"], 2 * q[:, 0] - 3 * q[:, 1] + 0.5 * q[:, 2] + 1, rtol=0, atol=1e-9
+    )
+    c = np.add.reduceat(out.vertices[out.face_indices], out.face_offsets[:-1]) / 3
+    near = [  # from every centroid to each triangle, then to each side (two triangles)
+        trimesh.triangles.closest_point(np.repeat(corners[[j]], len(c), axis=0), c)
+        for j in range(len(tri))
+    ]
+    to_side = np.linalg.norm(np.stack(near, axis=1) - c[:, None], axis=2)
+    to_side = to_side.reshape(len(c), 6, 2).min(axis=2)
+    side = out.face_data["side"].astype(int)
+    np.testing.assert_allclose(to_side[np.arange(len(c)), side], to_side.min(axis=1), atol=1e-12)
+    assert len(np.unique(side)) == 6
+    plain = run("mesh.decimate", box((2, 2, 2)), ratio=0.5)
+    assert not plain.point_data and not plain.face_data
+
+
 def test_tessellation_and_grid_carry_u_v():
     g = fg.Graph()
     g.add("l", "nurbs.curve", points=[[1, 0, 0], [2, 0, 1], [1, 0, 2]], degree=2)
@@ -419,3 +483,16 @@ def test_glb_writes_the_color_attribute_as_color_0(tmp_path):
     back = next(iter(scene.geometry.values()))
     assert len(back.vertices) == m.n_vertices
     np.testing.assert_allclose(back.visual.vertex_colors[:, :3] / 255.0, colour, atol=1 / 255)
+
+
+def test_onto_triangles_without_area():
+    from formgraph.kernels.attributes import propagate as carry
+
+    v = [[0, 0, 0], [1, 0, 0], [0, 1, 0], [5, 0, 0], [6, 0, 0], [7, 0, 0]] + [[9, 9, 9]] * 3
+    m = Mesh(np.array(v, float), np.arange(9), [0, 3, 6, 9])
+    m = m.with_data({"h": np.arange(9.0)}, {"f": [1.0, 2, 3]})
+    p = np.array([[0.25, 0.25, 1.0], [5.1, 0.5, 0.0], [6.8, -0.2, 0.3], [9, 9, 9.5]])
+    data = carry.onto(m, p, (np.array([0, 1, 2, 3]), np.array([0, 4])))
+    # a face: barycentric; collinear corners: along the nearest edge; one point: its value
+    np.testing.assert_allclose(data["point_data"]["h"], [0.75, 3.1, 4.8, 6], atol=1e-12)
+    assert data["face_data"]["f"].tolist() == [2.0]  # centroid (5.3, 2.4, 2.7): the segment

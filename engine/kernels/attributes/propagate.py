@@ -11,6 +11,11 @@ Subdivision is the one case where the weights are the operation itself: its kern
 extra columns beside the coordinates (:func:`columns` / :func:`split_columns`), so point
 attributes follow exactly the same stencils as the points.
 
+A surface made anew from another (decimated, remeshed, offset) has no operation weights
+to follow: :func:`onto` finds for each new point the closest point of the old surface
+(an exact nearest-triangle query) and interpolates there by barycentric weights, and gives
+each new face the old face nearest its centroid.
+
 A ``normal`` attribute (three components) is a direction, not a position: :func:`turn`
 maps it by the inverse transpose of the linear part and renormalizes it.
 """
@@ -27,12 +32,14 @@ __all__ = [
     "DROP",
     "SAME",
     "Carry",
+    "barycentric",
     "by_position",
     "carried",
     "columns",
     "concat",
     "copy",
     "mix",
+    "onto",
     "split_columns",
     "turn",
 ]
@@ -47,12 +54,13 @@ class Carry:
     Attributes
     ----------
     kind : str
-        ``same``, ``copy``, ``mix`` or ``drop``.
-    index : (m,) int or (k,) int, optional
+        ``same``, ``copy``, ``mix``, ``barycentric`` or ``drop``.
+    index : (m,) int or (k,) int or (m, 3) int, optional
         ``copy``: the source of each output element, -1 for none (it gets 0). ``mix``: the
-        source of each term.
-    row, weight : (k,) int, (k,) float, optional
-        ``mix``: the output element and the weight of each term.
+        source of each term. ``barycentric``: each output element's three corners a, b, c.
+    row, weight : (k,) int, (k,) float or (m, 2) float, optional
+        ``mix``: the output element and the weight of each term. ``barycentric``: (v, w),
+        the output being ``a + v (b - a) + w (c - a)``.
     size : int
         ``mix``: the number of output elements.
     """
@@ -77,6 +85,15 @@ class Carry:
                 out[ok] = a[idx[ok]]
                 return out
             return a[idx]
+        if self.kind == "barycentric":  # a constant stays exact: b - a = c - a = 0
+            i, (v, w) = self.index, self.weight.T
+            shape = (len(i),) + (1,) * (a.ndim - 1)
+            base = a[i[:, 0]]
+            return (
+                base
+                + v.reshape(shape) * (a[i[:, 1]] - base)
+                + w.reshape(shape) * (a[i[:, 2]] - base)
+            )
         flat = a.reshape(len(a), -1)
         out = np.empty((self.size, flat.shape[1]))
         for c in range(flat.shape[1]):
@@ -101,6 +118,17 @@ def mix(row: Any, index: Any, weight: Any, size: int) -> Carry:
         row=np.asarray(row, dtype=np.int64),
         weight=np.asarray(weight, dtype=np.float64),
         size=int(size),
+    )
+
+
+def barycentric(corners: Any, vw: Any) -> Carry:
+    """Each output element ``a + v (b - a) + w (c - a)`` of source elements ``corners[j]``
+    = (a, b, c) with ``vw[j]`` = (v, w): exact for a constant, and for an attribute linear
+    over the triangle up to rounding."""
+    return Carry(
+        "barycentric",
+        index=np.asarray(corners, dtype=np.int64).reshape(-1, 3),
+        weight=np.asarray(vw, dtype=np.float64).reshape(-1, 2),
     )
 
 
@@ -215,3 +243,69 @@ def by_position(source: np.ndarray, target: np.ndarray) -> np.ndarray:
     pos = np.minimum(np.searchsorted(ss, t), len(ss) - 1)
     found = ss[pos] == t
     return np.where(found, order[pos], -1)
+
+
+def _dot(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    return np.einsum("ij,ij->i", x, y)
+
+
+def onto(
+    source: Any,
+    vertices: np.ndarray,
+    faces: tuple[np.ndarray, np.ndarray],
+    triangles: np.ndarray | None = None,
+    max_tests: int | None = None,
+) -> dict[str, Any]:
+    """``point_data`` and ``face_data`` for a surface made anew from mesh ``source``.
+
+    Each new vertex takes the point attributes at its closest point of ``source`` (the
+    corners of the nearest triangle, by the barycentric weights of that point: a constant
+    stays exact, an attribute linear over the triangle stays linear); each new face the
+    face attributes of the source face nearest its centroid. Nothing is queried when the
+    source has no attributes.
+
+    Parameters
+    ----------
+    source : Mesh
+        The input, with its attributes.
+    vertices : (n, 3) float
+        The new surface's vertices.
+    faces : (face_indices, face_offsets)
+        The new surface's faces.
+    triangles : (t, 3) int, optional
+        ``source``'s faces triangulated (``meshops.triangulate``'s, face by face), when
+        the caller has them; else they are made here (``max_tests`` bounds the work).
+    """
+    pd, fd = source.point_data, source.face_data
+    point, face = DROP, DROP
+    if not (pd or fd) or source.n_faces == 0:
+        return carried(source, point, face)
+    from ..field.meshdist import Nearest, _triangle_coefficients
+    from ..mesh.meshops import triangulate
+
+    sv = np.asarray(source.vertices, np.float64)
+    if triangles is None:
+        _, tfi, _ = triangulate(sv, source.face_indices, source.face_offsets, max_tests)
+        triangles = tfi.reshape(-1, 3)
+    face_of = np.repeat(np.arange(source.n_faces), np.diff(source.face_offsets) - 2)
+    corners = sv[triangles]
+    nearest = Nearest(corners)
+    p = np.asarray(vertices, np.float64).reshape(-1, 3)
+    if pd and len(p):
+        tri = nearest.tree.order[nearest.nearest(p)[1]]
+        a, b, c = (corners[tri, j] for j in range(3))
+        e1, e2, ap = b - a, c - a, p - a
+        v, w = _triangle_coefficients(
+            _dot(e1, ap), _dot(e2, ap), _dot(e1, e1), _dot(e1, e2), _dot(e2, e2)
+        )
+        bad = ~(np.isfinite(v) & np.isfinite(w))  # no area: the nearest corner alone
+        if bad.any():
+            far = np.linalg.norm(p[bad, None, :] - corners[tri[bad]], axis=2)
+            best = np.argmin(far, axis=1)
+            v[bad], w[bad] = best == 1, best == 2
+        point = barycentric(triangles[tri], np.column_stack([v, w]))
+    fi, fo = (np.asarray(x, np.int64) for x in faces)
+    if fd and fo.size > 1:
+        centre = np.add.reduceat(p[fi], fo[:-1]) / np.diff(fo)[:, None]
+        face = copy(face_of[nearest.tree.order[nearest.nearest(centre)[1]]])
+    return carried(source, point, face)

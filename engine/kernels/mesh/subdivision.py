@@ -55,15 +55,6 @@ def _scatter(index: np.ndarray, values: np.ndarray, size: int) -> np.ndarray:
     return out.T
 
 
-def _face_sums(vertices: np.ndarray, fi: np.ndarray, fo: np.ndarray, quads: bool) -> np.ndarray:
-    if quads:
-        q = fi.reshape(-1, 4)
-        return vertices[q[:, 0]] + vertices[q[:, 1]] + vertices[q[:, 2]] + vertices[q[:, 3]]
-    if fi.size == 0:
-        return np.zeros((0, vertices.shape[1]))
-    return np.add.reduceat(vertices[fi], fo[:-1], axis=0)
-
-
 # --------------------------------------------------------------------------------------
 # Catmull-Clark
 # --------------------------------------------------------------------------------------
@@ -131,43 +122,66 @@ def _edge_sharpness(
 
 
 def _catmull_clark_step(
-    v: np.ndarray, lv: _Level, sharp: np.ndarray | None, last: bool
+    vt: np.ndarray, lv: _Level, sharp: np.ndarray | None, last: bool
 ) -> tuple[np.ndarray, _Level, np.ndarray | None]:
-    """One level; on the ``last`` one only the faces of the result are built."""
-    n = v.shape[0]
+    """One level on column-major vertices ``vt`` (d, n); returns the new ones (d, n')
+    the same way. On the ``last`` level only the faces of the result are built.
+
+    Column by column: every gather and ``bincount`` reads and writes one contiguous column,
+    the d columns (x, y, z and the point attributes) cost d times one, and no level
+    transposes anything. The sharp rules touch few vertices and work on row views.
+    """
+    d, n = vt.shape
     fi, fo, face, edge, ev = lv.face_indices, lv.face_offsets, lv.face, lv.edge, lv.edge_vertices
     n_edges = ev.shape[0]
+    n_faces = fo.size - 1
     m = fi.size
-    sizes = np.diff(fo)
+    new = np.empty((d, n + n_edges + n_faces))  # vertex points, edge points, face points
+    vp, ep, fp = new[:, :n], new[:, n : n + n_edges], new[:, n + n_edges :]
 
-    # face points: centroids
-    fp = _face_sums(v, fi, fo, lv.quads)
-    fp /= 4.0 if lv.quads else sizes[:, None]
-    fp_h = fp[face]
-
-    # edge points: (v0 + v1 + f0 + f1) / 4 inside, the midpoint on a boundary or crease
     n_side = np.bincount(edge, minlength=n_edges)
-    va, vb = v[ev[:, 0]], v[ev[:, 1]]
-    mid = 0.5 * (va + vb)
-    ep = 0.5 * mid + 0.25 * _scatter(edge, fp_h, n_edges)
     boundary_edge = n_side == 1
-    ep[boundary_edge] = mid[boundary_edge]
+    on_boundary_edge = np.flatnonzero(boundary_edge)
+    k = np.bincount(fi, minlength=n).astype(np.float64)
+    kk = np.maximum(k, 1.0)
+    kk2, keep = kk**2, (kk - 2.0) / kk
+    e0, e1 = np.ascontiguousarray(ev[:, 0]), np.ascontiguousarray(ev[:, 1])
+    sizes = np.diff(fo)
+    corners = [np.ascontiguousarray(fi[j::4]) for j in range(4)] if lv.quads else []
+    for c in range(d):
+        x = vt[c]
+        # face points: centroids
+        if lv.quads:
+            f = fp[c]
+            np.add(x[corners[0]], x[corners[1]], out=f)
+            f += x[corners[2]]
+            f += x[corners[3]]
+            f *= 0.25
+        elif m:
+            np.divide(np.add.reduceat(x[fi], fo[:-1]), sizes, out=fp[c])
+        f_h = np.repeat(fp[c], 4) if lv.quads else np.repeat(fp[c], sizes)  # = fp[face]
+        # edge points: (v0 + v1 + f0 + f1) / 4 inside, the midpoint on a boundary
+        a, b = x[e0], x[e1]
+        ends = a + b
+        e = ep[c]
+        np.add(np.bincount(edge, f_h, n_edges), ends, out=e)
+        e *= 0.25
+        if on_boundary_edge.size:
+            e[on_boundary_edge] = 0.5 * ends[on_boundary_edge]
+        # vertex points, smooth rule (Q + 2R + (n - 3) S) / n with n the valence:
+        # = (sum of face points + sum of edge neighbours) / n^2 + (n - 2) / n * S
+        ring = np.bincount(fi, f_h, n)
+        ring += np.bincount(e0, b, n)  # each edge adds its other end to both ends
+        ring += np.bincount(e1, a, n)
+        np.divide(ring, kk2, out=vp[c])
+        vp[c] += keep * x
+    v, epr, vpr = vt.T, ep.T, vp.T  # row views (n, d) for the few sharp elements
     creased = np.zeros(n_edges, dtype=bool) if sharp is None else sharp > 0
     if creased.any():
         w = np.minimum(sharp[creased], 1.0)[:, None]  # semi-sharp: blend (DeRose et al. 1998)
-        ep[creased] = (1.0 - w) * ep[creased] + w * mid[creased]
-
-    # vertex points, smooth rule (Q + 2R + (n - 3) S) / n with n the valence:
-    # = (sum of face points + sum of edge neighbours) / n^2 + (n - 2) / n * S
-    k = np.bincount(fi, minlength=n).astype(np.float64)
-    ring = _scatter(fi, fp_h, n)
-    e0, e1 = np.ascontiguousarray(ev[:, 0]), np.ascontiguousarray(ev[:, 1])
-    vbt, vat = np.ascontiguousarray(vb.T), np.ascontiguousarray(va.T)
-    for c in range(v.shape[1]):  # edge neighbours: each edge adds its other end to both ends
-        ring[:, c] += np.bincount(e0, vbt[c], minlength=n)
-        ring[:, c] += np.bincount(e1, vat[c], minlength=n)
-    kk = np.maximum(k, 1.0)[:, None]
-    vp = ring / kk**2 + (kk - 2.0) / kk * v
+        ce = ev[creased]
+        mid_c = 0.5 * (v[ce[:, 0]] + v[ce[:, 1]])
+        epr[creased] = (1.0 - w) * epr[creased] + w * mid_c
     # sharp rules: a vertex on two sharp edges (boundary or crease) follows the cubic
     # B-spline curve rule 1/8, 6/8, 1/8; on more than two, or a boundary corner in a single
     # face (valence 2), it stays put
@@ -180,21 +194,25 @@ def _catmull_clark_step(
         s_e = np.broadcast_to(np.minimum(s_e, 1e300), se.shape)
         s_v = np.bincount(ends, np.repeat(s_e, 2), minlength=n)
         s_v /= np.maximum(n_sharp, 1)  # vertex sharpness: mean over its sharp edges
-        nb = _scatter(ends, np.stack([vb[se], va[se]], axis=1).reshape(-1, v.shape[1]), n)
         crease_v = n_sharp == 2
         on_boundary = np.bincount(ev[boundary_edge].ravel(), minlength=n) > 0
         s_v[on_boundary] = 1.0  # the smooth rule does not hold on a boundary
         s_v = np.minimum(s_v, 1.0)
         corner_v = (n_sharp > 2) | (crease_v & on_boundary & (k == 1))
         crease_v &= ~corner_v
-        target = v.copy()
-        target[crease_v] = 0.125 * nb[crease_v] + 0.75 * v[crease_v]
-        hard = crease_v | corner_v
-        w = s_v[hard][:, None]
-        vp[hard] = (1.0 - w) * vp[hard] + w * target[hard]
-    vp[k == 0] = v[k == 0]  # vertices no face uses are carried along
-
-    new_v = np.concatenate([vp, ep, fp])
+        hard = np.flatnonzero(crease_v | corner_v)
+        if hard.size:
+            other = ev[se][:, ::-1].ravel()  # each sharp edge's other end, at both ends
+            nb = _scatter(ends, v[other], n)
+            target = v[hard]
+            on_crease = crease_v[hard]
+            target[on_crease] = 0.125 * nb[hard[on_crease]] + 0.75 * target[on_crease]
+            w = s_v[hard][:, None]
+            vpr[hard] = (1.0 - w) * vpr[hard] + w * target
+    unused = k == 0
+    if unused.any():
+        vpr[unused] = v[unused]  # vertices no face uses are carried along
+    new_v = new
 
     # connectivity: one quad per half-edge h = (vertex, edge point, face point, edge point)
     h = np.arange(m, dtype=np.int64)
@@ -285,7 +303,8 @@ def catmull_clark(
     -------
     vertices : (n', 3) float64
         The original vertices' new positions first (same indices), then one edge point per
-        edge, then one face point per face (with the extra columns, when given).
+        edge, then one face point per face (with the extra columns, when given). Laid out
+        column by column (Fortran order), as the levels compute them.
     face_indices : (4 * n_faces',) int64
     face_offsets : (n_faces' + 1,) int64
         All quads.
@@ -310,9 +329,10 @@ def catmull_clark(
     if levels == 0:
         return v.copy(), np.array(he.origin), np.array(he.face_offsets)
     lv = _Level.from_halfedges(he)
+    vt = np.ascontiguousarray(v.T)  # column-major through every level
     for level in range(levels):
-        v, lv, sharp = _catmull_clark_step(v, lv, sharp, last=level == levels - 1)
-    return v, lv.face_indices, lv.face_offsets
+        vt, lv, sharp = _catmull_clark_step(vt, lv, sharp, last=level == levels - 1)
+    return vt.T, lv.face_indices, lv.face_offsets
 
 
 def catmull_clark_face_parents(face_offsets: np.ndarray, levels: int) -> np.ndarray:
