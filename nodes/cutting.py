@@ -186,9 +186,10 @@ def _rings(
         batched.update(zip(members, sampled_batch, strict=True))
     for i, c in enumerate(curves):  # one step per curve; its samples are vectorized
         poly = isinstance(c, NurbsCurve) and c.degree == 1
-        if poly:  # a polyline is its own sampling: its control points, closed, as they are
-            ring = np.ascontiguousarray(np.asarray(c.control_points)[:, :2])
-            ring[-1] = ring[0]  # closed within 1e-9 (_closed): now bit for bit
+        if poly:
+            # a polyline is its own sampling: its control points, closed, as they are (with
+            # their z, which GEOS's planar overlay ignores: no copy into an (n, 2) array)
+            ring = np.asarray(c.control_points)
             guard(len(ring))
         elif i in batched:
             ring = batched[i]
