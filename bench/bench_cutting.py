@@ -42,16 +42,18 @@ def run(table) -> None:  # noqa: ANN001 - the harness's Table
     a, b = wiggly(N, 0.0), wiggly(N, 0.5)
     ca, cb = NurbsCurve.polyline(a, closed=True), NurbsCurve.polyline(b, closed=True)
     case = f"union of two {N:,}-vertex outlines"
-    table.time(case, "formgraph", lambda: cutting.union([ca, cb], ctx=ctx), repeat=3)
     diff = f"difference of two {N:,}-vertex outlines"
-    table.time(
-        diff,
-        "formgraph",
-        lambda: cutting.boolean([ca], [cb], operation=cutting.Operation.difference, ctx=ctx),
-        repeat=3,
-    )
+
+    def ours_difference():
+        return cutting.boolean([ca], [cb], operation=cutting.Operation.difference, ctx=ctx)
+
     try:
         import shapely
+    except ImportError:
+        table.time(case, "formgraph", lambda: cutting.union([ca, cb], ctx=ctx), repeat=3)
+        table.time(diff, "formgraph", ours_difference, repeat=3)
+        table.add(case, "shapely", None, "not installed (shapely)")
+    else:
 
         def reference(op):  # the same polylines in, the outlines' points out
             def go():
@@ -61,12 +63,22 @@ def run(table) -> None:  # noqa: ANN001 - the harness's Table
             return go
 
         note = "Polygons built from the arrays, rings' points out"
-        table.time(case, "shapely", reference(shapely.union), repeat=3, note=note)
-        table.time(diff, "shapely", reference(shapely.difference), repeat=3, note=note)
         pa, pb = shapely.Polygon(a), shapely.Polygon(b)
-        table.time(case, "shapely (overlay only)", lambda: shapely.union(pa, pb), repeat=3)
-    except ImportError:
-        table.add(case, "shapely", None, "not installed (shapely)")
+        table.time_together(  # alternating rounds: a burst of load falls on both
+            case,
+            [
+                ("formgraph", lambda: cutting.union([ca, cb], ctx=ctx), ""),
+                ("shapely", reference(shapely.union), note),
+                ("shapely (overlay only)", lambda: shapely.union(pa, pb), ""),
+            ],
+        )
+        table.time_together(
+            diff,
+            [
+                ("formgraph", ours_difference, ""),
+                ("shapely", reference(shapely.difference), note),
+            ],
+        )
 
     line = NurbsCurve.polyline(wiggly(N, 0.0))  # open: the loop without its closing edge
     case = f"divide a {N:,}-vertex polyline into 100,000 points"

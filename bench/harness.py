@@ -81,6 +81,26 @@ class Table:
         self.rows.append(Row(case, impl, seconds, note))
         return seconds
 
+    def time_together(
+        self,
+        case: str,
+        impls: list[tuple[str, Callable[[], object], str]],
+        *,
+        rounds: int = 7,
+    ) -> None:
+        """Time several implementations of one case in alternating rounds, best of each.
+
+        ``impls`` holds ``(impl, fn, note)``. Every round times each ``fn`` once after the
+        other (:func:`best_time` with one repeat), so a burst of load on a shared machine
+        falls on all of them rather than on whichever ran during it.
+        """
+        best = {impl: float("inf") for impl, _, _ in impls}
+        for _ in range(rounds):
+            for impl, fn, _ in impls:
+                best[impl] = min(best[impl], best_time(fn, repeat=1))
+        for impl, _, note in impls:
+            self.rows.append(Row(case, impl, best[impl], note))
+
     def add(self, case: str, impl: str, seconds: float | None, note: str = "") -> None:
         self.rows.append(Row(case, impl, seconds, note))
 

@@ -163,7 +163,8 @@ def _rings(
         if isinstance(c, NurbsCurve) and c.degree >= 2:
             by_degree.setdefault(c.degree, []).append(i)
         z = np.asarray(c.control_points)[:, 2] if isinstance(c, NurbsCurve) else c.sample(65)[:, 2]
-        if z.max() - z.min() > 1e-9 * max(1.0, float(np.abs(z).max())):
+        lo, hi = float(z.min()), float(z.max())
+        if hi - lo > 1e-9 * max(1.0, -lo, hi):
             tilted.append(i)
     if tilted:
         shown = ", ".join(str(i) for i in tilted[:10]) + (", ..." if len(tilted) > 10 else "")
@@ -184,7 +185,13 @@ def _rings(
         sampled_batch = _kernel(port, ksampling.sample_closed_batch, batch, tol, guard)
         batched.update(zip(members, sampled_batch, strict=True))
     for i, c in enumerate(curves):  # one step per curve; its samples are vectorized
-        if i in batched:
+        poly = isinstance(c, NurbsCurve) and c.degree == 1
+        if poly:
+            # a polyline is its own sampling: its control points, closed, as they are (with
+            # their z, which GEOS's planar overlay ignores: no copy into an (n, 2) array)
+            ring = np.asarray(c.control_points)
+            guard(len(ring))
+        elif i in batched:
             ring = batched[i]
         elif isinstance(c, NurbsCurve):
             w = np.asarray(c.weights) if c.rational else None
@@ -208,22 +215,22 @@ def _rings(
 
             _, ring = ksampling.refine_chords(at, u, at(u), tol, guard)
             ring = ring[:-1]
-        ring = _distinct(ring)
-        if len(ring) < 3:
+        ring = _distinct(ring, closed=poly)
+        if len(ring) - poly < 3:
             raise InputError(port, f"curve {i} encloses no area (fewer than 3 distinct points)")
         total += len(ring)
         rings.append(ring)
-        poly = isinstance(c, NurbsCurve) and c.degree == 1
         sampled.append(None if poly else ring)
     return rings, sampled
 
 
-def _distinct(ring: np.ndarray) -> np.ndarray:
-    """The ring without consecutive repeats (nor a repeat of the first point at the end)."""
-    d = np.diff(ring, axis=0)
-    repeat = (d[:, 0] == 0) & (d[:, 1] == 0)
+def _distinct(ring: np.ndarray, closed: bool = False) -> np.ndarray:
+    """The ring without consecutive repeats; ``closed``: its last point is its first again
+    (and stays), else a repeat of the first point at the end is dropped."""
+    x, y = ring[:, 0], ring[:, 1]
+    repeat = (x[1:] == x[:-1]) & (y[1:] == y[:-1])
     r = ring if not repeat.any() else ring[np.r_[True, ~repeat]]
-    if len(r) > 1 and np.array_equal(r[0], r[-1]):
+    if not closed and len(r) > 1 and np.array_equal(r[0], r[-1]):
         r = r[:-1]
     return r
 
@@ -249,34 +256,17 @@ def _outlines(
 ) -> list[Curve]:
     """The region's boundary as closed curves; an input curve the operation left whole
     comes back as itself (exact), turned to the right direction."""
-    coords, offsets, _ = kregions.rings_of(region)
+    coords, offsets, _ = kregions.rings_of(region, with_z=True)
     if len(offsets) < 2:
         ctx.warn("the result is empty: the regions leave no area")
         return []
-    out_rings = [coords[offsets[i] : offsets[i + 1] - 1] for i in range(len(offsets) - 1)]
-    matches = kregions.match_rings(out_rings, sampled)
-    # every outline's points in one frozen array, and its knots (the running chord length,
-    # ends doubled) in another: each curve's arrays are views, shared rather than copied
-    m, rings = len(coords), len(offsets) - 1
-    flat = np.zeros((m, 3))
-    flat[:, :2] = coords
-    xyz = frozen_array(flat)
-    dx, dy = coords[1:, 0] - coords[:-1, 0], coords[1:, 1] - coords[:-1, 1]
-    step = np.empty(m)
-    step[0] = 0.0
-    np.sqrt(dx * dx + dy * dy, out=step[1:])
-    step[offsets[:-1]] = 0.0  # each ring's length starts from 0
-    chord = np.cumsum(step)
-    chord -= np.repeat(chord[offsets[:-1]], np.diff(offsets))
-    # ring i's knots sit at [offsets[i] + 2 i, offsets[i + 1] + 2 i + 2): its chords with the
-    # first and last doubled
-    knots = np.empty(m + 2 * rings)
-    shift = 2 * np.repeat(np.arange(rings), np.diff(offsets))
-    knots[np.arange(m) + shift + 1] = chord
-    first = offsets[:-1] + 2 * np.arange(rings)
-    knots[first] = 0.0
-    knots[offsets[1:] + 2 * np.arange(rings) + 1] = chord[offsets[1:] - 1]
-    knots = frozen_array(knots)
+    if any(g is not None for g in sampled):
+        out_rings = [coords[offsets[i] : offsets[i + 1] - 1, :2] for i in range(len(offsets) - 1)]
+        matches = kregions.match_rings(out_rings, sampled)
+    else:  # polylines only: nothing to keep exact
+        matches = [None] * (len(offsets) - 1)
+    xyz = frozen_array(coords)  # every outline's points: each curve's are a view of them
+    knots = frozen_array(_chord_knots(coords, offsets))
     result: list[Curve] = []
     for i, match in enumerate(matches):  # one step per outline
         if match is not None:
@@ -285,8 +275,31 @@ def _outlines(
             result.append(_flat(c) if match[1] else _flat(_reversed(c)))
         else:
             a, b = offsets[i], offsets[i + 1]
-            result.append(NurbsCurve(xyz[a:b], 1, knots[a + 2 * i : b + 2 * i + 2]))
+            # GEOS's points of finite input and their running length: valid by making
+            result.append(NurbsCurve._of_valid(xyz[a:b], 1, knots[a + 2 * i : b + 2 * i + 2]))
     return result
+
+
+def _chord_knots(coords: np.ndarray, offsets: np.ndarray) -> np.ndarray:
+    """The knots of every closed ring as a polyline, in one array: ring i's running chord
+    length with its first and last value doubled, at ``[offsets[i] + 2 i, offsets[i + 1] +
+    2 i + 2)`` (so t is arc length along each outline)."""
+    m, r = len(coords), len(offsets) - 1
+    x, y = coords[:, 0], coords[:, 1]
+    seg = np.hypot(x[1:] - x[:-1], y[1:] - y[:-1])  # seg[j - 1]: from point j - 1 to j
+    knots = np.zeros(m + 2 * r)
+    if r == 1:  # the usual case, without the scatter: [0, 0, running length, last again]
+        np.cumsum(seg, out=knots[2 : m + 1])
+        knots[m + 1] = knots[m]
+        return knots
+    # point j of ring i sits at j + 2 i + 1; the step into it (none into a ring's first
+    # point, so each ring starts at 0 and its doubled ends repeat their neighbours)
+    ring = np.repeat(np.arange(r), np.diff(offsets))
+    inside = np.flatnonzero(ring[1:] == ring[:-1])
+    knots[inside + 2 + 2 * ring[inside + 1]] = seg[inside]
+    np.cumsum(knots, out=knots)
+    knots -= np.repeat(knots[offsets[:-1] + 2 * np.arange(r)], np.diff(offsets) + 2)
+    return knots
 
 
 def _tolerance(tolerance: float | None, curves: list[Curve]) -> float:

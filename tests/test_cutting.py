@@ -199,6 +199,29 @@ def test_holes_are_clockwise_and_untouched_curves_stay_exact():
     assert region_area(out) == pytest.approx(expected, rel=1e-6)
 
 
+def test_outlines_of_many_rings_are_chord_length_polylines_in_the_right_direction():
+    # two plates with two holes each (given either way round): six rings, two parts
+    a = [square(10), square(10, 20, ccw=False)]
+    b = [square(2, -2), square(2, 2, ccw=False), square(2, 18), square(2, 22)]
+    out = run("curves.boolean", a=a, b=b, operation="difference")
+    assert len(out) == 6
+    areas = np.array([signed_area(c) for c in out])
+    assert (areas > 0).sum() == 2 and (areas < 0).sum() == 4  # shells CCW, holes CW
+    assert areas.sum() == pytest.approx(2 * (100 - 8))
+    for c in out:
+        cp = np.asarray(c.control_points)
+        assert c.degree == 1 and np.array_equal(cp[0], cp[-1]) and not cp[:, 2].any()
+        chord = np.r_[0, np.cumsum(np.linalg.norm(np.diff(cp, axis=0), axis=1))]
+        np.testing.assert_allclose(c.knots, np.r_[0, chord, chord[-1]], atol=1e-12)
+        np.testing.assert_allclose(c.evaluate(np.asarray(c.knots)[1:-1]), cp, atol=1e-12)
+    # against shapely's area of the same region
+    ref = shapely.difference(
+        regions.even_odd_region([np.asarray(c.control_points)[:, :2] for c in a]),
+        regions.even_odd_region([np.asarray(c.control_points)[:, :2] for c in b]),
+    )
+    assert areas.sum() == pytest.approx(ref.area, rel=1e-12)
+
+
 def test_a_list_is_one_region_by_the_even_odd_rule():
     # a square inside a square (either direction) is a hole; two overlapping ones are xor
     annulus = run("curves.boolean", a=[square(4), square(2)], b=[])
@@ -419,3 +442,22 @@ def test_batch_sampling_is_the_sampling_of_each_curve():
             alone = sampling.sample_nurbs(*args, 1e-4, closed=True)
             assert got.shape == alone.shape  # the same samples, up to the parameter's rounding
             np.testing.assert_allclose(got, alone, rtol=0, atol=1e-12)
+
+
+def test_a_hundred_rings_take_the_indexed_path_and_agree_with_shapely():
+    # more rings than are made one by one (regions._FEW): one indexed creation call
+    t = np.linspace(0, 2 * np.pi, 24, endpoint=False)
+    unit = np.c_[np.cos(t), np.sin(t)]
+    rings = [0.6 * unit + [i, j] for i in range(10) for j in range(10)]  # neighbours overlap
+    assert len(rings) > regions._FEW
+    ref = shapely.union_all([shapely.Polygon(r) for r in rings])
+    ours = run("curves.union", curves=[NurbsCurve.polyline(r, closed=True) for r in rings])
+    assert region_area(ours) == pytest.approx(ref.area, rel=1e-12)
+    # read as one list by the even-odd rule, the 180 lenses drop out (xor)
+    xor = regions.even_odd_region(rings)
+    expected = (
+        ref.area
+        - (2 * 9 * 10)
+        * shapely.intersection(shapely.Polygon(rings[0]), shapely.Polygon(rings[1])).area
+    )
+    assert xor.area == pytest.approx(expected, rel=1e-9)

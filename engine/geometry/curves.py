@@ -89,6 +89,22 @@ class NurbsCurve(Curve):
         object.__setattr__(self, "rational", bool(rational))
 
     @classmethod
+    def _of_valid(cls, control_points: np.ndarray, degree: int, knots: np.ndarray) -> NurbsCurve:
+        """A non-rational curve of frozen arrays a kernel built valid (finite (n, 3) points,
+        non-decreasing knots of the right count): made without checking them again. For
+        kernels that make many or long curves, e.g. the outlines of a region boolean."""
+        from .base import is_frozen
+
+        assert is_frozen(control_points) and is_frozen(knots)
+        curve = object.__new__(cls)
+        object.__setattr__(curve, "control_points", control_points)
+        object.__setattr__(curve, "degree", int(degree))
+        object.__setattr__(curve, "knots", knots)
+        object.__setattr__(curve, "weights", frozen_array(np.ones(len(control_points))))
+        object.__setattr__(curve, "rational", False)
+        return curve
+
+    @classmethod
     def polyline(cls, points: Any, closed: bool = False) -> NurbsCurve:
         """The degree-1 curve through ``points``; ``closed`` joins the last to the first.
 
