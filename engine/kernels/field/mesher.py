@@ -1,25 +1,31 @@
-"""Adaptive meshing of the zero set of a distance field: octree culling, marching tetrahedra.
+"""Adaptive meshing of the zero set of a distance field: octree culling, marching cubes.
 
 The finest grid has cells of size ``cell``; only the cells the surface can reach are ever
-made. Starting from a coarse grid of blocks (``2^levels`` finest cells a side), each level
-keeps the cells whose centre value is within the field's Lipschitz reach of zero
-(``|f(c)| <= L * half-diagonal``: a cell farther than that from the surface cannot hold
-any of it) and splits them into eight, down to the finest level. This is the offset's
-quadtree in one more dimension, and it costs in the surface's area: halving the cell
-makes about four times the cells, not eight.
+made. Starting from a coarse grid, each level keeps the cells whose centre value is
+within the field's Lipschitz reach of zero (``|f(c)| <= L * half-diagonal``: a cell
+farther than that from the surface cannot hold any of it, nor any sign change among the
+grid corners in it) and splits them into eight. Down to blocks of 8^3 finest cells this
+is a list of cells; inside the kept blocks it goes on as dense per-block arrays (levels
+of 4 and 2 cells), so the work is in the surface's area: halving the cell makes about
+four times the cells, not eight.
 
-The finest kept cells are polygonized by marching tetrahedra on the Freudenthal (Kuhn)
-split of each cube into six tetrahedra round its main diagonal. The split is the same in
-every cube, so neighbouring cubes cut their shared face along the same diagonal, and the
-surface, a function of the values at shared corners only (each corner evaluated once,
-found by its integer key), is watertight by construction; every cell with a sign change
-among its corners is kept (a Lipschitz field with a zero in a cell has ``|f(c)|`` within
-the reach), so no piece of the surface is missing either. Triangles are oriented so their
-normals point to the positive (outside) side. Each vertex is put on its tetrahedron edge
-by regula falsi (Illinois variant) on the field itself, not only by linear interpolation.
+Every grid corner is owned by one block (a block owns its 8^3 lower corners; the corners
+on its upper faces belong to its neighbours), so a corner is sampled once and its sign
+decided once, in one place, whichever cells use it. A corner's sign is inferred without
+sampling where a sampled point of the level of 2 cells is farther from zero than the
+field can change between them (``|f(q)| > L |p - q|``); the rest are sampled, in chunks
+that stay in the processor's cache.
 
-Treuhaft & Nielson, "Marching tetrahedra" (Doi & Koide 1991); Freudenthal 1942; Dowson &
-Harrington's Illinois method (1971).
+The cells with a sign change are polygonized by marching cubes with a table built from
+one rule on each face (:mod:`.mctable`: inside corners are separated), so neighbouring
+cubes draw the same segments on a shared face and the surface, a function of the signs
+at shared corners only, is watertight by construction; triangles point to the positive
+(outside) side. A vertex is identified by its edge (owner block, corner, axis): a perfect
+hash, numbered by marking and counting, no sort. Each vertex is put on its edge by
+regula falsi (Illinois variant) on the field itself, not only by linear interpolation.
+
+Lorensen & Cline 1987; Nielson & Hamann 1991 (the ambiguous face); Dowson & Harrington's
+Illinois method (1971).
 """
 
 from __future__ import annotations
@@ -29,10 +35,13 @@ from collections.abc import Callable
 
 import numpy as np
 
-__all__ = ["BudgetExceeded", "mesh_field", "plan_grid"]
+from .mctable import EDGE_AXIS, EDGE_START, TRI_COUNT, TRI_EDGES
+
+__all__ = ["BudgetExceeded", "crossing_cells", "mesh_field", "plan_grid"]
 
 Fn = Callable[[np.ndarray], np.ndarray]
 SQRT3_2 = np.sqrt(3.0) / 2.0
+CHUNK = 1 << 16  # points per call of the field: its temporaries stay in the cache
 
 
 class BudgetExceeded(Exception):
@@ -44,83 +53,34 @@ class BudgetExceeded(Exception):
         self.what = what
 
 
-# ---------------------------------------------------------------- the tetrahedra's tables
-
 CORNERS = np.array(list(itertools.product((0, 1), repeat=3)), dtype=np.int64)  # (8, 3) xyz
-# direction vectors of the edges used (all from a corner toward +): 7 nonzero 0/1 vectors
-DIRS = CORNERS[1:]
-
-
-def _corner_id(v) -> int:
-    return int(v[0] * 4 + v[1] * 2 + v[2])
-
-
-def _tables():
-    """Per (tetrahedron, sign case): up to two triangles, each three (corner, direction)
-    edges, oriented with the normal toward the outside (positive) vertices."""
-    tets = []
-    for perm in itertools.permutations(range(3)):
-        path = [np.zeros(3, np.int64)]
-        for axis in perm:
-            step = path[-1].copy()
-            step[axis] = 1
-            path.append(step)
-        tets.append(path)
-    # edge of a tetrahedron between its path vertices i < j: from corner path[i], direction
-    # path[j] - path[i] (the path is monotone, so that is a 0/1 vector)
-    tri = np.full((6, 16, 2, 3, 2), -1, dtype=np.int64)  # (.., triangle, vertex, (corner, dir))
-    for t, path in enumerate(tets):
-        pos = np.array(path, dtype=np.float64)
-        for case in range(16):
-            inside = [(case >> i) & 1 == 1 for i in range(4)]
-            ins = [i for i in range(4) if inside[i]]
-            out = [i for i in range(4) if not inside[i]]
-            if not ins or not out:
-                continue
-            cross = [(a, b) if a < b else (b, a) for a in ins for b in out]
-
-            if len(ins) == 1 or len(out) == 1:
-                polys = [cross]
-            else:  # a quad: order its crossings round the loop (i0o0, i0o1, i1o1, i1o0)
-                (i0, i1), (o0, o1) = ins, out
-                loop = [(i0, o0), (i0, o1), (i1, o1), (i1, o0)]
-                loop = [(a, b) if a < b else (b, a) for a, b in loop]
-                polys = [[loop[0], loop[1], loop[2]], [loop[0], loop[2], loop[3]]]
-            c_in = pos[ins].mean(axis=0)
-            c_out = pos[out].mean(axis=0)
-            for k, poly in enumerate(polys):
-                a, b, c = ((pos[i] + pos[j]) / 2.0 for i, j in poly)
-                if np.dot(np.cross(b - a, c - a), c_out - c_in) < 0:
-                    poly = [poly[0], poly[2], poly[1]]
-                for m, (i, j) in enumerate(poly):
-                    tri[t, case, k, m] = (_corner_id(path[i]), _corner_id(path[j] - path[i]) - 1)
-    tet_corners = np.array([[_corner_id(v) for v in path] for path in tets], dtype=np.int64)
-    return tet_corners, tri
-
-
-TET_CORNERS, TRI_TABLE = _tables()  # (6, 4) cube corners; (6, 16, 2, 3, 2)
-
 
 # ---------------------------------------------------------------------------- the grid
-
 
 GRID_SHIFT = np.array([0.1234567, 0.2345678, 0.3456789]) * 0.5
 # a vertex stays this fraction of its edge off either end, so vertices never coincide, not
 # even as the float32 coordinates of an STL (at 2,000 cells from the origin an ulp of
 # float32 is 1e-4 of a cell)
 END_GAP = 5e-4
+CLOSE = 3e-3  # the last step is not sampled once |f| is this fraction of the bracket's change
+BLOCK_LEVEL = 3
+B = 1 << BLOCK_LEVEL  # a block is B^3 finest cells and owns B^3 corners
+B3 = B**3
+GROUP = 128  # kept blocks worked on at a time (65,536 cells)
+C2 = 4 * CORNERS + 2  # the centres of a block's cells of 4, in corners
 
 
 def plan_grid(lo: np.ndarray, hi: np.ndarray, cell: float, coarse: int = 16):
     """The finest grid over ``[lo, hi]`` (padded by a cell) and its octree depth.
 
-    Returns ``origin (3,)``, ``levels`` and ``blocks (3,)``: the coarse grid has ``blocks``
-    cells a side, each ``2^levels`` finest cells, and the finest grid covers the padded box.
+    Returns ``origin (3,)``, ``levels`` (at least the block level, 3) and ``blocks (3,)``:
+    the coarse grid has ``blocks`` cells a side, each ``2^levels`` finest cells, and the
+    finest grid covers the padded box.
     """
     lo = np.asarray(lo, dtype=np.float64) - cell
     hi = np.asarray(hi, dtype=np.float64) + cell
     n = np.maximum(np.ceil((hi - lo) / cell).astype(np.int64), 1)
-    levels = max(0, int(np.ceil(np.log2(max(n.max() / coarse, 1.0)))))
+    levels = max(BLOCK_LEVEL, int(np.ceil(np.log2(max(n.max() / coarse, 1.0)))))
     blocks = -(-n // (1 << levels))
     size = blocks * (1 << levels)
     # centre the grid on the box, shifted by a generic fraction of a cell: the planes of
@@ -136,27 +96,268 @@ def _check(values: np.ndarray) -> np.ndarray:
     return v
 
 
-def active_cells(
-    f: Fn, origin, levels: int, blocks, cell: float, lipschitz: float, max_cells: int
-) -> np.ndarray:
-    """Integer (i, j, k) of the finest cells the surface may cross: (m, 3) int64."""
-    g = np.stack(np.meshgrid(*(np.arange(b) for b in blocks), indexing="ij"), axis=-1).reshape(
-        -1, 3
-    )
+def _eval(f: Fn, p: np.ndarray) -> np.ndarray:
+    """``f`` at points ``(n, 3)``, checked, in chunks of :data:`CHUNK` points."""
+    if len(p) <= CHUNK:
+        return _check(f(p))
+    return np.concatenate([_check(f(p[i : i + CHUNK])) for i in range(0, len(p), CHUNK)])
+
+
+def _eval_ijk(f: Fn, origin, cell: float, ijk: np.ndarray, size: float = 1.0) -> np.ndarray:
+    """``f`` at grid points ``origin + ijk * cell * size``, the coordinates made per chunk."""
+    out = np.empty(len(ijk))
+    step = cell * size
+    for i in range(0, len(ijk), CHUNK):
+        out[i : i + CHUNK] = _check(f(origin + ijk[i : i + CHUNK] * step))
+    return out
+
+
+def _reach(lipschitz: float, size: float) -> float:
+    """How far from zero a value at the centre of a cell of ``size`` may be while the
+    surface still reaches a point of the closed cell."""
+    return lipschitz * SQRT3_2 * size * (1.0 + 1e-9) + 1e-12 * size
+
+
+def _kept_blocks(f: Fn, origin, levels: int, blocks, cell: float, lipschitz: float, max_cells):
+    """Integer (i, j, k) of the blocks (level 3) the surface may reach, and the values
+    at their centres."""
+    g = np.stack(np.meshgrid(*(np.arange(b) for b in blocks), indexing="ij"), axis=-1)
+    g = g.reshape(-1, 3)
     if len(g) > max_cells:
         raise BudgetExceeded(len(g), "coarse cells")
-    kids = CORNERS
-    for level in range(levels, -1, -1):
-        size = cell * (1 << level)
-        centres = origin + (g + 0.5) * size
-        val = _check(f(centres))
-        g = g[np.abs(val) <= lipschitz * SQRT3_2 * size * (1.0 + 1e-9) + 1e-12 * size]
-        if level == 0 or not len(g):
+    for level in range(levels, BLOCK_LEVEL - 1, -1):
+        size = float(1 << level)
+        val = _eval_ijk(f, origin, cell, g + 0.5, size)
+        keep = np.abs(val) <= _reach(lipschitz, size * cell)
+        g, val = g[keep], val[keep]
+        if level == BLOCK_LEVEL or not len(g):
             break
         if 8 * len(g) > max_cells:
             raise BudgetExceeded(8 * len(g), "cells")
-        g = (2 * g[:, None, :] + kids[None, :, :]).reshape(-1, 3)
-    return g
+        g = (2 * g[:, None, :] + CORNERS[None, :, :]).reshape(-1, 3)
+    return g, val
+
+
+# ------------------------------------------------------- blocks, their slots, their signs
+
+
+def _key(c: np.ndarray, dims: np.ndarray) -> np.ndarray:
+    return (c[..., 0] * dims[1] + c[..., 1]) * dims[2] + c[..., 2]
+
+
+def _region(w: int):
+    """For the neighbour ``w`` (a CORNERS code) of a block: where its owned corners sit in
+    the block's (9, 9, 9) corner grid, and where they sit in the neighbour's own slot."""
+    up = CORNERS[w]
+    here = tuple(B if u else slice(0, B) for u in up)
+    there = tuple(0 if u else slice(0, B) for u in up)
+    return (slice(None), *here), there
+
+
+REGIONS = [_region(w) for w in range(8)]
+
+
+class _Lattice:
+    """The kept blocks, the slots of the corners they use, and every needed corner's sign.
+
+    ``nbr (nk, 8)``: the slots of each kept block and its seven upper neighbours (its own
+    slot first); ``inside (ns, 8, 8, 8)``: the decided signs; ``values``: the sampled values
+    (NaN where a sign was inferred or not needed); ``kept1 (nk, 4, 4, 4)``: the kept cells
+    of 2. Blocks are worked on :data:`GROUP` at a time, so the arrays stay in the cache.
+    """
+
+    def __init__(self, f: Fn, lo, hi, cell: float, lipschitz: float, max_cells: int):
+        self.f, self.cell = f, cell
+        self.origin, levels, blocks = plan_grid(lo, hi, cell)
+        g, vc = _kept_blocks(f, self.origin, levels, blocks, cell, lipschitz, max_cells)
+        self.blocks = g
+        nk = len(g)
+        if not nk:
+            return
+        if nk * B3 > max_cells:
+            raise BudgetExceeded(nk * B3, "cells")
+        # slots: every kept block and its upper neighbours own their lower 8^3 corners
+        dims = (blocks << (levels - BLOCK_LEVEL)) + 1
+        order = np.argsort(_key(g, dims))  # neighbouring blocks, neighbouring slots
+        g, vc = g[order], vc[order]
+        self.blocks = g
+        keys = _key(g[:, None, :] + CORNERS[None, :, :], dims)
+        touched = np.unique(keys)
+        ns = len(touched)
+        if ns * B3 > 4 * max_cells:
+            raise BudgetExceeded(ns * B3, "corner slots")
+        d1, d2 = int(dims[1]), int(dims[2])
+        self.base = np.stack([touched // (d1 * d2), touched // d2 % d1, touched % d2], -1) * B
+        self.touched, self.dims = touched, dims
+        self.nbr = nbr = np.searchsorted(touched, keys)
+        values = np.full((ns, B, B, B), np.nan)
+        need = np.zeros((ns, B, B, B), dtype=bool)
+        known = np.zeros((ns, B, B, B), dtype=bool)
+        inside = np.zeros((ns, B, B, B), dtype=bool)
+        self.kept1 = np.zeros((nk, 4, 4, 4), dtype=bool)
+        values[nbr[:, 0], 4, 4, 4] = vc
+        for s in range(0, nk, GROUP):
+            e = min(s + GROUP, nk)
+            val1 = self._levels(g[s:e], nbr[s:e, 0], values, lipschitz)
+            with np.errstate(invalid="ignore"):
+                kept1 = np.abs(val1) <= _reach(lipschitz, 2 * cell)
+            self.kept1[s:e] = kept1
+            # the corners of the kept cells of 2 (3^3 each), marked in their owners' slots
+            need9 = np.zeros((e - s, B + 1, B + 1, B + 1), dtype=bool)
+            for i, j, k in itertools.product(range(3), repeat=3):
+                need9[:, i : i + B : 2, j : j + B : 2, k : k + B : 2] |= kept1
+            for w, (here, there) in enumerate(REGIONS):
+                need[(nbr[s:e, w], *there)] |= need9[here]
+            # signs inferred from the centres of the cells of 2: |f(q)| > L |p - q|
+            inferred, negative = _infer(val1, lipschitz * cell)
+            own = values[nbr[s:e, 0]]
+            sampled = ~np.isnan(own)
+            known[nbr[s:e, 0]] = inferred | sampled
+            inside[nbr[s:e, 0]] = np.where(sampled, own < 0, negative)
+        values, need, known, inside = (a.reshape(-1) for a in (values, need, known, inside))
+        todo = np.flatnonzero(need & ~known)
+        values[todo] = self.sample(todo)
+        inside[todo] = values[todo] < 0
+        self.values, self.inside = values, inside.reshape(ns, B, B, B)
+
+    def _levels(self, g, own, values, lipschitz: float) -> np.ndarray:
+        """The levels of 4 and 2 cells inside blocks ``g`` (dense per-block arrays): their
+        centres sampled into ``values``, the kept cells of 2 into ``kept1``; returns the
+        centres of the cells of 2 ``(n, 4, 4, 4)`` (NaN where the cell of 4 was culled)."""
+        n, cell = len(g), self.cell
+        v2 = _eval_ijk(self.f, self.origin, cell, (B * g[:, None, :] + C2).reshape(-1, 3))
+        b2, q2 = np.nonzero(np.abs(v2.reshape(n, 8)) <= _reach(lipschitz, 4 * cell))
+        r1 = (2 * CORNERS[q2][:, None, :] + CORNERS[None, :, :]).reshape(-1, 3)
+        b1 = np.repeat(b2, 8)
+        v1 = _eval_ijk(self.f, self.origin, cell, B * g[b1] + 2 * r1 + 1)
+        val1 = np.full((n, 4, 4, 4), np.nan)
+        val1[b1, r1[:, 0], r1[:, 1], r1[:, 2]] = v1
+        values[(np.repeat(own, 8), *np.tile(C2, (n, 1)).T)] = v2
+        values[(own[b1], *(2 * r1 + 1).T)] = v1
+        return val1
+
+    def sample(self, corners: np.ndarray) -> np.ndarray:
+        """The field at corner numbers (slot * 512 + local corner), chunk by chunk."""
+        out = np.empty(len(corners))
+        for i in range(0, len(corners), CHUNK):
+            c = corners[i : i + CHUNK]
+            out[i : i + CHUNK] = _check(self.f(self.origin + self.corner_ijk(c) * self.cell))
+        return out
+
+    def step(self, corner: np.ndarray, axis: np.ndarray, by: int) -> np.ndarray:
+        """The corners one step (``by`` = 1 or -1) along ``axis`` from ``corner``; -1 where
+        that corner has no slot."""
+        if not hasattr(self, "_next"):
+            unit = np.array([-1, 1])[None, :, None, None] * np.eye(3, dtype=np.int64)
+            there = self.base[:, None, None, :] // B + unit
+            key = _key(there, self.dims)
+            at = np.minimum(np.searchsorted(self.touched, key), len(self.touched) - 1)
+            self._next = np.where(self.touched[at] == key, at, -1)  # (ns, 2, 3)
+        slot, loc = corner >> 9, corner & (B3 - 1)
+        bit = 6 - 3 * axis
+        coord = ((loc >> bit) & 7) + by
+        wrap = (coord < 0) | (coord >= B)
+        out = np.where(wrap, 0, corner + np.left_shift(by, bit))
+        if wrap.any():
+            nxt = self._next[slot[wrap], (by + 1) // 2, axis[wrap]]
+            moved = nxt * B3 + (loc[wrap] & ~(7 << bit[wrap])) + ((coord[wrap] & 7) << bit[wrap])
+            out[wrap] = np.where(nxt >= 0, moved, -1)
+        return out
+
+    def corner_ijk(self, corner: np.ndarray) -> np.ndarray:
+        """Global (i, j, k) of corner numbers."""
+        loc = corner & (B3 - 1)
+        ijk = self.base[corner >> 9]
+        ijk[:, 0] += loc >> 6
+        ijk[:, 1] += (loc >> 3) & 7
+        ijk[:, 2] += loc & 7
+        return ijk
+
+    def mixed_cells(self, s: int, e: int):
+        """The cells with a sign change in kept blocks ``s:e``: flat indices (block * 512 +
+        local cell) and their cases."""
+        n, nbr = e - s, self.nbr[s:e]
+        ins9 = np.empty((n, B + 1, B + 1, B + 1), dtype=bool)
+        for w, (here, there) in enumerate(REGIONS):
+            ins9[here] = self.inside[(nbr[:, w], *there)]
+        ins9 = ins9.view(np.uint8)
+        case = np.zeros((n, B, B, B), dtype=np.uint8)
+        for c, (x, y, z) in enumerate(CORNERS):
+            case |= ins9[:, x : x + B, y : y + B, z : z + B] << np.uint8(c)
+        up = np.broadcast_to(self.kept1[s:e, :, None, :, None, :, None], (n, 4, 2, 4, 2, 4, 2))
+        cells = np.flatnonzero(up.reshape(n, B, B, B) & (case != 0) & (case != 255))
+        return cells + s * B3, case.reshape(-1)[cells]
+
+
+def _infer(val1: np.ndarray, step: float):
+    """Which of a block's 8^3 corners have a sign known from the sampled centres of the
+    cells of 2 (``val1 (nk, 4, 4, 4)``, NaN where not sampled), and whether it is negative.
+
+    A corner with ``e`` even coordinates is ``step * sqrt(e)`` from each of its ``2^e``
+    nearest centres (``step`` is the Lipschitz bound times the cell).
+    """
+    nk = len(val1)
+    pad = np.pad(val1, ((0, 0), (1, 0), (1, 0), (1, 0)), constant_values=np.nan)
+    inferred = np.zeros((nk, B, B, B), dtype=bool)
+    negative = np.zeros((nk, B, B, B), dtype=bool)
+    with np.errstate(invalid="ignore"):
+        for parity in CORNERS:
+            # an odd coordinate 2a + 1 is centre a's; an even one 2a lies between a - 1 and a
+            choices = [[slice(1, 5)] if p else [slice(1, 5), slice(0, 4)] for p in parity]
+            hi = lo = None
+            for view in itertools.product(*choices):
+                v = pad[(slice(None), *view)]
+                hi = v if hi is None else np.fmax(hi, v)
+                lo = v if lo is None else np.fmin(lo, v)
+            reach = step * np.sqrt(3 - int(parity.sum())) * (1 + 1e-9)
+            pos, neg = hi > reach, lo < -reach
+            at = (slice(None), *(slice(int(p), B, 2) for p in parity))
+            inferred[at] = pos | neg
+            negative[at] = neg & ~pos
+    return inferred, negative
+
+
+def _edge_tables():
+    """Per (local cell, cube edge): the neighbour code (CORNERS index) of the block owning
+    the edge's start, and ``local corner * 3 + axis`` there; the same for the end corner."""
+    loc = np.arange(B3)
+    cellxyz = np.stack([loc >> 6, (loc >> 3) & 7, loc & 7], axis=-1)
+    start = cellxyz[:, None, :] + CORNERS[EDGE_START][None, :, :]  # (512, 12, 3)
+    w = (start[..., 0] >> 3) << 2 | (start[..., 1] >> 3) << 1 | (start[..., 2] >> 3)
+    s = start & (B - 1)
+    lin = (s[..., 0] << 6) | (s[..., 1] << 3) | s[..., 2]
+    place = lin * 3 + EDGE_AXIS[None, :]
+    return w.reshape(-1).astype(np.int32), place.reshape(-1).astype(np.int32)
+
+
+EDGE_OWNER, EDGE_PLACE = _edge_tables()  # indexed by local cell * 12 + edge
+
+
+def crossing_cells(f: Fn, lo, hi, cell: float, lipschitz: float = 1.0, max_cells=50_000_000):
+    """Global (i, j, k) of the finest cells :func:`mesh_field` polygonizes (those with a
+    sign change among their corners), on the grid of :func:`plan_grid`."""
+    lat = _Lattice(f, lo, hi, cell, lipschitz, max_cells)
+    out = [np.zeros((0, 3), np.int64)]
+    for s in range(0, len(lat.blocks), GROUP):
+        cells, _ = lat.mixed_cells(s, min(s + GROUP, len(lat.blocks)))
+        loc = cells & (B3 - 1)
+        local = np.stack([loc >> 6, (loc >> 3) & 7, loc & 7], axis=-1)
+        out.append(lat.blocks[cells >> 9] * B + local)
+    return np.concatenate(out)
+
+
+def _edge_hashes(cells: np.ndarray, case: np.ndarray, nbr: np.ndarray) -> np.ndarray:
+    """The triangles of mixed ``cells`` (flat block * 512 + local indices) as ``(t, 3)``
+    edge hashes: owner slot * 1536 + owner's local corner * 3 + axis."""
+    count = TRI_COUNT[case]
+    first = np.cumsum(count) - count
+    n_tri = int(count.sum())
+    which = np.repeat(np.arange(len(cells), dtype=np.int32), count)
+    edges = TRI_EDGES[case[which], np.arange(n_tri) - first[which]]  # (t, 3) in 0..11
+    cw = cells[which]
+    key = ((cw & (B3 - 1)) * 12)[:, None] + edges
+    owner = nbr[(cw >> 9)[:, None], EDGE_OWNER[key]]
+    return owner * (3 * B3) + EDGE_PLACE[key]
 
 
 def mesh_field(
@@ -175,7 +376,8 @@ def mesh_field(
     f : callable (n, 3) -> (n,)
         The field, negative inside; ``lipschitz`` bounds its gradient (1 for a distance).
         For a closed surface the field must be positive on the box's boundary (intersect
-        an unbounded field with a box first).
+        an unbounded field with a box first). It is called on at most 65,536 points at a
+        time.
     lo, hi : (3,) float
         The box to mesh.
     cell : float
@@ -183,7 +385,8 @@ def mesh_field(
     max_cells : int
         Refuse (:class:`BudgetExceeded`) before making more cells or corners than this.
     root_steps : int
-        Regula falsi steps per vertex after the linear guess (skipped where converged).
+        Samples of the field per vertex at most before bisection takes over (most take
+        one, see :func:`_roots`); 0 is linear interpolation.
 
     Returns
     -------
@@ -193,123 +396,129 @@ def mesh_field(
     """
     if not (cell > 0 and np.isfinite(cell)):
         raise ValueError(f"cell must be > 0, got {cell:g}")
-    origin, levels, blocks = plan_grid(lo, hi, cell)
-    cells = active_cells(f, origin, levels, blocks, cell, lipschitz, max_cells)
-    if not len(cells):
-        return np.zeros((0, 3)), np.zeros((0, 3), np.int64)
-    corner, pts = _number_corners(cells, blocks * (1 << levels), max_cells)
-    val = _check(f(origin + pts * cell))
-    inside = val < 0
-    ins = inside[corner]  # (m, 8), corners in CORNERS order
-    mixed = ins.any(axis=1) & ~ins.all(axis=1)
-    corner = corner[mixed]
-    ins = ins[mixed]
-    # per tetrahedron: its sign case and up to two triangles of (corner, direction) edges
-    bits = ins.astype(np.int8)
-    case = sum(bits[:, TET_CORNERS[:, k]] << k for k in range(4))  # (m, 6)
-    cell_of, tet = np.nonzero((case != 0) & (case != 15))  # the tetrahedra the surface cuts
-    table = TRI_TABLE[tet, case[cell_of, tet]]  # (c, 2, 3, 2)
-    second = table[:, 1, 0, 0] >= 0  # a quad: two triangles
-    tri = np.concatenate([table[:, 0], table[second, 1]])  # (t, 3, 2): start corner, direction
-    cell_of = np.concatenate([cell_of, cell_of[second]])
-    start = corner[cell_of[:, None], tri[..., 0]]  # (t, 3) corner numbers
-    end = corner[cell_of[:, None], tri[..., 0] + tri[..., 1] + 1]  # bit codes add: s & d = 0
-    # one vertex per (start corner, direction): a perfect hash, no sort
-    edge = start * 7 + tri[..., 1]
-    used = np.zeros(len(pts) * 7, dtype=bool)
-    used[edge] = True
-    number = np.cumsum(used) - 1
-    tri_v = number[edge]
-    n_v = int(used.sum())
-    ia = np.empty(n_v, dtype=np.int64)
-    ib = np.empty(n_v, dtype=np.int64)
-    ia[tri_v] = start
-    ib[tri_v] = end
-    pa = origin + pts[ia] * cell
-    pb = origin + pts[ib] * cell
-    verts = _roots(f, pa, pb, val[ia], val[ib], root_steps, cell)
-    return verts, tri_v
+    empty = np.zeros((0, 3)), np.zeros((0, 3), np.int64)
+    lat = _Lattice(f, lo, hi, cell, lipschitz, max_cells)
+    nk = len(lat.blocks)
+    if not nk:
+        return empty
+    ns = len(lat.touched)
+    idx = np.int32 if ns * 3 * B3 < 2**31 else np.int64
+    nbr = lat.nbr.astype(idx)
+    used = np.zeros(ns * 3 * B3, dtype=bool)
+    hashes = []
+    for s in range(0, nk, GROUP):
+        cells, case = lat.mixed_cells(s, min(s + GROUP, nk))
+        edge = _edge_hashes(cells.astype(idx), case, nbr)  # a perfect hash of the edge
+        used[edge] = True
+        hashes.append(edge)
+    ue = np.flatnonzero(used)
+    if not len(ue):
+        return empty
+    number = np.empty(ns * 3 * B3, dtype=np.int64)  # pages never written are never made
+    number[ue] = np.arange(len(ue))
+    tri = np.concatenate([number[h] for h in hashes])
+    del used, number, hashes
+    verts = np.empty((len(ue), 3))
+    for i in range(0, len(ue), CHUNK):
+        v = ue[i : i + CHUNK]
+        slot, rem = v // (3 * B3), v % (3 * B3)
+        start, axis = slot * B3 + rem // 3, rem % 3
+        end = lat.step(start, axis, 1)  # an edge's end is always in a slot
+        before, after = lat.step(start, axis, -1), lat.step(end, axis, 1)
+        ends = np.concatenate([start, end])
+        missing = np.unique(ends[np.isnan(lat.values[ends])])
+        if len(missing):  # an end whose sign was inferred: sample it now
+            lat.values[missing] = lat.sample(missing)
+        fa, fb = lat.values[start], lat.values[end]
+        fm = np.where(before >= 0, lat.values[before], np.nan)
+        fq = np.where(after >= 0, lat.values[after], np.nan)
+        pa = lat.origin + lat.corner_ijk(start) * cell
+        pb = lat.origin + lat.corner_ijk(end) * cell
+        guess = _guess(fm, fa, fb, fq) if root_steps else None
+        verts[i : i + CHUNK] = _roots(f, pa, pb, fa, fb, root_steps, cell, guess)
+    return verts, tri.reshape(-1, 3)
 
 
-def _roots(f: Fn, pa, pb, fa, fb, steps: int, cell: float) -> np.ndarray:
-    """Points where ``f`` changes sign on segments ``pa -> pb`` (Illinois regula falsi).
+def _guess(fm, fa, fb, fq) -> np.ndarray:
+    """First guesses of the roots on edges (0, 1) from the values at -1, 0, 1, 2 along
+    them (``fm``, ``fq`` NaN where unknown): Newton's method on the cubic (or quadratic)
+    through the known ones, from the linear guess; linear where neither is known."""
+    c1, c2, c3 = fb - fa, np.zeros_like(fa), np.zeros_like(fa)
+    has_m, has_q = ~np.isnan(fm), ~np.isnan(fq)
+    both, m, q = has_m & has_q, has_m & ~has_q, ~has_m & has_q
+    c1 = np.where(both, -fm / 3 - fa / 2 + fb - fq / 6, c1)
+    c2 = np.where(both, fm / 2 - fa + fb / 2, c2)
+    c3 = np.where(both, -fm / 6 + fa / 2 - fb / 2 + fq / 6, c3)
+    c1 = np.where(m, (fb - fm) / 2, np.where(q, (-3 * fa + 4 * fb - fq) / 2, c1))
+    c2 = np.where(m, (fb - 2 * fa + fm) / 2, np.where(q, (fa - 2 * fb + fq) / 2, c2))
+    den = fa - fb
+    lin = np.divide(fa, den, out=np.full(len(fa), 0.5), where=den != 0)
+    t = lin
+    with np.errstate(divide="ignore", invalid="ignore"):
+        for _ in range(4):
+            p = fa + t * (c1 + t * (c2 + t * c3))
+            dp = c1 + t * (2 * c2 + 3 * t * c3)
+            t = np.clip(t - p / dp, 0.0, 1.0)
+    return np.where(np.isfinite(t), t, lin)
 
-    ``fa`` and ``fb`` have opposite signs (one is < 0, the other >= 0). Points are kept
-    ``END_GAP`` off the ends, so edges meeting at a corner on the surface give distinct
-    vertices (and no triangle collapses to a point in a file of float32 coordinates).
+
+def _roots(f: Fn, pa, pb, fa, fb, steps: int, cell: float, guess=None) -> np.ndarray:
+    """Points where ``f`` changes sign on segments ``pa -> pb``.
+
+    ``fa`` and ``fb`` have opposite signs (one is < 0, the other >= 0). From the linear
+    guess, each step samples the field and moves to the inverse quadratic interpolant's
+    root through the bracket's ends and the new sample (exact for a quadratic along the
+    edge, Brent 1973), or to the regula falsi point of the shrunk bracket where that root
+    falls outside it. A vertex whose sample is within ``CLOSE`` of the edge's change of
+    zero takes its next step without sampling it (on a smooth field that step's error is
+    of higher order), so most vertices cost one sample. What is left after ``steps``
+    (a kink of a sharp union on the edge) is bisected. Points are kept ``END_GAP`` off
+    the ends, so edges meeting at a corner on the surface give distinct vertices (and no
+    triangle collapses to a point in a file of float32 coordinates).
     """
-    lo_t = np.zeros(len(pa))
-    hi_t = np.ones(len(pa))
+    n = len(pa)
+    lo_t, hi_t = np.zeros(n), np.ones(n)
     flo, fhi = fa.copy(), fb.copy()
-    t = np.clip(flo / (flo - fhi), END_GAP, 1 - END_GAP)
+    den = flo - fhi
+    span = np.abs(den)  # the field's change along the edge: the scale of its slope
+    if guess is None:
+        guess = np.divide(flo, den, out=np.full(n, 0.5), where=den != 0)
+    t = np.clip(guess, END_GAP, 1 - END_GAP)
     tol = 1e-4 * cell
-    idx = np.arange(len(pa))
-    side = np.zeros(len(pa), dtype=np.int8)  # which end was kept last (Illinois)
+    idx = np.arange(n)
+    d = pb - pa
     for _ in range(steps):
-        p = pa[idx] + t[idx, None] * (pb[idx] - pa[idx])
-        fp = _check(f(p))
-        conv = np.abs(fp) <= tol
-        same_lo = (fp < 0) == (flo[idx] < 0)
-        # replace the end with the same sign; halve the other end's value if it was kept
-        # twice in a row (the Illinois rule, superlinear and never stuck on one side)
-        j = idx[same_lo]
-        lo_t[j], flo[j] = t[j], fp[same_lo]
-        fhi[j] = np.where(side[j] == 1, fhi[j] / 2.0, fhi[j])
-        side[j] = 1
-        k = idx[~same_lo]
-        hi_t[k], fhi[k] = t[k], fp[~same_lo]
-        flo[k] = np.where(side[k] == -1, flo[k] / 2.0, flo[k])
-        side[k] = -1
-        left = ~conv
-        idx = idx[left]
+        c = t[idx]
+        fc = _eval(f, pa[idx] + c[:, None] * d[idx])
+        a, b, f_a, f_b = lo_t[idx], hi_t[idx], flo[idx], fhi[idx]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            iqi = (
+                a * f_b * fc / ((f_a - f_b) * (f_a - fc))
+                + b * f_a * fc / ((f_b - f_a) * (f_b - fc))
+                + c * f_a * f_b / ((fc - f_a) * (fc - f_b))
+            )
+        low = (fc < 0) == (f_a < 0)  # the sample replaces the end of its own sign
+        a, f_a = np.where(low, c, a), np.where(low, fc, f_a)
+        b, f_b = np.where(low, b, c), np.where(low, f_b, fc)
+        lo_t[idx], flo[idx], hi_t[idx], fhi[idx] = a, f_a, b, f_b
+        den = f_a - f_b
+        rf = a + np.divide(f_a, den, out=np.full(len(a), 0.5), where=den != 0) * (b - a)
+        inside = np.isfinite(iqi) & (iqi > a) & (iqi < b)
+        conv = np.abs(fc) <= tol
+        step = np.clip(np.where(inside, iqi, rf), END_GAP, 1 - END_GAP)
+        t[idx] = np.where(conv, c, step)
+        idx = idx[~conv & (np.abs(fc) > CLOSE * span[idx])]
         if not len(idx):
             break
-        den = flo[idx] - fhi[idx]
-        frac = np.divide(flo[idx], den, out=np.full(len(idx), 0.5), where=den != 0)
-        t[idx] = np.clip(lo_t[idx] + frac * (hi_t[idx] - lo_t[idx]), END_GAP, 1 - END_GAP)
-    # what regula falsi left (a kink of a sharp union on the edge converges only linearly):
+    # what is left (a kink of a sharp union on the edge converges only linearly):
     # bisection of the bracket, which halves it every step whatever the field's shape
     for _ in range(16 if steps else 0):
         if not len(idx):
             break
         t[idx] = np.clip((lo_t[idx] + hi_t[idx]) / 2.0, END_GAP, 1 - END_GAP)
-        fp = _check(f(pa[idx] + t[idx, None] * (pb[idx] - pa[idx])))
+        fp = _eval(f, pa[idx] + t[idx, None] * d[idx])
         low = (fp < 0) == (flo[idx] < 0)
         lo_t[idx[low]], flo[idx[low]] = t[idx[low]], fp[low]
         hi_t[idx[~low]], fhi[idx[~low]] = t[idx[~low]], fp[~low]
         idx = idx[np.abs(fp) > tol]
-    return pa + t[:, None] * (pb - pa)
-
-
-BRICK = 8  # corners are hashed to (brick, position in the brick): 8 x 8 x 8 per brick
-
-
-def _number_corners(cells: np.ndarray, n: np.ndarray, max_cells: int):
-    """Number the distinct corners of ``cells`` without sorting.
-
-    A corner (i, j, k) of the ``n``-cell grid lies in brick ``(i, j, k) // 8``; the bricks
-    that hold any corner get a slot (a dense table over the bricks, 1/512 of the grid),
-    and each slot 512 places, so ``slot * 512 + place`` is a perfect hash of the corner:
-    marking the used places and counting them numbers the corners in O(cells).
-
-    Returns ``corner (m, 8)``, each cell's corner numbers, and ``ijk (c, 3)`` of each corner.
-    """
-    nb = n // BRICK + 1
-    cc = (cells[:, None, :] + CORNERS[None, :, :]).reshape(-1, 3)
-    x, y, z = cc[:, 0], cc[:, 1], cc[:, 2]  # (integer matmul has no fast path in numpy)
-    brick = ((x >> 3) * nb[1] + (y >> 3)) * nb[2] + (z >> 3)
-    place = ((x & 7) << 6) | ((y & 7) << 3) | (z & 7)
-    marked = np.zeros(int(np.prod(nb)), dtype=bool)
-    marked[brick] = True
-    n_slots = int(marked.sum())
-    if n_slots * BRICK**3 > 4 * max_cells:
-        raise BudgetExceeded(n_slots * BRICK**3, "corner slots")
-    slot = np.cumsum(marked, dtype=np.int64) - 1
-    hashed = slot[brick] * BRICK**3 + place
-    used = np.zeros(n_slots * BRICK**3, dtype=bool)
-    used[hashed] = True
-    number = np.cumsum(used, dtype=np.int64) - 1
-    corner = number[hashed]
-    ijk = np.empty((int(number[-1]) + 1, 3), dtype=np.int64)
-    ijk[corner] = cc
-    return corner.reshape(-1, 8), ijk
+    return pa + t[:, None] * d
