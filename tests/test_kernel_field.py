@@ -261,3 +261,53 @@ def test_pseudonormal_sign_on_a_closed_mesh_agrees_with_the_winding_number():
     assert ((d < 0) == (w > 0.5)).all()
     np.testing.assert_allclose(np.abs(d), meshdist.Nearest(m.triangles).distance(p))
     assert not meshdist.SignedDistance(m.vertices, m.faces[1:]).closed
+
+
+def _brute_nearest(p, corners):
+    if corners.shape[1] == 2:
+        d = [meshdist.point_segment_distance(p, s[0], s[1]) for s in corners]
+    else:
+        d = [meshdist.point_triangle_distance(p, t[0], t[1], t[2]) for t in corners]
+    return np.stack(d, 1).min(axis=1)
+
+
+@pytest.mark.parametrize("k", [2, 3])
+def test_nearest_is_exact_on_a_soup_of_all_sizes_near_and_far(k):
+    # sizes over six decades (several size classes), degenerate ones, duplicates, and
+    # points on, near and far from them: every distance is the brute force's, and the
+    # primitive it names is at that distance
+    rng = np.random.default_rng(11 + k)
+    n = 600
+    size = 10.0 ** rng.uniform(-4, 2, n)
+    corners = rng.uniform(-5, 5, (n, 1, 3)) + rng.normal(size=(n, k, 3)) * size[:, None, None]
+    corners[:10, 1:] = corners[:10, :1]  # points
+    corners[10:20, -1] = corners[10:20, 0] + 0.5 * (corners[10:20, 1] - corners[10:20, 0])
+    corners[20:30] = corners[30:40]  # duplicates
+    p = np.concatenate(
+        [
+            rng.uniform(-40, 40, (300, 3)),
+            corners[rng.integers(0, n, 300), 0] + rng.normal(0, 1e-3, (300, 3)),
+            corners[:50].mean(axis=1),
+        ]
+    )
+    near = meshdist.Nearest(corners)
+    assert len(near.classes) > 2
+    d, prim = near.nearest(p)
+    np.testing.assert_allclose(d, _brute_nearest(p, corners), rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(near._exact(p, prim), d, rtol=1e-12, atol=1e-12)
+
+
+def test_nearest_on_a_fine_surface_far_and_near_matches_trimesh():
+    # a fine torus (the clusters' cylinders carry the far points) against trimesh
+    m = trimesh.creation.torus(1.0, 0.4, major_sections=96, minor_sections=48)
+    rng = np.random.default_rng(8)
+    i = rng.integers(0, len(m.faces), 400)
+    p = np.concatenate(
+        [
+            rng.uniform(-3, 3, (400, 3)),
+            m.triangles_center[i] + m.face_normals[i] * rng.uniform(-0.3, 0.3, (400, 1)),
+        ]
+    )
+    d = meshdist.Nearest(m.triangles).distance(p)
+    _, ref, _ = trimesh.proximity.closest_point(m, p)
+    np.testing.assert_allclose(d, ref, atol=1e-9)

@@ -3,9 +3,10 @@
 - ``sdf``: exact distances to spheres, boxes (rounded), cylinders, tori; polynomial smooth
   min/max (Lipschitz-preserving blends); TPMS sheets (gyroid, Schwarz P, diamond) of even
   wall thickness;
-- ``meshdist``: exact distance to a triangle mesh (candidates pruned by a k-d tree of
-  triangle centres), its sign by the generalized winding number (a Barnes-Hut tree of
-  dipoles, Barill et al. 2018), and the distance to polylines (tubes round curves);
+- ``meshdist``: exact distance to a triangle mesh (candidates from k-d trees of triangle
+  centres and of clusters, pruned by disc and cylinder bounds), its sign by the
+  angle-weighted pseudonormal on a closed mesh or the generalized winding number (a
+  Barnes-Hut tree of dipoles, Barill et al. 2018), and the distance to polylines;
 - ``mesher``: adaptive meshing of the zero set: octree culling by the Lipschitz reach,
   marching tetrahedra on the finest cells, vertices by regula falsi on the field.
 

@@ -4,11 +4,12 @@
   triangles, pair by pair (the plane's foot where it falls inside the triangle, else the
   nearest of the three edges), degenerate triangles included.
 * :class:`Nearest`: the distance from many points to the nearest of many primitives
-  (triangles or segments), exact, by a bounding-box hierarchy over the primitives in
-  Morton order (a linear BVH: leaves of 2, nodes of 8), traversed for all points at once:
-  the primitive with the nearest centre (scipy's cKDTree) gives each point an upper
-  bound, then every (point, node) pair whose box is nearer than that bound is opened,
-  level by level, down to the exact distances.
+  (triangles or segments), exact: each primitive's disc (or ball) bounds its distance
+  from below, so only candidates whose bound beats the best distance so far get an exact
+  one; the candidates come from scipy's cKDTree, first the primitive with the nearest
+  centre, then clusters of neighbouring primitives (one cube of a grid each) bounded by
+  thin cylinders along the surface, nearest first, until no cluster left can hold a
+  nearer primitive. All points go through each pass at once.
 * :class:`WindingNumber`: the generalized winding number of a triangle soup (Jacobson,
   Kavan & Sorkine-Hornung 2013), fast by a Barnes-Hut tree of area-vector dipoles (Barill,
   Dickson, Schmidt, Levin & Jacobson, "Fast winding numbers for soups and clouds", 2018):
@@ -28,7 +29,7 @@ __all__ = [
     "point_triangle_distance",
 ]
 
-CHUNK = 8192  # points per batch: bounds the (point, candidate) pairs held at once
+CHUNK = 8192  # winding-number points per batch: bounds the (point, node) pairs held at once
 
 
 def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -38,8 +39,9 @@ def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 def point_segment_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Distances from points ``p`` to segments ``a -> b`` (all (..., 3), broadcast)."""
     ab = b - a
-    den = _dot(ab, ab)
-    t = np.clip(np.divide(_dot(p - a, ab), den, out=np.zeros(den.shape), where=den > 0), 0, 1)
+    num = _dot(p - a, ab)
+    den = np.broadcast_to(_dot(ab, ab), num.shape)
+    t = np.clip(np.divide(num, den, out=np.zeros(num.shape), where=den > 0), 0, 1)
     return np.linalg.norm(p - (a + t[..., None] * ab), axis=-1)
 
 
@@ -144,12 +146,98 @@ class _Hierarchy:
         return np.broadcast_to(pi[:, None], items.shape)[ok], items[ok]
 
 
-def _box_distance(p: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-    return np.linalg.norm(np.maximum(np.maximum(lo - p, p - hi), 0.0), axis=1)
+class _Class:
+    """Primitives of about one size (radii within :attr:`Nearest.SPREAD`), and clusters.
+
+    ``tree`` is a k-d tree of the primitives' centres. A cluster holds the primitives
+    whose centres fall in one cube of a grid (sized for about ``CLUSTER`` of them where
+    the surface crosses a cube, so every cluster is compact); ``ctree`` is a k-d tree of
+    the clusters' middles, and each cluster has a bounding cylinder: a slab of
+    half-thickness ``thick`` across the unit ``axis`` (its primitives' mean normal) cut
+    by the ball of radius ``reach`` round ``middle``. The primitives are stored cluster
+    by cluster (``start``, ``count``), each as one row of ``disc``: centre, unit normal
+    (0 for a segment or a sliver) and radius.
+    """
+
+    CLUSTER = 12
+
+    def __init__(self, idx, centre, normal, radius, corners, area):
+        from scipy.spatial import cKDTree
+
+        q = centre[idx]
+        cube = float(np.sqrt(self.CLUSTER * max(area[idx].mean(), 0.0)))
+        extent = float(np.ptp(q, axis=0).max())
+        cube = max(cube, 2.0 * float(radius[idx].max()), 1e-6 * extent, 1e-300)
+        ijk = np.floor((q - q.min(axis=0)) / cube).astype(np.int64)
+        dims = ijk.max(axis=0) + 1
+        key = (ijk[:, 0] * dims[1] + ijk[:, 1]) * dims[2] + ijk[:, 2]
+        _, g, count = np.unique(key, return_inverse=True, return_counts=True)
+        g = g.reshape(-1)
+        o = np.argsort(g, kind="stable")
+        idx, g = idx[o], g[o]
+        self.idx = idx
+        self.disc = np.ascontiguousarray(np.column_stack([centre[idx], normal[idx], radius[idx]]))
+        self.r_max = float(radius[idx].max())
+        self.tree = cKDTree(centre[idx])
+        n = len(count)
+        self.n_clusters = n
+        self.count = count
+        self.start = np.cumsum(count) - count
+        c = corners[idx]  # (m, k, 3)
+        blo = np.full((n, 3), np.inf)
+        bhi = np.full((n, 3), -np.inf)
+        np.minimum.at(blo, g, c.min(axis=1))
+        np.maximum.at(bhi, g, c.max(axis=1))
+        middle = (blo + bhi) / 2.0
+        rel = c - middle[g][:, None, :]
+        reach = np.zeros(n)
+        np.maximum.at(reach, g, np.linalg.norm(rel, axis=2).max(axis=1))
+        w = area[idx]
+        axis = np.stack([np.bincount(g, normal[idx, k] * w, n) for k in range(3)], 1)
+        la = np.linalg.norm(axis, axis=1, keepdims=True)
+        axis = np.where(la > 0, axis / np.maximum(la, 1e-300), 0.0)
+        thick = np.zeros(n)
+        np.maximum.at(thick, g, np.abs(np.einsum("mki,mi->mk", rel, axis[g])).max(axis=1))
+        self.cyl = np.ascontiguousarray(np.column_stack([middle, axis, thick, reach]))
+        self.reach_max = float(reach.max())
+        self.ctree = cKDTree(middle)
+
+
+def _disc_bound2(q: np.ndarray, disc: np.ndarray, dist2: np.ndarray | None = None) -> np.ndarray:
+    """Squared lower bounds of the distance from points ``q`` (..., 3) to the primitives of
+    rows ``disc`` (..., 7): each lies in the disc of its radius round its centre, in the
+    plane of its normal (the ball, where the normal is 0)."""
+    diff = q - disc[..., :3]
+    h = np.abs(_dot(diff, disc[..., 3:6]))
+    if dist2 is None:
+        dist2 = _dot(diff, diff)
+    rho = np.sqrt(np.maximum(dist2 - h * h, 0.0))
+    return h * h + np.maximum(rho - disc[..., 6], 0.0) ** 2
+
+
+def _cylinder_bound2(q: np.ndarray, cyl: np.ndarray, dist: np.ndarray) -> np.ndarray:
+    """Squared lower bounds of the distance from points ``q`` (..., 3) to clusters of rows
+    ``cyl`` (..., 8): the slab ``|axis . (x - middle)| <= thick`` within ``reach`` of
+    the middle, ``dist`` from it."""
+    h = np.abs(_dot(q - cyl[..., :3], cyl[..., 3:6]))
+    rho = np.sqrt(np.maximum(dist * dist - h * h, 0.0))
+    return np.maximum(h - cyl[..., 6], 0.0) ** 2 + np.maximum(rho - cyl[..., 7], 0.0) ** 2
 
 
 class Nearest:
     """Exact distance from points to the nearest of a set of primitives.
+
+    Every primitive lies in the disc of its circumradius round its centre, in its plane
+    (a segment or a sliver: in the ball), which bounds its distance from below; only
+    candidates whose bound is below the best exact distance so far get their exact
+    distance (Ericson's closest point). On scipy's cKDTree: the primitive with the
+    nearest centre gives each point its first bound; then clusters of neighbouring
+    primitives (one cube of a grid each), bounded by cylinders (thin slabs along the
+    surface, tight across it, where balls are weak), are taken nearest first, four times
+    more each pass, until the nearest cluster not looked at is farther than the best
+    distance plus the largest cluster radius: every primitive left is then farther still.
+    So that one huge triangle among small ones loosens no bound, the primitives are split
+    by size into classes whose radii differ by less than 4x, each with its own trees.
 
     Parameters
     ----------
@@ -157,38 +245,65 @@ class Nearest:
         Each primitive's corners: k = 3 for triangles, k = 2 for segments.
     """
 
+    K_CLUSTERS = 24  # the first pass's clusters: enough for most points near a surface
+    PAIRS = 1 << 19  # (point, candidate) pairs held at once
+    SPREAD = 4.0
+
     def __init__(self, corners: np.ndarray):
         c = np.asarray(corners, dtype=np.float64)
         if c.ndim != 3 or c.shape[1] not in (2, 3) or c.shape[2] != 3 or not len(c):
             raise ValueError("need at least one triangle or segment")
-        from scipy.spatial import cKDTree
-
-        self.tree = _Hierarchy(c)
-        c = self.tree.corners
-        self.centres = cKDTree(c.mean(axis=1))
-        self.a = c[:, 0]
+        if not np.isfinite(c).all():
+            raise ValueError("the corners are not all finite")
+        self.a = np.ascontiguousarray(c[:, 0])
         self.e1 = c[:, 1] - c[:, 0]
         self.e2 = c[:, 2] - c[:, 0] if c.shape[1] == 3 else None
         self.aa = _dot(self.e1, self.e1)
+        centre = c.mean(axis=1)
+        radius = np.linalg.norm(c - centre[:, None, :], axis=2).max(axis=1)
         if self.e2 is not None:
             self.ab = _dot(self.e1, self.e2)
             self.bb = _dot(self.e2, self.e2)
+            n = np.cross(self.e1, self.e2)
+            ln = np.linalg.norm(n, axis=1, keepdims=True)
+            area = 0.5 * ln[:, 0]
+            # a sliver's normal is noise: its bound falls back to the ball's
+            normal = np.where(ln > 1e-9 * radius[:, None] ** 2, n / np.maximum(ln, 1e-300), 0.0)
+        else:
+            area = radius**2
+            normal = np.zeros_like(centre)
+        parts = [self.a, self.e1] + ([self.aa[:, None]] if self.e2 is None else [self.e2])
+        if self.e2 is not None:
+            parts += [self.aa[:, None], self.ab[:, None], self.bb[:, None]]
+        self.rows = np.ascontiguousarray(np.hstack(parts))
+        order = np.argsort(-radius, kind="stable")
+        rs = radius[order]
+        self.classes: list[_Class] = []
+        s = 0
+        while s < len(order):
+            e = s + int(np.searchsorted(-rs[s:], -rs[s] / self.SPREAD, side="right"))
+            e = max(e, s + 1) if rs[s] > 0 else len(order)
+            self.classes.append(_Class(order[s:e], centre, normal, radius, c, area))
+            s = e
+        # the class with most primitives first: it gives most points their bound
+        self.classes.sort(key=lambda cl: -len(cl.idx))
 
     def _exact(self, p: np.ndarray, prim: np.ndarray) -> np.ndarray:
-        """Distances from points ``p`` (n, 3) to sorted primitives ``prim`` (n,) -> (n,)."""
-        ap = p - self.a[prim]
-        e1 = self.e1[prim]
+        """Distances from points ``p`` (n, 3) to primitives ``prim`` (n,) -> (n,)."""
+        row = np.take(self.rows, prim, axis=0)  # one gather: a, e1, (e2), aa, (ab, bb)
+        ap = p - row[:, 0:3]
+        e1 = row[:, 3:6]
         d1 = _dot(e1, ap)
         if self.e2 is None:
-            aa = self.aa[prim]
+            aa = row[:, 6]
             t = np.clip(np.divide(d1, aa, out=np.zeros_like(d1), where=aa > 0), 0.0, 1.0)
             return np.linalg.norm(ap - t[:, None] * e1, axis=1)
-        e2 = self.e2[prim]
-        v, w = _triangle_coefficients(d1, _dot(e2, ap), self.aa[prim], self.ab[prim], self.bb[prim])
+        e2 = row[:, 6:9]
+        v, w = _triangle_coefficients(d1, _dot(e2, ap), row[:, 9], row[:, 10], row[:, 11])
         bad = ~(np.isfinite(v) & np.isfinite(w))
         out = np.linalg.norm(ap - v[:, None] * e1 - w[:, None] * e2, axis=1)
         if bad.any():
-            a = self.a[prim][bad]
+            a = row[bad, 0:3]
             out[bad] = point_triangle_distance(p[bad], a, a + e1[bad], a + e2[bad])
         return out
 
@@ -197,38 +312,60 @@ class Nearest:
         return self.nearest(points)[0]
 
     def nearest(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(n,) distances and (n,) the nearest primitive of each point (in ``tree`` order)."""
+        """(n,) distances and (n,) the index of each point's nearest primitive."""
         p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
-        dist = np.empty(len(p))
-        prim = np.empty(len(p), dtype=np.int64)
-        for s in range(0, len(p), CHUNK):
-            dist[s : s + CHUNK], prim[s : s + CHUNK] = self._chunk(p[s : s + CHUNK])
-        return dist, prim
+        best = np.full(len(p), np.inf)
+        prim = np.zeros(len(p), dtype=np.int64)
+        for cl in self.classes:
+            _, near = cl.tree.query(p, k=1)
+            near = cl.idx[near]
+            d = self._exact(p, near)
+            win = d < best
+            best[win], prim[win] = d[win], near[win]
+        for cl in self.classes:
+            todo = np.arange(len(p))
+            k0, k1 = 0, min(self.K_CLUSTERS, cl.n_clusters)
+            while len(todo):
+                step = max(1, self.PAIRS // ((k1 - k0) * cl.CLUSTER))
+                todo = np.concatenate(
+                    [
+                        self._clusters(cl, p, todo[s : s + step], k0, k1, best, prim)
+                        for s in range(0, len(todo), step)
+                    ]
+                )
+                k0, k1 = k1, min(4 * k1, cl.n_clusters)
+        return best, prim
 
-    def _chunk(self, p: np.ndarray) -> np.ndarray:
-        tree = self.tree
-        top = len(tree.boxes) - 1
-        # the primitive with the nearest centre gives every point an upper bound
-        _, near = self.centres.query(p, k=1)
-        ub = self._exact(p, near)
-        pi = np.arange(len(p))
-        # every (point, node) whose box is within the bound, level by level
-        node = np.zeros(len(p), dtype=np.int64)
-        for level in range(top, -1, -1):
-            lo, hi = tree.boxes[level]
-            keep = _box_distance(p[pi], lo[node], hi[node]) <= ub[pi]
-            pi, node = pi[keep], node[keep]
-            if level:
-                pi, node = tree.children(level, node, pi)
-        ip, prim = tree.leaf_items(node, pi)
-        d = self._exact(p[ip], prim)
-        # the best pair per point, the first guess included
-        ip = np.concatenate([np.arange(len(p)), ip])
-        prim = np.concatenate([near, prim])
-        d = np.concatenate([ub, d])
-        order = np.lexsort((d, ip))
-        first = order[np.r_[True, ip[order][1:] != ip[order][:-1]]]
-        return d[first], prim[first]
+    def _clusters(self, cl: _Class, p, pts, k0: int, k1: int, best, prim) -> np.ndarray:
+        """Clusters ``k0 + 1 .. k1`` nearest to points ``pts``: the exact distances of their
+        primitives that may beat the best (updated in place); return the points whose
+        nearest primitive may still lie in a cluster farther out."""
+        q = p[pts]
+        b = best[pts]
+        dc, ic = cl.ctree.query(q, k=np.arange(k0 + 1, k1 + 1))
+        lb2 = _cylinder_bound2(q[:, None, :], np.take(cl.cyl, ic, axis=0), dc)
+        r, col = np.nonzero(lb2 < (b * b)[:, None])
+        if len(r):
+            # every primitive of each open cluster, with its own bound
+            open_ = ic[r, col]
+            n_items = cl.count[open_]
+            r = np.repeat(r, n_items)
+            skip = np.cumsum(n_items) - n_items
+            item = np.arange(len(r)) + np.repeat(cl.start[open_] - skip, n_items)
+            qr = np.take(q, r, axis=0)
+            keep = _disc_bound2(qr, np.take(cl.disc, item, axis=0)) < b[r] ** 2
+            r, cand, qr = r[keep], cl.idx[item[keep]], qr[keep]
+        if len(r):
+            d = self._exact(qr, cand)
+            o = np.lexsort((d, r))
+            head = o[np.r_[True, r[o][1:] != r[o][:-1]]]
+            rr, dd = r[head], d[head]
+            better = dd < b[rr]
+            b[rr[better]] = dd[better]
+            prim[pts[rr[better]]] = cand[head][better]
+            best[pts] = b
+        done = (k1 >= cl.n_clusters) | (dc[:, -1] - cl.reach_max >= b)
+        return pts[~done]
 
 
 class SignedDistance:
@@ -246,7 +383,6 @@ class SignedDistance:
         v = np.asarray(vertices, dtype=np.float64)
         t = np.asarray(triangles, dtype=np.int64)
         self.nearest = Nearest(v[t])
-        t = t[self.nearest.tree.order]  # the tree's order from here on
         e = np.sort(np.stack([t, np.roll(t, -1, axis=1)], axis=2).reshape(-1, 2), axis=1)
         keys, edge, uses = np.unique(
             e[:, 0] * len(v) + e[:, 1], return_inverse=True, return_counts=True
