@@ -53,24 +53,35 @@ def interpolation_parameters(
     pts = np.asarray(points, dtype=np.float64)
     k = pts.shape[0]
     seq = np.concatenate([pts, pts[:1]]) if closed else pts
-    steps = seq[1:] - seq[:-1]
-    s3 = steps.reshape(len(steps), -1, steps.shape[-1])
-    if s3.shape[1] == 1 and s3.shape[2] == 3:  # (points: coordinates by hand, no reductions)
-        x, y, z = s3[:, 0, 0], s3[:, 0, 1], s3[:, 0, 2]
-        dist = np.sqrt(x * x + y * y + z * z)
+    if seq.ndim == 2 and seq.shape[1] == 3:
+        # points: coordinate by coordinate into one buffer (no (k, 3) steps array, no
+        # reductions over a short axis; fresh memory costs page faults at this size)
+        dist = np.subtract(seq[1:, 0], seq[:-1, 0])
+        dist *= dist
+        tmp = np.subtract(seq[1:, 1], seq[:-1, 1])
+        tmp *= tmp
+        dist += tmp
+        np.subtract(seq[1:, 2], seq[:-1, 2], out=tmp)
+        tmp *= tmp
+        dist += tmp
+        np.sqrt(dist, out=dist)
     else:
+        steps = seq[1:] - seq[:-1]
+        s3 = steps.reshape(len(steps), -1, steps.shape[-1])
         dist = np.linalg.norm(s3, axis=-1).mean(axis=1)
     if parametrization == "uniform":
         dist = np.ones_like(dist)
     elif parametrization == "centripetal":
-        dist = np.sqrt(dist)
+        np.sqrt(dist, out=dist)
     if np.any(dist == 0):
         i = int(np.argmax(dist == 0))
         j = (i + 1) % k
         raise ValueError(
             f"points {i} and {j} coincide; interpolation needs consecutive points to differ"
         )
-    u = np.concatenate([[0.0], np.cumsum(dist)])
+    u = np.empty(dist.size + 1)
+    u[0] = 0.0
+    np.cumsum(dist, out=u[1:])
     u /= u[-1]
     return u[:k] if closed else u
 
@@ -79,13 +90,18 @@ def _averaged_knots(u: np.ndarray, degree: int) -> np.ndarray:
     """Clamped knots by averaging the parameters (Eq. 9.8)."""
     p = degree
     k = len(u)
-    if k - p - 1 > 0:  # means of p consecutive parameters, by a running sum
-        run = np.concatenate([[0.0], np.cumsum(u[1:-1])])
-        inner = (run[p : k - 1] - run[: k - p - 1]) / p
-        inner = np.clip(np.maximum.accumulate(inner), 0.0, 1.0)  # (rounding kept in order)
-    else:
-        inner = np.empty(0)
-    return np.concatenate([np.zeros(p + 1), inner, np.ones(p + 1)])
+    knots = np.empty(k + p + 1)
+    knots[: p + 1] = 0.0
+    knots[k:] = 1.0
+    if k - p - 1 > 0:  # means of p consecutive parameters, by a running sum, in place
+        inner = knots[p + 1 : k]
+        run = np.cumsum(u[1 : k - 1])  # run[m] = u[1] + ... + u[m + 1]
+        inner[0] = run[p - 1]
+        np.subtract(run[p:], run[:-p], out=inner[1:])
+        inner /= p
+        np.maximum.accumulate(inner, out=inner)  # (rounding kept in order)
+        np.clip(inner, 0.0, 1.0, out=inner)
+    return knots
 
 
 def _periodic_knots(u: np.ndarray, degree: int) -> np.ndarray:
@@ -147,15 +163,15 @@ def _fit_open(flat: np.ndarray, params: np.ndarray, p: int, knots: np.ndarray) -
     """Open interpolation: scipy's compiled collocation and LAPACK's banded LU
     (``gbsv``, partial pivoting), checked by how far the curve misses the data at the
     parameters; where it misses by more than 1e-10 of the data's size (a nearly singular
-    system) or the solve refuses, the rows' own solve decides (refinement, a dense solve
-    when small, or a clear error)."""
+    system, or data that is not finite) or the solve refuses, the rows' own solve decides
+    (refinement, a dense solve when small, or a clear error)."""
     k = flat.shape[0]
-    if k > 4 * (p + 1) and np.isfinite(flat).all():
+    if k > 4 * (p + 1):
         try:
             with np.errstate(all="ignore"):
-                ctrl, miss = _collocation_solve(flat, params, p, knots)
-            scale = float(np.abs(flat).max(initial=0.0))
-            if np.isfinite(ctrl).all() and miss <= 1e-10 * max(scale, 1e-300):
+                ctrl, miss, scale = _collocation_solve(flat, params, p, knots)
+            # a finite miss means finite control points: each one enters some row's miss
+            if miss <= 1e-10 * max(scale, 1e-300):
                 return ctrl
         except (ValueError, TypeError, AttributeError, np.linalg.LinAlgError):
             pass  # (scipy's internals moved, or it refused: the rows' solve decides)
@@ -173,15 +189,26 @@ def _scipy_coloc():
         return None
 
 
+_BLOCK = 8192  # rows of the miss computed at once (its temporaries stay in cache)
+
+
 def _collocation_solve(
     flat: np.ndarray, params: np.ndarray, p: int, knots: np.ndarray
-) -> tuple[np.ndarray, float]:
-    """The interpolating coefficients and the largest miss at the parameters.
+) -> tuple[np.ndarray, float, float]:
+    """The interpolating coefficients, the largest miss at the parameters and the largest
+    absolute datum.
 
     What ``make_interp_spline`` does (scipy's compiled collocation into LAPACK band storage,
-    then ``gbsv``), with the band kept so the miss is one pass over its ``2 p + 1``
-    diagonals rather than an evaluation of the curve. The collocation routine is scipy's
-    own, not public (``_dierckx._coloc`` since 1.15): where it is missing, the public
+    then ``gbsv``), with two differences. The solve gets only the diagonals that hold
+    entries: scipy's storage has ``2 p + 1`` (``kl = ku = p``), but with averaged knots
+    parameter ``u_i`` lies between knots ``i + 1`` and ``i + p`` (means of p parameters up
+    to and from ``u_i``), so the band is at most ``p - 1`` wide on each side (cubic: 2 + 2)
+    and the elimination does less. And the band is kept so that the miss is a pass over
+    its diagonals rather than an evaluation of the curve, done in blocks of rows whose
+    temporaries stay in cache (at this size fresh memory costs more in page faults than the
+    arithmetic). The answer is Fortran-ordered, as LAPACK leaves it. The collocation
+    routine is scipy's own, not public
+    (``_dierckx._coloc`` since 1.15): where it is missing, the public
     ``make_interp_spline`` and an evaluation do the same.
     """
     coloc = _scipy_coloc()
@@ -190,35 +217,47 @@ def _collocation_solve(
 
         spline = make_interp_spline(params, flat, k=p, t=knots, check_finite=False)
         ctrl = np.asarray(spline.c)
-        return ctrl, float(np.abs(spline(params) - flat).max(initial=0.0))
+        scale = float(np.abs(flat).max(initial=0.0))
+        return ctrl, float(np.abs(spline(params) - flat).max(initial=0.0)), scale
     from scipy.linalg import get_lapack_funcs
 
     n = flat.shape[0]
-    kl = ku = p
-    ab = np.zeros((2 * kl + ku + 1, n), dtype=np.float64, order="F")
+    mid = 2 * p  # ab[mid + i - j, j] = A[i, j]: row mid - o holds the diagonal j - i = o
+    ab = np.zeros((3 * p + 1, n), dtype=np.float64, order="F")
     coloc(np.ascontiguousarray(params), np.ascontiguousarray(knots), p, ab.T, 0)
-    band = ab[kl:].copy()  # band[ku + i - j, j] = A[i, j]
+    # A row's entries are p + 1 consecutive columns, the diagonal among them (Schoenberg-
+    # Whitney: N_i(u_i) > 0), so the live diagonals are one run around 0: look from outside
+    if not ab[mid].all():
+        raise np.linalg.LinAlgError("the collocation matrix has a zero on its diagonal")
+    ku = next(o for o in range(p, -1, -1) if ab[mid - o].any())
+    kl = next(o for o in range(p, -1, -1) if ab[mid + o].any())
+    # The live diagonals (offsets ku .. -kl) are kept, C-ordered, for the miss; the solve
+    # gets them in LAPACK's storage of the narrow band, laid out in scipy's wider array's
+    # own memory (fresh memory costs page faults: at this size more than the arithmetic).
+    band = np.array(ab[mid - ku : mid + kl + 1])
+    rows = 2 * kl + ku + 1
+    lu = ab.reshape(-1, order="F")[: rows * n].reshape((rows, n), order="F")
+    lu[:kl] = 0.0
+    lu[kl:] = band
     rhs = np.array(flat, dtype=np.float64, order="F")
-    (gbsv,) = get_lapack_funcs(("gbsv",), (ab, rhs))
-    _, _, ctrl, info = gbsv(kl, ku, ab, rhs, overwrite_ab=True, overwrite_b=True)
+    (gbsv,) = get_lapack_funcs(("gbsv",), (lu, rhs))
+    _, _, ctrl, info = gbsv(kl, ku, lu, rhs, overwrite_ab=True, overwrite_b=True)
+    del lu, ab  # (the factors)
     if info != 0:
         raise np.linalg.LinAlgError("the collocation matrix is singular")
-    # The miss, column by column (gbsv's Fortran-ordered answer is contiguous that way),
-    # over the diagonals that hold entries (a collocation row has p + 1 of the 2 p + 1).
-    cols = np.asarray(ctrl).T
-    miss = np.array(flat.T, order="C")
-    scratch = np.empty_like(miss)
-    for o in range(-kl, ku + 1):  # diagonal j - i = o
-        d = band[ku - o]
-        if not d.any():
-            continue
-        if o >= 0:
-            t = np.multiply(d[o:], cols[:, o:], out=scratch[:, : n - o])
-            miss[:, : n - o] -= t
-        else:
-            t = np.multiply(d[: n + o], cols[:, : n + o], out=scratch[:, : n + o])
-            miss[:, -o:] -= t
-    return np.ascontiguousarray(ctrl), float(max(miss.max(initial=0.0), -miss.min(initial=0.0)))
+    misses, scales = [], []
+    cols = ctrl.T  # (d, n), C-ordered: gbsv's answer is Fortran-ordered
+    for a in range(0, n, _BLOCK):
+        b = min(a + _BLOCK, n)
+        acc = np.array(flat[a:b].T)
+        scales.append(np.abs(acc).max())
+        for o in range(-kl, ku + 1):  # rows i in [a, b) meet columns i + o
+            i0, i1 = max(a, -o), min(b, n - o)
+            if i1 > i0:
+                acc[:, i0 - a : i1 - a] -= band[ku - o, i0 + o : i1 + o] * cols[:, i0 + o : i1 + o]
+        misses.append(np.abs(acc).max())
+    # np.max keeps a NaN (Python's max would drop it)
+    return ctrl, float(np.max(misses)), float(np.max(scales))
 
 
 def _collocation_rows(p: int, knots: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
