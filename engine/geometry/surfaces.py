@@ -54,7 +54,10 @@ class Surface(Geometry):
         from ..kernels.attributes.propagate import by_position
 
         gu, gv = np.meshgrid(u[: pts.shape[0]], v[: pts.shape[1]], indexing="ij")
-        source = by_position(pts.reshape(-1, 3), vertices)  # a pole keeps its row's first
+        if len(vertices) == pts.shape[0] * pts.shape[1]:
+            source = np.arange(len(vertices))  # no pole: the grid's own points, in order
+        else:
+            source = by_position(pts.reshape(-1, 3), vertices)  # a pole keeps its row's first
         return Mesh(vertices, fi, fo, {"u": gu.reshape(-1)[source], "v": gv.reshape(-1)[source]})
 
     def to_pyvista(self) -> Any:

@@ -17,6 +17,7 @@ import numpy as np
 from ..io.meshdata import fan_triangles
 from .halfedge import build_halfedges
 from .measure import edge_table, face_areas, next_corner, signed_volume, union_find
+from .memo import by_faces
 from .meshops import reverse_faces, triangulate
 
 __all__ = [
@@ -369,19 +370,11 @@ def orient(
     n_faces = fo.size - 1
     if n_faces == 0:
         return fi.copy(), 0
-    sizes = np.diff(fo)
-    face = np.repeat(np.arange(n_faces), sizes)
-    t = edge_table(fi, fo, len(v))
-    two = t.starts[t.counts == 2]
-    h0, h1 = t.order[two], t.order[two + 1]
-    same = fi[h0] == fi[h1]  # both start at the same vertex: same direction
-    f0, f1 = face[h0], face[h1]
-    root, flip = union_find(n_faces, f0, f1, same)
-    conflicts = int(np.count_nonzero((flip[f0] ^ flip[f1]) != same))
+    sizes, face, root, flip, conflicts, open_face, reversed_ = by_faces(
+        "orient", fi, fo, len(v), lambda: _orient_topology(fi, fo, len(v))
+    )
     # decide each part's overall direction with the faces as they would be after the flips
     sign = np.where(flip, -1.0, 1.0)
-    areas = face_areas(v, fi, fo)
-    part_area = np.bincount(root, weights=areas, minlength=n_faces)
     centroid = np.stack(
         [np.bincount(face, weights=v[fi, k], minlength=n_faces) for k in range(3)], 1
     )
@@ -395,14 +388,15 @@ def orient(
     vol = np.bincount(
         root, weights=sign * signed_volume(v, fi, fo, part_centroid[root]), minlength=n_faces
     )
-    open_face = np.zeros(n_faces, dtype=bool)
-    open_face[face[t.order[t.starts[t.counts != 2]]]] = True
     part_open = np.bincount(root, weights=open_face, minlength=n_faces) > 0
-    kept = np.bincount(root, weights=sign * areas, minlength=n_faces)
-    flat = np.abs(vol) <= 1e-9 * np.maximum(part_area, 1e-300) ** 1.5
-    turn = np.where(part_open & flat, kept < 0, vol < 0)
+    turn = vol < 0
+    if part_open.any():  # an open flat part keeps the side most of its area had
+        areas = face_areas(v, fi, fo)
+        part_area = np.bincount(root, weights=areas, minlength=n_faces)
+        kept = np.bincount(root, weights=sign * areas, minlength=n_faces)
+        flat = np.abs(vol) <= 1e-9 * np.maximum(part_area, 1e-300) ** 1.5
+        turn = np.where(part_open & flat, kept < 0, turn)
     flip = flip ^ turn[root]
-    reversed_ = reverse_faces(fi, fo)
     out = np.where(np.repeat(flip, sizes), reversed_, fi)
     closed_parts = np.flatnonzero((np.bincount(root, minlength=n_faces) > 0) & ~part_open)
     if 1 < closed_parts.size <= MAX_NESTED_PARTS:
@@ -412,6 +406,25 @@ def orient(
             flip_part[closed_parts[inner]] = True
             out = np.where(np.repeat(flip_part[root], sizes), reverse_faces(out, fo), out)
     return out, conflicts
+
+
+def _orient_topology(fi: np.ndarray, fo: np.ndarray, n_vertices: int) -> tuple:
+    """What :func:`orient` finds from the faces alone (the same while only positions
+    change): corners per face, the face of each corner, each face's part and parity, the
+    conflicts, the faces on a boundary and the faces reversed."""
+    n_faces = fo.size - 1
+    sizes = np.diff(fo)
+    face = np.repeat(np.arange(n_faces), sizes)
+    t = edge_table(fi, fo, n_vertices)
+    two = t.starts[t.counts == 2]
+    h0, h1 = t.order[two], t.order[two + 1]
+    same = fi[h0] == fi[h1]  # both start at the same vertex: same direction
+    f0, f1 = face[h0], face[h1]
+    root, flip = union_find(n_faces, f0, f1, same)
+    conflicts = int(np.count_nonzero((flip[f0] ^ flip[f1]) != same))
+    open_face = np.zeros(n_faces, dtype=bool)
+    open_face[face[t.order[t.starts[t.counts != 2]]]] = True
+    return sizes, face, root, flip, conflicts, open_face, reverse_faces(fi, fo)
 
 
 #: parts of one mesh above which orient skips the nesting test (each part is tested
@@ -494,7 +507,7 @@ def cap(
     v = np.asarray(vertices, dtype=np.float64)
     fi = np.asarray(face_indices, dtype=np.int64)
     fo = np.asarray(face_offsets, dtype=np.int64)
-    loops = build_halfedges(fi, fo, len(v)).boundary_loops()
+    loops = by_faces("loops", fi, fo, len(v), lambda: _boundary_loops(fi, fo, len(v)))
     if not loops:
         return v.copy(), fi.copy(), fo.copy()
     lo_sizes = np.array([len(lp) for lp in loops], dtype=np.int64)
@@ -553,10 +566,9 @@ def flat_open_parts(
     fo = np.asarray(face_offsets, dtype=np.int64)
     if fi.size == 0:
         return 0
-    root, _ = union_find(len(v), fi, fi[next_corner(fo)])
-    used = np.zeros(len(v), dtype=bool)
-    used[fi] = True
-    parts, part = np.unique(root[used], return_inverse=True)
+    used, parts, part, has_open = by_faces(
+        "sheets", fi, fo, len(v), lambda: _vertex_parts(fi, fo, len(v))
+    )
     p = v[used]
     count = np.bincount(part, minlength=parts.size)[:, None]
     mean = np.stack([np.bincount(part, p[:, k], parts.size) for k in range(3)], 1) / count
@@ -574,9 +586,22 @@ def flat_open_parts(
     np.maximum.at(hi, part, p)
     np.minimum.at(lo, part, p)
     flat = far <= planar_tolerance * np.linalg.norm(hi - lo, axis=1)
-    t = edge_table(fi, fo, len(v))
+    return int(np.count_nonzero(flat & has_open))
+
+
+def _boundary_loops(fi: np.ndarray, fo: np.ndarray, n_vertices: int) -> list[np.ndarray]:
+    return build_halfedges(fi, fo, n_vertices).boundary_loops()
+
+
+def _vertex_parts(fi: np.ndarray, fo: np.ndarray, n_vertices: int) -> tuple:
+    """The used vertices, the parts they join into (by shared vertices; each part's root
+    and each used vertex's part) and which parts have a boundary edge."""
+    root, _ = union_find(n_vertices, fi, fi[next_corner(fo)])
+    used = np.zeros(n_vertices, dtype=bool)
+    used[fi] = True
+    parts, part = np.unique(root[used], return_inverse=True)
+    t = edge_table(fi, fo, n_vertices)
     open_vertex = t.vertices[t.counts == 1, 0]
     has_open = np.zeros(parts.size, dtype=bool)
-    where = np.searchsorted(parts, root[open_vertex])
-    has_open[where] = True
-    return int(np.count_nonzero(flat & has_open))
+    has_open[np.searchsorted(parts, root[open_vertex])] = True
+    return used, parts, part, has_open
