@@ -292,7 +292,7 @@ def onto(
     nearest = Nearest(corners)
     p = np.asarray(vertices, np.float64).reshape(-1, 3)
     if pd and len(p):
-        tri = nearest.tree.order[nearest.nearest(p)[1]]
+        tri = nearest.nearest(p)[1]
         a, b, c = (corners[tri, j] for j in range(3))
         e1, e2, ap = b - a, c - a, p - a
         v, w = _triangle_coefficients(
@@ -307,5 +307,5 @@ def onto(
     fi, fo = (np.asarray(x, np.int64) for x in faces)
     if fd and fo.size > 1:
         centre = np.add.reduceat(p[fi], fo[:-1]) / np.diff(fo)[:, None]
-        face = copy(face_of[nearest.tree.order[nearest.nearest(centre)[1]]])
+        face = copy(face_of[nearest.nearest(centre)[1]])
     return carried(source, point, face)
