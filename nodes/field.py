@@ -3,7 +3,7 @@
 A :class:`~formgraph.geometry.Field` is a signed distance function, negative inside, kept
 as the recipe that built it: the nodes here build recipes (primitives, TPMS sheets, smooth
 booleans, shells, offsets, transforms, distances to meshes and curves) and ``field.mesh``
-turns one into a watertight, outward mesh by adaptive marching tetrahedra
+turns one into a watertight, outward mesh by adaptive marching cubes
 (:mod:`formgraph.kernels.field.mesher`). ``mesh.offset`` is ``field.from_mesh`` ->
 ``field.offset`` -> ``field.mesh`` in one node: the 3-D twin of ``offset.marching_squares``.
 """
@@ -434,8 +434,9 @@ def mesh(
     Adaptive: a coarse grid is refined (an octree) only where the surface can be (a cell
     whose centre value is within the field's Lipschitz reach of zero), so the work grows
     with the surface's area: halving ``cell`` costs about 4x. The finest cells are cut by
-    marching tetrahedra (the same six tetrahedra in every cube, so the surface has no
-    cracks), each vertex placed on the surface by regula falsi on the field.
+    marching cubes whose table decides an ambiguous face from its four corners alone
+    (inside corners separated), so the cubes on either side agree and the surface has no
+    cracks; each vertex is placed on the surface by root-finding on the field.
 
     Parameters
     ----------

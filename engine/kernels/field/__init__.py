@@ -7,8 +7,12 @@
   centres and of clusters, pruned by disc and cylinder bounds), its sign by the
   angle-weighted pseudonormal on a closed mesh or the generalized winding number (a
   Barnes-Hut tree of dipoles, Barill et al. 2018), and the distance to polylines;
-- ``mesher``: adaptive meshing of the zero set: octree culling by the Lipschitz reach,
-  marching tetrahedra on the finest cells, vertices by regula falsi on the field.
+- ``mesher``: adaptive meshing of the zero set: octree culling by the Lipschitz reach
+  down to blocks of 8^3 cells, then dense per-block levels, corners owned by one block and
+  signs inferred where the Lipschitz bound decides them, marching cubes, vertices by
+  root-finding on the field;
+- ``mctable``: the marching-cubes table, built from one rule on each face (inside corners
+  separated), so shared faces agree and the surface is watertight.
 
 The modules are imported on use (``from formgraph.kernels.field import mesher``).
 """

@@ -15,7 +15,9 @@ ambiguous faces between neighbours and leaves holes; Nielson & Hamann 1991, Dür
 
 Each segment is directed so the surface's normal points to the outside corners; the
 directed segments of a case chain into closed loops on the cube's boundary, and each loop
-becomes a fan of triangles (Bloomenthal's polygonizer makes its polygons the same way).
+becomes a fan of triangles (Bloomenthal's polygonizer makes its polygons the same way)
+whose diagonals never join two edges of one face (a diagonal in a face could be drawn
+by the neighbouring cube too: an edge of four triangles).
 """
 
 from __future__ import annotations
@@ -111,13 +113,31 @@ def _case_loops(case: int) -> list[list[int]]:
     return loops
 
 
+def _same_face(a: int, b: int) -> bool:
+    """Whether cube edges ``a`` and ``b`` lie on one face of the cube."""
+    pa, pb = _mid(a), _mid(b)
+    return bool(np.any((pa == pb) & ((pa == 0) | (pa == 1))))
+
+
+def _fan(loop: list[int]) -> list[tuple[int, int, int]]:
+    """Triangles of a loop: a fan from the first apex whose diagonals cross the cube's
+    inside. A diagonal between two edges of one face would lie in that face, and the cube
+    on its other side could draw the same diagonal: four triangles on one edge."""
+    k = len(loop)
+    for r in range(k):
+        lp = loop[r:] + loop[:r]
+        if not any(_same_face(lp[0], lp[i]) for i in range(2, k - 1)):
+            return [(lp[0], lp[i], lp[i + 1]) for i in range(1, k - 1)]
+    raise AssertionError(f"no fan of {loop} keeps its diagonals off the faces")
+
+
 def tables() -> tuple[np.ndarray, np.ndarray]:
     """``TRI_COUNT (256,)`` triangles per case and ``TRI_EDGES (256, 5, 3)`` their edges
     (``-1`` past the count), each triangle's normal toward the outside corners."""
     count = np.zeros(256, dtype=np.int64)
     tri = np.full((256, 5, 3), -1, dtype=np.int64)
     for case in range(256):
-        fan = [(lp[0], lp[i], lp[i + 1]) for lp in _case_loops(case) for i in range(1, len(lp) - 1)]
+        fan = [t for lp in _case_loops(case) for t in _fan(lp)]
         count[case] = len(fan)
         if fan:
             tri[case, : len(fan)] = fan
@@ -125,4 +145,3 @@ def tables() -> tuple[np.ndarray, np.ndarray]:
 
 
 TRI_COUNT, TRI_EDGES = tables()
-TRI_EDGES_32 = TRI_EDGES.astype(np.int32)

@@ -68,6 +68,7 @@ B = 1 << BLOCK_LEVEL  # a block is B^3 finest cells and owns B^3 corners
 B3 = B**3
 GROUP = 128  # kept blocks worked on at a time (65,536 cells)
 C2 = 4 * CORNERS + 2  # the centres of a block's cells of 4, in corners
+LOCAL = np.stack(np.unravel_index(np.arange(B3), (B, B, B)), axis=-1).astype(np.float64)
 
 
 def plan_grid(lo: np.ndarray, hi: np.ndarray, cell: float, coarse: int = 16):
@@ -240,9 +241,15 @@ class _Lattice:
         """The field at corner numbers (slot * 512 + local corner), chunk by chunk."""
         out = np.empty(len(corners))
         for i in range(0, len(corners), CHUNK):
-            c = corners[i : i + CHUNK]
-            out[i : i + CHUNK] = _check(self.f(self.origin + self.corner_ijk(c) * self.cell))
+            out[i : i + CHUNK] = _check(self.f(self.point(corners[i : i + CHUNK])))
         return out
+
+    def point(self, corner: np.ndarray) -> np.ndarray:
+        """The coordinates of corner numbers."""
+        if not hasattr(self, "_at"):
+            self._at = self.origin + self.base * self.cell  # each slot's corner 0
+            self._local = LOCAL * self.cell
+        return self._at[corner >> 9] + self._local[corner & (B3 - 1)]
 
     def step(self, corner: np.ndarray, axis: np.ndarray, by: int) -> np.ndarray:
         """The corners one step (``by`` = 1 or -1) along ``axis`` from ``corner``; -1 where
@@ -264,15 +271,6 @@ class _Lattice:
             out[wrap] = np.where(nxt >= 0, moved, -1)
         return out
 
-    def corner_ijk(self, corner: np.ndarray) -> np.ndarray:
-        """Global (i, j, k) of corner numbers."""
-        loc = corner & (B3 - 1)
-        ijk = self.base[corner >> 9]
-        ijk[:, 0] += loc >> 6
-        ijk[:, 1] += (loc >> 3) & 7
-        ijk[:, 2] += loc & 7
-        return ijk
-
     def mixed_cells(self, s: int, e: int):
         """The cells with a sign change in kept blocks ``s:e``: flat indices (block * 512 +
         local cell) and their cases."""
@@ -289,28 +287,41 @@ class _Lattice:
         return cells + s * B3, case.reshape(-1)[cells]
 
 
+def _with_previous(a: np.ndarray, axis: int, pick) -> np.ndarray:
+    """``pick`` (np.fmax or np.fmin) of each entry and the one before it along ``axis``
+    (of the last three: 1, 2, 3), the first against nothing."""
+    out = a.copy()
+    here = [slice(None)] * 4
+    before = [slice(None)] * 4
+    here[axis], before[axis] = slice(1, None), slice(None, -1)
+    out[tuple(here)] = pick(a[tuple(here)], a[tuple(before)])
+    return out
+
+
 def _infer(val1: np.ndarray, step: float):
     """Which of a block's 8^3 corners have a sign known from the sampled centres of the
     cells of 2 (``val1 (nk, 4, 4, 4)``, NaN where not sampled), and whether it is negative.
 
     A corner with ``e`` even coordinates is ``step * sqrt(e)`` from each of its ``2^e``
-    nearest centres (``step`` is the Lipschitz bound times the cell).
+    nearest centres (``step`` is the Lipschitz bound times the cell); the largest and
+    smallest of them are running maxima along the even axes, one axis at a time.
     """
     nk = len(val1)
-    pad = np.pad(val1, ((0, 0), (1, 0), (1, 0), (1, 0)), constant_values=np.nan)
     inferred = np.zeros((nk, B, B, B), dtype=bool)
     negative = np.zeros((nk, B, B, B), dtype=bool)
+    hi: dict[tuple, np.ndarray] = {(): val1}
+    lo: dict[tuple, np.ndarray] = {(): val1}
     with np.errstate(invalid="ignore"):
         for parity in CORNERS:
             # an odd coordinate 2a + 1 is centre a's; an even one 2a lies between a - 1 and a
-            choices = [[slice(1, 5)] if p else [slice(1, 5), slice(0, 4)] for p in parity]
-            hi = lo = None
-            for view in itertools.product(*choices):
-                v = pad[(slice(None), *view)]
-                hi = v if hi is None else np.fmax(hi, v)
-                lo = v if lo is None else np.fmin(lo, v)
-            reach = step * np.sqrt(3 - int(parity.sum())) * (1 + 1e-9)
-            pos, neg = hi > reach, lo < -reach
+            even = tuple(k for k in range(3) if not parity[k])
+            for n in range(1, len(even) + 1):
+                sub, parent = even[:n], even[: n - 1]
+                if sub not in hi:
+                    hi[sub] = _with_previous(hi[parent], 1 + sub[-1], np.fmax)
+                    lo[sub] = _with_previous(lo[parent], 1 + sub[-1], np.fmin)
+            reach = step * np.sqrt(len(even)) * (1 + 1e-9)
+            pos, neg = hi[even] > reach, lo[even] < -reach
             at = (slice(None), *(slice(int(p), B, 2) for p in parity))
             inferred[at] = pos | neg
             negative[at] = neg & ~pos
@@ -432,8 +443,8 @@ def mesh_field(
         fa, fb = lat.values[start], lat.values[end]
         fm = np.where(before >= 0, lat.values[before], np.nan)
         fq = np.where(after >= 0, lat.values[after], np.nan)
-        pa = lat.origin + lat.corner_ijk(start) * cell
-        pb = lat.origin + lat.corner_ijk(end) * cell
+        pa = lat.point(start)
+        pb = pa + np.eye(3)[axis] * cell
         guess = _guess(fm, fa, fb, fq) if root_steps else None
         verts[i : i + CHUNK] = _roots(f, pa, pb, fa, fb, root_steps, cell, guess)
     return verts, tri.reshape(-1, 3)
