@@ -66,7 +66,8 @@ class _Level:
 
     Half-edge ``h`` is corner ``h`` of the flat face list; ``edge`` is its undirected edge,
     ``prev`` the half-edge before it in its face; ``edge_vertices`` the two ends of each
-    edge (not sorted after the first level).
+    edge (not sorted after the first level); ``edge_faces`` the two faces of each edge (a
+    boundary edge's one face twice).
     """
 
     face_indices: np.ndarray
@@ -76,10 +77,16 @@ class _Level:
     prev: np.ndarray
     edge_vertices: np.ndarray
     quads: bool
+    edge_faces: np.ndarray | None = None
 
     @classmethod
     def from_halfedges(cls, he: HalfEdges) -> _Level:
         sizes = he.face_sizes
+        one = (he.twin < 0) | (np.arange(he.twin.size) < he.twin)  # each edge once
+        e, h, t = he.edge[one], np.flatnonzero(one), he.twin[one]
+        edge_faces = np.empty((he.n_edges, 2), dtype=np.int64)
+        edge_faces[e, 0] = he.face[h]
+        edge_faces[e, 1] = he.face[np.where(t < 0, h, t)]
         return cls(
             face_indices=he.origin,
             face_offsets=he.face_offsets,
@@ -88,6 +95,7 @@ class _Level:
             prev=he.prev,
             edge_vertices=he.edge_vertices,
             quads=bool(sizes.size and (sizes == 4).all()),
+            edge_faces=edge_faces,
         )
 
 
@@ -148,6 +156,7 @@ def _catmull_clark_step(
     e0, e1 = np.ascontiguousarray(ev[:, 0]), np.ascontiguousarray(ev[:, 1])
     sizes = np.diff(fo)
     corners = [np.ascontiguousarray(fi[j::4]) for j in range(4)] if lv.quads else []
+    ef0, ef1 = np.ascontiguousarray(lv.edge_faces[:, 0]), np.ascontiguousarray(lv.edge_faces[:, 1])
     for c in range(d):
         x = vt[c]
         # face points: centroids
@@ -164,7 +173,9 @@ def _catmull_clark_step(
         a, b = x[e0], x[e1]
         ends = a + b
         e = ep[c]
-        np.add(np.bincount(edge, f_h, n_edges), ends, out=e)
+        f = fp[c]
+        np.add(f[ef0], f[ef1], out=e)  # the two faces' points (a boundary's: replaced)
+        e += ends
         e *= 0.25
         if on_boundary_edge.size:
             e[on_boundary_edge] = 0.5 * ends[on_boundary_edge]
@@ -235,6 +246,17 @@ def _catmull_clark_step(
     new_ev[2 * n_edges :, 1] = n + n_edges + face
     prev4 = np.arange(m4, dtype=np.int64) - 1
     prev4[::4] += 4
+    # each new edge's two quads (quad h is half-edge h's): a split edge lies in the quad of
+    # the half-edge leaving its end and in the quad after the one arriving there; the edge
+    # 2E + h in quad h and in the quad after it
+    new_ef = np.full((2 * n_edges + m, 2), -1, dtype=np.int64)
+    new_ef[child, 0] = h
+    new_ef[2 * n_edges + h, 0] = h
+    new_ef[child_prev, 1] = h
+    new_ef[2 * n_edges + lv.prev, 1] = h
+    for a, b in ((0, 1), (1, 0)):  # a boundary edge: its one quad twice
+        lone = new_ef[:, a] < 0
+        new_ef[lone, a] = new_ef[lone, b]
     nxt = _Level(
         face_indices=quad.reshape(-1),
         face_offsets=face_offsets,
@@ -243,6 +265,7 @@ def _catmull_clark_step(
         prev=prev4,
         edge_vertices=new_ev,
         quads=True,
+        edge_faces=new_ef,
     )
     if sharp is None or not (sharp > 1.0).any():
         return new_v, nxt, None
