@@ -158,22 +158,20 @@ def _catmull_clark_step(
     corners = [np.ascontiguousarray(fi[j::4]) for j in range(4)] if lv.quads else []
     ef0, ef1 = np.ascontiguousarray(lv.edge_faces[:, 0]), np.ascontiguousarray(lv.edge_faces[:, 1])
     for c in range(d):
-        x = vt[c]
+        x, f = vt[c], fp[c]
         # face points: centroids
         if lv.quads:
-            f = fp[c]
-            np.add(x[corners[0]], x[corners[1]], out=f)
-            f += x[corners[2]]
-            f += x[corners[3]]
+            g = [x[q] for q in corners]
+            np.add(g[0], g[1], out=f)
+            f += g[2]
+            f += g[3]
             f *= 0.25
         elif m:
-            np.divide(np.add.reduceat(x[fi], fo[:-1]), sizes, out=fp[c])
-        f_h = np.repeat(fp[c], 4) if lv.quads else np.repeat(fp[c], sizes)  # = fp[face]
+            np.divide(np.add.reduceat(x[fi], fo[:-1]), sizes, out=f)
         # edge points: (v0 + v1 + f0 + f1) / 4 inside, the midpoint on a boundary
         a, b = x[e0], x[e1]
         ends = a + b
         e = ep[c]
-        f = fp[c]
         np.add(f[ef0], f[ef1], out=e)  # the two faces' points (a boundary's: replaced)
         e += ends
         e *= 0.25
@@ -181,9 +179,19 @@ def _catmull_clark_step(
             e[on_boundary_edge] = 0.5 * ends[on_boundary_edge]
         # vertex points, smooth rule (Q + 2R + (n - 3) S) / n with n the valence:
         # = (sum of face points + sum of edge neighbours) / n^2 + (n - 2) / n * S
-        ring = np.bincount(fi, f_h, n)
-        ring += np.bincount(e0, b, n)  # each edge adds its other end to both ends
-        ring += np.bincount(e1, a, n)
+        if lv.quads:  # each quad gives each corner its face point and half of the two
+            # corners beside it: an inside edge lies in two quads, so every neighbour
+            # counts once (a boundary vertex's smooth value is replaced by its rule below)
+            ring = np.zeros(n)
+            for j in range(4):
+                t = g[(j + 1) % 4] + g[(j + 3) % 4]
+                t *= 0.5
+                t += f
+                ring += np.bincount(corners[j], t, n)
+        else:
+            ring = np.bincount(fi, np.repeat(f, sizes), n)  # fp[face]: faces in order
+            ring += np.bincount(e0, b, n)  # each edge adds its other end to both ends
+            ring += np.bincount(e1, a, n)
         np.divide(ring, kk2, out=vp[c])
         vp[c] += keep * x
     v, epr, vpr = vt.T, ep.T, vp.T  # row views (n, d) for the few sharp elements
