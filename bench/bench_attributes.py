@@ -44,15 +44,18 @@ _now = time.process_time if CLOCK == "cpu" else time.perf_counter
 def interleaved(
     fns: dict[str, Callable[[], object]], rounds: int
 ) -> tuple[dict[str, float], dict[str, np.ndarray]]:
-    """Each function's best time (s) over ``rounds`` rounds that call every one in turn,
-    and every round's times (for ratios within a round)."""
+    """Each function's best time (s) over ``rounds`` rounds that call every one in turn
+    (in a turning order), and every round's times (for ratios within a round)."""
     for fn in fns.values():
         fn()  # warm up
     times: dict[str, list[float]] = {name: [] for name in fns}
-    for _ in range(rounds):
-        for name, fn in fns.items():
+    names = list(fns)
+    for r in range(rounds):
+        # the order turns each round: a call's time depends on what ran just before it
+        # (freed and new large buffers: page faults), so every one takes every place
+        for name in names[r % len(names) :] + names[: r % len(names)]:
             t0 = _now()
-            fn()
+            fns[name]()
             times[name].append(_now() - t0)
     return {k: min(t) for k, t in times.items()}, {k: np.array(t) for k, t in times.items()}
 
@@ -117,7 +120,7 @@ def run(table) -> None:
             "two": lambda: subdivide(two),
             "more": lambda: subdivide(more),
         },
-        rounds=25,
+        rounds=30,
     )
     case = "catmull_clark 10k-quad torus 2 lvl, 2 point attributes"
     table.add(case, "plain mesh", best["plain"])
