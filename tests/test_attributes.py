@@ -496,3 +496,31 @@ def test_onto_triangles_without_area():
     # a face: barycentric; collinear corners: along the nearest edge; one point: its value
     np.testing.assert_allclose(data["point_data"]["h"], [0.75, 3.1, 4.8, 6], atol=1e-12)
     assert data["face_data"]["f"].tolist() == [2.0]  # centroid (5.3, 2.4, 2.7): the segment
+
+
+def test_onto_finds_the_closest_triangle_exactly():
+    from formgraph.kernels.attributes import propagate as carry
+
+    tm = trimesh.creation.torus(2.0, 0.6, 40, 12)
+    rng = np.random.default_rng(9)
+    p = np.concatenate(
+        [
+            tm.vertices[rng.integers(0, len(tm.vertices), 300)] + rng.normal(size=(300, 3)) * s
+            for s in (0.01, 0.2, 3.0)
+        ]
+    )
+    closest = carry._Closest(tm.vertices[tm.faces])
+    tri, v, w = closest.query(p)
+    a, b, c = (tm.vertices[tm.faces[tri, j]] for j in range(3))
+    assert np.all((v >= -1e-12) & (w >= -1e-12) & (v + w <= 1 + 1e-12))
+    q = a + v[:, None] * (b - a) + w[:, None] * (c - a)
+    # brute force: every point against every triangle (Ericson's exact distance)
+    from formgraph.kernels.field.meshdist import point_triangle_distance
+
+    t = tm.vertices[tm.faces]
+    ref = point_triangle_distance(p[:, None], t[None, :, 0], t[None, :, 1], t[None, :, 2])
+    np.testing.assert_allclose(np.linalg.norm(p - q, axis=1), ref.min(axis=1), atol=1e-12)
+    # never farther than trimesh's closest points (its candidates by box are approximate)
+    assert np.all(
+        np.linalg.norm(p - q, axis=1) <= trimesh.proximity.closest_point(tm, p)[1] + 1e-12
+    )

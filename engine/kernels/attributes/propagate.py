@@ -249,6 +249,42 @@ def _dot(x: np.ndarray, y: np.ndarray) -> np.ndarray:
     return np.einsum("ij,ij->i", x, y)
 
 
+class _Closest:
+    """The closest point of a set of triangles ``corners`` (t, 3, 3) to many points: the
+    nearest triangle (``field.meshdist.Nearest``'s exact search) and the point's
+    barycentric (v, w) there."""
+
+    def __init__(self, corners: np.ndarray):
+        from ..field.meshdist import Nearest
+
+        self.corners = corners
+        self.a = corners[:, 0]
+        self.e1, self.e2 = corners[:, 1] - self.a, corners[:, 2] - self.a
+        self.aa, self.ab = _dot(self.e1, self.e1), _dot(self.e1, self.e2)
+        self.bb = _dot(self.e2, self.e2)
+        self.nearest = Nearest(corners)
+
+    def pairs(self, p: np.ndarray, tri: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(v, w) of the closest points of triangles ``tri`` to points ``p``, pair by pair."""
+        from ..field.meshdist import _triangle_coefficients
+
+        ap, e1, e2 = p - self.a[tri], self.e1[tri], self.e2[tri]
+        v, w = _triangle_coefficients(
+            _dot(e1, ap), _dot(e2, ap), self.aa[tri], self.ab[tri], self.bb[tri]
+        )
+        bad = ~(np.isfinite(v) & np.isfinite(w))
+        if bad.any():  # no area and no edge to follow: the nearest corner alone
+            far = np.linalg.norm(p[bad, None, :] - self.corners[tri[bad]], axis=2)
+            best = np.argmin(far, axis=1)
+            v[bad], w[bad] = best == 1, best == 2
+        return v, w
+
+    def query(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(tri, v, w) of each point's closest point."""
+        tri = self.nearest.nearest(points)[1]
+        return (tri, *self.pairs(points, tri))
+
+
 def onto(
     source: Any,
     vertices: np.ndarray,
@@ -280,7 +316,6 @@ def onto(
     point, face = DROP, DROP
     if not (pd or fd) or source.n_faces == 0:
         return carried(source, point, face)
-    from ..field.meshdist import Nearest, _triangle_coefficients
     from ..mesh.meshops import triangulate
 
     sv = np.asarray(source.vertices, np.float64)
@@ -288,24 +323,13 @@ def onto(
         _, tfi, _ = triangulate(sv, source.face_indices, source.face_offsets, max_tests)
         triangles = tfi.reshape(-1, 3)
     face_of = np.repeat(np.arange(source.n_faces), np.diff(source.face_offsets) - 2)
-    corners = sv[triangles]
-    nearest = Nearest(corners)
+    closest = _Closest(sv[triangles])
     p = np.asarray(vertices, np.float64).reshape(-1, 3)
     if pd and len(p):
-        tri = nearest.nearest(p)[1]
-        a, b, c = (corners[tri, j] for j in range(3))
-        e1, e2, ap = b - a, c - a, p - a
-        v, w = _triangle_coefficients(
-            _dot(e1, ap), _dot(e2, ap), _dot(e1, e1), _dot(e1, e2), _dot(e2, e2)
-        )
-        bad = ~(np.isfinite(v) & np.isfinite(w))  # no area: the nearest corner alone
-        if bad.any():
-            far = np.linalg.norm(p[bad, None, :] - corners[tri[bad]], axis=2)
-            best = np.argmin(far, axis=1)
-            v[bad], w[bad] = best == 1, best == 2
+        tri, v, w = closest.query(p)
         point = barycentric(triangles[tri], np.column_stack([v, w]))
     fi, fo = (np.asarray(x, np.int64) for x in faces)
     if fd and fo.size > 1:
         centre = np.add.reduceat(p[fi], fo[:-1]) / np.diff(fo)[:, None]
-        face = copy(face_of[nearest.nearest(centre)[1]])
+        face = copy(face_of[closest.query(centre)[0]])
     return carried(source, point, face)

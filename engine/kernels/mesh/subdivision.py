@@ -66,7 +66,8 @@ class _Level:
 
     Half-edge ``h`` is corner ``h`` of the flat face list; ``edge`` is its undirected edge,
     ``prev`` the half-edge before it in its face; ``edge_vertices`` the two ends of each
-    edge (not sorted after the first level).
+    edge (not sorted after the first level); ``edge_faces`` the two faces of each edge (a
+    boundary edge's one face twice).
     """
 
     face_indices: np.ndarray
@@ -76,10 +77,16 @@ class _Level:
     prev: np.ndarray
     edge_vertices: np.ndarray
     quads: bool
+    edge_faces: np.ndarray | None = None
 
     @classmethod
     def from_halfedges(cls, he: HalfEdges) -> _Level:
         sizes = he.face_sizes
+        one = (he.twin < 0) | (np.arange(he.twin.size) < he.twin)  # each edge once
+        e, h, t = he.edge[one], np.flatnonzero(one), he.twin[one]
+        edge_faces = np.empty((he.n_edges, 2), dtype=np.int64)
+        edge_faces[e, 0] = he.face[h]
+        edge_faces[e, 1] = he.face[np.where(t < 0, h, t)]
         return cls(
             face_indices=he.origin,
             face_offsets=he.face_offsets,
@@ -88,6 +95,7 @@ class _Level:
             prev=he.prev,
             edge_vertices=he.edge_vertices,
             quads=bool(sizes.size and (sizes == 4).all()),
+            edge_faces=edge_faces,
         )
 
 
@@ -148,31 +156,42 @@ def _catmull_clark_step(
     e0, e1 = np.ascontiguousarray(ev[:, 0]), np.ascontiguousarray(ev[:, 1])
     sizes = np.diff(fo)
     corners = [np.ascontiguousarray(fi[j::4]) for j in range(4)] if lv.quads else []
+    ef0, ef1 = np.ascontiguousarray(lv.edge_faces[:, 0]), np.ascontiguousarray(lv.edge_faces[:, 1])
     for c in range(d):
-        x = vt[c]
+        x, f = vt[c], fp[c]
         # face points: centroids
         if lv.quads:
-            f = fp[c]
-            np.add(x[corners[0]], x[corners[1]], out=f)
-            f += x[corners[2]]
-            f += x[corners[3]]
+            g = [x[q] for q in corners]
+            np.add(g[0], g[1], out=f)
+            f += g[2]
+            f += g[3]
             f *= 0.25
         elif m:
-            np.divide(np.add.reduceat(x[fi], fo[:-1]), sizes, out=fp[c])
-        f_h = np.repeat(fp[c], 4) if lv.quads else np.repeat(fp[c], sizes)  # = fp[face]
+            np.divide(np.add.reduceat(x[fi], fo[:-1]), sizes, out=f)
         # edge points: (v0 + v1 + f0 + f1) / 4 inside, the midpoint on a boundary
         a, b = x[e0], x[e1]
         ends = a + b
         e = ep[c]
-        np.add(np.bincount(edge, f_h, n_edges), ends, out=e)
+        np.add(f[ef0], f[ef1], out=e)  # the two faces' points (a boundary's: replaced)
+        e += ends
         e *= 0.25
         if on_boundary_edge.size:
             e[on_boundary_edge] = 0.5 * ends[on_boundary_edge]
         # vertex points, smooth rule (Q + 2R + (n - 3) S) / n with n the valence:
         # = (sum of face points + sum of edge neighbours) / n^2 + (n - 2) / n * S
-        ring = np.bincount(fi, f_h, n)
-        ring += np.bincount(e0, b, n)  # each edge adds its other end to both ends
-        ring += np.bincount(e1, a, n)
+        if lv.quads:  # each quad gives each corner its face point and half of the two
+            # corners beside it: an inside edge lies in two quads, so every neighbour
+            # counts once (a boundary vertex's smooth value is replaced by its rule below)
+            ring = np.zeros(n)
+            for j in range(4):
+                t = g[(j + 1) % 4] + g[(j + 3) % 4]
+                t *= 0.5
+                t += f
+                ring += np.bincount(corners[j], t, n)
+        else:
+            ring = np.bincount(fi, np.repeat(f, sizes), n)  # fp[face]: faces in order
+            ring += np.bincount(e0, b, n)  # each edge adds its other end to both ends
+            ring += np.bincount(e1, a, n)
         np.divide(ring, kk2, out=vp[c])
         vp[c] += keep * x
     v, epr, vpr = vt.T, ep.T, vp.T  # row views (n, d) for the few sharp elements
@@ -235,6 +254,17 @@ def _catmull_clark_step(
     new_ev[2 * n_edges :, 1] = n + n_edges + face
     prev4 = np.arange(m4, dtype=np.int64) - 1
     prev4[::4] += 4
+    # each new edge's two quads (quad h is half-edge h's): a split edge lies in the quad of
+    # the half-edge leaving its end and in the quad after the one arriving there; the edge
+    # 2E + h in quad h and in the quad after it
+    new_ef = np.full((2 * n_edges + m, 2), -1, dtype=np.int64)
+    new_ef[child, 0] = h
+    new_ef[2 * n_edges + h, 0] = h
+    new_ef[child_prev, 1] = h
+    new_ef[2 * n_edges + lv.prev, 1] = h
+    for a, b in ((0, 1), (1, 0)):  # a boundary edge: its one quad twice
+        lone = new_ef[:, a] < 0
+        new_ef[lone, a] = new_ef[lone, b]
     nxt = _Level(
         face_indices=quad.reshape(-1),
         face_offsets=face_offsets,
@@ -243,6 +273,7 @@ def _catmull_clark_step(
         prev=prev4,
         edge_vertices=new_ev,
         quads=True,
+        edge_faces=new_ef,
     )
     if sharp is None or not (sharp > 1.0).any():
         return new_v, nxt, None
