@@ -25,6 +25,7 @@ from formgraph.kernels.curves import shapes as kshapes
 from formgraph.kernels.curves import text as ktext
 
 _TOLERANCE = 1e-5  # default sampling tolerance of region booleans, relative to the extent
+_LARGEST = 1e150  # the largest extent whose areas (its square, times vertex counts) are finite
 
 
 def _kernel(port: str, fn: Any, *args: Any, **kwargs: Any) -> Any:
@@ -302,13 +303,20 @@ def _chord_knots(coords: np.ndarray, offsets: np.ndarray) -> np.ndarray:
     return knots
 
 
-def _tolerance(tolerance: float | None, curves: list[Curve]) -> float:
+def _tolerance(tolerance: float | None, curves: list[Curve], port: str = "curves") -> float:
     """The sampling tolerance: given (and checked), else 1e-5 of the curves' extent. Polylines
     are taken at their vertices, so when every curve is one no extent is needed."""
     polylines = all(isinstance(c, NurbsCurve) and c.degree == 1 for c in curves)
     if tolerance is None and polylines:
         return 1.0  # unused: nothing is sampled
     extent = _extent(curves)
+    if not extent < _LARGEST:
+        raise InputError(
+            "curves" if port == "curves" else "a",
+            f"the curves span {extent:.3g}: too large for a region boolean, whose areas "
+            f"(squares of lengths) overflow double precision past {_LARGEST:.0e}; scale them "
+            "down",
+        )
     if tolerance is None:
         return _TOLERANCE * (extent if extent > 0 else 1.0)
     if not tolerance > 0:
@@ -366,7 +374,7 @@ def boolean(
     everything = [*a, *b]
     if not everything:
         raise InputError("a", "give curves to a or b, got none")
-    tol = _tolerance(tolerance, everything)
+    tol = _tolerance(tolerance, everything, "a")
     ra, sa = _rings(a, "a", tol, ctx)
     rb, sb = _rings(b, "b", tol, ctx)
     region = kregions.boolean(

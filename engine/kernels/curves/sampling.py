@@ -43,6 +43,18 @@ def _power_matrix(p: int) -> np.ndarray:
     return m
 
 
+def _steps(curv: np.ndarray, tol: float) -> np.ndarray:
+    """Equal parameter steps per piece from the bound on its ``|C''|``; a bound that
+    overflowed (coordinates near the end of double precision) is refused, not cast."""
+    steps = np.ceil(np.sqrt(_SAFETY * curv / (8.0 * tol)))
+    if not np.isfinite(steps).all() or steps.max(initial=0) > 2**53:
+        raise ValueError(
+            "the curve's numbers overflow double precision when it is sampled (its bound "
+            "on the curvature is not a finite number): scale it down"
+        )
+    return np.maximum(1, steps).astype(np.int64)
+
+
 def bezier_pieces(
     control_points: np.ndarray, degree: int, knots: np.ndarray, weights: np.ndarray | None
 ) -> np.ndarray:
@@ -168,7 +180,7 @@ def sample_nurbs(
         piece = np.repeat(np.arange(k), _GRID + 1)
         _, _, d2 = _evaluate(coef, piece, g, order=2)
         curv = np.linalg.norm(d2, axis=1).reshape(k, _GRID + 1).max(axis=1)
-        steps = np.maximum(1, np.ceil(np.sqrt(_SAFETY * curv / (8.0 * tol)))).astype(np.int64)
+        steps = _steps(curv, tol)
         total = int(steps.sum()) + 1
         if guard is not None:
             guard(total)
@@ -268,7 +280,7 @@ def sample_closed_batch(
     g = np.tile(np.linspace(0.0, 1.0, _GRID + 1), total_pieces)
     _, _, d2 = _evaluate(coef_all, np.repeat(np.arange(total_pieces), _GRID + 1), g, order=2)
     curv = np.linalg.norm(d2, axis=1).reshape(total_pieces, _GRID + 1).max(axis=1)
-    steps = np.maximum(1, np.ceil(np.sqrt(_SAFETY * curv / (8.0 * tol)))).astype(np.int64)
+    steps = _steps(curv, tol)
     if guard is not None:
         guard(int(steps.sum()) + len(k))
     piece_curve = np.repeat(np.arange(len(k)), k)
