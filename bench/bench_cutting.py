@@ -14,7 +14,8 @@ Cases:
 * ``curves.text`` of 1,000 characters (an English pangram repeated) at 10 mm: glyph
   outlines as exact NURBS, laid out with kerning, one curve per contour — against
   matplotlib's ``TextPath`` of the same text and font (which gives one path of Bezier
-  codes, no curves). The font is parsed once, as in a graph's process.
+  codes, no curves). The font is parsed once, as in a graph's process;
+* ``export.svg`` of those outlines (ours alone: the cost a curve).
 """
 
 from __future__ import annotations
@@ -112,3 +113,21 @@ def run(table) -> None:  # noqa: ANN001 - the harness's Table
 
     prop = FontProperties(family="DejaVu Sans")
     table.time(case, "matplotlib TextPath", lambda: TextPath((0, 0), text, 10, prop), repeat=3)
+
+    # export.svg of the same text: every glyph contour an exact cubic chain, all paths'
+    # numbers formatted in one call (there is no reference writer of the same paths)
+    import tempfile
+
+    from formgraph.nodes import export
+
+    glyphs = cutting.text(text, ctx=ctx)
+    with tempfile.TemporaryDirectory() as out:
+        wctx = Context("bench", Path(out))
+        seconds = table.time(
+            f"export.svg of 1,000 characters ({len(glyphs):,} curves)",
+            "formgraph",
+            lambda: export.svg(glyphs, "text.svg", ctx=wctx),
+            repeat=3,
+        )
+    if seconds is not None:
+        table.rows[-1].note = f"{seconds / len(glyphs) * 1e6:.0f} us a curve"
