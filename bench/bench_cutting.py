@@ -8,6 +8,8 @@ Cases:
   curves built from it — against shapely's ``union`` of the two ``Polygon``s of the same
   vertices (GEOS alone, nothing checked or oriented);
 * ``curves.boolean`` difference of the same pair;
+* the union of two exact circles, the arcs it cuts rebuilt exact, against shapely's union
+  of the same samples (which gives a polygon);
 * ``curves.divide`` of a 10,000-vertex open polyline into 100,000 points at equal arc
   length (with tangents and parameters) against shapely's ``line_interpolate_point`` at the
   same distances, and of a cubic NURBS of 100 control points into 10,000 points;
@@ -78,6 +80,39 @@ def run(table) -> None:  # noqa: ANN001 - the harness's Table
             [
                 ("formgraph", ours_difference, ""),
                 ("shapely", reference(shapely.difference), note),
+            ],
+        )
+
+    # two exact circles: sampled to the tolerance, united, and the cut arcs rebuilt exact
+    # (the crossings by Newton on both circles) -- against shapely on the same samples
+    from formgraph.kernels import nurbs as knurbs
+    from formgraph.kernels.curves import sampling as ksampling
+
+    circles = [NurbsCurve(*knurbs.circle(1.0)), NurbsCurve(*knurbs.circle(1.0, (1.0, 0, 0)))]
+    samples = [
+        ksampling.sample_nurbs(c.control_points, 2, c.knots, c.weights, 2e-5, closed=True)
+        for c in circles
+    ]
+    case = "union of two circles (cut arcs rebuilt exact)"
+    try:
+        import shapely
+    except ImportError:
+        table.time(case, "formgraph", lambda: cutting.union(circles, ctx=ctx), repeat=3)
+    else:
+
+        def on_samples():
+            region = shapely.union(shapely.Polygon(samples[0]), shapely.Polygon(samples[1]))
+            return shapely.get_coordinates(shapely.get_rings(shapely.get_parts(region)))
+
+        table.time_together(
+            case,
+            [
+                ("formgraph", lambda: cutting.union(circles, ctx=ctx), ""),
+                (
+                    "shapely",
+                    on_samples,
+                    f"the same {sum(map(len, samples)):,} samples, a polygon out",
+                ),
             ],
         )
 

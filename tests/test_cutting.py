@@ -511,3 +511,16 @@ def test_an_arc_meeting_a_polyline_ends_on_the_polyline():
         - shapely.Point(0, 0).buffer(1, 8192).intersection(shapely.box(0.2, 0.2, 1.4, 1.4)).area
     )
     assert region_area(out) == pytest.approx(expected, rel=1e-6)
+
+
+def test_text_cut_by_a_bar_keeps_its_quadratic_arcs_and_the_area():
+    g = fg.Graph()
+    g.add("t", "curves.text", text="AOB8&", size=10)
+    g.add("r", "curves.rectangle", size=[30, 4], radius=1.5, center=[15, 3.5, 0])
+    g.add("d", "curves.boolean", a="@t", b=["@r"], operation="difference")
+    out = g.evaluate("d")
+    assert all(c.closed and c.degree == 2 for c in out)
+    # the reference: shapely on dense samples of the same exact curves (even-odd glyphs)
+    glyphs = regions.even_odd_region([ring(c, 20000) for c in g.evaluate("t")])
+    ref = shapely.difference(glyphs, shapely.Polygon(ring(g.evaluate("r"), 40000)))
+    assert region_area(out) == pytest.approx(ref.area, rel=1e-6)
