@@ -52,6 +52,11 @@ class Source:
         return pt, d / width
 
     @functools.cached_property
+    def span(self) -> float:
+        """The diagonal of the samples' box: the scale of rounding on this curve."""
+        return float(np.hypot(*np.ptp(self.samples, axis=0)))
+
+    @functools.cached_property
     def bezier(self) -> np.ndarray:
         """The curve's Bezier pieces in XY as homogeneous points (k, p + 1, 4) (A5.6)."""
         seg, sw = decompose_bezier(self.control_points, self.degree, self.knots, self.weights)
@@ -174,8 +179,11 @@ def exact_outline(
                 if not np.array_equal(a, b):
                     chain.add(line_piece(np.r_[a, 0.0], np.r_[b, 0.0]))
             continue
-        verts = [*run.tolist(), (int(run[-1]) + 1) % m]
-        chain.add(_arc(sources[c], [t_at(v, c) for v in verts]))
+        verts = np.append(run, (run[-1] + 1) % m)
+        ts = param[verts]
+        for k in {0, len(verts) - 1, *np.flatnonzero(np.isnan(ts)).tolist()}:  # ends, crossings
+            ts[k] = t_at(int(verts[k]), c)
+        chain.add(_arc(sources[c], ts))
     return chain.curve()
 
 
@@ -202,8 +210,7 @@ def _on_chord(x: np.ndarray, src: Source, j: int) -> float | None:
             best = (gap, tj + f * (tk - tj))
     if best is None:
         return None
-    span = float(np.hypot(*np.ptp(src.samples, axis=0)))
-    return best[1] if best[0] <= 1e-9 * max(span, 1e-300) else None
+    return best[1] if best[0] <= 1e-9 * max(src.span, 1e-300) else None
 
 
 def _wrap(src: Source, t: float) -> float:
@@ -243,7 +250,7 @@ def _meet_line(a: Source, t: float, x: np.ndarray, y: np.ndarray) -> float:
     return t
 
 
-def _arc(src: Source, ts: list[float]) -> list[np.ndarray]:
+def _arc(src: Source, ts: np.ndarray) -> list[np.ndarray]:
     """The source curve from ts[0] through ts[1], ... to ts[-1] (running either way, maybe
     across its seam) as homogeneous Bezier pieces (k, p + 1, 4) in standard form."""
     lo, hi = src.domain
