@@ -8,13 +8,16 @@ Cases:
   curves built from it — against shapely's ``union`` of the two ``Polygon``s of the same
   vertices (GEOS alone, nothing checked or oriented);
 * ``curves.boolean`` difference of the same pair;
+* the union of two exact circles, the arcs it cuts rebuilt exact, against shapely's union
+  of the same samples (which gives a polygon);
 * ``curves.divide`` of a 10,000-vertex open polyline into 100,000 points at equal arc
   length (with tangents and parameters) against shapely's ``line_interpolate_point`` at the
   same distances, and of a cubic NURBS of 100 control points into 10,000 points;
 * ``curves.text`` of 1,000 characters (an English pangram repeated) at 10 mm: glyph
   outlines as exact NURBS, laid out with kerning, one curve per contour — against
   matplotlib's ``TextPath`` of the same text and font (which gives one path of Bezier
-  codes, no curves). The font is parsed once, as in a graph's process.
+  codes, no curves). The font is parsed once, as in a graph's process;
+* ``export.svg`` of those outlines (ours alone: the cost a curve).
 """
 
 from __future__ import annotations
@@ -80,6 +83,39 @@ def run(table) -> None:  # noqa: ANN001 - the harness's Table
             ],
         )
 
+    # two exact circles: sampled to the tolerance, united, and the cut arcs rebuilt exact
+    # (the crossings by Newton on both circles) -- against shapely on the same samples
+    from formgraph.kernels import nurbs as knurbs
+    from formgraph.kernels.curves import sampling as ksampling
+
+    circles = [NurbsCurve(*knurbs.circle(1.0)), NurbsCurve(*knurbs.circle(1.0, (1.0, 0, 0)))]
+    samples = [
+        ksampling.sample_nurbs(c.control_points, 2, c.knots, c.weights, 2e-5, closed=True)
+        for c in circles
+    ]
+    case = "union of two circles (cut arcs rebuilt exact)"
+    try:
+        import shapely
+    except ImportError:
+        table.time(case, "formgraph", lambda: cutting.union(circles, ctx=ctx), repeat=3)
+    else:
+
+        def on_samples():
+            region = shapely.union(shapely.Polygon(samples[0]), shapely.Polygon(samples[1]))
+            return shapely.get_coordinates(shapely.get_rings(shapely.get_parts(region)))
+
+        table.time_together(
+            case,
+            [
+                ("formgraph", lambda: cutting.union(circles, ctx=ctx), ""),
+                (
+                    "shapely",
+                    on_samples,
+                    f"the same {sum(map(len, samples)):,} samples, a polygon out",
+                ),
+            ],
+        )
+
     line = NurbsCurve.polyline(wiggly(N, 0.0))  # open: the loop without its closing edge
     case = f"divide a {N:,}-vertex polyline into 100,000 points"
     table.time(case, "formgraph", lambda: cutting.divide(line, count=100_000, ctx=ctx), repeat=3)
@@ -112,3 +148,21 @@ def run(table) -> None:  # noqa: ANN001 - the harness's Table
 
     prop = FontProperties(family="DejaVu Sans")
     table.time(case, "matplotlib TextPath", lambda: TextPath((0, 0), text, 10, prop), repeat=3)
+
+    # export.svg of the same text: every glyph contour an exact cubic chain, all paths'
+    # numbers formatted in one call (there is no reference writer of the same paths)
+    import tempfile
+
+    from formgraph.nodes import export
+
+    glyphs = cutting.text(text, ctx=ctx)
+    with tempfile.TemporaryDirectory() as out:
+        wctx = Context("bench", Path(out))
+        seconds = table.time(
+            f"export.svg of 1,000 characters ({len(glyphs):,} curves)",
+            "formgraph",
+            lambda: export.svg(glyphs, "text.svg", ctx=wctx),
+            repeat=3,
+        )
+    if seconds is not None:
+        table.rows[-1].note = f"{seconds / len(glyphs) * 1e6:.0f} us a curve"

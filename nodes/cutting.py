@@ -19,12 +19,14 @@ from formgraph.core.registry import Context, Range, node
 from formgraph.core.types import InputPath, Vec3
 from formgraph.geometry import Curve, NurbsCurve, Points, frozen_array
 from formgraph.kernels import curves as kc
+from formgraph.kernels.curves import arcs as karcs
 from formgraph.kernels.curves import regions as kregions
 from formgraph.kernels.curves import sampling as ksampling
 from formgraph.kernels.curves import shapes as kshapes
 from formgraph.kernels.curves import text as ktext
 
 _TOLERANCE = 1e-5  # default sampling tolerance of region booleans, relative to the extent
+_LARGEST = 1e150  # the largest extent whose areas (its square, times vertex counts) are finite
 
 
 def _kernel(port: str, fn: Any, *args: Any, **kwargs: Any) -> Any:
@@ -139,11 +141,13 @@ def _closed(c: Curve) -> bool:
 
 def _rings(
     curves: list[Curve], port: str, tol: float, ctx: Context
-) -> tuple[list[np.ndarray], list[np.ndarray | None]]:
-    """Each closed curve sampled to ``tol`` in XY, and (for curves that are not polylines)
-    the same rings again, to recognize the curves a boolean leaves whole."""
+) -> tuple[list[np.ndarray], list[np.ndarray | None], list[karcs.Source | None]]:
+    """Each closed curve sampled to ``tol`` in XY; (for curves that are not polylines) the
+    same rings again, to recognize the curves a boolean leaves whole; and (for NURBS of
+    degree >= 2) the curve with its samples' parameters, to rebuild the arcs it cuts."""
     rings: list[np.ndarray] = []
     sampled: list[np.ndarray | None] = []
+    sources: list[karcs.Source | None] = [None] * len(curves)
     total = 0
 
     def guard(n: int) -> None:
@@ -182,7 +186,7 @@ def _rings(
             )
             for i in members
         ]
-        sampled_batch = _kernel(port, ksampling.sample_closed_batch, batch, tol, guard)
+        sampled_batch = _kernel(port, ksampling.sample_closed_batch, batch, tol, guard, params=True)
         batched.update(zip(members, sampled_batch, strict=True))
     for i, c in enumerate(curves):  # one step per curve; its samples are vectorized
         poly = isinstance(c, NurbsCurve) and c.degree == 1
@@ -192,7 +196,15 @@ def _rings(
             ring = np.asarray(c.control_points)
             guard(len(ring))
         elif i in batched:
-            ring = batched[i]
+            ring, t = batched[i]
+            x, y = ring[:, 0], ring[:, 1]
+            keep = np.r_[True, (x[1:] != x[:-1]) | (y[1:] != y[:-1])]
+            ring, t = ring[keep], t[keep]
+            w = np.asarray(c.weights) if c.rational else None
+            flat = _flat(c)
+            sources[i] = karcs.Source(
+                np.asarray(flat.control_points), c.degree, np.asarray(c.knots), w, ring, t
+            )
         elif isinstance(c, NurbsCurve):
             w = np.asarray(c.weights) if c.rational else None
             ring = _kernel(
@@ -221,7 +233,7 @@ def _rings(
         total += len(ring)
         rings.append(ring)
         sampled.append(None if poly else ring)
-    return rings, sampled
+    return rings, sampled, sources
 
 
 def _distinct(ring: np.ndarray, closed: bool = False) -> np.ndarray:
@@ -252,10 +264,16 @@ def _flat(c: NurbsCurve) -> NurbsCurve:
 
 
 def _outlines(
-    region: Any, curves: list[Curve], sampled: list[np.ndarray | None], ctx: Context
+    region: Any,
+    curves: list[Curve],
+    sampled: list[np.ndarray | None],
+    sources: list[karcs.Source | None],
+    tol: float,
+    ctx: Context,
 ) -> list[Curve]:
     """The region's boundary as closed curves; an input curve the operation left whole
-    comes back as itself (exact), turned to the right direction."""
+    comes back as itself (exact), turned to the right direction, and the arcs of exact
+    curves it cut come back as arcs of those curves (:mod:`formgraph.kernels.curves.arcs`)."""
     coords, offsets, _ = kregions.rings_of(region, with_z=True)
     if len(offsets) < 2:
         ctx.warn("the result is empty: the regions leave no area")
@@ -267,14 +285,23 @@ def _outlines(
         matches = [None] * (len(offsets) - 1)
     xyz = frozen_array(coords)  # every outline's points: each curve's are a view of them
     knots = frozen_array(_chord_knots(coords, offsets))
+    exact = [x for x in sources if x is not None]
+    index = karcs.SampleIndex(exact) if exact else None
     result: list[Curve] = []
     for i, match in enumerate(matches):  # one step per outline
+        a, b = offsets[i], offsets[i + 1]
+        rebuilt = (
+            karcs.exact_outline(coords[a : b - 1, :2], exact, index, tol)
+            if index is not None and match is None
+            else None
+        )
         if match is not None:
             c = curves[match[0]]
             assert isinstance(c, NurbsCurve)
             result.append(_flat(c) if match[1] else _flat(_reversed(c)))
+        elif rebuilt is not None:
+            result.append(NurbsCurve(*rebuilt))
         else:
-            a, b = offsets[i], offsets[i + 1]
             # GEOS's points of finite input and their running length: valid by making
             result.append(NurbsCurve._of_valid(xyz[a:b], 1, knots[a + 2 * i : b + 2 * i + 2]))
     return result
@@ -302,13 +329,20 @@ def _chord_knots(coords: np.ndarray, offsets: np.ndarray) -> np.ndarray:
     return knots
 
 
-def _tolerance(tolerance: float | None, curves: list[Curve]) -> float:
+def _tolerance(tolerance: float | None, curves: list[Curve], port: str = "curves") -> float:
     """The sampling tolerance: given (and checked), else 1e-5 of the curves' extent. Polylines
     are taken at their vertices, so when every curve is one no extent is needed."""
     polylines = all(isinstance(c, NurbsCurve) and c.degree == 1 for c in curves)
     if tolerance is None and polylines:
         return 1.0  # unused: nothing is sampled
     extent = _extent(curves)
+    if not extent < _LARGEST:
+        raise InputError(
+            "curves" if port == "curves" else "a",
+            f"the curves span {extent:.3g}: too large for a region boolean, whose areas "
+            f"(squares of lengths) overflow double precision past {_LARGEST:.0e}; scale them "
+            "down",
+        )
     if tolerance is None:
         return _TOLERANCE * (extent if extent > 0 else 1.0)
     if not tolerance > 0:
@@ -340,7 +374,9 @@ def boolean(
     vertices), and the regions are combined by GEOS (shapely's overlay). Out come closed
     outlines at z = 0, outer boundaries counter-clockwise and holes clockwise; a curve the
     operation leaves whole (a hole that touches nothing, the plate around it) comes back
-    exact, as the input curve itself.
+    exact, as the input curve itself, and a NURBS curve it cuts comes back as its exact
+    arcs between the cuts (the cuts found by Newton's method on the exact curves), joined
+    with straight pieces into one NURBS outline.
 
     Parameters
     ----------
@@ -366,13 +402,13 @@ def boolean(
     everything = [*a, *b]
     if not everything:
         raise InputError("a", "give curves to a or b, got none")
-    tol = _tolerance(tolerance, everything)
-    ra, sa = _rings(a, "a", tol, ctx)
-    rb, sb = _rings(b, "b", tol, ctx)
+    tol = _tolerance(tolerance, everything, "a")
+    ra, sa, xa = _rings(a, "a", tol, ctx)
+    rb, sb, xb = _rings(b, "b", tol, ctx)
     region = kregions.boolean(
         kregions.even_odd_region(ra), kregions.even_odd_region(rb), operation.value
     )
-    return _outlines(region, everything, [*sa, *sb], ctx)
+    return _outlines(region, everything, [*sa, *sb], [*xa, *xb], tol, ctx)
 
 
 @node("curves.union", version=1)
@@ -407,8 +443,8 @@ def union(
     if not curves:
         raise InputError("curves", "the union needs at least one curve, got none")
     tol = _tolerance(tolerance, curves)
-    rings, sampled = _rings(curves, "curves", tol, ctx)
-    return _outlines(kregions.each_region(rings), curves, sampled, ctx)
+    rings, sampled, sources = _rings(curves, "curves", tol, ctx)
+    return _outlines(kregions.each_region(rings), curves, sampled, sources, tol, ctx)
 
 
 class Align(str, Enum):

@@ -9,6 +9,7 @@ returns the written file's path.
 from __future__ import annotations
 
 from enum import Enum
+from typing import Any
 
 import numpy as np
 
@@ -202,6 +203,7 @@ def export_step(
     meshes : list[Mesh] | None
         Meshes, as faceted solids when closed.
     """
+    _something(curves, surfaces, meshes, "STEP")
     c = _nurbs_curves(curves or [], "curves")
     s = _nurbs_surfaces(surfaces or [], "surfaces")
     meshes = meshes or []
@@ -248,6 +250,7 @@ def export_rhino(
         takes any further objects (default: a layer per kind, ``curves``, ``surfaces``,
         ``meshes``).
     """
+    _something(curves, surfaces, meshes, ".3dm")
     c = _nurbs_curves(curves or [], "curves")
     s = _nurbs_surfaces(surfaces or [], "surfaces")
     m = [_arrays(x) for x in meshes or []]
@@ -257,6 +260,25 @@ def export_rhino(
     except ValueError as exc:
         raise InputError("layers" if "layers" in str(exc) else "path", str(exc)) from None
     return str(ctx.write(path, data))
+
+
+def _something(curves: Any, surfaces: Any, meshes: Any, kind: str) -> None:
+    """Refuse to write a file of nothing (before anything is written)."""
+    if curves or surfaces or meshes:
+        return
+    given = [
+        n
+        for n, v in (("curves", curves), ("surfaces", surfaces), ("meshes", meshes))
+        if v is not None
+    ]
+    if given:
+        raise InputError(
+            given[0],
+            f"{' and '.join(given)} hold nothing: a {kind} file of no geometry is not written",
+        )
+    raise InputError(
+        "curves", f"give curves, surfaces or meshes: a {kind} file of no geometry is not written"
+    )
 
 
 def _arrays(m: Mesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

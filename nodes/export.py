@@ -404,7 +404,9 @@ def curve_path(curve: Curve, samples: int = 1024) -> Path2D:
             return Path2D("polyline", pts, closed=closed)
         w = np.asarray(curve.weights) if curve.rational else None
         if curve.degree <= 3 and w is None:
-            seg, _ = nurbs.decompose_bezier(cp, curve.degree, curve.knots, None)
+            seg = _bezier_form(cp, curve.degree, np.asarray(curve.knots))
+            if seg is None:
+                seg = nurbs.decompose_bezier(cp, curve.degree, curve.knots, None)[0]
             seg = seg[:, :, :2]
             if curve.degree == 2:  # degree elevation of a quadratic Bezier (exact)
                 seg = np.stack(
@@ -426,6 +428,28 @@ def curve_path(curve: Curve, samples: int = 1024) -> Path2D:
     if closed:
         pts = pts[:-1]
     return Path2D("polyline", pts, closed=closed)
+
+
+def _bezier_form(cp: np.ndarray, p: int, knots: np.ndarray) -> np.ndarray | None:
+    """The Bezier pieces (k, p + 1, 3) of a curve already in Bezier form (clamped, every
+    inner knot of multiplicity p: glyph outlines, rounded rectangles), read off its control
+    points without knot insertion; None for any other knot vector."""
+    n = len(cp)
+    if (n - 1) % p or len(knots) != n + p + 1:
+        return None
+    k = (n - 1) // p
+    ends = knots[: p + 1], knots[n:]
+    inner = knots[p + 1 : n].reshape(k - 1, p)
+    breaks = np.concatenate([ends[0][:1], inner[:, 0], ends[1][:1]])
+    if not (
+        np.all(ends[0] == ends[0][0])
+        and np.all(ends[1] == ends[1][0])
+        and np.all(inner == inner[:, :1])
+        and np.all(np.diff(breaks) > 0)
+    ):
+        return None
+    at = np.arange(k)[:, None] * p + np.arange(p + 1)
+    return cp[at]
 
 
 def _circular_pieces(cp: np.ndarray, knots: np.ndarray, w: np.ndarray) -> np.ndarray | None:

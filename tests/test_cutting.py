@@ -461,3 +461,66 @@ def test_a_hundred_rings_take_the_indexed_path_and_agree_with_shapely():
         * shapely.intersection(shapely.Polygon(rings[0]), shapely.Polygon(rings[1])).area
     )
     assert xor.area == pytest.approx(expected, rel=1e-9)
+
+
+# --------------------------------------------------------------------------- exact arcs
+
+
+def _on_circles(c: NurbsCurve, circles: list[tuple[float, float, float]], n: int = 4001):
+    """Per point of c, its distance from the nearest of the circles (cx, cy, r)."""
+    p = np.asarray(c.evaluate(np.linspace(*c.domain, n)))[:, :2]
+    return np.min([np.abs(np.hypot(*(p - [x, y]).T) - r) for x, y, r in circles], axis=0)
+
+
+def test_the_union_of_two_circles_is_two_exact_arcs_of_them():
+    out = run("curves.union", curves=[circle(1.0), circle(1.0, 1.0)])
+    assert len(out) == 1
+    c = out[0]
+    assert c.degree == 2 and c.rational and c.closed and signed_area(c) > 0
+    assert _on_circles(c, [(0, 0, 1), (1, 0, 1)]).max() < 1e-12
+    # the two crossings (1/2, +-sqrt(3)/2) are corners of the outline, exactly
+    cp = np.asarray(c.control_points)[:, :2]
+    for y in (math.sqrt(3) / 2, -math.sqrt(3) / 2):
+        assert np.min(np.hypot(cp[:, 0] - 0.5, cp[:, 1] - y)) < 1e-14
+    assert region_area(out) == pytest.approx(2 * math.pi - lens(1, 1), abs=1e-6)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_cut_arcs_of_random_circles_stay_on_their_circles(seed):
+    rng = np.random.default_rng(seed)
+    circles = [(*rng.uniform(-2, 2, 2), rng.uniform(0.5, 1.5)) for _ in range(4)]
+    curves = [circle(r, x, y) for x, y, r in circles]
+    union = run("curves.union", curves=curves)
+    ref = shapely.union_all([shapely.Point(x, y).buffer(r, 4096) for x, y, r in circles])
+    assert region_area(union) == pytest.approx(ref.area, rel=1e-5)
+    diff = run("curves.boolean", a=curves[:1], b=curves[1:], operation="difference")
+    for c in [*union, *diff]:
+        assert c.closed and _on_circles(c, circles).max() < 1e-9
+
+
+def test_an_arc_meeting_a_polyline_ends_on_the_polyline():
+    # a disc cut by a square: arcs of the circle, then the square's sides, joined exactly
+    out = run("curves.boolean", a=[circle(1.0)], b=[square(1.2, 0.8, 0.8)], operation="difference")
+    (c,) = out
+    p = np.asarray(c.evaluate(np.linspace(*c.domain, 8001)))[:, :2]
+    on_circle = np.abs(np.hypot(*p.T) - 1) < 1e-12
+    on_side = (np.abs(p[:, 0] - 0.2) < 1e-12) | (np.abs(p[:, 1] - 0.2) < 1e-12)
+    assert (on_circle | on_side).all() and on_circle.sum() > 5000
+    expected = (
+        math.pi
+        - shapely.Point(0, 0).buffer(1, 8192).intersection(shapely.box(0.2, 0.2, 1.4, 1.4)).area
+    )
+    assert region_area(out) == pytest.approx(expected, rel=1e-6)
+
+
+def test_text_cut_by_a_bar_keeps_its_quadratic_arcs_and_the_area():
+    g = fg.Graph()
+    g.add("t", "curves.text", text="AOB8&", size=10)
+    g.add("r", "curves.rectangle", size=[30, 4], radius=1.5, center=[15, 3.5, 0])
+    g.add("d", "curves.boolean", a="@t", b=["@r"], operation="difference")
+    out = g.evaluate("d")
+    assert all(c.closed and c.degree == 2 for c in out)
+    # the reference: shapely on dense samples of the same exact curves (even-odd glyphs)
+    glyphs = regions.even_odd_region([ring(c, 20000) for c in g.evaluate("t")])
+    ref = shapely.difference(glyphs, shapely.Polygon(ring(g.evaluate("r"), 40000)))
+    assert region_area(out) == pytest.approx(ref.area, rel=1e-6)

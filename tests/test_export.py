@@ -259,3 +259,27 @@ def test_nurbs_circles_and_arcs_become_svg_arcs_and_dxf_splines(tmp_path):
     ):
         pts = np.array(list(spline.construction_tool().points(np.linspace(0, 1, 501))))
         assert np.abs(np.linalg.norm(pts - centre, axis=1) - r).max() < 1e-9
+
+
+def test_curves_in_bezier_form_are_read_off_their_control_points():
+    # glyph outlines and rounded rectangles are in Bezier form already: the drawing path
+    # takes their pieces without knot insertion, the same pieces as A5.6 gives
+    import formgraph as fg
+    from formgraph.kernels import nurbs as kn
+    from formgraph.nodes.export import _bezier_form
+
+    g = fg.Graph()
+    g.add("t", "curves.text", text="gS8")
+    g.add("r", "curves.rectangle", size=[8, 3], radius=1)
+    rect = g.evaluate("r")
+    cubic = fg.NurbsCurve(
+        np.random.default_rng(3).normal(size=(7, 3)), 3, kn.clamped_uniform_knots(7, 3)
+    )
+    for c in [*g.evaluate("t"), rect]:
+        cp = np.asarray(c.control_points)
+        ours = _bezier_form(cp, c.degree, np.asarray(c.knots))
+        ref, _ = kn.decompose_bezier(cp, c.degree, c.knots, None)
+        np.testing.assert_array_equal(ours, ref)
+        assert c.closed == fg.Curve.closed.fget(c)  # the clamped shortcut agrees
+    assert _bezier_form(np.asarray(cubic.control_points), 3, np.asarray(cubic.knots)) is None
+    assert cubic.closed is False and fg.Curve.closed.fget(cubic) is False

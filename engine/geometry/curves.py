@@ -126,6 +126,18 @@ class NurbsCurve(Curve):
         return cls(p, 1, knots)
 
     @property
+    def closed(self) -> bool:
+        """Whether the curve ends where it starts. A clamped curve ends on its first and
+        last control points, so those are compared (relative to the control points' size,
+        the hull the curve lies in) without evaluating anything; others are evaluated."""
+        p, k = self.degree, self.knots
+        if k[0] == k[p] and k[-1] == k[-1 - p]:
+            cp = self.control_points
+            scale = max(1.0, float(np.abs(cp).max()))
+            return bool(np.linalg.norm(cp[0] - cp[-1]) <= 1e-9 * scale)
+        return super().closed
+
+    @property
     def domain(self) -> tuple[float, float]:  # type: ignore[override]
         p = self.degree
         return float(self.knots[p]), float(self.knots[len(self.control_points)])

@@ -23,6 +23,7 @@ from ..nurbs import decompose_bezier
 __all__ = [
     "bezier_pieces",
     "chord_gap",
+    "piece_jet",
     "polyline_at_lengths",
     "refine_chords",
     "sample_closed_batch",
@@ -41,6 +42,18 @@ def _power_matrix(p: int) -> np.ndarray:
         for j in range(i, p + 1):
             m[i, j] = math.comb(p, i) * math.comb(p - i, j - i) * (-1) ** (j - i)
     return m
+
+
+def _steps(curv: np.ndarray, tol: float) -> np.ndarray:
+    """Equal parameter steps per piece from the bound on its ``|C''|``; a bound that
+    overflowed (coordinates near the end of double precision) is refused, not cast."""
+    steps = np.ceil(np.sqrt(_SAFETY * curv / (8.0 * tol)))
+    if not np.isfinite(steps).all() or steps.max(initial=0) > 2**53:
+        raise ValueError(
+            "the curve's numbers overflow double precision when it is sampled (its bound "
+            "on the curvature is not a finite number): scale it down"
+        )
+    return np.maximum(1, steps).astype(np.int64)
 
 
 def bezier_pieces(
@@ -77,6 +90,17 @@ def _evaluate(coef: np.ndarray, piece: np.ndarray, t: np.ndarray, order: int = 0
     v1 = (h1[:, :2] - w1 * pt) / w
     v2 = (h2[:, :2] - 2 * w1 * v1 - w2 * pt) / w
     return pt, v1, v2
+
+
+def piece_jet(coef: np.ndarray, piece: int, t: float) -> tuple[np.ndarray, np.ndarray]:
+    """The point and first derivative (in the piece's parameter on [0, 1]) of Bezier piece
+    ``piece`` of :func:`bezier_pieces` at ``t``: a handful of flops, for Newton steps."""
+    c = coef[piece]  # (p + 1, 3): power-form rows of (w x, w y, w)
+    j = np.arange(len(c))
+    h = (t**j) @ c
+    h1 = (j[1:] * t ** (j[1:] - 1)) @ c[1:]
+    pt = h[:2] / h[2]
+    return pt, (h1[:2] - h1[2] * pt) / h[2]
 
 
 def chord_gap(a: np.ndarray, b: np.ndarray, p: np.ndarray) -> np.ndarray:
@@ -131,7 +155,8 @@ def sample_nurbs(
     tol: float,
     closed: bool,
     guard: Callable[[int], None] | None = None,
-) -> np.ndarray:
+    params: bool = False,
+) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
     """XY points of a NURBS curve with every chord within ``tol`` of the curve.
 
     A degree-1 curve is its control polygon (exact). Otherwise each Bezier piece gets
@@ -152,23 +177,31 @@ def sample_nurbs(
         Called with the count before sampling (and before each refinement round), to
         refuse too many.
 
+    params : bool
+        Also give each point's curve parameter.
+
     Returns
     -------
-    (m, 2) float
+    (m, 2) float, and with ``params`` the (m,) parameters
     """
     if not tol > 0:
         raise ValueError(f"the sampling tolerance must be positive, got {tol}")
     cp = np.asarray(control_points, dtype=np.float64)
+    kn = np.asarray(knots, dtype=np.float64)
     if degree == 1:
         p = cp[:, :2]
+        u = np.arange(len(cp), dtype=np.float64)  # degree 1: piece j runs from point j to j + 1
+        breaks = kn[1 : len(cp) + 1]
     else:
+        n = len(cp)
+        breaks = np.unique(kn[degree : n + 1])
         coef = bezier_pieces(cp, degree, knots, weights)
         k = coef.shape[0]
         g = np.tile(np.linspace(0.0, 1.0, _GRID + 1), k)
         piece = np.repeat(np.arange(k), _GRID + 1)
         _, _, d2 = _evaluate(coef, piece, g, order=2)
         curv = np.linalg.norm(d2, axis=1).reshape(k, _GRID + 1).max(axis=1)
-        steps = np.maximum(1, np.ceil(np.sqrt(_SAFETY * curv / (8.0 * tol)))).astype(np.int64)
+        steps = _steps(curv, tol)
         total = int(steps.sum()) + 1
         if guard is not None:
             guard(total)
@@ -183,10 +216,19 @@ def sample_nurbs(
 
         u, p = refine_chords(at, u, at(u), tol, guard)
     if closed and len(p) > 1 and np.array_equal(p[0], p[-1]):
-        p = p[:-1]
+        p, u = p[:-1], u[:-1]
     elif closed and len(p) > 1 and np.abs(p[0] - p[-1]).max() <= 1e-12 * max(1.0, np.abs(p).max()):
-        p = p[:-1]
-    return np.ascontiguousarray(p)
+        p, u = p[:-1], u[:-1]
+    if not params:
+        return np.ascontiguousarray(p)
+    return np.ascontiguousarray(p), _knot_parameter(u, breaks)
+
+
+def _knot_parameter(u: np.ndarray, breaks: np.ndarray) -> np.ndarray:
+    """The curve parameter of piece-space parameters ``u`` (piece j is ``[j, j + 1]``, the
+    knot span ``[breaks[j], breaks[j + 1]]``, mapped linearly as the decomposition does)."""
+    j = np.minimum(np.floor(u).astype(np.int64), len(breaks) - 2)
+    return breaks[j] + (u - j) * (breaks[j + 1] - breaks[j])
 
 
 def polyline_at_lengths(
@@ -237,7 +279,8 @@ def sample_closed_batch(
     curves: list[tuple[np.ndarray, int, np.ndarray, np.ndarray | None]],
     tol: float,
     guard: Callable[[int], None] | None = None,
-) -> list[np.ndarray]:
+    params: bool = False,
+) -> list[np.ndarray] | list[tuple[np.ndarray, np.ndarray]]:
     """:func:`sample_nurbs` of many closed curves of one degree (>= 2) at once.
 
     Every curve's Bezier pieces go into one array, so the curvature bound, the sampling and
@@ -268,7 +311,7 @@ def sample_closed_batch(
     g = np.tile(np.linspace(0.0, 1.0, _GRID + 1), total_pieces)
     _, _, d2 = _evaluate(coef_all, np.repeat(np.arange(total_pieces), _GRID + 1), g, order=2)
     curv = np.linalg.norm(d2, axis=1).reshape(total_pieces, _GRID + 1).max(axis=1)
-    steps = np.maximum(1, np.ceil(np.sqrt(_SAFETY * curv / (8.0 * tol)))).astype(np.int64)
+    steps = _steps(curv, tol)
     if guard is not None:
         guard(int(steps.sum()) + len(k))
     piece_curve = np.repeat(np.arange(len(k)), k)
@@ -302,4 +345,16 @@ def sample_closed_batch(
         curve_of = np.concatenate([curve_of, cm[far]])[order]
     ends = np.searchsorted(curve_of, np.arange(len(k) + 1))
     # each curve without its last sample (its end, the start again)
-    return [np.ascontiguousarray(pts[ends[i] : ends[i + 1] - 1]) for i in range(len(k))]
+    out = [np.ascontiguousarray(pts[ends[i] : ends[i + 1] - 1]) for i in range(len(k))]
+    if not params:
+        return out
+    local = u - base[curve_of]
+    return [
+        (out[i], _knot_parameter(local[ends[i] : ends[i + 1] - 1], _breaks(curves[i])))
+        for i in range(len(k))
+    ]
+
+
+def _breaks(curve: tuple[np.ndarray, int, np.ndarray, np.ndarray | None]) -> np.ndarray:
+    cp, p, kn, _ = curve
+    return np.unique(np.asarray(kn, dtype=np.float64)[p : len(cp) + 1])

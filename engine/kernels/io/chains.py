@@ -43,6 +43,12 @@ def arc_pieces(
     scaled ellipse) is exact this way.
     """
     sweep = t1 - t0
+    if not (math.isfinite(sweep) and np.isfinite(center).all() and np.isfinite(a).all()
+            and np.isfinite(b).all()):  # fmt: skip
+        raise ValueError(
+            "an arc's centre, radii or angles are not finite numbers (too large for double "
+            "precision, or not numbers at all)"
+        )
     if sweep == 0:
         return []
     n = max(1, math.ceil(abs(sweep) / (math.pi / 2) - 1e-9))
@@ -67,6 +73,8 @@ def bulge_arc(p0: np.ndarray, p1: np.ndarray, bulge: float) -> list[np.ndarray]:
     p0, p1 = np.asarray(p0, dtype=np.float64), np.asarray(p1, dtype=np.float64)
     chord = p1[:2] - p0[:2]
     length = float(np.hypot(*chord))
+    if not math.isfinite(bulge):
+        raise ValueError(f"a bulge of {bulge} is not a finite number")
     if length == 0 or bulge == 0:
         return [line_piece(p0, p1)]
     theta = 4.0 * math.atan(bulge)

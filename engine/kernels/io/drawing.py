@@ -186,24 +186,6 @@ def _numbers(values: np.ndarray, decimals: int, lead: bytes = b" ") -> np.ndarra
     return float_words(np.asarray(values, dtype=np.float64).ravel(), decimals=decimals, lead=lead)
 
 
-def _command(letter: bytes, nwords: int) -> np.ndarray:
-    row = np.zeros((1, nwords), dtype=np.uint64)
-    row[0, 0] = np.uint64(int.from_bytes(letter, "little"))
-    return row
-
-
-def _path_text(items: list[tuple[bytes, np.ndarray]]) -> bytes:
-    """Squeeze a sequence of (command letters, rows of number words) into path data."""
-    blocks = []
-    for letter, rows in items:  # a handful of commands per path
-        blocks.append(_command(letter, rows.shape[1] if rows.size else 3))
-        if rows.size:
-            blocks.append(rows)
-    width = max(b.shape[1] for b in blocks)
-    blocks = [np.pad(b, ((0, 0), (0, width - b.shape[1]))) for b in blocks]
-    return squeeze(np.concatenate(blocks).view(np.uint8))
-
-
 # --------------------------------------------------------------------------------------------
 # SVG
 
@@ -272,7 +254,7 @@ def svg_bytes(
         f'fill="none" stroke-width="{fmt([stroke_width])}" '
         'stroke-linecap="round" stroke-linejoin="round"'
     )
-    body = [_svg_path(path, decimals) for path in paths]
+    body = _svg_paths(paths, decimals)
     lines = [head]
     if styles is None:
         lines += [f'<g {style} stroke="#000000">\n'.encode(), *body, b"</g>\n"]
@@ -291,13 +273,13 @@ def svg_bytes(
     return b"".join(lines)
 
 
-def _svg_path(path: Path2D, decimals: int) -> bytes:
-    """One ``<path d=...>`` element (its points formatted in bulk)."""
+def _svg_items(path: Path2D) -> list[tuple[bytes, np.ndarray]]:
+    """The path data of one path as (command, (k, m) numbers) in order."""
     q = path.points * np.array([1.0, -1.0])
     if path.kind == "polyline":
-        items = [(b" M", _numbers(q[:1], decimals)), (b" L", _numbers(q[1:], decimals))]
+        items = [(b"M", q[:1]), (b" L", q[1:])]
     elif path.kind == "cubic":
-        items = [(b" M", _numbers(q[:1], decimals)), (b" C", _numbers(q[1:], decimals))]
+        items = [(b"M", q[:1]), (b" C", q[1:])]
     else:
         _, radius, _, sweep, straight = _arc_geometry(path.points)
         # Flipping y mirrors every arc, so a counter-clockwise arc of the model runs the
@@ -306,18 +288,55 @@ def _svg_path(path: Path2D, decimals: int) -> bytes:
         k = len(radius)
         cols = [radius, radius, np.zeros(k), np.zeros(k), (sweep < 0) * 1.0]
         args = np.column_stack(cols + [q[2::2, 0], q[2::2, 1]])
-        items = [(b" M", _numbers(q[:1], decimals))]
+        items = [(b"M", q[:1])]
         # straight pieces (a rounded rectangle's sides) as L: an arc of radius 0 is a line in
         # the SVG spec (F.6.2) but not in every reader; runs of each kind share a command
         cuts = np.flatnonzero(np.diff(straight.astype(np.int8))) + 1
         for run in np.split(np.arange(k), cuts):  # alternating runs: a handful
             if straight[run[0]]:
-                items.append((b" L", _numbers(args[run, 5:], decimals)))
+                items.append((b" L", args[run, 5:]))
             else:
-                items.append((b" A", _numbers(args[run], decimals)))
+                items.append((b" A", args[run]))
     if path.closed:
-        items.append((b" Z", np.zeros((0, 3), dtype=np.uint64)))
-    return b'<path d="' + _path_text(items)[1:] + b'"/>\n'
+        items.append((b" Z", np.zeros((0, 1))))
+    return items
+
+
+def _svg_paths(paths: Sequence[Path2D], decimals: int) -> list[bytes]:
+    """Every ``<path d=...>`` element, one per path (each ends in a newline).
+
+    The numbers of all paths are formatted in one call and all the elements squeezed out of
+    one canvas of words, so a drawing of many small curves (text) costs what its numbers
+    cost, not a fixed overhead per curve.
+    """
+    items = [_svg_items(path) for path in paths]
+    flat = [v for its in items for _, v in its]
+    values = np.concatenate([v.ravel() for v in flat]) if flat else np.zeros(0)
+    rows = _numbers(values, decimals)
+    width = max(rows.shape[1], 2)
+    if rows.shape[1] < width:
+        rows = np.pad(rows, ((0, 0), (0, width - rows.shape[1])))
+    words: dict[bytes, np.ndarray] = {}
+
+    def text(t: bytes) -> np.ndarray:  # a short text as one row of words
+        if t not in words:
+            row = np.zeros(width * 8, dtype=np.uint8)
+            row[: len(t)] = np.frombuffer(t, dtype=np.uint8)
+            words[t] = row.view(np.uint64)[None, :]
+        return words[t]
+
+    blocks: list[np.ndarray] = []
+    at = 0
+    for its in items:  # one step per path, a handful of commands each
+        blocks.append(text(b'<path d="'))
+        for letter, v in its:
+            blocks.append(text(letter))
+            blocks.append(rows[at : at + v.size])
+            at += v.size
+        blocks.append(text(b'"/>\n'))
+    return [
+        line + b"\n" for line in squeeze(np.concatenate(blocks).view(np.uint8)).split(b"\n")[:-1]
+    ]
 
 
 # --------------------------------------------------------------------------------------------

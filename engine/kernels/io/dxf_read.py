@@ -46,18 +46,25 @@ def read_dxf(data: bytes, max_entities: int = MAX_ENTITIES) -> tuple[list[DxfCur
     Raises
     ------
     ValueError
-        For a file ezdxf cannot read, or an expansion over the budget.
+        For a file ezdxf cannot read, an expansion over the budget, or an INSERT scaled by
+        zero (or a non-finite number).
     """
     import ezdxf
     from ezdxf import recover
+    from ezdxf.audit import AuditError
 
     try:
-        doc, _ = recover.read(io.BytesIO(data))
+        doc, auditor = recover.read(io.BytesIO(data))
     except (ezdxf.DXFError, ValueError, TypeError, IndexError, KeyError, UnicodeError) as exc:
         raise ValueError(f"not a DXF drawing ({type(exc).__name__}: {str(exc)[:100]})") from None
     scale = UNITS_MM.get(int(doc.header.get("$INSUNITS", 0) or 0), 1.0)
     out: list[DxfCurve] = []
     skipped: Counter = Counter()
+    # the recovery deletes an INSERT whose block the file does not define: counted, so the
+    # reader says so rather than drawing less without a word
+    for fix in auditor.fixes:
+        if fix.code == AuditError.UNDEFINED_BLOCK:
+            skipped["INSERT of a block the file does not define"] += 1
     count = 0
     stack = [(iter(doc.modelspace()), None, 0)]
     while stack:
@@ -78,6 +85,14 @@ def read_dxf(data: bytes, max_entities: int = MAX_ENTITIES) -> tuple[list[DxfCur
         if kind == "INSERT":
             if depth >= MAX_DEPTH:
                 raise ValueError(f"blocks nest deeper than {MAX_DEPTH} levels")
+            name = e.dxf.get("name", "")
+            scales = [e.dxf.get(f"{axis}scale", 1.0) for axis in "xyz"]
+            if not all(math.isfinite(f) and f != 0 for f in scales):
+                raise ValueError(
+                    f"INSERT {e.dxf.get('handle', '?')} of block {name!r}: a scale of "
+                    f"{', '.join(f'{f:g}' for f in scales)} (x, y, z) flattens or overflows it; "
+                    "every scale must be a non-zero finite number"
+                )
             copies = max(1, int(e.dxf.get("row_count", 1))) * max(
                 1, int(e.dxf.get("column_count", 1))
             )

@@ -14,7 +14,7 @@ import re
 
 import numpy as np
 
-from .textscan import Lines, ints_at, line_numbers, parse_floats, token_starts
+from .textscan import Lines, TokenError, ints_at, line_numbers, parse_floats, token_starts
 
 __all__ = ["read_obj", "read_off", "read_stl", "triangles_flat"]
 
@@ -129,7 +129,15 @@ def read_obj(data: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     buf = np.frombuffer(data, dtype=np.uint8)
     lines = Lines(buf)
     is_v, is_f = lines.keyword(b"v"), lines.keyword(b"f")
+    if not is_v.any() and not is_f.any() and bytes(data).strip() and not _any_obj_line(lines):
+        raise ValueError("no OBJ statement (v, f, o, g, # ...) on any line: not an OBJ file")
     v = _rows(lines, is_v, b"v", 3, "vertex")
+    finite = np.isfinite(v).all(axis=1)
+    if not finite.all():
+        k = int(np.argmin(finite))
+        bad = v[k][~np.isfinite(v[k])][0]
+        line = np.flatnonzero(is_v)[k] + 1
+        raise ValueError(f"line {line}: a vertex coordinate is {bad}, not a finite number")
     text, starts = lines.text(is_f, skip=1)
     tokens = token_starts(text)
     line_of = line_numbers(starts, tokens)
@@ -140,8 +148,9 @@ def read_obj(data: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         raise ValueError(f"line {f_lines[k] + 1}: a face needs at least 3 vertices")
     try:
         idx, _ = ints_at(text, tokens)  # a token 'v/vt/vn' starts with its vertex index
-    except ValueError as exc:
-        raise ValueError(f"a face line has {exc}") from None
+    except TokenError as exc:
+        line = f_lines[line_numbers(starts, np.array([exc.offset]))[0]] + 1
+        raise ValueError(f"line {line}: a face's vertex: {exc}") from None
     before = np.cumsum(is_v)[f_lines] if f_lines.size else np.zeros(0, np.int64)
     idx = np.where(idx < 0, idx + np.repeat(before, sizes), idx - 1)
     bad = (idx < 0) | (idx >= len(v))
@@ -154,6 +163,17 @@ def read_obj(data: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return v, idx, np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
 
 
+_OBJ_WORDS = (b"#", b"v", b"vt", b"vn", b"vp", b"f", b"l", b"p", b"o", b"g", b"s", b"usemtl",
+              b"mtllib", b"cstype", b"deg", b"curv", b"parm", b"end")  # fmt: skip
+
+
+def _any_obj_line(lines: Lines) -> bool:
+    """Whether any line starts with an OBJ statement (a file of none is not OBJ)."""
+    return any(lines.keyword(w).any() for w in _OBJ_WORDS) or bool(
+        (lines.buf[np.minimum(lines.starts, lines.buf.size - 1)] == ord("#")).any()
+    )
+
+
 def _rows(lines: Lines, which: np.ndarray, word: bytes, width: int, what: str) -> np.ndarray:
     """The first ``width`` numbers of each chosen line (which must have at least that many)."""
     text, starts = lines.text(which, skip=len(word))
@@ -163,7 +183,11 @@ def _rows(lines: Lines, which: np.ndarray, word: bytes, width: int, what: str) -
     if counts.size and counts.min() < width:
         k = int(np.argmin(counts))
         raise ValueError(f"line {chosen[k] + 1}: a {what} needs {width} numbers")
-    values = parse_floats(text, int(counts.sum()))
+    try:
+        values = parse_floats(text, int(counts.sum()))
+    except TokenError as exc:
+        line = chosen[line_numbers(starts, np.array([exc.offset]))[0]] + 1
+        raise ValueError(f"line {line}: {exc}") from None
     if np.all(counts == width):
         return values.reshape(-1, width)
     first = np.concatenate([[0], np.cumsum(counts)[:-1]])

@@ -142,10 +142,12 @@ def read_svg(data: bytes, max_elements: int = MAX_ELEMENTS) -> tuple[list[SvgCur
     import svgelements as se
 
     _bounded(data, max_elements)
+    _finite_values(data)
     try:
         doc = se.SVG.parse(io.BytesIO(data), reify=False, ppi=96.0, on_error="raise")
     except Exception as exc:  # svgelements raises what its XML parser raises
         raise ValueError(f"not an SVG document ({type(exc).__name__}: {str(exc)[:100]})") from None
+    _drawable_view_box(data)
     mm, declared = _mm_per_px(data, doc)
     height = _length(getattr(doc, "height", None)) if declared else 0.0
     flip = np.array([mm, -mm, 1.0])
@@ -174,10 +176,61 @@ def read_svg(data: bytes, max_elements: int = MAX_ELEMENTS) -> tuple[list[SvgCur
         m = node.transform  # local to document pixels: applied to the control points (exact)
         lin = np.array([[m.a, m.c, 0.0], [m.b, m.d, 0.0], [0.0, 0.0, 1.0]], dtype=np.float64)
         move = np.array([m.e, m.f, 0.0], dtype=np.float64)
-        for chain in _chains(se.Path(node), se):
+        try:
+            chains = _chains(se.Path(node), se)
+        except ValueError as exc:
+            tag = type(node).__name__.lower()
+            name = f" id {node.id!r}" if getattr(node, "id", None) else ""
+            raise ValueError(f"a {tag}{name}: {exc}") from None
+        for chain in chains:
             cp, p, k, w = chain.curve()
             out.append(SvgCurve(((cp @ lin.T + move) * flip + shift, p, k, w), layer))
     return out, passed
+
+
+# the attributes that hold coordinates and lengths, and a NaN or infinity written in one
+_GEOMETRIC = rb"d|points|x|y|x1|y1|x2|y2|cx|cy|r|rx|ry|width|height|viewBox|transform"
+_ATTRIBUTE = re.compile(rb"\s(" + _GEOMETRIC + rb")\s*=\s*(\"[^\"]*\"|'[^']*')")
+_NOT_FINITE = re.compile(rb"(?<![A-Za-z0-9_#.-])[+-]?(nan|inf(inity)?)(?![A-Za-z0-9_-])", re.I)
+
+
+def _finite_values(data: bytes) -> None:
+    """Refuse a NaN or an infinity in a coordinate, length or transform, naming its line
+    and attribute (svgelements parses them as numbers and then draws nothing, or fails
+    without a word)."""
+    if not re.search(rb"(?i)nan|inf", data):
+        return
+    for m in _ATTRIBUTE.finditer(data):  # the rare file that spells one: attribute by attribute
+        bad = _NOT_FINITE.search(m.group(2))
+        if bad:
+            line = data.count(b"\n", 0, m.start()) + 1
+            raise ValueError(
+                f"line {line}: the {m.group(1).decode()} attribute holds "
+                f"{bad.group().decode('latin-1')!r}; coordinates and lengths must be finite "
+                "numbers"
+            )
+
+
+def _drawable_view_box(data: bytes) -> None:
+    """Refuse a root ``viewBox`` of zero (or negative) width or height: the SVG
+    specification draws nothing for it (zero disables rendering; negative is an error)."""
+    root = re.search(rb"<(?:\w+:)?svg\b([^>]*)>", data[: 1 << 16])
+    box = root and re.search(rb"\sviewBox\s*=\s*[\"']([^\"']*)[\"']", root.group(1))
+    if not box:
+        return
+    numbers = re.split(rb"[\s,]+", box.group(1).strip())
+    try:
+        w, h = float(numbers[2]), float(numbers[3])
+    except (IndexError, ValueError):
+        raise ValueError(
+            f"the root's viewBox {box.group(1).decode('latin-1')[:40]!r} is not four numbers "
+            "(min-x min-y width height)"
+        ) from None
+    if not (w > 0 and h > 0):
+        raise ValueError(
+            f"the root's viewBox {box.group(1).decode('latin-1')[:40]!r} has a width or height "
+            "of zero or less: an SVG viewer draws nothing of it"
+        )
 
 
 _UNIT_MM = {
@@ -314,6 +367,11 @@ def _arc(seg: object, p0: np.ndarray, p1: np.ndarray) -> list[np.ndarray]:
         delta -= 2 * math.pi
     a = rx * np.array([cos_p, sin_p, 0.0])
     b = ry * np.array([-sin_p, cos_p, 0.0])
+    if not (np.isfinite(center).all() and math.isfinite(delta) and np.isfinite(a + b).all()):
+        raise ValueError(
+            "an arc is too large for double precision: its radii or its centre overflow (the "
+            "centre is found through squares of the radii)"
+        )
     pieces = arc_pieces(center, a, b, t0, t0 + delta)
     pieces[0][0, :3], pieces[-1][-1, :3] = p0, p1  # the joints exactly where the path has them
     return pieces

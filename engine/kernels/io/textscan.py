@@ -8,11 +8,27 @@ text reads back as the same double.
 
 from __future__ import annotations
 
+import re
 import warnings
 
 import numpy as np
 
-__all__ = ["Lines", "ints_at", "line_numbers", "parse_floats", "token_starts"]
+__all__ = ["Lines", "TokenError", "ints_at", "line_numbers", "parse_floats", "token_starts"]
+
+# what C's strtod (np.fromstring) reads as one number: Python's float() also takes "1_000"
+_C_NUMBER = re.compile(
+    rb"[+-]?(?:(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?|nan|inf(?:inity)?)", re.I
+)
+
+
+class TokenError(ValueError):
+    """A token that is not what the format wants; ``offset`` is where it starts in the
+    scanned text, so a reader can name its line."""
+
+    def __init__(self, message: str, offset: int):
+        super().__init__(message)
+        self.offset = offset
+
 
 _SPACE = np.zeros(256, dtype=bool)
 _SPACE[[9, 10, 11, 12, 13, 32]] = True
@@ -86,8 +102,8 @@ def parse_floats(buf: np.ndarray, expected: int) -> np.ndarray:
 
     Raises
     ------
-    ValueError
-        When a token is not a number or the count differs.
+    TokenError
+        When a token is not a number or the count differs (a ValueError with the offset).
     """
     if expected == 0:
         return np.zeros(0)
@@ -98,19 +114,20 @@ def parse_floats(buf: np.ndarray, expected: int) -> np.ndarray:
     except ValueError:  # numpy >= 2.3: unmatched data is an error
         values = np.zeros(0)
     if values.size != expected:
-        raise ValueError(_first_bad(buf, expected))
+        message, offset = _first_bad(buf, expected)
+        raise TokenError(message, offset)
     return values
 
 
-def _first_bad(buf: np.ndarray, expected: int) -> str:
-    """Why the text is not ``expected`` numbers (the error path: token by token is fine)."""
-    words = bytes(buf).split()
-    for w in words:
-        try:
-            float(w)
-        except ValueError:
-            return f"{w[:20].decode('latin-1')!r} is not a number"
-    return f"expected {expected:,} numbers, found {len(words):,}"
+def _first_bad(buf: np.ndarray, expected: int) -> tuple[str, int]:
+    """Why the text is not ``expected`` numbers, and where (the error path: token by token
+    is fine)."""
+    text = bytes(buf)
+    words = list(re.finditer(rb"\S+", text))
+    for m in words:
+        if _C_NUMBER.fullmatch(m.group()) is None:
+            return f"{m.group()[:20].decode('latin-1')!r} is not a number", m.start()
+    return f"expected {expected:,} numbers, found {len(words):,}", 0
 
 
 def ints_at(buf: np.ndarray, starts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -119,8 +136,9 @@ def ints_at(buf: np.ndarray, starts: np.ndarray) -> tuple[np.ndarray, np.ndarray
 
     Raises
     ------
-    ValueError
-        When a start holds no digit or a number has more than 18 digits.
+    TokenError
+        When a start holds no digit or a number has more than 18 digits (a ValueError with
+        the offset).
     """
     starts = np.asarray(starts, dtype=np.int64)
     if starts.size == 0:
@@ -141,9 +159,10 @@ def ints_at(buf: np.ndarray, starts: np.ndarray) -> tuple[np.ndarray, np.ndarray
         length += alive
         at += alive
     if alive.any():
-        raise ValueError("an index has more than 18 digits")
+        raise TokenError("an index has more than 18 digits", int(starts[np.argmax(alive)]))
     if length.min() < 1:
         k = int(starts[np.argmin(length)])
         word = bytes(buf[k : k + 20]).split()
-        raise ValueError(f"{(word[0] if word else b'').decode('latin-1')!r} is not an index")
+        shown = (word[0] if word else b"").decode("latin-1")
+        raise TokenError(f"{shown!r} is not an index (a whole number)", k)
     return np.where(negative, -value, value), at
