@@ -344,6 +344,27 @@ def _edge_tables():
 EDGE_OWNER, EDGE_PLACE = _edge_tables()  # indexed by local cell * 12 + edge
 
 
+POP16 = np.unpackbits(np.arange(1 << 16, dtype="<u2").view(np.uint8)).reshape(-1, 16).sum(1)
+
+
+def _ranks(used: np.ndarray, hashes: list[np.ndarray]) -> np.ndarray:
+    """Each hash's rank among the ``used`` ones (its vertex number), ``(t, 3)`` int64.
+
+    The rank is the count of used entries before it: a prefix sum over 16-bit words of
+    the packed bitmap plus the bits below it in its own word, so no array of the hash
+    space's size is ever written (its pages alone cost more than the counting).
+    """
+    words = np.packbits(used, bitorder="little").view("<u2")
+    pop = POP16[words]
+    before = np.cumsum(pop, dtype=np.int64) - pop
+    out = []
+    for h in hashes:
+        w = h >> 4
+        below = words[w] & (np.left_shift(1, h & 15, dtype=np.int32) - 1)
+        out.append(before[w] + POP16[below])
+    return np.concatenate(out)
+
+
 def crossing_cells(f: Fn, lo, hi, cell: float, lipschitz: float = 1.0, max_cells=50_000_000):
     """Global (i, j, k) of the finest cells :func:`mesh_field` polygonizes (those with a
     sign change among their corners), on the grid of :func:`plan_grid`."""
@@ -425,10 +446,8 @@ def mesh_field(
     ue = np.flatnonzero(used)
     if not len(ue):
         return empty
-    number = np.empty(ns * 3 * B3, dtype=np.int64)  # pages never written are never made
-    number[ue] = np.arange(len(ue))
-    tri = np.concatenate([number[h] for h in hashes])
-    del used, number, hashes
+    tri = _ranks(used, hashes)
+    del used, hashes
     verts = np.empty((len(ue), 3))
     for i in range(0, len(ue), CHUNK):
         v = ue[i : i + CHUNK]
