@@ -342,6 +342,8 @@ def _edge_tables():
 
 
 EDGE_OWNER, EDGE_PLACE = _edge_tables()  # indexed by local cell * 12 + edge
+EDGE_PACK = EDGE_OWNER << 11 | EDGE_PLACE  # both in one gather (a place is below 1536)
+TRI_ROWS = TRI_EDGES.reshape(-1, 3).astype(np.int32)  # case * 5 + triangle -> its edges
 
 
 POP16 = np.unpackbits(np.arange(1 << 16, dtype="<u2").view(np.uint8)).reshape(-1, 16).sum(1)
@@ -380,16 +382,18 @@ def crossing_cells(f: Fn, lo, hi, cell: float, lipschitz: float = 1.0, max_cells
 
 def _edge_hashes(cells: np.ndarray, case: np.ndarray, nbr: np.ndarray) -> np.ndarray:
     """The triangles of mixed ``cells`` (flat block * 512 + local indices) as ``(t, 3)``
-    edge hashes: owner slot * 1536 + owner's local corner * 3 + axis."""
+    edge hashes: owner slot * 1536 + owner's local corner * 3 + axis (``nbr`` flattened,
+    eight slots a block)."""
     count = TRI_COUNT[case]
     first = np.cumsum(count) - count
     n_tri = int(count.sum())
-    which = np.repeat(np.arange(len(cells), dtype=np.int32), count)
-    edges = TRI_EDGES[case[which], np.arange(n_tri) - first[which]]  # (t, 3) in 0..11
+    which = np.repeat(np.arange(len(cells), dtype=cells.dtype), count)
+    row = case[which].astype(cells.dtype) * 5 + (np.arange(n_tri, dtype=cells.dtype) - first[which])
     cw = cells[which]
-    key = ((cw & (B3 - 1)) * 12)[:, None] + edges
-    owner = nbr[(cw >> 9)[:, None], EDGE_OWNER[key]]
-    return owner * (3 * B3) + EDGE_PLACE[key]
+    key = ((cw & (B3 - 1)) * 12)[:, None] + TRI_ROWS[row]  # (t, 3): local cell, cube edge
+    packed = EDGE_PACK[key]
+    owner = nbr[((cw >> 9) * 8)[:, None] + (packed >> 11)]
+    return owner * (3 * B3) + (packed & 2047)
 
 
 def mesh_field(
@@ -435,7 +439,7 @@ def mesh_field(
         return empty
     ns = len(lat.touched)
     idx = np.int32 if ns * 3 * B3 < 2**31 else np.int64
-    nbr = lat.nbr.astype(idx)
+    nbr = lat.nbr.astype(idx).reshape(-1)
     used = np.zeros(ns * 3 * B3, dtype=bool)
     hashes = []
     for s in range(0, nk, GROUP):
