@@ -187,10 +187,21 @@ class _Lattice:
         ns = len(touched)
         if ns * B3 > 4 * max_cells:
             raise BudgetExceeded(ns * B3, "corner slots")
+        # the kept blocks take slots 0..nk-1 in their order (a group's own slots are a
+        # slice), the other touched blocks the rest
+        at = np.searchsorted(touched, keys)
+        remap = np.empty(ns, dtype=np.int64)
+        remap[at[:, 0]] = np.arange(nk)
+        rest = np.ones(ns, dtype=bool)
+        rest[at[:, 0]] = False
+        remap[rest] = np.arange(nk, ns)
         d1, d2 = int(dims[1]), int(dims[2])
-        self.base = np.stack([touched // (d1 * d2), touched // d2 % d1, touched % d2], -1) * B
-        self.touched, self.dims = touched, dims
-        self.nbr = nbr = np.searchsorted(touched, keys)
+        self.base = np.empty((ns, 3), dtype=np.int64)
+        self.base[remap] = (
+            np.stack([touched // (d1 * d2), touched // d2 % d1, touched % d2], -1) * B
+        )
+        self.touched, self.dims, self._remap = touched, dims, remap
+        self.nbr = nbr = remap[at]
         values = np.full((ns, B, B, B), np.nan)
         need = np.zeros((ns, B, B, B), dtype=bool)
         known = np.zeros((ns, B, B, B), dtype=bool)
@@ -199,7 +210,7 @@ class _Lattice:
         values[nbr[:, 0], 4, 4, 4] = vc
         for s in range(0, nk, GROUP):
             e = min(s + GROUP, nk)
-            val1 = self._levels(g[s:e], nbr[s:e, 0], values, lipschitz)
+            val1 = self._levels(g[s:e], np.arange(s, e), values, lipschitz)
             with np.errstate(invalid="ignore"):
                 kept1 = np.abs(val1) <= _reach(lipschitz, 2 * cell)
             self.kept1[s:e] = kept1
@@ -208,13 +219,13 @@ class _Lattice:
             for i, j, k in itertools.product(range(3), repeat=3):
                 need9[:, i : i + B : 2, j : j + B : 2, k : k + B : 2] |= kept1
             for w, (here, there) in enumerate(REGIONS):
-                need[(nbr[s:e, w], *there)] |= need9[here]
+                need[(slice(s, e) if w == 0 else nbr[s:e, w], *there)] |= need9[here]
             # signs inferred from the centres of the cells of 2: |f(q)| > L |p - q|
             inferred, negative = _infer(val1, lipschitz * cell)
-            own = values[nbr[s:e, 0]]
+            own = values[s:e]
             sampled = ~np.isnan(own)
-            known[nbr[s:e, 0]] = inferred | sampled
-            inside[nbr[s:e, 0]] = np.where(sampled, own < 0, negative)
+            known[s:e] = inferred | sampled
+            inside[s:e] = np.where(sampled, own < 0, negative)
         values, need, known, inside = (a.reshape(-1) for a in (values, need, known, inside))
         todo = np.flatnonzero(need & ~known)
         values[todo] = self.sample(todo)
@@ -259,7 +270,7 @@ class _Lattice:
             there = self.base[:, None, None, :] // B + unit
             key = _key(there, self.dims)
             at = np.minimum(np.searchsorted(self.touched, key), len(self.touched) - 1)
-            self._next = np.where(self.touched[at] == key, at, -1)  # (ns, 2, 3)
+            self._next = np.where(self.touched[at] == key, self._remap[at], -1)  # (ns, 2, 3)
         slot, loc = corner >> 9, corner & (B3 - 1)
         bit = 6 - 3 * axis
         coord = ((loc >> bit) & 7) + by
@@ -277,7 +288,7 @@ class _Lattice:
         n, nbr = e - s, self.nbr[s:e]
         ins9 = np.empty((n, B + 1, B + 1, B + 1), dtype=bool)
         for w, (here, there) in enumerate(REGIONS):
-            ins9[here] = self.inside[(nbr[:, w], *there)]
+            ins9[here] = self.inside[(slice(s, e) if w == 0 else nbr[:, w], *there)]
         ins9 = ins9.view(np.uint8)
         case = np.zeros((n, B, B, B), dtype=np.uint8)
         for c, (x, y, z) in enumerate(CORNERS):
