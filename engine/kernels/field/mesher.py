@@ -187,10 +187,21 @@ class _Lattice:
         ns = len(touched)
         if ns * B3 > 4 * max_cells:
             raise BudgetExceeded(ns * B3, "corner slots")
+        # the kept blocks take slots 0..nk-1 in their order (a group's own slots are a
+        # slice), the other touched blocks the rest
+        at = np.searchsorted(touched, keys)
+        remap = np.empty(ns, dtype=np.int64)
+        remap[at[:, 0]] = np.arange(nk)
+        rest = np.ones(ns, dtype=bool)
+        rest[at[:, 0]] = False
+        remap[rest] = np.arange(nk, ns)
         d1, d2 = int(dims[1]), int(dims[2])
-        self.base = np.stack([touched // (d1 * d2), touched // d2 % d1, touched % d2], -1) * B
-        self.touched, self.dims = touched, dims
-        self.nbr = nbr = np.searchsorted(touched, keys)
+        self.base = np.empty((ns, 3), dtype=np.int64)
+        self.base[remap] = (
+            np.stack([touched // (d1 * d2), touched // d2 % d1, touched % d2], -1) * B
+        )
+        self.touched, self.dims, self._remap = touched, dims, remap
+        self.nbr = nbr = remap[at]
         values = np.full((ns, B, B, B), np.nan)
         need = np.zeros((ns, B, B, B), dtype=bool)
         known = np.zeros((ns, B, B, B), dtype=bool)
@@ -199,7 +210,7 @@ class _Lattice:
         values[nbr[:, 0], 4, 4, 4] = vc
         for s in range(0, nk, GROUP):
             e = min(s + GROUP, nk)
-            val1 = self._levels(g[s:e], nbr[s:e, 0], values, lipschitz)
+            val1 = self._levels(g[s:e], np.arange(s, e), values, lipschitz)
             with np.errstate(invalid="ignore"):
                 kept1 = np.abs(val1) <= _reach(lipschitz, 2 * cell)
             self.kept1[s:e] = kept1
@@ -208,13 +219,13 @@ class _Lattice:
             for i, j, k in itertools.product(range(3), repeat=3):
                 need9[:, i : i + B : 2, j : j + B : 2, k : k + B : 2] |= kept1
             for w, (here, there) in enumerate(REGIONS):
-                need[(nbr[s:e, w], *there)] |= need9[here]
+                need[(slice(s, e) if w == 0 else nbr[s:e, w], *there)] |= need9[here]
             # signs inferred from the centres of the cells of 2: |f(q)| > L |p - q|
             inferred, negative = _infer(val1, lipschitz * cell)
-            own = values[nbr[s:e, 0]]
+            own = values[s:e]
             sampled = ~np.isnan(own)
-            known[nbr[s:e, 0]] = inferred | sampled
-            inside[nbr[s:e, 0]] = np.where(sampled, own < 0, negative)
+            known[s:e] = inferred | sampled
+            inside[s:e] = np.where(sampled, own < 0, negative)
         values, need, known, inside = (a.reshape(-1) for a in (values, need, known, inside))
         todo = np.flatnonzero(need & ~known)
         values[todo] = self.sample(todo)
@@ -259,7 +270,7 @@ class _Lattice:
             there = self.base[:, None, None, :] // B + unit
             key = _key(there, self.dims)
             at = np.minimum(np.searchsorted(self.touched, key), len(self.touched) - 1)
-            self._next = np.where(self.touched[at] == key, at, -1)  # (ns, 2, 3)
+            self._next = np.where(self.touched[at] == key, self._remap[at], -1)  # (ns, 2, 3)
         slot, loc = corner >> 9, corner & (B3 - 1)
         bit = 6 - 3 * axis
         coord = ((loc >> bit) & 7) + by
@@ -277,7 +288,7 @@ class _Lattice:
         n, nbr = e - s, self.nbr[s:e]
         ins9 = np.empty((n, B + 1, B + 1, B + 1), dtype=bool)
         for w, (here, there) in enumerate(REGIONS):
-            ins9[here] = self.inside[(nbr[:, w], *there)]
+            ins9[here] = self.inside[(slice(s, e) if w == 0 else nbr[:, w], *there)]
         ins9 = ins9.view(np.uint8)
         case = np.zeros((n, B, B, B), dtype=np.uint8)
         for c, (x, y, z) in enumerate(CORNERS):
@@ -342,6 +353,29 @@ def _edge_tables():
 
 
 EDGE_OWNER, EDGE_PLACE = _edge_tables()  # indexed by local cell * 12 + edge
+EDGE_PACK = EDGE_OWNER << 11 | EDGE_PLACE  # both in one gather (a place is below 1536)
+TRI_ROWS = TRI_EDGES.reshape(-1, 3).astype(np.int32)  # case * 5 + triangle -> its edges
+
+
+POP16 = np.unpackbits(np.arange(1 << 16, dtype="<u2").view(np.uint8)).reshape(-1, 16).sum(1)
+
+
+def _ranks(used: np.ndarray, hashes: list[np.ndarray]) -> np.ndarray:
+    """Each hash's rank among the ``used`` ones (its vertex number), ``(t, 3)`` int64.
+
+    The rank is the count of used entries before it: a prefix sum over 16-bit words of
+    the packed bitmap plus the bits below it in its own word, so no array of the hash
+    space's size is ever written (its pages alone cost more than the counting).
+    """
+    words = np.packbits(used, bitorder="little").view("<u2")
+    pop = POP16[words]
+    before = np.cumsum(pop, dtype=np.int64) - pop
+    out = []
+    for h in hashes:
+        w = h >> 4
+        below = words[w] & (np.left_shift(1, h & 15, dtype=np.int32) - 1)
+        out.append(before[w] + POP16[below])
+    return np.concatenate(out)
 
 
 def crossing_cells(f: Fn, lo, hi, cell: float, lipschitz: float = 1.0, max_cells=50_000_000):
@@ -359,16 +393,18 @@ def crossing_cells(f: Fn, lo, hi, cell: float, lipschitz: float = 1.0, max_cells
 
 def _edge_hashes(cells: np.ndarray, case: np.ndarray, nbr: np.ndarray) -> np.ndarray:
     """The triangles of mixed ``cells`` (flat block * 512 + local indices) as ``(t, 3)``
-    edge hashes: owner slot * 1536 + owner's local corner * 3 + axis."""
+    edge hashes: owner slot * 1536 + owner's local corner * 3 + axis (``nbr`` flattened,
+    eight slots a block)."""
     count = TRI_COUNT[case]
     first = np.cumsum(count) - count
     n_tri = int(count.sum())
-    which = np.repeat(np.arange(len(cells), dtype=np.int32), count)
-    edges = TRI_EDGES[case[which], np.arange(n_tri) - first[which]]  # (t, 3) in 0..11
+    which = np.repeat(np.arange(len(cells), dtype=cells.dtype), count)
+    row = case[which].astype(cells.dtype) * 5 + (np.arange(n_tri, dtype=cells.dtype) - first[which])
     cw = cells[which]
-    key = ((cw & (B3 - 1)) * 12)[:, None] + edges
-    owner = nbr[(cw >> 9)[:, None], EDGE_OWNER[key]]
-    return owner * (3 * B3) + EDGE_PLACE[key]
+    key = ((cw & (B3 - 1)) * 12)[:, None] + TRI_ROWS[row]  # (t, 3): local cell, cube edge
+    packed = EDGE_PACK[key]
+    owner = nbr[((cw >> 9) * 8)[:, None] + (packed >> 11)]
+    return owner * (3 * B3) + (packed & 2047)
 
 
 def mesh_field(
@@ -414,7 +450,7 @@ def mesh_field(
         return empty
     ns = len(lat.touched)
     idx = np.int32 if ns * 3 * B3 < 2**31 else np.int64
-    nbr = lat.nbr.astype(idx)
+    nbr = lat.nbr.astype(idx).reshape(-1)
     used = np.zeros(ns * 3 * B3, dtype=bool)
     hashes = []
     for s in range(0, nk, GROUP):
@@ -425,10 +461,8 @@ def mesh_field(
     ue = np.flatnonzero(used)
     if not len(ue):
         return empty
-    number = np.empty(ns * 3 * B3, dtype=np.int64)  # pages never written are never made
-    number[ue] = np.arange(len(ue))
-    tri = np.concatenate([number[h] for h in hashes])
-    del used, number, hashes
+    tri = _ranks(used, hashes)
+    del used, hashes
     verts = np.empty((len(ue), 3))
     for i in range(0, len(ue), CHUNK):
         v = ue[i : i + CHUNK]
