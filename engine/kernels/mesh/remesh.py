@@ -243,6 +243,13 @@ def _collapse(v, t, feat, low: float, high: float, rng):
 
     both = np.intersect1d(ring(o1, f1), ring(o2, f2), assume_unique=True) // n
     ok = np.bincount(both, minlength=len(cand)) == e.count[cand]
+    # and no opposite corner is left on two triangles only (back to back: a tetrahedron
+    # would collapse into a flat pillow), as OpenMesh's is_collapse_ok refuses
+    valence = np.bincount(e.ends.reshape(-1), minlength=n)
+    for side in range(2):
+        h = e.half[cand, side]
+        opp = t.reshape(-1)[np.where(h >= 0, h - h % 3 + (h % 3 + 2) % 3, 0)]
+        ok &= (h < 0) | (valence[opp] > 3)
     # after the move: no face round the two ends flips over or grows an edge past high
     moved = np.where(t[face] == r[owner][:, None], k[owner][:, None], t[face])
     keep_face = ~((t[face] == r[owner][:, None]).any(1) & (t[face] == k[owner][:, None]).any(1))
