@@ -66,6 +66,12 @@ class _Edges:
         self.half[two, 1] = order[first[two] + 1]
 
 
+def _member(sorted_keys: np.ndarray, keys: np.ndarray) -> np.ndarray:
+    """Which of ``keys`` are in ``sorted_keys`` (sorted, unique)."""
+    i = np.minimum(np.searchsorted(sorted_keys, keys), max(len(sorted_keys) - 1, 0))
+    return (sorted_keys[i] == keys) if len(sorted_keys) else np.zeros(len(keys), bool)
+
+
 def _normals(v: np.ndarray, t: np.ndarray) -> np.ndarray:
     return np.cross(v[t[:, 1]] - v[t[:, 0]], v[t[:, 2]] - v[t[:, 0]])
 
@@ -144,7 +150,7 @@ def _split(v, t, feat, high: float):
     mid[long] = len(v) + np.arange(int(long.sum()))
     v = np.concatenate([v, (v[e.ends[long, 0]] + v[e.ends[long, 1]]) / 2.0])
     # the split feature edges' halves are feature edges
-    fs = np.isin(feat, e.key[long])
+    fs = _member(e.key[long], feat)
     fe = e.ends[np.searchsorted(e.key, feat[fs])]
     fm = mid[np.searchsorted(e.key, feat[fs])]
     feat = np.unique(np.concatenate([feat[~fs], _key(fe[:, 0], fm), _key(fm, fe[:, 1])]))
@@ -209,7 +215,7 @@ def _collapse(v, t, feat, low: float, high: float, rng):
     a, b = e.ends[:, 0], e.ends[:, 1]
     length = np.linalg.norm(v[a] - v[b], axis=1)
     kind = _kinds(n, feat)
-    is_feat = np.isin(e.key, feat)
+    is_feat = _member(feat, e.key)
     ka, kb = kind[a], kind[b]
     # which end goes (r) into which (k), and where k ends
     free2 = (ka == 0) & (kb == 0)
@@ -286,8 +292,7 @@ def _flip(v, t, feat, boundary_vertex: np.ndarray, rng):
     """Flip an independent set of edges that bring valences nearer 6 (4 on a boundary)."""
     n = len(v)
     e = _Edges(t)
-    inner = (e.count == 2) & ~np.isin(e.key, feat)
-    cand = np.flatnonzero(inner)
+    cand = np.flatnonzero((e.count == 2) & ~_member(feat, e.key))
     h1, h2 = e.half[cand, 0], e.half[cand, 1]
     f1, k1 = h1 // 3, h1 % 3
     f2, k2 = h2 // 3, h2 % 3
@@ -295,25 +300,29 @@ def _flip(v, t, feat, boundary_vertex: np.ndarray, rng):
     d = t[f2, (k2 + 2) % 3]
     val = np.bincount(e.ends.reshape(-1), minlength=n)
     want = np.where(boundary_vertex[:n], 4, 6)
-    dev = lambda x, s: (val[x] + s - want[x]) ** 2  # noqa: E731
-    gain = (dev(a, 0) + dev(b, 0) + dev(c, 0) + dev(d, 0)) - (
-        dev(a, -1) + dev(b, -1) + dev(c, 1) + dev(d, 1)
-    )
-    ok = (gain > 0) & (c != d) & ~np.isin(_key(c, d), e.key)
+    # the change of sum (valence - want)^2 over the four: -1 at a and b, +1 at c and d
+    da, db, dc, dd = (val[x] - want[x] for x in (a, b, c, d))
+    gain = 2 * (da + db - dc - dd) - 4
+    # the geometry only for those that would help
+    s = np.flatnonzero((gain > 0) & (c != d))
+    s = s[~_member(e.key, _key(c[s], d[s]))]
+    if not len(s):
+        return t, 0
+    a, b, c, d, f1, f2, gain = a[s], b[s], c[s], d[s], f1[s], f2[s], gain[s]
     # no fold: the new triangles face the way the old pair did, and are not slivers
     n_old = _normals(v, t[f1]) + _normals(v, t[f2])
     t1 = np.stack([a, d, c], 1)
     t2 = np.stack([d, b, c], 1)
     n1, n2 = _normals(v, t1), _normals(v, t2)
-    ok &= (np.einsum("ij,ij->i", n1, n_old) > 0) & (np.einsum("ij,ij->i", n2, n_old) > 0)
+    ok = (np.einsum("ij,ij->i", n1, n_old) > 0) & (np.einsum("ij,ij->i", n2, n_old) > 0)
     ok &= np.einsum("ij,ij->i", _unit(n1), _unit(n2)) > 0.5  # no sharp new crease
     was = np.minimum(_shape(v[t[f1]]), _shape(v[t[f2]]))
     ok &= np.minimum(_shape(v[t1], n1), _shape(v[t2], n2)) >= np.minimum(SLIVER, was)
     if not ok.any():
         return t, 0
-    prio = gain + rng.random(len(cand))
+    prio = gain + rng.random(len(s))
     prio[~ok] = -np.inf
-    owner = np.repeat(np.arange(len(cand)), 4)
+    owner = np.repeat(np.arange(len(s)), 4)
     win = _independent(n, owner, np.stack([a, b, c, d], 1).reshape(-1), prio) & ok
     t = t.copy()
     t[f1[win]] = t1[win]
