@@ -103,6 +103,24 @@ def test_remesh_gives_even_edges_and_a_closed_outward_torus():
     assert r.volume == pytest.approx(t.volume, rel=0.03)
 
 
+def test_remesh_of_quads_keeps_the_box_and_refuses_a_non_manifold_mesh():
+    # polygons are triangulated first; the box's creases and corners survive exactly
+    g = fg.Graph()
+    g.add("box", "mesh.box", size=[2, 1, 1])
+    g.add("even", "mesh.remesh", mesh="@box", edge_length=0.2, iterations=4)
+    r = tm(g.evaluate("even"))
+    assert r.is_watertight and r.volume == pytest.approx(2.0, rel=1e-9)
+    s = trimesh.creation.icosphere(1)
+    extra = np.setdiff1d(np.arange(len(s.vertices)), s.faces[0])[0]
+    flap = np.concatenate([s.faces, [[s.faces[0, 0], s.faces[0, 1], extra]]])
+    with pytest.raises(fg.NodeError, match="more than two"):
+        run(
+            "mesh.remesh",
+            mesh=as_mesh(trimesh.Trimesh(s.vertices, flap, process=False)),
+            edge_length=0.3,
+        )
+
+
 def test_is_closed_sees_an_open_edge():
     s = trimesh.creation.icosphere(1)
     assert ksimp.is_closed(s.faces) and not ksimp.is_closed(s.faces[1:])

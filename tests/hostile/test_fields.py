@@ -88,3 +88,21 @@ def test_a_field_evaluated_at_2d_points_says_what_it_needs():
     f = fg.geometry.Field.sphere(1.0)
     with pytest.raises(ValueError, match=r"\(n, 3\)"):
         f.evaluate(np.zeros((4, 2)))
+
+
+def test_remeshing_coarser_than_the_mesh_leaves_a_tetrahedron_not_a_flat_pillow():
+    g = graph(
+        s=("mesh.sphere", {"radius": 1.0}),
+        r=("mesh.remesh", {"mesh": "@s", "edge_length": 50.0}),
+    )
+    m = g.evaluate("r")
+    assert m.is_watertight and m.n_faces >= 4 and m.volume > 0
+
+
+def test_remeshing_finer_than_the_budget_fails_before_allocating():
+    g = graph(
+        s=("mesh.sphere", {"radius": 1.0}),
+        r=("mesh.remesh", {"mesh": "@s", "edge_length": 1e-5}),
+    )
+    with pytest.raises(BudgetError, match="vertices"):
+        g.evaluate("r")

@@ -36,6 +36,14 @@ def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.einsum("...i,...i->...", a, b)
 
 
+def _segment_foot(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The points of segments ``a -> b`` nearest to ``p`` (all (n, 3))."""
+    ab = b - a
+    num, den = _dot(p - a, ab), _dot(ab, ab)
+    t = np.clip(np.divide(num, den, out=np.zeros(num.shape), where=den > 0), 0, 1)
+    return a + t[..., None] * ab
+
+
 def point_segment_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Distances from points ``p`` to segments ``a -> b`` (all (..., 3), broadcast)."""
     ab = b - a
@@ -166,8 +174,7 @@ class _Class:
 
         q = centre[idx]
         cube = float(np.sqrt(self.CLUSTER * max(area[idx].mean(), 0.0)))
-        extent = float(np.ptp(q, axis=0).max())
-        cube = max(cube, 2.0 * float(radius[idx].max()), 1e-6 * extent, 1e-300)
+        cube = max(cube, 1e-6 * float(np.ptp(q, axis=0).max()), 1e-300)
         ijk = np.floor((q - q.min(axis=0)) / cube).astype(np.int64)
         dims = ijk.max(axis=0) + 1
         key = (ijk[:, 0] * dims[1] + ijk[:, 1]) * dims[2] + ijk[:, 2]
@@ -311,6 +318,31 @@ class Nearest:
         """(n,) unsigned distances from ``points`` (n, 3) to the nearest primitive."""
         return self.nearest(points)[0]
 
+    def closest(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(n, 3) the nearest point on the primitives to each of ``points``, and (n,) the
+        primitive it lies on."""
+        p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+        _, prim = self.nearest(p)
+        row = self.rows[prim]
+        ap = p - row[:, 0:3]
+        e1 = row[:, 3:6]
+        if self.e2 is None:
+            aa = row[:, 6]
+            d1 = _dot(e1, ap)
+            t = np.clip(np.divide(d1, aa, out=np.zeros_like(d1), where=aa > 0), 0.0, 1.0)
+            return row[:, 0:3] + t[:, None] * e1, prim
+        e2 = row[:, 6:9]
+        v, w = _triangle_coefficients(_dot(e1, ap), _dot(e2, ap), row[:, 9], row[:, 10], row[:, 11])
+        out = row[:, 0:3] + v[:, None] * e1 + w[:, None] * e2
+        bad = ~(np.isfinite(v) & np.isfinite(w))
+        if bad.any():  # a degenerate triangle: the nearest point of its three edges
+            a = row[bad, 0:3]
+            ends = [(a, a + e1[bad]), (a + e1[bad], a + e2[bad]), (a + e2[bad], a)]
+            feet = np.stack([_segment_foot(p[bad], s, e) for s, e in ends], axis=1)
+            k = np.argmin(np.linalg.norm(feet - p[bad, None], axis=2), axis=1)
+            out[bad] = feet[np.arange(len(k)), k]
+        return out, prim
+
     def nearest(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(n,) distances and (n,) the index of each point's nearest primitive."""
         p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
@@ -336,6 +368,25 @@ class Nearest:
                 k0, k1 = k1, min(4 * k1, cl.n_clusters)
         return best, prim
 
+    def _open(self, cl: _Class, q, r, clusters, n_items, b, prim, pts) -> None:
+        """Every primitive of clusters ``clusters`` for points ``q[r]``: the exact distance
+        of those whose disc bound beats ``b`` (updated in place, with ``prim[pts]``)."""
+        r = np.repeat(r, n_items)
+        skip = np.cumsum(n_items) - n_items
+        item = np.arange(len(r)) + np.repeat(cl.start[clusters] - skip, n_items)
+        qr = np.take(q, r, axis=0)
+        keep = _disc_bound2(qr, np.take(cl.disc, item, axis=0)) < b[r] ** 2
+        r, cand, qr = r[keep], cl.idx[item[keep]], qr[keep]
+        if not len(r):
+            return
+        d = self._exact(qr, cand)
+        o = np.lexsort((d, r))
+        head = o[np.r_[True, r[o][1:] != r[o][:-1]]]
+        rr, dd = r[head], d[head]
+        better = dd < b[rr]
+        b[rr[better]] = dd[better]
+        prim[pts[rr[better]]] = cand[head][better]
+
     def _clusters(self, cl: _Class, p, pts, k0: int, k1: int, best, prim) -> np.ndarray:
         """Clusters ``k0 + 1 .. k1`` nearest to points ``pts``: the exact distances of their
         primitives that may beat the best (updated in place); return the points whose
@@ -345,25 +396,13 @@ class Nearest:
         dc, ic = cl.ctree.query(q, k=np.arange(k0 + 1, k1 + 1))
         lb2 = _cylinder_bound2(q[:, None, :], np.take(cl.cyl, ic, axis=0), dc)
         r, col = np.nonzero(lb2 < (b * b)[:, None])
-        if len(r):
-            # every primitive of each open cluster, with its own bound
-            open_ = ic[r, col]
-            n_items = cl.count[open_]
-            r = np.repeat(r, n_items)
-            skip = np.cumsum(n_items) - n_items
-            item = np.arange(len(r)) + np.repeat(cl.start[open_] - skip, n_items)
-            qr = np.take(q, r, axis=0)
-            keep = _disc_bound2(qr, np.take(cl.disc, item, axis=0)) < b[r] ** 2
-            r, cand, qr = r[keep], cl.idx[item[keep]], qr[keep]
-        if len(r):
-            d = self._exact(qr, cand)
-            o = np.lexsort((d, r))
-            head = o[np.r_[True, r[o][1:] != r[o][:-1]]]
-            rr, dd = r[head], d[head]
-            better = dd < b[rr]
-            b[rr[better]] = dd[better]
-            prim[pts[rr[better]]] = cand[head][better]
-            best[pts] = b
+        open_ = ic[r, col]
+        n_items = cl.count[open_]
+        # the open clusters' primitives, a bounded number of pairs at a time
+        cut = np.searchsorted(np.cumsum(n_items), np.arange(self.PAIRS, n_items.sum(), self.PAIRS))
+        for rs, os_, ns in zip(*(np.split(x, cut) for x in (r, open_, n_items)), strict=True):
+            self._open(cl, q, rs, os_, ns, b, prim, pts)
+        best[pts] = b
         done = (k1 >= cl.n_clusters) | (dc[:, -1] - cl.reach_max >= b)
         return pts[~done]
 

@@ -1,23 +1,20 @@
-"""Fewer or better triangles: quadric decimation and isotropic remeshing, through libraries.
+"""Fewer triangles: quadric decimation, through fast-simplification.
 
 * :func:`decimate`: Garland & Heckbert's quadric error metric edge collapse ("Surface
   simplification using quadric error metrics", SIGGRAPH 1997) as fast-simplification
   implements it (Fast-Quadric-Mesh-Simplification, C++; the collapse order by threshold
   sweeps, not a global heap).
-* :func:`remesh`: approximated centroidal Voronoi clustering (Valette & Chassery 2004,
-  ACVD) through pyacvd: clusters of about equal area become the new vertices, the dual of
-  the clustering the new triangles; the input is first subdivided until it has several
-  vertices per cluster, as ACVD needs.
 
-Both take and give triangles (callers triangulate polygons first) and report, never hide,
-a closed input that came out open (:class:`OpenedError`).
+It takes and gives triangles (callers triangulate polygons first) and reports, never
+hides, a closed input that came out open (:class:`OpenedError`); :func:`is_closed` is
+shared with the remesher (:mod:`.remesh`).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["OpenedError", "decimate", "is_closed", "remesh"]
+__all__ = ["OpenedError", "decimate", "is_closed"]
 
 
 class OpenedError(ValueError):
@@ -97,46 +94,3 @@ def decimate(
             "faces"
         )
     return out_v, out_t
-
-
-def cluster_count(vertices: np.ndarray, triangles: np.ndarray, edge_length: float) -> int:
-    """The vertices of an equilateral triangulation of the surface with that edge length:
-    its area over ``sqrt(3) / 2 * edge_length^2`` (the area per vertex), at least 4."""
-    v = np.asarray(vertices, dtype=np.float64)
-    t = np.asarray(triangles, dtype=np.int64)
-    area = 0.5 * np.linalg.norm(np.cross(v[t[:, 1]] - v[t[:, 0]], v[t[:, 2]] - v[t[:, 0]]), axis=1)
-    return max(4, int(round(area.sum() / (np.sqrt(3) / 2 * edge_length**2))))
-
-
-def remesh(vertices: np.ndarray, triangles: np.ndarray, clusters: int):
-    """About ``clusters`` vertices evenly spread over the surface, as triangles (ACVD)."""
-    import warnings
-
-    import pyacvd
-    import pyvista as pv
-
-    v = np.asarray(vertices, dtype=np.float64)
-    t = np.asarray(triangles, dtype=np.int64)
-    closed = is_closed(t)
-    cells = np.hstack([np.full((len(t), 1), 3), t]).ravel()
-    mesh = pv.PolyData(v, cells)
-    with warnings.catch_warnings():  # pyacvd calls a pyvista API that pyvista deprecates
-        warnings.simplefilter("ignore", DeprecationWarning)
-        clus = pyacvd.Clustering(mesh)
-        # ACVD wants several input vertices per cluster: subdivide (each level x4) to ~3
-        levels = 0
-        while len(v) * 4**levels < 3 * clusters and levels < 6:
-            levels += 1
-        if levels:
-            clus.subdivide(levels)
-        clus.cluster(clusters)
-        out = clus.create_mesh()
-    ov = np.asarray(out.points, dtype=np.float64)
-    ot = np.asarray(out.faces, dtype=np.int64).reshape(-1, 4)[:, 1:]
-    ov, ot = _compact(ov, ot)
-    if closed and not is_closed(ot):
-        raise OpenedError(
-            "remeshing opened the closed mesh (a cluster pinched the surface); use a shorter "
-            "edge_length"
-        )
-    return ov, ot
