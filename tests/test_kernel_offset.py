@@ -93,14 +93,14 @@ def test_clockwise_input_gives_the_same_result():
 def test_sparse_sample_store_gives_the_same_loops(monkeypatch, d):
     # Big grids keep their band of samples sorted and searched instead of in a dense table;
     # both stores must give the very same offset.
-    import formgraph.kernels.offset.marching as marching
+    import formgraph.kernels.offset.band as band
 
     t = np.linspace(0, 2 * np.pi, 400, endpoint=False)
     r = 1 + 0.1 * np.sin(9 * t)
     pts = np.c_[r * np.cos(t), r * np.sin(t)]
     dense = offset_polylines([pts], [True], d)
-    monkeypatch.setattr(marching, "_DENSE", 0)
-    monkeypatch.setattr(marching, "_DENSE_MIN", 0)
+    monkeypatch.setattr(band, "_DENSE", 0)
+    monkeypatch.setattr(band, "_DENSE_MIN", 0)
     sparse = offset_polylines([pts], [True], d)
     assert len(dense) == len(sparse)
     for a, b in zip(dense, sparse, strict=True):

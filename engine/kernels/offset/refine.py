@@ -38,7 +38,9 @@ def _feet(tree: SegmentTree, near: Nearest, p: np.ndarray) -> tuple[np.ndarray, 
     return foot, unit(p - foot)
 
 
-def project(tree: SegmentTree, p: np.ndarray, radius: float, band: float):
+def project(
+    tree: SegmentTree, p: np.ndarray, radius: float, band: float, upper: np.ndarray | None = None
+):
     """Move points onto the level ``radius`` along the gradient of the distance.
 
     For a distance function the step ``x -> foot + radius * (x - foot) / |x - foot|`` lands
@@ -53,6 +55,8 @@ def project(tree: SegmentTree, p: np.ndarray, radius: float, band: float):
     radius : float
     band : float
         How far from the level the points may be (the query is exact within it).
+    upper : (m,) float, optional
+        Known upper bounds of the points' distances (inf: none), which prune the search.
 
     Returns
     -------
@@ -66,7 +70,7 @@ def project(tree: SegmentTree, p: np.ndarray, radius: float, band: float):
     ok : (m,) bool
         ``moved`` lies on the level.
     """
-    near = tree.query(p, radius - band, radius + band)
+    near = tree.query(p, radius - band, radius + band, upper=upper)
     foot, normal = _feet(tree, near, p)
     ok = near.exact & (near.dist > 0)
     moved = foot + radius * normal
@@ -470,6 +474,7 @@ def exact_loops(
     band: float,
     tol: float,
     far_inside: bool,
+    upper: np.ndarray | None = None,
 ) -> Loops:
     """Traced loops made exact: vertices on the level ``radius``, chords within ``tol``.
 
@@ -487,6 +492,8 @@ def exact_loops(
         Largest distance allowed between a chord and the level set.
     far_inside : bool
         The region (on the loops' left) is where the distance exceeds ``radius``.
+    upper : (n,) float, optional
+        Known upper bounds of the traced vertices' distances (inf: none).
 
     Returns
     -------
@@ -494,7 +501,7 @@ def exact_loops(
     """
     n = xy.shape[0]
     loop = np.repeat(np.arange(offsets.size - 1), np.diff(offsets))
-    moved, normal, seg, _, ok = project(tree, xy, radius, band)
+    moved, normal, seg, _, ok = project(tree, xy, radius, band, upper)
     # Where the contour passes within a hair of a sample, marching squares puts two or
     # three vertices on top of each other; projection could then fold them.
     prev = np.arange(n) - 1
