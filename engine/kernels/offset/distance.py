@@ -270,7 +270,7 @@ class SegmentTree:
         if shape.prod() > max(4096, 8 * self.n):
             return
         level = 0
-        for k in range(self.depth - 1, 0, -1):
+        for k in range(self.depth, 0, -1):
             ax, ay, ux, uy, _, rad = self._levels[k]
             size = np.nanmedian(np.hypot(ux, uy) + 2 * rad)
             if size > reach:
