@@ -1,6 +1,7 @@
 """Offset kernels: offsets of polylines through a signed distance field and marching squares.
 
 - ``distance``: exact point-segment distances (a segment tree), crossing-number signs per row;
+- ``band``: the field sampled on a band of a quadtree, and the checks for thin parts;
 - ``contour``: marching squares on sparse samples, crossings joined into closed loops;
 - ``loops``: flat loop storage and the clean-up passes (folds, crossings, simplification);
 - ``refine``: vertices moved onto the exact level set, corner and chord points inserted;

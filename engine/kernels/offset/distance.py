@@ -193,6 +193,7 @@ class SegmentTree:
             tuple(f[lo:hi] for f in fields) for lo, hi in zip(bounds[:-1], bounds[1:], strict=True)
         ]
         self._segs = _fields(pa[:, 0], pa[:, 1], pb[:, 0], pb[:, 1])
+        self._grid = None
 
     def query(
         self,
@@ -248,6 +249,75 @@ class SegmentTree:
             start = stop
         return Nearest(*(np.concatenate([getattr(r, f) for r in parts]) for f in _NEAREST))
 
+    def index_reach(self, reach: float) -> None:
+        """Index the tree's nodes of one level in a grid of buckets for queries that need
+        nothing farther than ``reach`` (a band's top, or a known upper bound, at most
+        ``reach``): such a query starts at that level with the nodes of each point's bucket
+        in one pass, instead of descending from the root in several.
+
+        Each node goes into every bucket within ``reach`` of its capsule, so one bucket
+        lists every node a point in it can need. The level is the coarsest whose nodes are
+        mostly no longer than a bucket (side ``reach``); no index is made if the buckets
+        would outnumber the segments by far (a reach tiny next to the input).
+        """
+        self._grid = None
+        if not (np.isfinite(reach) and reach > 0) or self.depth < 2:
+            return
+        a, b = self.a, self.b
+        lo = np.array([min(a[:, k].min(), b[:, k].min()) for k in range(2)]) - 2 * reach
+        hi = np.array([max(a[:, k].max(), b[:, k].max()) for k in range(2)]) + 2 * reach
+        shape = np.ceil((hi - lo) / reach).astype(np.int64)
+        if shape.prod() > max(4096, 8 * self.n):
+            return
+        level = 0
+        for k in range(self.depth, 0, -1):
+            ax, ay, ux, uy, _, rad = self._levels[k]
+            size = np.nanmedian(np.hypot(ux, uy) + 2 * rad)
+            if size > reach:
+                break
+            level = k
+        if level == 0:
+            return
+        ax, ay, ux, uy, _, rad = self._levels[level]
+        real = np.flatnonzero(np.isfinite(rad))
+        ax, ay, ux, uy, rad = ax[real], ay[real], ux[real], uy[real], rad[real]
+        grow = rad + reach * (1 + 1e-9) + 1e-12 * self._scale
+        i0 = np.floor((np.minimum(ax, ax + ux) - grow - lo[0]) / reach).astype(np.int64)
+        i1 = np.floor((np.maximum(ax, ax + ux) + grow - lo[0]) / reach).astype(np.int64)
+        j0 = np.floor((np.minimum(ay, ay + uy) - grow - lo[1]) / reach).astype(np.int64)
+        j1 = np.floor((np.maximum(ay, ay + uy) + grow - lo[1]) / reach).astype(np.int64)
+        i0, j0 = np.maximum(i0, 0), np.maximum(j0, 0)
+        i1, j1 = np.minimum(i1, shape[0] - 1), np.minimum(j1, shape[1] - 1)
+        wide, tall = i1 - i0 + 1, j1 - j0 + 1
+        count = wide * tall
+        owner = np.repeat(np.arange(real.size), count)
+        k = np.arange(owner.size) - np.repeat(np.cumsum(count) - count, count)
+        di, dj = np.divmod(k, tall[owner])
+        bucket = (j0[owner] + dj) * shape[0] + i0[owner] + di
+        order = np.argsort(bucket, kind="stable")
+        offsets = np.zeros(shape.prod() + 2, dtype=np.int64)  # (last: an empty bucket)
+        np.cumsum(np.bincount(bucket, minlength=shape.prod() + 1), out=offsets[1:])
+        self._grid = (lo, float(reach), shape, level, offsets, real[owner[order]])
+
+    def _grid_start(self, px, py, best2, hi2):
+        """``(level, qi, node)`` of the first pass from the bucket index (`index_reach`), or
+        None if there is none or some point needs farther than its reach."""
+        if self._grid is None:
+            return None
+        lo, reach, shape, level, offsets, nodes = self._grid
+        if not np.minimum(best2, hi2).max() <= reach * reach:
+            return None
+        i = np.floor((px - lo[0]) / reach)
+        j = np.floor((py - lo[1]) / reach)
+        outside = (i < 0) | (i >= shape[0]) | (j < 0) | (j >= shape[1])
+        key = np.where(outside, shape.prod(), j * shape[0] + i).astype(np.int64)
+        first = offsets.take(key)
+        count = offsets.take(key + 1) - first
+        qi = np.arange(px.size).repeat(count)
+        shift = first - (np.cumsum(count) - count)
+        node = nodes.take(np.arange(qi.size) + shift.take(qi))
+        return level, qi, node
+
     def _charge(self, pairs: int) -> None:
         self.pairs += pairs
         if self.max_pairs is not None and self.pairs > self.max_pairs:
@@ -276,9 +346,13 @@ class SegmentTree:
         # Levels are visited in jumps that keep about _PAIRS (point, node) pairs per visit:
         # few points start deep and skip levels (numpy calls cost more than the few more
         # capsules tested), many go two levels a step.
-        level = min(self.depth, max(0, int(np.log2(max(_PAIRS // q, 1)))))
-        qi = np.arange(q).repeat(2**level)
-        node = _fan_out(np.zeros(q, dtype=np.int64), 2**level)
+        start = self._grid_start(px, py, best2, hi2)
+        if start is None:
+            level = min(self.depth, max(0, int(np.log2(max(_PAIRS // q, 1)))))
+            qi = np.arange(q).repeat(2**level)
+            node = _fan_out(np.zeros(q, dtype=np.int64), 2**level)
+        else:
+            level, qi, node = start
         while True:
             ax, ay, ux, uy, inv, rad = self._levels[level]
             peak = max(peak, qi.size)
@@ -294,9 +368,10 @@ class SegmentTree:
             np.minimum(np.maximum(t, 0.0, out=t), 1.0, out=t)
             # The axis start is a curve point: an upper bound. (Its end is the next node's
             # start, so it adds little.)
-            d2 = dx * dx
-            d2 += dy * dy
-            np.minimum.at(best2, qi, d2)
+            if level >= self.depth - 3:
+                d2 = dx * dx
+                d2 += dy * dy
+                np.minimum.at(best2, qi, d2)
             nux *= t
             dx -= nux
             nuy *= t

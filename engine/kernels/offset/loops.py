@@ -17,10 +17,19 @@ import numpy as np
 
 from .distance import point_segment
 
-__all__ = ["Loops", "crosses", "drop_folds", "segments_cross", "simplify", "tidy", "unit"]
+__all__ = [
+    "Loops",
+    "crosses",
+    "drop_covered",
+    "drop_folds",
+    "segments_cross",
+    "simplify",
+    "tidy",
+    "unit",
+]
 
 COS30 = float(np.cos(np.radians(30)))
-_UNTANGLE = 8  # chords ahead checked for a crossing by the final clean-up
+_UNTANGLE = 16  # chords ahead checked for a crossing by the final clean-up
 
 
 @dataclass
@@ -205,6 +214,66 @@ def tidy(loops: Loops, gap: float) -> Loops:
     count = np.bincount(loops.loop, minlength=area.size)
     keep = (count >= 3) & (np.abs(area) > gap * gap)
     return loops.select(keep[loops.loop])
+
+
+_COVER_PAIRS = 1 << 22  # (vertex, chord) pairs `drop_covered` tests at once, about
+
+
+def drop_covered(loops: Loops, max_area: float) -> Loops:
+    """Drop the small loops that lie inside what the other loops bound already.
+
+    Where a part of the result narrows below a cell (the tip of a thin spike), marching
+    squares can cut it off as a loop of its own; refinement then recovers the true corner of
+    the main loop, whose tip comes to cover the piece cut off. Such a piece is an island
+    inside an island (or a hole outside every island): the winding number of its inside
+    with respect to the other loops is 1 or more for an island (0 or less for a hole),
+    where a piece that belongs would have 0 (1). A loop of area at most ``max_area`` goes
+    when most of its points halfway between its vertex mean and its vertices are so covered
+    (points inside it: such a piece is a sliver of a few vertices, some of them on the
+    other loop, found from both).
+    """
+    if loops.loop.size == 0:
+        return loops
+    nxt = loops.next
+    x, y = loops.xy[:, 0], loops.xy[:, 1]
+    n_loops = int(loops.loop[-1]) + 1
+    area2 = np.bincount(loops.loop, x * y[nxt] - x[nxt] * y, minlength=n_loops)
+    count = np.bincount(loops.loop, minlength=n_loops)
+    if (count > 0).sum() < 2:
+        return loops
+    small = (count > 0) & (np.abs(area2) <= 2 * max_area)
+    test = np.flatnonzero(small[loops.loop])
+    if test.size == 0:
+        return loops
+    mean = (
+        np.stack(
+            [np.bincount(loops.loop, x, n_loops), np.bincount(loops.loop, y, n_loops)], axis=-1
+        )
+        / np.maximum(count, 1)[:, None]
+    )
+    inner = (loops.xy[test] + mean[loops.loop[test]]) / 2
+    # Winding numbers by signed crossings of the ray toward +x (Haines's half-open rule).
+    x0, y0, x1, y1 = x, y, x[nxt], y[nxt]
+    dy = np.where(y1 != y0, y1 - y0, 1.0)
+    winding = np.zeros(test.size, dtype=np.int64)
+    step = max(1, _COVER_PAIRS // x.size)
+    for start in range(0, test.size, step):  # (chunks of vertices: a few, for big inputs)
+        t = test[start : start + step]
+        px, py = inner[start : start + step, :1], inner[start : start + step, 1:]
+        up = (y0 <= py) & (y1 > py)
+        down = (y1 <= py) & (y0 > py)
+        right = x0 + (py - y0) * (x1 - x0) / dy > px
+        other = loops.loop[None, :] != loops.loop[t, None]
+        winding[start : start + step] = ((up & right & other).sum(axis=1)) - (
+            (down & right & other).sum(axis=1)
+        )
+    island = area2[loops.loop[test]] > 0
+    covered = np.where(island, winding >= 1, winding <= 0)
+    votes = np.bincount(loops.loop[test], covered, minlength=n_loops)
+    drop = small & (votes > count / 2)
+    if not drop.any():
+        return loops
+    return loops.select(~drop[loops.loop])
 
 
 def _detours(loops: Loops, gap: float) -> np.ndarray:

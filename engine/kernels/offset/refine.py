@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from .distance import Nearest, SegmentTree, point_segment
-from .loops import COS30, Loops, drop_folds, segments_cross, tidy, unit
+from .loops import COS30, Loops, drop_covered, drop_folds, segments_cross, tidy, unit
 
 __all__ = ["exact_loops", "project", "refine_chords", "smooth"]
 
@@ -38,7 +38,9 @@ def _feet(tree: SegmentTree, near: Nearest, p: np.ndarray) -> tuple[np.ndarray, 
     return foot, unit(p - foot)
 
 
-def project(tree: SegmentTree, p: np.ndarray, radius: float, band: float):
+def project(
+    tree: SegmentTree, p: np.ndarray, radius: float, band: float, upper: np.ndarray | None = None
+):
     """Move points onto the level ``radius`` along the gradient of the distance.
 
     For a distance function the step ``x -> foot + radius * (x - foot) / |x - foot|`` lands
@@ -53,6 +55,8 @@ def project(tree: SegmentTree, p: np.ndarray, radius: float, band: float):
     radius : float
     band : float
         How far from the level the points may be (the query is exact within it).
+    upper : (m,) float, optional
+        Known upper bounds of the points' distances (inf: none), which prune the search.
 
     Returns
     -------
@@ -66,7 +70,7 @@ def project(tree: SegmentTree, p: np.ndarray, radius: float, band: float):
     ok : (m,) bool
         ``moved`` lies on the level.
     """
-    near = tree.query(p, radius - band, radius + band)
+    near = tree.query(p, radius - band, radius + band, upper=upper)
     foot, normal = _feet(tree, near, p)
     ok = near.exact & (near.dist > 0)
     moved = foot + radius * normal
@@ -308,6 +312,37 @@ class _Picks:
         self.seg[rows], self.seg_in[rows] = seg[ok], seg_in[ok]
 
 
+def _choose(pick: _Picks, steps, fits) -> None:
+    """Give each chord the first candidate of ``steps`` that works.
+
+    ``steps``: in order of preference, tuples ``(rows, ok, point, normal, seg, normal_in,
+    seg_in, checked)``; a candidate works where ``ok`` and, if ``checked``, where
+    ``fits(rows, point)`` says it makes no local fold (asked once for all candidates).
+    """
+    rows, ok, point, normal, seg, normal_in, seg_in = (
+        np.concatenate([step[k] for step in steps]) for k in range(7)
+    )
+    checked = np.concatenate([np.full(step[0].size, step[7]) for step in steps])
+    ask = np.flatnonzero(ok & checked)
+    ok = ok.copy()
+    ok[ask] = fits(rows[ask], point[ask])
+    good = np.flatnonzero(ok)  # (in order of preference)
+    by_row = good[np.argsort(rows[good], kind="stable")]
+    first = np.ones(by_row.size, dtype=bool)
+    np.not_equal(rows[by_row[1:]], rows[by_row[:-1]], out=first[1:])
+    chosen = by_row[first]
+    every = np.ones(chosen.size, dtype=bool)
+    pick.take(
+        rows[chosen],
+        every,
+        point[chosen],
+        normal[chosen],
+        seg[chosen],
+        normal_in[chosen],
+        seg_in[chosen],
+    )
+
+
 def refine_chords(
     tree: SegmentTree,
     loops: Loops,
@@ -399,7 +434,13 @@ def refine_chords(
         # New vertices keep clear of the chord's ends.
         gap = np.maximum(eps, 1e-3 * clen)
         pick = _Picks(todo.size)
-        found, take = pick.found, pick.take
+        found = pick.found
+
+        def choose(candidates, todo=todo, gap=gap, pick=pick, fits=fits):
+            _choose(pick, candidates, lambda r, p: fits(todo[r], p, gap[r]))
+
+        # Each step's candidates are checked together (`_choose`: the first step that works
+        # wins): steps 1 to 3, then 4 to 6 on the chords left.
         # 1. A corner: the tangent intersection on the level, and on the offsets of both
         # end segments (so both stretches run straight to it, or round one arc).
         rows = np.flatnonzero(reach_k)
@@ -411,53 +452,55 @@ def refine_chords(
         # (Only those need a query: that no other segment comes closer.)
         near = tree.query(kr[ok], radius - eps, radius + eps)
         ok[ok] = near.exact & (np.abs(near.dist - radius) <= eps)
-        ok &= fits(todo[rows], kr, gap[rows])
         n_in = unit(kr - (tree.a[su] + tu[:, None] * (tree.b[su] - tree.a[su])))
         n_out = unit(kr - (tree.a[sw] + tw[:, None] * (tree.b[sw] - tree.a[sw])))
-        take(rows, ok, kr, n_out, sw, n_in, su)
+        steps = [(rows, ok, kr, n_out, sw, n_in, su, True)]
         # 2. Where the normals turn sharply, the corner where the end segments' offsets
-        # meet (chasing a third segment that comes closer).
+        # meet (chasing a third segment that comes closer). (Solved for every such chord,
+        # whatever step 1 gives: a few more rows cost the solve no more numpy calls.)
         rows = np.flatnonzero(
-            ~found
-            & (np.einsum("ij,ij->i", nu, nw) < COS30)
-            & (loops.seg[todo] != loops.seg_in[nxt])
+            (np.einsum("ij,ij->i", nu, nw) < COS30) & (loops.seg[todo] != loops.seg_in[nxt])
         )
         if rows.size:
             start = np.where(reach_k[rows, None], k[rows], u[rows] + c[rows] / 2)
             ends = loops.seg[todo[rows]], loops.seg_in[nxt[rows]]
             ok, p2, n_in, s_in, n_out, s_out = _corner(tree, *ends, start, radius, tol)
-            ok &= fits(todo[rows], p2, gap[rows])
             ok &= np.hypot(*(p2 - u[rows]).T) < 0.9 * radius
-            take(rows, ok, p2, n_out, s_out, n_in, s_in)
+            steps.append((rows, ok, p2, n_out, s_out, n_in, s_in, True))
         # 3. The chord point below k, moved along the gradient (projected above).
         at = np.einsum("ij,ij->i", p3 - u, c) / clen**2
         slid = ok3 & ~((at > 0.1) & (at < 0.9))
-        rows = np.flatnonzero(~found)
-        take(rows, (ok3 & ~slid)[rows], p3[rows], n3[rows], s3[rows])
-        slid_rows = np.flatnonzero(slid & ~found)
-        slid_p, slid_n, slid_s = p3[slid_rows], n3[slid_rows], s3[slid_rows]
+        rows = np.arange(todo.size)
+        steps.append((rows, ok3 & ~slid, p3, n3, s3, n3, s3, False))
+        choose(steps)
         # 4. Near a corner that point slides toward a chord end: look between it and k,
         # where the distance crosses the level.
-        rows = np.flatnonzero(~found & inside)
-        ok, p4, n4, s4 = _crossing(tree, m[rows], k[rows], dist_m[rows], radius, tol)
-        # (That segment may meet the level again past the chord's ends, folding the loop.)
-        ok &= _between(u[rows], c[rows], p4) & fits(todo[rows], p4, gap[rows])
-        take(rows, ok, p4, n4, s4)
+        rest = np.flatnonzero(~found)
+        r4 = rest[inside[rest]]
         # 5. Straight across the chord, toward the level: out of the region (on the
         # loop's left) if the chord point is in it, else into it. This also finds a spike
-        # of the region narrower than a cell.
-        rows = np.flatnonzero(~found)
-        left = np.stack([-c[rows, 1], c[rows, 0]], axis=-1) / clen[rows, None]
-        region = (dist_m[rows] > radius) == far_inside
-        reach = 0.85 * radius - np.hypot(*(m - u)[rows].T)
-        end = m[rows] + np.where(region, -1.0, 1.0)[:, None] * reach[:, None] * left
-        ok, p5, n5, s5 = _crossing(tree, m[rows], end, dist_m[rows], radius, tol)
-        ok &= (reach > 0) & _between(u[rows], c[rows], p5)
-        take(rows, ok & fits(todo[rows], p5, gap[rows]), p5, n5, s5)
+        # of the region narrower than a cell. (Both solved at once.)
+        left = np.stack([-c[rest, 1], c[rest, 0]], axis=-1) / clen[rest, None]
+        region = (dist_m[rest] > radius) == far_inside
+        reach = 0.85 * radius - np.hypot(*(m - u)[rest].T)
+        end = m[rest] + np.where(region, -1.0, 1.0)[:, None] * reach[:, None] * left
+        both = np.concatenate([r4, rest])
+        ok, p45, n45, s45 = _crossing(
+            tree, m[both], np.concatenate([k[r4], end]), dist_m[both], radius, tol
+        )
+        # (That segment may meet the level again past the chord's ends, folding the loop.)
+        ok &= _between(u[both], c[both], p45)
+        ok[r4.size :] &= reach > 0
+        four, five = slice(0, r4.size), slice(r4.size, None)
+        steps = [
+            (r4, ok[four], p45[four], n45[four], s45[four], n45[four], s45[four], True),
+            (rest, ok[five], p45[five], n45[five], s45[five], n45[five], s45[five], True),
+        ]
         # 6. A projection that slid toward an end is still a point of the level.
-        last = ~found[slid_rows] & _between(u[slid_rows], c[slid_rows], slid_p)
-        last &= fits(todo[slid_rows], slid_p, gap[slid_rows])
-        take(slid_rows, last, slid_p, slid_n, slid_s)
+        rows = np.flatnonzero(slid & ~found)
+        last = _between(u[rows], c[rows], p3[rows])
+        steps.append((rows, last, p3[rows], n3[rows], s3[rows], n3[rows], s3[rows], True))
+        choose(steps)
         loops = loops.insert(todo[found], pick, np.flatnonzero(found))
     return loops
 
@@ -470,6 +513,7 @@ def exact_loops(
     band: float,
     tol: float,
     far_inside: bool,
+    upper: np.ndarray | None = None,
 ) -> Loops:
     """Traced loops made exact: vertices on the level ``radius``, chords within ``tol``.
 
@@ -487,6 +531,8 @@ def exact_loops(
         Largest distance allowed between a chord and the level set.
     far_inside : bool
         The region (on the loops' left) is where the distance exceeds ``radius``.
+    upper : (n,) float, optional
+        Known upper bounds of the traced vertices' distances (inf: none).
 
     Returns
     -------
@@ -494,7 +540,7 @@ def exact_loops(
     """
     n = xy.shape[0]
     loop = np.repeat(np.arange(offsets.size - 1), np.diff(offsets))
-    moved, normal, seg, _, ok = project(tree, xy, radius, band)
+    moved, normal, seg, _, ok = project(tree, xy, radius, band, upper)
     # Where the contour passes within a hair of a sample, marching squares puts two or
     # three vertices on top of each other; projection could then fold them.
     prev = np.arange(n) - 1
@@ -509,7 +555,8 @@ def exact_loops(
     # offset: it goes, and the chord across the corner recovers the corner.
     loops = drop_folds(loops, xy, ok)
     loops = refine_chords(tree, loops, radius, tol, far_inside)
-    return tidy(loops, 1e-3 * tol)
+    # A piece of a thin spike's tip that the grid cut off lies under the recovered tip.
+    return drop_covered(tidy(loops, 1e-3 * tol), band * band)
 
 
 def smooth(tree: SegmentTree, loops: Loops, radius: float, passes: int) -> Loops:
