@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..io.meshdata import fan_triangles
+from .keys import sort_keys
 
 __all__ = [
     "EdgeTable",
@@ -88,8 +89,7 @@ def edge_table(face_indices: np.ndarray, face_offsets: np.ndarray, n_vertices: i
     lo, hi = np.minimum(a, b), np.maximum(a, b)
     # the direction is the last bit, so equal neighbours in the sort run an edge the same way
     key = (lo * nv + hi) * 2 + (a > b)
-    order = np.argsort(key)
-    skey = key[order]
+    order, skey = sort_keys(key, 2 * nv * nv)
     edge = skey >> 1
     first = np.r_[edge.size > 0, edge[1:] != edge[:-1]] if edge.size else np.zeros(0, bool)
     starts = np.flatnonzero(first)
