@@ -17,7 +17,14 @@ import numpy as np
 from ..io.meshdata import fan_triangles
 from .halfedge import boundary_loops
 from .keys import sort_keys
-from .measure import edge_table, face_areas, next_corner, signed_volume, union_find
+from .measure import (
+    edge_table,
+    face_areas,
+    flat_open_parts,
+    next_corner,
+    signed_volume,
+    union_find,
+)
 from .meshops import reverse_faces, triangulate
 
 __all__ = [
@@ -600,57 +607,3 @@ def cap(
     caps = np.concatenate([tri, fans])
     out_fo = np.concatenate([fo, fo[-1] + np.arange(3, caps.size + 1, 3)])
     return np.concatenate([v, new_v]), np.concatenate([fi, caps]), out_fo
-
-
-def flat_open_parts(
-    vertices: np.ndarray,
-    face_indices: np.ndarray,
-    face_offsets: np.ndarray,
-    planar_tolerance: float = 1e-6,
-) -> int:
-    """How many connected parts are flat open sheets (all in one plane, with a boundary).
-
-    Capping such a part fills its outline in its own plane: the cap lies on the sheet, and
-    the result is a two-sided shell of zero volume, doubled and usually non-manifold, which
-    no slicer can print. Parts are joined by shared vertices (a parallel union-find); each
-    one's plane is the least-squares plane of its vertices (the smallest eigenvector of their
-    covariance, batched), and it is flat when every vertex lies within ``planar_tolerance``
-    of the part's bounding-box diagonal from that plane.
-
-    Returns
-    -------
-    int
-        The number of flat parts that have at least one boundary edge.
-    """
-    v = np.asarray(vertices, dtype=np.float64)
-    fi = np.asarray(face_indices, dtype=np.int64)
-    fo = np.asarray(face_offsets, dtype=np.int64)
-    if fi.size == 0:
-        return 0
-    root, _ = union_find(len(v), fi, fi[next_corner(fo)])
-    used = np.zeros(len(v), dtype=bool)
-    used[fi] = True
-    parts, part = np.unique(root[used], return_inverse=True)
-    p = v[used]
-    count = np.bincount(part, minlength=parts.size)[:, None]
-    mean = np.stack([np.bincount(part, p[:, k], parts.size) for k in range(3)], 1) / count
-    d = p - mean[part]
-    cov = np.zeros((parts.size, 3, 3))
-    for a in range(3):
-        for b in range(a, 3):
-            cov[:, a, b] = cov[:, b, a] = np.bincount(part, d[:, a] * d[:, b], parts.size)
-    normal = np.linalg.eigh(cov)[1][:, :, 0]  # eigenvalues ascending: the plane's normal
-    dist = np.abs(np.einsum("ij,ij->i", d, normal[part]))
-    far = np.zeros(parts.size)
-    np.maximum.at(far, part, dist)
-    hi = np.full((parts.size, 3), -np.inf)
-    lo = np.full((parts.size, 3), np.inf)
-    np.maximum.at(hi, part, p)
-    np.minimum.at(lo, part, p)
-    flat = far <= planar_tolerance * np.linalg.norm(hi - lo, axis=1)
-    t = edge_table(fi, fo, len(v))
-    open_vertex = t.vertices[t.counts == 1, 0]
-    has_open = np.zeros(parts.size, dtype=bool)
-    where = np.searchsorted(parts, root[open_vertex])
-    has_open[where] = True
-    return int(np.count_nonzero(flat & has_open))
