@@ -297,7 +297,7 @@ def exact_duplicates(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     packed <<= shift
     packed |= np.arange(n, dtype=np.uint64)
     packed.sort(kind="stable")
-    order = (packed & ((np.uint64(1) << shift) - np.uint64(1))).astype(np.int64)
+    order = (packed & ((np.uint64(1) << shift) - np.uint64(1))).view(np.int64)
     packed >>= shift
     new = np.empty(n, dtype=bool)
     new[0] = True
