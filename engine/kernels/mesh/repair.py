@@ -248,7 +248,7 @@ def weld(
     if len(v) == 0:
         return v.copy(), fi.copy(), fo.copy()
     first, inverse = exact_duplicates(v)
-    uniq = v[first]
+    uniq = np.take(v, first, axis=0)
     if tolerance is None:  # (the distinct points have the same box, and are fewer)
         tol = weld_tolerance(uniq)
     if tol > 0 and len(uniq) > 1:
@@ -303,7 +303,9 @@ def exact_duplicates(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     new[0] = True
     np.not_equal(packed[1:], packed[:-1], out=new[1:])
     del packed
-    sb = bits[order]  # the rows' bits in sorted order: a group's rows are neighbours
+    # the rows' bits in sorted order (a group's rows are neighbours); take, not fancy
+    # indexing: 2.5 times faster on rows
+    sb = np.take(bits, order, axis=0)
     differ = (sb[1:, 0] != sb[:-1, 0]) | (sb[1:, 1] != sb[:-1, 1]) | (sb[1:, 2] != sb[:-1, 2])
     clash = np.flatnonzero(differ & ~new[1:])
     if clash.size:
