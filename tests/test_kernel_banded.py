@@ -193,3 +193,28 @@ def test_open_fit_without_scipys_private_collocation(monkeypatch):
     np.testing.assert_allclose(
         K.curve_evaluate(cp, 3, knots, None, u), pts, atol=1e-9 * np.abs(pts).max()
     )
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.integers(0, 2**31), st.sampled_from([1, 2, 3, 4, 5]), st.sampled_from([1, 3, 7]))
+def test_open_fit_of_many_columns_matches_scipy(seed, degree, columns):
+    # The band is at most p - 1 wide on each side with averaged knots (each parameter lies
+    # between the means of the p parameters up to and from it; up to rounding, which may
+    # leave a tiny entry one further out), and the solve gets only the live diagonals;
+    # three columns or fewer share the collocation's own array, more get their own.
+    from scipy import interpolate
+
+    rng = np.random.default_rng(seed)
+    k = 60 + int(rng.integers(0, 200))
+    u = np.concatenate([[0.0], np.sort(rng.uniform(0, 1, k - 2)), [1.0]])
+    knots = fit._averaged_knots(u, degree)
+    cols, vals = fit._collocation_rows(degree, knots, u)
+    live = np.abs(vals) > 1e-9
+    offsets = (cols - np.arange(k)[:, None])[live]
+    assert np.abs(offsets).max() <= max(degree - 1, 0)
+    values = rng.normal(size=(k, columns))
+    ctrl, knots2 = fit.fit_columns(values, u, degree)
+    np.testing.assert_array_equal(knots2, knots)
+    ref = interpolate.make_interp_spline(u, values, k=degree, t=knots)
+    np.testing.assert_allclose(ctrl, ref.c, atol=1e-8 * np.abs(values).max())
+    np.testing.assert_allclose(ref.__class__(knots, ctrl, degree)(u), values, atol=1e-9)

@@ -22,6 +22,7 @@ from scipy.interpolate import BSpline
 from scipy.spatial import cKDTree
 
 from formgraph.kernels.mesh import MeshTopologyError, build_halfedges
+from formgraph.kernels.mesh.halfedge import boundary_loops
 from formgraph.kernels.mesh.meshops import (
     reverse_faces,
     triangulate,
@@ -136,6 +137,9 @@ def test_bowtie_vertex_has_two_fans():
     assert he.is_manifold_vertex.tolist() == [False, True, True, True, True]
     assert (he.fans.vertex == 0).sum() == 2
     assert len(he.boundary_loops()) == 2
+    assert [loop.tolist() for loop in boundary_loops(fi, fo, len(v))] == [
+        loop.tolist() for loop in he.boundary_loops()
+    ]
 
 
 @pytest.mark.parametrize(
@@ -147,6 +151,7 @@ def test_bowtie_vertex_has_two_fans():
         ([[0, 1, 2], [2, -1, 3]], 4, r"face 1 refers to vertex -1"),
         ([[0, 1, 2], [2, 3]], 4, r"face 1 has 2 vertices; a face needs at least 3"),
         ([[0, 1, 2, 1]], 3, r"face 0 visits vertex 1 twice"),
+        ([[0, 1, 2], [2, 3, 2]], 4, r"face 1 visits vertex 2 twice"),
     ],
 )
 def test_bad_topology_is_rejected(faces, n, message):
@@ -154,6 +159,8 @@ def test_bad_topology_is_rejected(faces, n, message):
     v = np.zeros((n, 3))
     with pytest.raises(MeshTopologyError, match=message):
         build_halfedges(fi, fo, n)
+    with pytest.raises(MeshTopologyError, match=message):
+        boundary_loops(fi, fo, n)
     for kernel in (catmull_clark, doo_sabin, validate_faces):
         with pytest.raises(ValueError, match=message):
             kernel(v, fi, fo)
@@ -536,3 +543,15 @@ def test_halfedges_random_meshes(mesh):
     edges = {tuple(e) for e in he.boundary_edges.tolist()}
     for loop in loops:
         assert all((a, b) in edges for a, b in zip(loop, np.roll(loop, -1), strict=True))
+
+
+@settings(max_examples=60, deadline=None)
+@given(random_meshes())
+def test_boundary_loops_from_one_sort_match_the_half_edges(mesh):
+    # the same loops, starting at the same vertices, in the same order (pinched 'bowtie'
+    # vertices take the fans' way; all others link a boundary edge to the one leaving its
+    # end)
+    v, fi, fo = mesh
+    expect = build_halfedges(fi, fo, len(v)).boundary_loops()
+    got = boundary_loops(fi, fo, len(v))
+    assert [loop.tolist() for loop in got] == [loop.tolist() for loop in expect]

@@ -504,6 +504,67 @@ def test_exact_duplicates_survive_a_hash_collision(monkeypatch):
     assert first2.tolist() == [0, 1, 3] and inverse2.tolist() == [0, 1, 0, 2, 2]
 
 
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**31), st.sampled_from([0, 1 << 63, 0xF << 60, 0xFFF << 52]))
+def test_exact_duplicates_split_what_a_weak_hash_joins(seed, mask):
+    # A hash of a few (top) bits puts many different rows in one run of the sort, next to
+    # runs of rows that agree; each mixed run
+    # is split by the rows themselves: the groups are numpy's unique rows, in the order
+    # they first appear (-0.0 and 0.0 are one value).
+    rng = np.random.default_rng(seed)
+    base = rng.integers(-2, 3, (40, 3)).astype(float)
+    pts = base[rng.integers(0, 40, 200)]
+    pts[rng.random(pts.shape) < 0.1] *= -1.0  # signed zeros among them
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(kr, "_mix", lambda x: x & np.uint64(mask))
+        first, inverse = kr.exact_duplicates(pts)
+    _, idx, inv = np.unique(pts + 0.0, axis=0, return_index=True, return_inverse=True)
+    rank = np.argsort(idx)
+    where = np.empty_like(rank)
+    where[rank] = np.arange(rank.size)
+    np.testing.assert_array_equal(first, idx[rank])
+    np.testing.assert_array_equal(inverse, where[inv.reshape(-1)])
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.integers(0, 2**31))
+def test_dropping_collapsed_triangles_keeps_the_others_in_order(seed):
+    rng = np.random.default_rng(seed)
+    fi = rng.integers(0, 6, 3 * 50)
+    fo = np.arange(0, fi.size + 1, 3)
+    out_fi, out_fo = kr.drop_collapsed(fi, fo, 6)
+    kept = [t for t in fi.reshape(-1, 3).tolist() if len(set(t)) == 3]
+    assert out_fi.reshape(-1, 3).tolist() == kept
+    assert out_fo.tolist() == list(range(0, 3 * len(kept) + 1, 3))
+    # the polygon path (a quad appended) drops the same triangles
+    poly_fi, poly_fo = kr.drop_collapsed(np.r_[fi, 0, 1, 2, 3], np.r_[fo, fo[-1] + 4], 6)
+    assert poly_fi[:-4].tolist() == out_fi.tolist()
+
+
+def test_triangle_measures_of_orient_match_the_polygon_ones():
+    v, fi, fo = triangulate(*kp.torus(2, 0.7, 12, 7))
+    v = v + [1e3, -2e3, 5e2]  # far from the origin
+    origin = np.random.default_rng(1).normal(size=(fo.size - 1, 3)) + v.mean(axis=0)
+    fast = kr._face_measures(v, fi, fo, True)
+    slow = kr._face_measures(v, fi, fo, False)
+    np.testing.assert_allclose(fast[0], slow[0], rtol=1e-9)
+    np.testing.assert_allclose(fast[1], slow[1], rtol=1e-12)
+    np.testing.assert_allclose(fast[2](origin), slow[2](origin), rtol=1e-9, atol=1e-9)
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.integers(0, 2**31), st.sampled_from(["torus", "sphere", "prism"]))
+def test_orient_a_randomly_flipped_triangle_soup(seed, which):
+    # all triangles, welded from a soup (the triangle paths of weld, orient and cap)
+    mesh = {"torus": kp.torus(2, 0.7, 12, 7), "sphere": kp.sphere(1, 10), "prism": prism(5)}
+    v, fi, fo = triangulate(*mesh[which])
+    welded = kr.weld(*mix(soup((v, fi, fo)), seed))
+    out, conflicts = kr.orient(*welded)
+    t = tri((welded[0], out, welded[2]))
+    assert conflicts == 0 and t.is_winding_consistent and t.volume > 0
+    assert t.volume == pytest.approx(volume((v, fi, fo)), rel=1e-12)
+
+
 def test_weld_refuses_a_tolerance_that_would_compare_everything(monkeypatch):
     monkeypatch.setattr(kr, "MAX_PAIRS", 1000)
     v, fi, fo = kp.sphere(1, 64)

@@ -5,7 +5,9 @@
 - :func:`union_find`: connected components of a graph given by edge lists, optionally with
   a parity per edge (two-colouring, used to orient faces), by hooking and pointer jumping;
 - :func:`face_areas`, :func:`signed_volume`, :func:`solid_report`: area of the exported fan,
-  volume by the divergence theorem over the fan triangles of each face.
+  volume by the divergence theorem over the fan triangles of each face;
+- :func:`flat_open_parts`: how many connected parts are flat open sheets (which a cap
+  would only double).
 
 A mesh is ``vertices (n, 3)``, ``face_indices (m,)`` and ``face_offsets (n_faces + 1,)``.
 """
@@ -17,6 +19,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..io.meshdata import fan_triangles
+from .keys import sort_keys
+from .memo import by_faces
 
 __all__ = [
     "EdgeTable",
@@ -24,6 +28,7 @@ __all__ = [
     "edge_table",
     "face_areas",
     "face_vectors",
+    "flat_open_parts",
     "is_closed_oriented",
     "next_corner",
     "signed_volume",
@@ -88,8 +93,7 @@ def edge_table(face_indices: np.ndarray, face_offsets: np.ndarray, n_vertices: i
     lo, hi = np.minimum(a, b), np.maximum(a, b)
     # the direction is the last bit, so equal neighbours in the sort run an edge the same way
     key = (lo * nv + hi) * 2 + (a > b)
-    order = np.argsort(key)
-    skey = key[order]
+    order, skey = sort_keys(key, 2 * nv * nv)
     edge = skey >> 1
     first = np.r_[edge.size > 0, edge[1:] != edge[:-1]] if edge.size else np.zeros(0, bool)
     starts = np.flatnonzero(first)
@@ -336,3 +340,65 @@ def solid_report(
         misoriented_edges=int(np.count_nonzero(t.same_way & (t.counts == 2))),
         example=example,  # type: ignore[arg-type]
     )
+
+
+def flat_open_parts(
+    vertices: np.ndarray,
+    face_indices: np.ndarray,
+    face_offsets: np.ndarray,
+    planar_tolerance: float = 1e-6,
+) -> int:
+    """How many connected parts are flat open sheets (all in one plane, with a boundary).
+
+    Capping such a part fills its outline in its own plane: the cap lies on the sheet, and
+    the result is a two-sided shell of zero volume, doubled and usually non-manifold, which
+    no slicer can print. Parts are joined by shared vertices (a parallel union-find); each
+    one's plane is the least-squares plane of its vertices (the smallest eigenvector of their
+    covariance, batched), and it is flat when every vertex lies within ``planar_tolerance``
+    of the part's bounding-box diagonal from that plane.
+
+    Returns
+    -------
+    int
+        The number of flat parts that have at least one boundary edge.
+    """
+    v = np.asarray(vertices, dtype=np.float64)
+    fi = np.asarray(face_indices, dtype=np.int64)
+    fo = np.asarray(face_offsets, dtype=np.int64)
+    if fi.size == 0:
+        return 0
+    used, parts, part, has_open = by_faces(
+        "sheets", fi, fo, len(v), lambda: _vertex_parts(fi, fo, len(v))
+    )
+    p = v[used]
+    count = np.bincount(part, minlength=parts.size)[:, None]
+    mean = np.stack([np.bincount(part, p[:, k], parts.size) for k in range(3)], 1) / count
+    d = p - mean[part]
+    cov = np.zeros((parts.size, 3, 3))
+    for a in range(3):
+        for b in range(a, 3):
+            cov[:, a, b] = cov[:, b, a] = np.bincount(part, d[:, a] * d[:, b], parts.size)
+    normal = np.linalg.eigh(cov)[1][:, :, 0]  # eigenvalues ascending: the plane's normal
+    dist = np.abs(np.einsum("ij,ij->i", d, normal[part]))
+    far = np.zeros(parts.size)
+    np.maximum.at(far, part, dist)
+    hi = np.full((parts.size, 3), -np.inf)
+    lo = np.full((parts.size, 3), np.inf)
+    np.maximum.at(hi, part, p)
+    np.minimum.at(lo, part, p)
+    flat = far <= planar_tolerance * np.linalg.norm(hi - lo, axis=1)
+    return int(np.count_nonzero(flat & has_open))
+
+
+def _vertex_parts(fi: np.ndarray, fo: np.ndarray, n_vertices: int) -> tuple:
+    """The used vertices, the parts they join into (by shared vertices; each part's root
+    and each used vertex's part) and which parts have a boundary edge."""
+    root, _ = union_find(n_vertices, fi, fi[next_corner(fo)])
+    used = np.zeros(n_vertices, dtype=bool)
+    used[fi] = True
+    parts, part = np.unique(root[used], return_inverse=True)
+    t = edge_table(fi, fo, n_vertices)
+    open_vertex = t.vertices[t.counts == 1, 0]
+    has_open = np.zeros(parts.size, dtype=bool)
+    has_open[np.searchsorted(parts, root[open_vertex])] = True
+    return used, parts, part, has_open

@@ -53,10 +53,13 @@ def interpolation_parameters(
     pts = np.asarray(points, dtype=np.float64)
     k = pts.shape[0]
     seq = np.concatenate([pts, pts[:1]]) if closed else pts
+    u = np.empty(len(seq))
+    u[0] = 0.0
+    dist = u[1:]  # the steps' lengths, summed where they are (fresh memory costs faults)
     if seq.ndim == 2 and seq.shape[1] == 3:
-        # points: coordinate by coordinate into one buffer (no (k, 3) steps array, no
-        # reductions over a short axis; fresh memory costs page faults at this size)
-        dist = np.subtract(seq[1:, 0], seq[:-1, 0])
+        # points: coordinate by coordinate (no (k, 3) steps array, no reductions over a
+        # short axis)
+        np.subtract(seq[1:, 0], seq[:-1, 0], out=dist)
         dist *= dist
         tmp = np.subtract(seq[1:, 1], seq[:-1, 1])
         tmp *= tmp
@@ -68,9 +71,9 @@ def interpolation_parameters(
     else:
         steps = seq[1:] - seq[:-1]
         s3 = steps.reshape(len(steps), -1, steps.shape[-1])
-        dist = np.linalg.norm(s3, axis=-1).mean(axis=1)
+        dist[:] = np.linalg.norm(s3, axis=-1).mean(axis=1)
     if parametrization == "uniform":
-        dist = np.ones_like(dist)
+        dist[:] = 1.0
     elif parametrization == "centripetal":
         np.sqrt(dist, out=dist)
     if np.any(dist == 0):
@@ -79,9 +82,7 @@ def interpolation_parameters(
         raise ValueError(
             f"points {i} and {j} coincide; interpolation needs consecutive points to differ"
         )
-    u = np.empty(dist.size + 1)
-    u[0] = 0.0
-    np.cumsum(dist, out=u[1:])
+    np.cumsum(dist, out=dist)
     u /= u[-1]
     return u[:k] if closed else u
 
@@ -202,11 +203,13 @@ def _collocation_solve(
     then ``gbsv``), with two differences. The solve gets only the diagonals that hold
     entries: scipy's storage has ``2 p + 1`` (``kl = ku = p``), but with averaged knots
     parameter ``u_i`` lies between knots ``i + 1`` and ``i + p`` (means of p parameters up
-    to and from ``u_i``), so the band is at most ``p - 1`` wide on each side (cubic: 2 + 2)
-    and the elimination does less. And the band is kept so that the miss is a pass over
+    to and from ``u_i``), so the band is at most ``p - 1`` wide on each side (cubic: 2 + 2;
+    the diagonals are found from the entries, so rounding cannot hide one) and the
+    elimination does less. And the band is kept so that the miss is a pass over
     its diagonals rather than an evaluation of the curve, done in blocks of rows whose
     temporaries stay in cache (at this size fresh memory costs more in page faults than the
-    arithmetic). The answer is Fortran-ordered, as LAPACK leaves it. The collocation
+    arithmetic). The answer is Fortran-ordered, where LAPACK leaves it (for up to 3
+    columns a view of the collocation's array, which it keeps alive). The collocation
     routine is scipy's own, not public
     (``_dierckx._coloc`` since 1.15): where it is missing, the public
     ``make_interp_spline`` and an evaluation do the same.
@@ -232,14 +235,20 @@ def _collocation_solve(
     ku = next(o for o in range(p, -1, -1) if ab[mid - o].any())
     kl = next(o for o in range(p, -1, -1) if ab[mid + o].any())
     # The live diagonals (offsets ku .. -kl) are kept, C-ordered, for the miss; the solve
-    # gets them in LAPACK's storage of the narrow band, laid out in scipy's wider array's
-    # own memory (fresh memory costs page faults: at this size more than the arithmetic).
+    # gets them in LAPACK's storage of the narrow band, and (3 columns or fewer) the
+    # right-hand sides after them, laid out in scipy's wider array's own memory (fresh
+    # memory costs page faults: at this size more than the arithmetic).
     band = np.array(ab[mid - ku : mid + kl + 1])
     rows = 2 * kl + ku + 1
     lu = ab.reshape(-1, order="F")[: rows * n].reshape((rows, n), order="F")
     lu[:kl] = 0.0
     lu[kl:] = band
-    rhs = np.array(flat, dtype=np.float64, order="F")
+    if (rows + flat.shape[1]) * n <= ab.size:  # the right-hand sides fit the rest of it
+        rhs = ab.reshape(-1, order="F")[rows * n : (rows + flat.shape[1]) * n]
+        rhs = rhs.reshape(flat.shape, order="F")
+        rhs[:] = flat
+    else:
+        rhs = np.array(flat, dtype=np.float64, order="F")
     (gbsv,) = get_lapack_funcs(("gbsv",), (lu, rhs))
     _, _, ctrl, info = gbsv(kl, ku, lu, rhs, overwrite_ab=True, overwrite_b=True)
     del lu, ab  # (the factors)
