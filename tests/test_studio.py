@@ -452,6 +452,28 @@ def test_wrong_host_and_origin_are_refused(studio):
 # ---------------------------------------------------------------------------- browser
 
 
+# the time of the page's first WebGL draw call (page clock), put in before the page loads
+FIRST_DRAW = """
+(() => {
+  const getContext = HTMLCanvasElement.prototype.getContext;
+  HTMLCanvasElement.prototype.getContext = function (type, ...rest) {
+    const ctx = getContext.call(this, type, ...rest);
+    if (ctx && /webgl/.test(type) && !ctx.__fg) {
+      ctx.__fg = true;
+      for (const f of ['drawArrays', 'drawElements']) {
+        const draw = ctx[f].bind(ctx);
+        ctx[f] = (...a) => {
+          if (window.__fgFirstDraw === undefined) window.__fgFirstDraw = performance.now();
+          return draw(...a);
+        };
+      }
+    }
+    return ctx;
+  };
+})();
+"""
+
+
 @pytest.fixture(scope="module")
 def page(studio):
     if CHROMIUM is None:
@@ -468,10 +490,12 @@ def page(studio):
         try:
             pg = browser.new_page(viewport={"width": 1400, "height": 850})
             pg.set_default_timeout(30_000)
+            pg.add_init_script(FIRST_DRAW)
             pg.goto(studio.url)
             pg.wait_for_function(
                 "document.querySelector('#status')?.innerText.includes('computed')"
             )
+            pg.wait_for_selector("#editor .view-lines")  # Monaco, loaded after the picture
             yield pg
         finally:
             browser.close()
@@ -515,6 +539,20 @@ def test_page_shows_the_model(page):
     assert "type: nurbs.sweep" in page.inner_text("#editor").replace("\xa0", " ")
     assert page.locator("#graph [data-node='tube']").count() == 1
     assert re.search(r"\d+ computed, \d+ cached in", _status(page))
+
+
+def test_the_editor_loads_after_the_first_picture(page):
+    """Monaco (most of the page's script) is not what the page starts with: it is fetched
+    once the model is drawn, and then edits as before (the tests below type in it)."""
+    started = page.evaluate(
+        "performance.getEntriesByType('resource')"
+        ".find(r => r.name.includes('trame-code.umd.js'))?.startTime"
+    )
+    drawn = page.evaluate("window.__fgFirstDraw")
+    assert drawn is not None and started is not None and started > drawn
+    scripts = page.evaluate("window.trame.state.get('trame__scripts')")
+    assert scripts and not any("trame-code" in u for u in scripts)
+    assert page.locator("#editor .view-lines").count() == 1
 
 
 def _turns(pg) -> int:

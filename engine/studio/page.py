@@ -391,13 +391,8 @@ class Page:
 
     def _settled(self) -> None:
         self._settle_timer = None
-        if self._scene_stale:  # the whole scene, for a page that loads from now on
-            self._scene_stale = False
-            view = self.view
-            full = view._helper.scene(
-                view._VtkLocalView__view, new_state=True, widgets=view._widgets, orientation_axis=0
-            )
-            self.state[view._VtkLocalView__scene_id] = full
+        if self._scene_stale:
+            self._send_whole_scene()
         if self._settled_svg is not None:
             svg, self._settled_svg = self._settled_svg, None
             with self.state:
@@ -430,7 +425,7 @@ class Page:
         first = self._framed is None
         if first:
             self.plotter.reset_camera(render=False)  # a render would send the scene
-        if first or added or not self._send_changes():
+        if not self._send_changes(immediately=first or bool(added)):
             self.view.update()
         if first:
             self.view.push_camera()
@@ -441,7 +436,7 @@ class Page:
             self._framed = bounds
         self.updates += 1
 
-    def _send_changes(self) -> bool:
+    def _send_changes(self, immediately: bool = False) -> bool:
         """Send the page the scene's changes alone (False: not possible here).
 
         trame-vtk's ``update()`` serializes the scene twice, its changes for the pages open
@@ -459,7 +454,19 @@ class Page:
         )
         protocol.publish("trame.vtk.delta", delta)
         self._scene_stale = True
+        if immediately:  # a first picture, or new actors: a page loading now needs them
+            self._send_whole_scene()
         return True
+
+    def _send_whole_scene(self) -> None:
+        """The whole scene into the state, for a page that loads from now on (the pages
+        open now got its changes; trame-vtk's own page ignores the state after its first)."""
+        self._scene_stale = False
+        view = self.view
+        full = view._helper.scene(
+            view._VtkLocalView__view, new_state=True, widgets=view._widgets, orientation_axis=0
+        )
+        self.state[view._VtkLocalView__scene_id] = full
 
 
 def _as_param(c: Control, value: Any) -> Any:
