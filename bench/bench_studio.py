@@ -166,11 +166,14 @@ def run(table) -> None:
                 )
                 timing = json.loads(page.inner_text("#timing") or "{}")
                 m = re.search(r"(\d+) computed, (\d+) cached", page.inner_text("#status"))
-                ws = [w for w in fg["ws"] if w[0] >= key]
                 draws = [d for d in fg["draws"] if d >= key]
+                drawn = max(draws, default=key)
+                # what came before the picture was drawn (the page sends the graph's drawing
+                # and the whole scene for later pages once the steps settle, after it)
+                ws = [w for w in fg["ws"] if key <= w[0] <= drawn]
                 if not ws or not draws:
                     continue
-                last, drawn = ws[-1][0], max(draws)
+                last = ws[-1][0]
                 server = (
                     timing.get("asked_to_done_ms", 0.0)
                     + timing.get("state_ms", 0.0)
@@ -209,7 +212,8 @@ def run(table) -> None:
         case_step,
         "formgraph",
         med("total"),
-        f"median of {len(rows)} key presses; {rows[0]['nodes']}; {kib:.0f} KiB sent per step",
+        f"median of {len(rows)} key presses; {rows[0]['nodes']}; {kib:.0f} KiB sent before "
+        "each picture",
     )
     parts = [
         ("recook", "the engine's evaluation"),

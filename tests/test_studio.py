@@ -452,6 +452,28 @@ def test_wrong_host_and_origin_are_refused(studio):
 # ---------------------------------------------------------------------------- browser
 
 
+# the time of the page's first WebGL draw call (page clock), put in before the page loads
+FIRST_DRAW = """
+(() => {
+  const getContext = HTMLCanvasElement.prototype.getContext;
+  HTMLCanvasElement.prototype.getContext = function (type, ...rest) {
+    const ctx = getContext.call(this, type, ...rest);
+    if (ctx && /webgl/.test(type) && !ctx.__fg) {
+      ctx.__fg = true;
+      for (const f of ['drawArrays', 'drawElements']) {
+        const draw = ctx[f].bind(ctx);
+        ctx[f] = (...a) => {
+          if (window.__fgFirstDraw === undefined) window.__fgFirstDraw = performance.now();
+          return draw(...a);
+        };
+      }
+    }
+    return ctx;
+  };
+})();
+"""
+
+
 @pytest.fixture(scope="module")
 def page(studio):
     if CHROMIUM is None:
@@ -468,10 +490,12 @@ def page(studio):
         try:
             pg = browser.new_page(viewport={"width": 1400, "height": 850})
             pg.set_default_timeout(30_000)
+            pg.add_init_script(FIRST_DRAW)
             pg.goto(studio.url)
             pg.wait_for_function(
                 "document.querySelector('#status')?.innerText.includes('computed')"
             )
+            pg.wait_for_selector("#editor .view-lines")  # Monaco, loaded after the picture
             yield pg
         finally:
             browser.close()
@@ -517,6 +541,20 @@ def test_page_shows_the_model(page):
     assert re.search(r"\d+ computed, \d+ cached in", _status(page))
 
 
+def test_the_editor_loads_after_the_first_picture(page):
+    """Monaco (most of the page's script) is not what the page starts with: it is fetched
+    once the model is drawn, and then edits as before (the tests below type in it)."""
+    started = page.evaluate(
+        "performance.getEntriesByType('resource')"
+        ".find(r => r.name.includes('trame-code.umd.js'))?.startTime"
+    )
+    drawn = page.evaluate("window.__fgFirstDraw")
+    assert drawn is not None and started is not None and started > drawn
+    scripts = page.evaluate("window.trame.state.get('trame__scripts')")
+    assert scripts and not any("trame-code" in u for u in scripts)
+    assert page.locator("#editor .view-lines").count() == 1
+
+
 def _turns(pg) -> int:
     return int(re.search(r"turns = (\d+)", pg.inner_text("#controls")).group(1))
 
@@ -532,6 +570,37 @@ def test_slider_recooks_and_redraws(page):
     m = re.search(r"(\d+) computed, (\d+) cached", _status(page))
     assert m and (int(m.group(1)), int(m.group(2))) == (5, 1)  # the section circle stays
     assert _turns(page) == (turns + 1 if turns < 12 else turns - 1)
+
+
+def _aspect(img: np.ndarray) -> float:
+    """Height over width of the model's (blue) pixels."""
+    rows, cols = np.nonzero(img[..., 2] > img[..., 0] + 40)
+    return float(np.ptp(rows) + 1) / float(np.ptp(cols) + 1)
+
+
+def test_a_page_loaded_after_steps_shows_them(page, studio):
+    """A step sends the open page its changes alone; the whole scene, which a page that
+    loads later starts from, follows once the steps settle."""
+    turns, before = _turns(page), _status(page)
+    page.locator(".fg-slider-turns .v-slider-thumb").focus()
+    page.keyboard.press("ArrowRight" if turns < 12 else "ArrowLeft")  # away from the start
+    page.wait_for_function(f"document.querySelector('#status').innerText != {before!r}")
+    assert _turns(page) not in (turns, 3)
+    time.sleep(1.0)  # past the settle delay
+    context = page.context.browser.new_context(viewport=page.viewport_size)
+    try:
+        other = context.new_page()  # a second tab, or the page reloaded
+        other.set_default_timeout(30_000)
+        other.goto(studio.url)
+        other.wait_for_function("document.querySelector('#status')?.innerText.includes('cached')")
+        end = time.monotonic() + 20
+        while _shows_model(_canvas(other)) < 0.02 and time.monotonic() < end:
+            time.sleep(0.2)
+        # the same tube (the cameras may differ: the first page was framed again as the
+        # tube grew), told by its proportions: each turn makes it taller, not wider
+        assert _aspect(_canvas(other)) == pytest.approx(_aspect(_canvas(page)), rel=0.12)
+    finally:
+        context.close()
 
 
 def test_typo_shows_its_line_and_fixing_recovers(page, studio):
@@ -752,6 +821,22 @@ def test_a_step_changes_arrays_in_place(tube, tmp_path):
         assert data.bounds[5] == pytest.approx(3.4, abs=0.02)  # 3 turns up, 0.4 tube radius
     finally:
         plotter.close()
+
+
+def test_normals_go_as_int8_within_half_a_degree():
+    from formgraph.studio.scene import quantized_normals
+
+    rng = np.random.default_rng(7)
+    n = rng.normal(size=(20_000, 3)) * rng.uniform(0.1, 10, size=(20_000, 1))
+    n[0] = [0, 0, 0]  # a degenerate normal stays 0, not NaN
+    q = quantized_normals(n)
+    assert q.dtype == np.int8 and np.abs(q.astype(int)).max() <= 127
+    unit = n[1:] / np.linalg.norm(n[1:], axis=1, keepdims=True)
+    back = q[1:] / np.linalg.norm(q[1:].astype(float), axis=1, keepdims=True)
+    angle = np.degrees(np.arccos(np.clip(np.einsum("ij,ij->i", unit, back), -1, 1)))
+    assert angle.max() < 0.5 and (q[0] == 0).all()
+    # the same directions give the same bytes: a step that only scales them sends nothing
+    assert np.array_equal(quantized_normals(unit * 3.0), quantized_normals(unit))
 
 
 def test_choice_control_for_an_enum_param():

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from typing import Any
 
-__all__ = ["CSS", "build", "clickable_svg"]
+__all__ = ["CSS", "EDITOR_LOADER", "build", "clickable_svg"]
 
 CSS = """
 html, body { overflow: hidden; }
@@ -18,6 +18,8 @@ html, body { overflow: hidden; }
 .fg-left { flex: 0 0 32%; min-width: 0; display: flex; flex-direction: column;
   border-right: 1px solid #ddd; }
 .fg-editor { flex: 1 1 auto; min-height: 0; }
+.fg-plain { margin: 0; padding: 4px 8px 4px 30px; font: 13px monospace; white-space: pre;
+  overflow: auto; height: 100%; color: #333; }
 .fg-problems { max-height: 30%; overflow: auto; font: 12px monospace; color: #b00020;
   padding: 4px 8px; border-top: 1px solid #ddd; white-space: pre-wrap; }
 .fg-center { flex: 1 1 auto; display: flex; flex-direction: column; min-width: 0; }
@@ -31,6 +33,58 @@ html, body { overflow: hidden; }
 .fg-status { font: 13px sans-serif; margin-left: 12px; white-space: nowrap; overflow: hidden;
   text-overflow: ellipsis; }
 .fg-status.bad { color: #b00020; }
+"""
+
+
+# Monaco is most of the page's script (4 MB of trame-code's 7 MB), and nothing of the first
+# picture needs it: the page starts without it and loads it once the model is drawn, by
+# hand as trame would have (its style, its script, then Vue.use on trame's app: a component
+# registered late is found when the v-if that holds it renders).
+EDITOR_LOADER = """
+// the first WebGL draw call of the page (this runs before the 3-D view makes its context)
+window.fgDrawn = false;
+window.fgOnDraw = [];
+(() => {
+  const getContext = HTMLCanvasElement.prototype.getContext;
+  HTMLCanvasElement.prototype.getContext = function (type, ...rest) {
+    const ctx = getContext.call(this, type, ...rest);
+    if (ctx && /webgl/.test(type) && !ctx.fgWatched) {
+      ctx.fgWatched = true;
+      for (const f of ['drawArrays', 'drawElements']) {
+        const draw = ctx[f].bind(ctx);
+        ctx[f] = (...a) => {
+          const out = draw(...a);
+          if (!window.fgDrawn) {
+            window.fgDrawn = true;
+            setTimeout(() => window.fgOnDraw.splice(0).forEach((g) => g()), 0);
+          }
+          return out;
+        };
+      }
+    }
+    return ctx;
+  };
+})();
+window.fgAfterDraw = function (fn, most) {  // after the first draw, or ``most`` ms at most
+  if (window.fgDrawn) return setTimeout(fn, 0);
+  window.fgOnDraw.push(fn);
+  setTimeout(fn, most);
+};
+window.fgLoadEditor = function (dir, ready) {
+  if (window.fgEditorAsked) return;
+  window.fgEditorAsked = true;
+  const css = document.createElement('link');
+  css.rel = 'stylesheet';
+  css.href = dir + '/style.css';
+  document.head.appendChild(css);
+  const js = document.createElement('script');
+  js.src = dir + '/trame-code.umd.js';
+  js.onload = () => {
+    window.trame.app.use(window.trame_code, {serveDirectory: dir});
+    ready();
+  };
+  document.head.appendChild(js);
+};
 """
 
 
@@ -67,8 +121,23 @@ def build(page: Any) -> tuple[Any, Any]:
     from trame.widgets import vuetify3 as v
     from trame_pyvista.widgets import PyVistaLocalView
 
+    page.state.editor_ready = False
     with VAppLayout(page.server, full_height=True) as layout:
         client.Style(CSS)
+        client.Script(EDITOR_LOADER)
+        ready = "() => trame.state.set('editor_ready', true)"
+        load = f"window.fgLoadEditor({_code_directory()!r}, {ready})"
+        after_draw = f"window.fgAfterDraw(() => {load}, 8000)"
+        # the first picture drawn (or sent and given 8 s to draw: a result with nothing to
+        # draw), or the first problem shown: the editor's turn
+        client.ClientStateChange(
+            value="status_bad", change=f"status_bad && {load}", trigger_on_create=True
+        )
+        client.ClientStateChange(
+            value="cook_id",
+            change=f"cook_id > 0 && {after_draw}",
+            trigger_on_create=True,
+        )
         with v.VAppBar(density="compact", flat=True, border=True):
             v.VAppBarTitle(f"{page.session.path.name}", style="flex: 0 0 auto; font-size: 16px;")
             v.VBtn("Save", click=page.ctrl.save, variant="tonal", classes="ml-2", id="save")
@@ -95,7 +164,11 @@ def build(page: Any) -> tuple[Any, Any]:
             with html.Div(classes="fg-main"):
                 with html.Div(classes="fg-left"):
                     with html.Div(classes="fg-editor", id="editor"):
-                        code.Editor(
+                        # the text until Monaco (4 MB of script) has loaded, after the
+                        # first picture (see EDITOR_LOADER)
+                        html.Pre("{{ text }}", v_if="!editor_ready", classes="fg-plain")
+                        editor = code.Editor(
+                            v_if="editor_ready",
                             v_model=("text",),
                             language="yaml",
                             theme="vs",
@@ -105,6 +178,10 @@ def build(page: Any) -> tuple[Any, Any]:
                                 "automaticLayout: true, scrollBeyondLastLine: false }",
                             ),
                         )
+                        # resolved by name when it renders: it is registered after the
+                        # page's template was compiled
+                        editor._elem_name = "component"
+                        editor._attributes["is"] = 'is="vs-editor"'
                     with html.Div(classes="fg-problems", id="problems", v_show="problems.length"):
                         html.Div(
                             "{{ p }}",
@@ -113,7 +190,10 @@ def build(page: Any) -> tuple[Any, Any]:
                         )
                 with html.Div(classes="fg-center"):
                     with html.Div(classes="fg-view", id="view"):
-                        view = PyVistaLocalView(page.plotter)
+                        view = PyVistaLocalView(
+                            page.plotter,
+                            after_scene_loaded=f"cook_id > 0 && {after_draw}",
+                        )
                     with html.Div(classes="fg-graph", id="graph"):
                         html.Div(
                             "showing {{ shown }}",
@@ -177,7 +257,28 @@ def build(page: Any) -> tuple[Any, Any]:
                         id="colour-by",
                     )
                     _control_widgets(v, html)
+    _defer_editor(page.server)
     return layout, view
+
+
+def _code_directory() -> str:
+    from trame_code.module import serve_directory
+
+    return serve_directory
+
+
+def _defer_editor(server: Any) -> None:
+    """Take trame-code's script and style out of what the page loads before it starts
+    (they stay served): :data:`EDITOR_LOADER` loads them after the first picture."""
+    directory = _code_directory()
+    state = server.state
+    for key in ("trame__scripts", "trame__styles"):
+        state[key] = [u for u in state[key] if not str(u).startswith(directory)]
+    state.trame__vue_use = [
+        u
+        for u in state.trame__vue_use
+        if (u[0] if isinstance(u, (list, tuple)) else u) != "trame_code"
+    ]
 
 
 def _control_widgets(v: Any, html: Any) -> None:

@@ -29,6 +29,10 @@ __all__ = ["Page"]
 
 EDIT_DELAY = 0.35  # seconds of no typing before an edit is checked and cooked
 POLL_SECONDS = 0.5  # how often the graph's files are looked at
+# after a step, how long the page waits for the next before it sends what the picture does
+# not need: the graph's drawing with its times, and the whole scene for a page that loads
+# later (the page open now gets each step's changes alone)
+SETTLE_DELAY = 0.3
 _names = itertools.count()
 
 
@@ -74,6 +78,9 @@ class Page:
         self._edit_timer: Any = None
         self._framed: tuple[float, ...] | None = None  # the bounds the camera was fit to
         self.updates = 0  # view updates sent
+        self._settle_timer: Any = None
+        self._settled_svg: str | None = None  # the drawing to send once steps settle
+        self._scene_stale = False  # the state's whole scene is older than the picture
         from formgraph.viewer.watch import _Watched
 
         page = self
@@ -303,6 +310,7 @@ class Page:
                     s.status_bad = False
                 s.busy = not self.worker.idle()
                 s.cook_id = s.cook_id + 1
+            self._settle()
             return
         with s:
             if kind == "disk":
@@ -337,7 +345,9 @@ class Page:
                 self._wanted = dict(snap["values"])
                 s.controls = [c.as_dict() for c in self.controls]
                 s.params = {c.name: plain(c.value) for c in self.controls}
-            if svg is not None:
+            if svg is not None and kind == "params":
+                self._settled_svg = svg  # a slider step: the drawing once the steps settle
+            elif svg is not None:
                 s.graph_svg = svg
             s.shown = snap["shown_text"]
             if cooked.ok:
@@ -369,6 +379,24 @@ class Page:
         with s:
             s.cook_id = s.cook_id + 1
             s.timing = timing
+        self._settle()
+
+    def _settle(self) -> None:
+        """Send what the picture did not need (see SETTLE_DELAY), once steps pause."""
+        if self.loop is None or (self._settled_svg is None and not self._scene_stale):
+            return
+        if self._settle_timer is not None:
+            self._settle_timer.cancel()
+        self._settle_timer = self.loop.call_later(SETTLE_DELAY, self._settled)
+
+    def _settled(self) -> None:
+        self._settle_timer = None
+        if self._scene_stale:
+            self._send_whole_scene()
+        if self._settled_svg is not None:
+            svg, self._settled_svg = self._settled_svg, None
+            with self.state:
+                self.state.graph_svg = svg
 
     def _drawing(self, cooked: Cooked) -> str | None:
         """The graph's drawing, coloured by the last evaluation (None: nothing to draw)."""
@@ -397,7 +425,8 @@ class Page:
         first = self._framed is None
         if first:
             self.plotter.reset_camera(render=False)  # a render would send the scene
-        self.view.update()
+        if not self._send_changes(immediately=first or bool(added)):
+            self.view.update()
         if first:
             self.view.push_camera()
         elif added or _camera_lost(self._framed, bounds):
@@ -406,6 +435,38 @@ class Page:
         if first or added or _camera_lost(self._framed, bounds):
             self._framed = bounds
         self.updates += 1
+
+    def _send_changes(self, immediately: bool = False) -> bool:
+        """Send the page the scene's changes alone (False: not possible here).
+
+        trame-vtk's ``update()`` serializes the scene twice, its changes for the pages open
+        now and the whole of it into the state for a page that loads later (which the open
+        page ignores); a step sends the changes, and the whole scene follows once the steps
+        settle (:meth:`_settle`).
+        """
+        view = self.view
+        window = getattr(view, "_VtkLocalView__view", None)  # trame-vtk 2.x's render window
+        protocol = self.server.protocol
+        if window is None or protocol is None or not hasattr(view, "_helper"):
+            return False
+        delta = view._helper.scene(
+            window, new_state=False, widgets=view._widgets, orientation_axis=0
+        )
+        protocol.publish("trame.vtk.delta", delta)
+        self._scene_stale = True
+        if immediately:  # a first picture, or new actors: a page loading now needs them
+            self._send_whole_scene()
+        return True
+
+    def _send_whole_scene(self) -> None:
+        """The whole scene into the state, for a page that loads from now on (the pages
+        open now got its changes; trame-vtk's own page ignores the state after its first)."""
+        self._scene_stale = False
+        view = self.view
+        full = view._helper.scene(
+            view._VtkLocalView__view, new_state=True, widgets=view._widgets, orientation_axis=0
+        )
+        self.state[view._VtkLocalView__scene_id] = full
 
 
 def _as_param(c: Control, value: Any) -> Any:
