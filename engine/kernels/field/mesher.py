@@ -233,9 +233,10 @@ class _Lattice:
         self.values, self.inside = values, inside.reshape(ns, B, B, B)
 
     def _levels(self, g, own, values, lipschitz: float) -> np.ndarray:
-        """The levels of 4 and 2 cells inside blocks ``g`` (dense per-block arrays): their
-        centres sampled into ``values``, the kept cells of 2 into ``kept1``; returns the
-        centres of the cells of 2 ``(n, 4, 4, 4)`` (NaN where the cell of 4 was culled)."""
+        """The levels of 4 and 2 cells inside blocks ``g`` (dense per-block arrays, their
+        own slots ``own``): their centres sampled into ``values``; returns the values at
+        the centres of the cells of 2 ``(n, 4, 4, 4)`` (NaN where the cell of 4 was
+        culled)."""
         n, cell = len(g), self.cell
         v2 = _eval_ijk(self.f, self.origin, cell, (B * g[:, None, :] + C2).reshape(-1, 3))
         b2, q2 = np.nonzero(np.abs(v2.reshape(n, 8)) <= _reach(lipschitz, 4 * cell))
