@@ -62,7 +62,7 @@ GRID_SHIFT = np.array([0.1234567, 0.2345678, 0.3456789]) * 0.5
 # even as the float32 coordinates of an STL (at 2,000 cells from the origin an ulp of
 # float32 is 1e-4 of a cell)
 END_GAP = 5e-4
-CLOSE = 3e-3  # the last step is not sampled once |f| is this fraction of the bracket's change
+ACCEPT = 5e-4  # a vertex is done once |f| there is surely below this (cells), see _roots
 BLOCK_LEVEL = 3
 B = 1 << BLOCK_LEVEL  # a block is B^3 finest cells and owns B^3 corners
 B3 = B**3
@@ -233,9 +233,10 @@ class _Lattice:
         self.values, self.inside = values, inside.reshape(ns, B, B, B)
 
     def _levels(self, g, own, values, lipschitz: float) -> np.ndarray:
-        """The levels of 4 and 2 cells inside blocks ``g`` (dense per-block arrays): their
-        centres sampled into ``values``, the kept cells of 2 into ``kept1``; returns the
-        centres of the cells of 2 ``(n, 4, 4, 4)`` (NaN where the cell of 4 was culled)."""
+        """The levels of 4 and 2 cells inside blocks ``g`` (dense per-block arrays, their
+        own slots ``own``): their centres sampled into ``values``; returns the values at
+        the centres of the cells of 2 ``(n, 4, 4, 4)`` (NaN where the cell of 4 was
+        culled)."""
         n, cell = len(g), self.cell
         v2 = _eval_ijk(self.f, self.origin, cell, (B * g[:, None, :] + C2).reshape(-1, 3))
         b2, q2 = np.nonzero(np.abs(v2.reshape(n, 8)) <= _reach(lipschitz, 4 * cell))
@@ -260,7 +261,10 @@ class _Lattice:
         if not hasattr(self, "_at"):
             self._at = self.origin + self.base * self.cell  # each slot's corner 0
             self._local = LOCAL * self.cell
-        return self._at[corner >> 9] + self._local[corner & (B3 - 1)]
+        # np.take gathers rows faster than fancy indexing does
+        return np.take(self._at, corner >> 9, axis=0) + np.take(
+            self._local, corner & (B3 - 1), axis=0
+        )
 
     def step(self, corner: np.ndarray, axis: np.ndarray, by: int) -> np.ndarray:
         """The corners one step (``by`` = 1 or -1) along ``axis`` from ``corner``; -1 where
@@ -401,9 +405,11 @@ def _edge_hashes(cells: np.ndarray, case: np.ndarray, nbr: np.ndarray) -> np.nda
     which = np.repeat(np.arange(len(cells), dtype=cells.dtype), count)
     row = case[which].astype(cells.dtype) * 5 + (np.arange(n_tri, dtype=cells.dtype) - first[which])
     cw = cells[which]
-    key = ((cw & (B3 - 1)) * 12)[:, None] + TRI_ROWS[row]  # (t, 3): local cell, cube edge
-    packed = EDGE_PACK[key]
-    owner = nbr[((cw >> 9) * 8)[:, None] + (packed >> 11)]
+    key = ((cw & (B3 - 1)) * 12)[:, None] + np.take(
+        TRI_ROWS, row, axis=0
+    )  # (t, 3): local cell, cube edge
+    packed = np.take(EDGE_PACK, key)
+    owner = np.take(nbr, ((cw >> 9) * 8)[:, None] + (packed >> 11))
     return owner * (3 * B3) + (packed & 2047)
 
 
@@ -480,7 +486,7 @@ def mesh_field(
         pa = lat.point(start)
         pb = pa + np.eye(3)[axis] * cell
         guess = _guess(fm, fa, fb, fq) if root_steps else None
-        verts[i : i + CHUNK] = _roots(f, pa, pb, fa, fb, root_steps, cell, guess)
+        verts[i : i + CHUNK] = _roots(f, pa, pb, fa, fb, root_steps, cell, guess, lipschitz)
     return verts, tri.reshape(-1, 3)
 
 
@@ -507,35 +513,38 @@ def _guess(fm, fa, fb, fq) -> np.ndarray:
     return np.where(np.isfinite(t), t, lin)
 
 
-def _roots(f: Fn, pa, pb, fa, fb, steps: int, cell: float, guess=None) -> np.ndarray:
+def _roots(
+    f: Fn, pa, pb, fa, fb, steps: int, cell: float, guess=None, lipschitz: float = 1.0
+) -> np.ndarray:
     """Points where ``f`` changes sign on segments ``pa -> pb``.
 
-    ``fa`` and ``fb`` have opposite signs (one is < 0, the other >= 0). From the linear
-    guess, each step samples the field and moves to the inverse quadratic interpolant's
-    root through the bracket's ends and the new sample (exact for a quadratic along the
-    edge, Brent 1973), or to the regula falsi point of the shrunk bracket where that root
-    falls outside it. A vertex whose sample is within ``CLOSE`` of the edge's change of
-    zero takes its next step without sampling it (on a smooth field that step's error is
-    of higher order), so most vertices cost one sample. What is left after ``steps``
-    (a kink of a sharp union on the edge) is bisected. Points are kept ``END_GAP`` off
-    the ends, so edges meeting at a corner on the surface give distinct vertices (and no
-    triangle collapses to a point in a file of float32 coordinates).
+    ``fa`` and ``fb`` have opposite signs (one is < 0, the other >= 0). From ``guess``
+    (the linear one if none), each step samples the field and moves to the inverse
+    quadratic interpolant's root through the bracket's ends and the new sample (exact for
+    a quadratic along the edge, Brent 1973), or to the regula falsi point of the shrunk
+    bracket where that root falls outside it. A step is taken without sampling it where
+    the Lipschitz bound already keeps ``|f|`` there below ``ACCEPT`` cells, so most
+    vertices cost one sample and every one ends within that (an L-Lipschitz field). What
+    is left after ``steps`` (a kink of a sharp union on the edge) is bisected. Points are
+    kept ``END_GAP`` off the ends, so edges meeting at a corner on the surface give
+    distinct vertices (and no triangle collapses to a point in a file of float32
+    coordinates).
     """
     n = len(pa)
     lo_t, hi_t = np.zeros(n), np.ones(n)
     flo, fhi = fa.copy(), fb.copy()
     den = flo - fhi
-    span = np.abs(den)  # the field's change along the edge: the scale of its slope
     if guess is None:
         guess = np.divide(flo, den, out=np.full(n, 0.5), where=den != 0)
     t = np.clip(guess, END_GAP, 1 - END_GAP)
     tol = 1e-4 * cell
     idx = np.arange(n)
     d = pb - pa
-    for _ in range(steps):
-        c = t[idx]
-        fc = _eval(f, pa[idx] + c[:, None] * d[idx])
-        a, b, f_a, f_b = lo_t[idx], hi_t[idx], flo[idx], fhi[idx]
+    for k in range(steps):
+        at = slice(None) if k == 0 else idx  # every vertex takes the first step
+        c = t[at]
+        fc = _eval(f, pa[at] + c[:, None] * d[at])
+        a, b, f_a, f_b = lo_t[at], hi_t[at], flo[at], fhi[at]
         with np.errstate(divide="ignore", invalid="ignore"):
             iqi = (
                 a * f_b * fc / ((f_a - f_b) * (f_a - fc))
@@ -545,14 +554,21 @@ def _roots(f: Fn, pa, pb, fa, fb, steps: int, cell: float, guess=None) -> np.nda
         low = (fc < 0) == (f_a < 0)  # the sample replaces the end of its own sign
         a, f_a = np.where(low, c, a), np.where(low, fc, f_a)
         b, f_b = np.where(low, b, c), np.where(low, f_b, fc)
-        lo_t[idx], flo[idx], hi_t[idx], fhi[idx] = a, f_a, b, f_b
+        lo_t[at], flo[at], hi_t[at], fhi[at] = a, f_a, b, f_b
         den = f_a - f_b
         rf = a + np.divide(f_a, den, out=np.full(len(a), 0.5), where=den != 0) * (b - a)
         inside = np.isfinite(iqi) & (iqi > a) & (iqi < b)
         conv = np.abs(fc) <= tol
         step = np.clip(np.where(inside, iqi, rf), END_GAP, 1 - END_GAP)
-        t[idx] = np.where(conv, c, step)
-        idx = idx[~conv & (np.abs(fc) > CLOSE * span[idx])]
+        # a step not sampled moves the point by |t' - c| of the edge: for an L-Lipschitz
+        # field its value is then at most |f(c)| + L cell |t' - c|. Where that bound is
+        # within ACCEPT of a cell, take the step (on a smooth field it lands far closer);
+        # where only |f(c)| is, keep c; the rest sample again
+        bound = np.abs(fc) + lipschitz * cell * np.abs(step - c)
+        take = ~conv & (bound <= ACCEPT * cell)
+        keep = ~conv & ~take & (np.abs(fc) <= ACCEPT * cell)
+        t[at] = np.where(conv | keep, c, step)
+        idx = idx[~(conv | take | keep)]
         if not len(idx):
             break
     # what is left (a kink of a sharp union on the edge converges only linearly):
