@@ -137,3 +137,25 @@ def test_smooth_keeps_point_and_face_attributes():
     assert np.array_equal(after.point_data["h"], before.point_data["h"])
     assert np.array_equal(after.face_data["side"], before.face_data["side"])
     assert not np.array_equal(after.vertices, before.vertices)
+
+
+def test_decimate_reports_a_closed_input_that_came_out_open_or_pinched(monkeypatch):
+    # the library's result stood in by one with a face missing / two vertices at one
+    # point: refused for a closed input, passed through for an open one
+    s = trimesh.creation.icosphere(2)
+    small = trimesh.creation.icosphere(1)
+    sv, sf = np.array(small.vertices), np.array(small.faces)
+    monkeypatch.setattr(fast_simplification, "simplify", lambda v, t, **kw: (sv, sf[1:]))
+    with pytest.raises(ksimp.OpenedError, match="opened the closed mesh"):
+        ksimp.decimate(s.vertices, s.faces, 40)
+    ov, ot = ksimp.decimate(s.vertices, s.faces[1:], 40)
+    assert len(ot) == len(sf) - 1
+    # a pinch: two tetrahedra touching at a point, closed by indices, two vertices there
+    tv = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.0]])
+    tf = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+    pv = np.concatenate([tv, -tv])
+    pf = np.concatenate([tf, tf[:, ::-1] + 4])
+    assert ksimp.is_closed(pf)
+    monkeypatch.setattr(fast_simplification, "simplify", lambda v, t, **kw: (pv, pf))
+    with pytest.raises(ksimp.OpenedError, match="pinched the surface at 1 point "):
+        ksimp.decimate(s.vertices, s.faces, 40)

@@ -275,7 +275,7 @@ class Nearest:
             ln = np.linalg.norm(n, axis=1, keepdims=True)
             area = 0.5 * ln[:, 0]
             # a sliver's normal is noise: its bound falls back to the ball's
-            normal = np.where(ln > 1e-9 * radius[:, None] ** 2, n / np.maximum(ln, 1e-300), 0.0)
+            normal = np.where(ln > 1e-6 * radius[:, None] ** 2, n / np.maximum(ln, 1e-300), 0.0)
         else:
             area = radius**2
             normal = np.zeros_like(centre)

@@ -71,21 +71,25 @@ def decimate(
     """
     import fast_simplification
 
-    # writable copies: the extension refuses read-only (frozen) arrays
-    v = np.array(vertices, dtype=np.float64, order="C")
-    t = np.array(triangles, dtype=np.int64, order="C")
+    # the extension refuses read-only (frozen) arrays: copies of those only (it leaves its
+    # inputs as they were)
+    v = np.require(vertices, dtype=np.float64, requirements=["C", "W"])
+    t = np.require(triangles, dtype=np.int64, requirements=["C", "W"])
     if target_faces >= len(t):
-        return v, t
-    closed = is_closed(t)
+        return v.copy(), t.copy()
     reduction = 1.0 - target_faces / len(t)
     out_v, out_t = fast_simplification.simplify(v, t, target_reduction=reduction, agg=aggression)
     out_v, out_t = _collapse_zero_edges(np.asarray(out_v, np.float64), np.asarray(out_t, np.int64))
-    if closed and not is_closed(out_t):
-        raise OpenedError(
-            f"decimating to {len(out_t)} triangles opened the closed mesh; ask for more faces"
-        )
+    # the checks look at the (small) result first, and at the input only when the result
+    # fails one: whether that is a defect depends on whether the input was closed
+    if not is_closed(out_t):
+        if is_closed(t):
+            raise OpenedError(
+                f"decimating to {len(out_t)} triangles opened the closed mesh; ask for more faces"
+            )
+        return out_v, out_t
     pinched = len(out_v) - len(np.unique(out_v.astype(np.float32), axis=0))
-    if closed and pinched:
+    if pinched and is_closed(t):
         # two vertices at one point (as float32, an STL's precision): closed by its
         # indices, but a file of coordinates welds them into a non-manifold vertex
         raise OpenedError(
