@@ -194,12 +194,17 @@ def tidy(loops: Loops, gap: float) -> Loops:
         for o in range(1, _UNTANGLE + 1):
             steps[o] = nxt[steps[o - 1]]
         n = nxt.size
-        crossing = segments_cross(
-            np.tile(xy, (_UNTANGLE - 1, 1)),
-            np.tile(xy[nxt], (_UNTANGLE - 1, 1)),
-            xy[steps[1:_UNTANGLE].reshape(-1)],
-            xy[steps[2:].reshape(-1)],
-        ).reshape(_UNTANGLE - 1, n)  # row o - 2
+        # (Only chords whose bounding boxes overlap can cross: the few tested exactly.)
+        x, y = xy[:, 0], xy[:, 1]
+        x_lo, x_hi = np.minimum(x, x[nxt]), np.maximum(x, x[nxt])
+        y_lo, y_hi = np.minimum(y, y[nxt]), np.maximum(y, y[nxt])
+        ahead = steps[1:_UNTANGLE]  # (o - 2, i): the chord o ahead of chord i
+        overlap = (x_lo[ahead] <= x_hi) & (x_lo <= x_hi[ahead])
+        overlap &= (y_lo[ahead] <= y_hi) & (y_lo <= y_hi[ahead])
+        pair = np.flatnonzero(overlap)
+        i, j = pair % n, ahead.reshape(-1)[pair]
+        crossing = np.zeros((_UNTANGLE - 1, n), dtype=bool)  # row o - 2
+        crossing.reshape(-1)[pair] = segments_cross(xy[i], xy[nxt[i]], xy[j], xy[nxt[j]])
         beyond = np.logical_or.accumulate(crossing[::-1], axis=0)[::-1]  # any offset >= o
         between = beyond[np.maximum(np.arange(_UNTANGLE) - 1, 0)]  # (k, n): any o > k
         cut[steps[:_UNTANGLE][between]] = True
@@ -228,9 +233,10 @@ def drop_covered(loops: Loops, max_area: float) -> Loops:
     inside an island (or a hole outside every island): the winding number of its inside
     with respect to the other loops is 1 or more for an island (0 or less for a hole),
     where a piece that belongs would have 0 (1). A loop of area at most ``max_area`` goes
-    when most of its points halfway between its vertex mean and its vertices are so covered
+    when any of its points halfway between its vertex mean and its vertices is so covered
     (points inside it: such a piece is a sliver of a few vertices, some of them on the
-    other loop, found from both).
+    other loop, found from both). Loops of a valid result never overlap, so a piece that
+    overlaps in part goes too (what it held outside the other loop is smaller than it).
     """
     if loops.loop.size == 0:
         return loops
@@ -270,7 +276,7 @@ def drop_covered(loops: Loops, max_area: float) -> Loops:
     island = area2[loops.loop[test]] > 0
     covered = np.where(island, winding >= 1, winding <= 0)
     votes = np.bincount(loops.loop[test], covered, minlength=n_loops)
-    drop = small & (votes > count / 2)
+    drop = small & (votes > 0)
     if not drop.any():
         return loops
     return loops.select(~drop[loops.loop])
