@@ -14,6 +14,7 @@ from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 from formgraph.kernels.mesh import boolean as kb
+from formgraph.kernels.mesh import cells as kc
 from formgraph.kernels.mesh import measure as km
 from formgraph.kernels.mesh import primitives as kp
 from formgraph.kernels.mesh import repair as kr
@@ -177,7 +178,7 @@ def test_weld_groups_match_a_kd_tree(seed, tol):
     pts = rng.random((80, 3))
     pts = np.concatenate([pts, pts[:20] + rng.normal(0, tol / 4, (20, 3))])  # near copies
     # the weld's vertex groups against kd-tree pairs and scipy's components
-    i, j = kr._close_pairs(pts, tol)
+    i, j = kc.close_pairs(pts, tol)
     root, _ = km.union_find(len(pts), i, j)
     pairs = np.array(sorted(cKDTree(pts).query_pairs(tol)), dtype=np.int64).reshape(-1, 2)
     graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(len(pts),) * 2)
@@ -566,7 +567,7 @@ def test_orient_a_randomly_flipped_triangle_soup(seed, which):
 
 
 def test_weld_refuses_a_tolerance_that_would_compare_everything(monkeypatch):
-    monkeypatch.setattr(kr, "MAX_PAIRS", 1000)
+    monkeypatch.setattr(kc, "MAX_PAIRS", 1000)
     v, fi, fo = kp.sphere(1, 64)
     with pytest.raises(ValueError, match=r"weld tolerance 3 is too coarse for this mesh: [\d,]+ "):
         kr.weld(v, fi, fo, 3.0)
@@ -613,15 +614,13 @@ def test_fast_solid_check_agrees_with_the_report(seed, which):
 def test_packed_and_hashed_cell_keys_find_the_same_pairs(monkeypatch):
     # Cell numbers that fit 21 bits an axis take the packed-key path; forcing the hashed
     # one must give the same close pairs (and so the same weld).
-    from formgraph.kernels.mesh import repair
-
     rng = np.random.default_rng(4)
     base = rng.uniform(-1, 1, (3000, 3))
     near = base[rng.integers(0, 3000, 2000)] + rng.normal(scale=3e-4, size=(2000, 3))
     v = np.concatenate([base, near])
-    packed = repair._close_pairs(v, 1e-3)
-    monkeypatch.setattr(repair, "_PACKED", 0)
-    hashed = repair._close_pairs(v, 1e-3)
+    packed = kc.close_pairs(v, 1e-3)
+    monkeypatch.setattr(kc, "_PACKED", 0)
+    hashed = kc.close_pairs(v, 1e-3)
 
     def canon(ij):
         i, j = np.minimum(*ij), np.maximum(*ij)
