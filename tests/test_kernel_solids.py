@@ -632,6 +632,29 @@ def test_packed_and_hashed_cell_keys_find_the_same_pairs(monkeypatch):
     assert canon(packed) == sorted(map(tuple, brute.tolist()))
 
 
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**31), st.sampled_from([1e-3, 0.02]))
+def test_coarse_cells_find_every_close_pair(seed, tol):
+    # Cells 8 tolerances wide, each point probing only the faces it is near, against all
+    # pairs by brute force; points on a few shared planes (as meshes have them) and close
+    # copies across cell faces.
+    rng = np.random.default_rng(seed)
+    pts = rng.uniform(0, 1, (300, 3))
+    pts[rng.random(300) < 0.3, 2] = 0.5  # a plane of points
+    near = pts[:100] + rng.normal(0, tol / 2, (100, 3))
+    v = np.concatenate([pts, near])
+    lo = v.min(axis=0)
+    side = tol + 8 * np.finfo(np.float64).eps * float(np.abs(v).max())
+    got = kc._close_pairs_coarse(v, lo, side, tol)
+    assert got is not None
+    d = np.linalg.norm(v[:, None] - v[None], axis=2)
+    brute = sorted(map(tuple, np.argwhere(np.triu(d <= tol, k=1)).tolist()))
+    i, j = np.minimum(*got), np.maximum(*got)
+    assert sorted(zip(i.tolist(), j.tolist(), strict=True)) == brute
+    # crowded coarse cells are left to the fine ones
+    assert kc._close_pairs_coarse(v, lo, 0.1, 0.1) is None
+
+
 def test_triangle_face_vectors_match_the_polygon_formula():
     from formgraph.kernels.mesh import measure
 
