@@ -14,6 +14,7 @@ from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 from formgraph.kernels.mesh import boolean as kb
+from formgraph.kernels.mesh import cells as kc
 from formgraph.kernels.mesh import measure as km
 from formgraph.kernels.mesh import primitives as kp
 from formgraph.kernels.mesh import repair as kr
@@ -177,7 +178,7 @@ def test_weld_groups_match_a_kd_tree(seed, tol):
     pts = rng.random((80, 3))
     pts = np.concatenate([pts, pts[:20] + rng.normal(0, tol / 4, (20, 3))])  # near copies
     # the weld's vertex groups against kd-tree pairs and scipy's components
-    i, j = kr._close_pairs(pts, tol)
+    i, j = kc.close_pairs(pts, tol)
     root, _ = km.union_find(len(pts), i, j)
     pairs = np.array(sorted(cKDTree(pts).query_pairs(tol)), dtype=np.int64).reshape(-1, 2)
     graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(len(pts),) * 2)
@@ -566,7 +567,7 @@ def test_orient_a_randomly_flipped_triangle_soup(seed, which):
 
 
 def test_weld_refuses_a_tolerance_that_would_compare_everything(monkeypatch):
-    monkeypatch.setattr(kr, "MAX_PAIRS", 1000)
+    monkeypatch.setattr(kc, "MAX_PAIRS", 1000)
     v, fi, fo = kp.sphere(1, 64)
     with pytest.raises(ValueError, match=r"weld tolerance 3 is too coarse for this mesh: [\d,]+ "):
         kr.weld(v, fi, fo, 3.0)
@@ -613,15 +614,13 @@ def test_fast_solid_check_agrees_with_the_report(seed, which):
 def test_packed_and_hashed_cell_keys_find_the_same_pairs(monkeypatch):
     # Cell numbers that fit 21 bits an axis take the packed-key path; forcing the hashed
     # one must give the same close pairs (and so the same weld).
-    from formgraph.kernels.mesh import repair
-
     rng = np.random.default_rng(4)
     base = rng.uniform(-1, 1, (3000, 3))
     near = base[rng.integers(0, 3000, 2000)] + rng.normal(scale=3e-4, size=(2000, 3))
     v = np.concatenate([base, near])
-    packed = repair._close_pairs(v, 1e-3)
-    monkeypatch.setattr(repair, "_PACKED", 0)
-    hashed = repair._close_pairs(v, 1e-3)
+    packed = kc.close_pairs(v, 1e-3)
+    monkeypatch.setattr(kc, "_PACKED", 0)
+    hashed = kc.close_pairs(v, 1e-3)
 
     def canon(ij):
         i, j = np.minimum(*ij), np.maximum(*ij)
@@ -631,6 +630,29 @@ def test_packed_and_hashed_cell_keys_find_the_same_pairs(monkeypatch):
     d = np.linalg.norm(v[:, None] - v[None], axis=2)
     brute = np.argwhere(np.triu(d <= 1e-3, k=1))
     assert canon(packed) == sorted(map(tuple, brute.tolist()))
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**31), st.sampled_from([1e-3, 0.02]))
+def test_coarse_cells_find_every_close_pair(seed, tol):
+    # Cells 8 tolerances wide, each point probing only the faces it is near, against all
+    # pairs by brute force; points on a few shared planes (as meshes have them) and close
+    # copies across cell faces.
+    rng = np.random.default_rng(seed)
+    pts = rng.uniform(0, 1, (300, 3))
+    pts[rng.random(300) < 0.3, 2] = 0.5  # a plane of points
+    near = pts[:100] + rng.normal(0, tol / 2, (100, 3))
+    v = np.concatenate([pts, near])
+    lo = v.min(axis=0)
+    side = tol + 8 * np.finfo(np.float64).eps * float(np.abs(v).max())
+    got = kc._close_pairs_coarse(v, lo, side, tol)
+    assert got is not None
+    d = np.linalg.norm(v[:, None] - v[None], axis=2)
+    brute = sorted(map(tuple, np.argwhere(np.triu(d <= tol, k=1)).tolist()))
+    i, j = np.minimum(*got), np.maximum(*got)
+    assert sorted(zip(i.tolist(), j.tolist(), strict=True)) == brute
+    # crowded coarse cells are left to the fine ones
+    assert kc._close_pairs_coarse(v, lo, 0.1, 0.1) is None
 
 
 def test_triangle_face_vectors_match_the_polygon_formula():

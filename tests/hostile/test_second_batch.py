@@ -189,13 +189,13 @@ def test_a_small_tolerance_on_huge_coordinates_matches_a_kd_tree():
     from scipy.sparse.csgraph import connected_components
     from scipy.spatial import cKDTree
 
+    from formgraph.kernels.mesh import cells
     from formgraph.kernels.mesh import measure as km
-    from formgraph.kernels.mesh import repair as kr
 
     rng = np.random.default_rng(7)
     pts = 1e10 * rng.normal(size=(300, 3))
     pts = np.concatenate([pts, pts[:100] + rng.normal(0, 3e-4, (100, 3))])  # near copies
-    i, j = kr._close_pairs(pts, 1e-3)
+    i, j = cells.close_pairs(pts, 1e-3)
     root, _ = km.union_find(len(pts), i, j)
     pairs = np.array(sorted(cKDTree(pts).query_pairs(1e-3)), dtype=np.int64).reshape(-1, 2)
     assert len(pairs) > 20  # the near copies are found

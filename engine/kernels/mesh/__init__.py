@@ -10,7 +10,9 @@
 - ``primitives``: cylinder, UV sphere, torus, plane;
 - ``repair``: weld, orient, cap; ``solidify``: thickened shells;
 - ``boolean``: union, difference, intersection through manifold3d;
-- ``measure``: the edge table, union-find, areas, volumes, the solid report.
+- ``measure``: the edge table, union-find, areas, volumes, the solid report;
+- ``keys``: the sort of int64 keys with their positions behind edge tables and welds;
+  ``cells``: pairs of points closer than a tolerance (the weld's neighbour search).
 
 The solid modules are imported on use (``from formgraph.kernels.mesh import repair``), so
 ``import formgraph`` does not pay for them.

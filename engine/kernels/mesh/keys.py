@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["sort_keys"]
+__all__ = ["mix64", "sort_keys"]
 
 
 def sort_keys(key: np.ndarray, key_bound: int) -> tuple[np.ndarray, np.ndarray]:
@@ -49,3 +49,11 @@ def sort_keys(key: np.ndarray, key_bound: int) -> tuple[np.ndarray, np.ndarray]:
         return order, packed
     order = np.argsort(key, kind="stable")
     return order, key[order]
+
+
+def mix64(x: np.ndarray) -> np.ndarray:
+    """The splitmix64 finalizer (Steele et al. 2014): a bijection of 64-bit words."""
+    with np.errstate(over="ignore"):
+        x = (x ^ (x >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
+        x = (x ^ (x >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
+        return x ^ (x >> np.uint64(31))

@@ -1,8 +1,8 @@
 """Mesh repair on flat arrays: weld close vertices, orient faces, cap boundary loops.
 
 - :func:`weld`: vertices closer than a tolerance merged (transitively), faces that collapse
-  dropped; neighbours found in a sparse (hashed) grid of cells one tolerance wide, so only
-  the 27 cells around a point are searched, whatever the size of the coordinates;
+  dropped; exact duplicates first (one sort of a hash), then neighbours in a sparse grid of
+  cells (:mod:`.cells`), whatever the size of the coordinates;
 - :func:`orient`: one orientation per connected part, found by a parity union-find over the
   faces (two faces sharing an edge the same way must differ), then each closed part turned
   outward by its signed volume;
@@ -15,7 +15,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..io.meshdata import fan_triangles
+from .cells import close_pairs
 from .halfedge import boundary_loops
+from .keys import mix64 as _mix
 from .keys import sort_keys
 from .measure import (
     edge_table,
@@ -42,9 +44,6 @@ MeshArrays = tuple[np.ndarray, np.ndarray, np.ndarray]
 
 #: default weld tolerance, relative to the bounding-box diagonal
 RELATIVE_TOLERANCE = 1e-6
-#: most candidate vertex pairs a weld compares (a tolerance near the mesh's size would
-#: compare every vertex with every other)
-MAX_PAIRS = 20_000_000
 
 
 def weld_tolerance(vertices: np.ndarray) -> float:
@@ -53,162 +52,6 @@ def weld_tolerance(vertices: np.ndarray) -> float:
     if len(v) == 0:
         return 0.0
     return RELATIVE_TOLERANCE * float(np.linalg.norm(v.max(axis=0) - v.min(axis=0)))
-
-
-def _cell_hash(q: np.ndarray, salt: int) -> np.ndarray:
-    """A 64-bit hash of int64 cell coordinates ``q`` (k, 3), salted."""
-    b = q.view(np.uint64)
-    return _mix(_mix(_mix(b[:, 0] ^ np.uint64(salt)) ^ b[:, 1]) ^ b[:, 2])
-
-
-def _close_pairs(v: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
-    """All pairs ``i < j`` with ``|v[i] - v[j]| <= tol`` (cells of side about ``tol``).
-
-    The cells are sparse: each point's three int64 cell numbers, relative to the bounding
-    box's minimum, are hashed and sorted, so only occupied cells cost anything and a tolerance
-    that is tiny against the coordinates works (a radius-1e10 sphere welded at 1e-3).
-    """
-    lo = v.min(axis=0)
-    # a cell a little wider than tol absorbs the rounding of (v - lo) / side: two points
-    # within tol then never land two cells apart (the error is below 8 eps max|v|)
-    side = tol + 8 * np.finfo(np.float64).eps * float(np.abs(v).max())
-    with np.errstate(over="ignore"):
-        qf = np.floor((v - lo) / side)
-    # only the cell numbers themselves must fit an int64 (with room for the +-1 neighbours)
-    if not np.isfinite(qf).all() or qf.max() >= 2.0**62:
-        raise ValueError(
-            f"weld tolerance {tol:g} is too small for a mesh this large (a cell number "
-            "along an axis would pass 2^62); 0 merges exact duplicates only"
-        )
-    q = np.ascontiguousarray(qf.astype(np.int64))
-    if qf.max(initial=0.0) < _PACKED - 2:
-        return _close_pairs_packed(v, q, tol)
-    for salt in (0, 0x9E3779B97F4A7C15, 0x2545F4914F6CDD1D):
-        h = _cell_hash(q, salt)
-        order = np.argsort(h, kind="stable")
-        hs = h[order]
-        new_cell = np.r_[True, hs[1:] != hs[:-1]]
-        starts = np.flatnonzero(new_cell)
-        cells, rep = hs[starts], q[order[starts]]
-        # a hash collision would put two cells in one bucket: check, and re-salt
-        if np.array_equal(q[order], rep[np.cumsum(new_cell) - 1]):
-            break
-    else:  # pragma: no cover - three 64-bit collisions in a row
-        raise ValueError("weld could not hash its cells without collisions")
-    counts = np.diff(np.r_[starts, len(v)])
-    start = np.r_[starts, len(v)]
-    # the cell itself and the 13 neighbours "after" it: each unordered cell pair once
-    offsets = [(dx, dy, dz) for dx in (-1, 0, 1) for dy in (-1, 0, 1) for dz in (-1, 0, 1)]
-    found = []
-    for dx, dy, dz in offsets[13:]:
-        target = rep + np.array([dx, dy, dz], dtype=np.int64)
-        pos = np.minimum(np.searchsorted(cells, _cell_hash(target, salt)), cells.size - 1)
-        hit = np.flatnonzero((rep[pos] == target).all(axis=1))
-        found.append((dx, dy, dz, hit, pos[hit]))
-    # pairs to compare: na * nb between two cells, na (na - 1) / 2 within one
-    total = 0
-    for dx, dy, dz, ca, cb in found:
-        na, nb = counts[ca], counts[cb]
-        same = (dx, dy, dz) == (0, 0, 0)
-        total += int(np.sum(na * (nb - 1) // 2 if same else na * nb))
-    if total > MAX_PAIRS:
-        why = (
-            "use a smaller tolerance"
-            if side < 2 * tol
-            else f"the coordinates' float spacing ({side - tol:.3g}) is coarser than the "
-            "tolerance, so the cells cannot be smaller"
-        )
-        raise ValueError(
-            f"weld tolerance {tol:g} is too coarse for this mesh: {total:,} vertex pairs fall "
-            f"within a cell of each other (limit {MAX_PAIRS:,}); {why}"
-        )
-    ii, jj = [], []
-    for dx, dy, dz, ca, cb in found:
-        if ca.size == 0:
-            continue
-        na, nb = counts[ca], counts[cb]
-        pairs = na * nb
-        owner = np.repeat(np.arange(ca.size), pairs)
-        k = np.arange(owner.size) - np.repeat(np.cumsum(pairs) - pairs, pairs)
-        i = order[start[ca][owner] + k // nb[owner]]
-        j = order[start[cb][owner] + k % nb[owner]]
-        keep = i < j if (dx, dy, dz) == (0, 0, 0) else i != j
-        ii.append(i[keep])
-        jj.append(j[keep])
-    i = np.concatenate(ii) if ii else np.zeros(0, np.int64)
-    j = np.concatenate(jj) if jj else np.zeros(0, np.int64)
-    # compared in units of tol: tol * tol underflows for a tiny tolerance
-    with np.errstate(over="ignore"):
-        d = (v[i] - v[j]) / tol
-        close = np.einsum("ij,ij->i", d, d) <= 1.0
-    return i[close], j[close]
-
-
-_PACKED = 1 << 21  # cell numbers below this per axis pack into one int64 key (3 x 21 bits)
-_NEIGHBOURS = [(dx, dy, dz) for dx in (-1, 0, 1) for dy in (-1, 0, 1) for dz in (-1, 0, 1)][13:]
-
-
-def _close_pairs_packed(v: np.ndarray, q: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
-    """`_close_pairs` where the cell numbers fit 21 bits an axis (a tolerance above about
-    1e-6 of the extent): each cell is one int64 key ``(x + 1) << 42 | (y + 1) << 21 | z + 1``,
-    so a neighbour's key is the cell's plus a constant. The cells sorted once, every
-    neighbour look-up is then a search of sorted keys in sorted keys (no hashing, no
-    collision check, and cache-friendly: the searches walk both arrays in order)."""
-    key = ((q[:, 0] + 1) << 42) | ((q[:, 1] + 1) << 21) | (q[:, 2] + 1)
-    order = np.argsort(key, kind="stable")
-    ks = key[order]
-    new_cell = np.empty(ks.size, dtype=bool)
-    new_cell[0] = True
-    np.not_equal(ks[1:], ks[:-1], out=new_cell[1:])
-    starts = np.flatnonzero(new_cell)
-    cells = ks[starts]
-    counts = np.diff(np.r_[starts, len(v)])
-    found = []
-    for dx, dy, dz in _NEIGHBOURS:
-        shift = (dx << 42) + (dy << 21) + dz
-        if shift == 0:
-            hit = np.flatnonzero(counts > 1)
-            found.append((True, hit, hit))
-            continue
-        target = cells + shift  # sorted, as cells are
-        pos = np.minimum(np.searchsorted(cells, target), cells.size - 1)
-        hit = np.flatnonzero(cells[pos] == target)
-        found.append((False, hit, pos[hit]))
-    return _pairs_within(v, tol, order, starts, counts, found)
-
-
-def _pairs_within(v, tol, order, starts, counts, found):
-    """The point pairs of the cell pairs ``found`` (same cell, cells a, cells b) closer than
-    ``tol``, after the count of pairs to compare is checked against ``MAX_PAIRS``."""
-    total = 0
-    for same, ca, cb in found:
-        na, nb = counts[ca], counts[cb]
-        total += int(np.sum(na * (nb - 1) // 2 if same else na * nb))
-    if total > MAX_PAIRS:
-        raise ValueError(
-            f"weld tolerance {tol:g} is too coarse for this mesh: {total:,} vertex pairs fall "
-            f"within a cell of each other (limit {MAX_PAIRS:,}); use a smaller tolerance"
-        )
-    start = np.r_[starts, len(v)]
-    ii, jj = [], []
-    for same, ca, cb in found:
-        if ca.size == 0:
-            continue
-        na, nb = counts[ca], counts[cb]
-        pairs = na * nb
-        owner = np.repeat(np.arange(ca.size), pairs)
-        k = np.arange(owner.size) - np.repeat(np.cumsum(pairs) - pairs, pairs)
-        i = order[start[ca][owner] + k // nb[owner]]
-        j = order[start[cb][owner] + k % nb[owner]]
-        keep = i < j if same else i != j
-        ii.append(i[keep])
-        jj.append(j[keep])
-    i = np.concatenate(ii) if ii else np.zeros(0, np.int64)
-    j = np.concatenate(jj) if jj else np.zeros(0, np.int64)
-    with np.errstate(over="ignore"):  # compared in units of tol: tol * tol may underflow
-        d = (v[i] - v[j]) / tol
-        close = np.einsum("ij,ij->i", d, d) <= 1.0
-    return i[close], j[close]
 
 
 def weld(
@@ -253,7 +96,7 @@ def weld(
     if tolerance is None:  # (the distinct points have the same box, and are fewer)
         tol = weld_tolerance(uniq)
     if tol > 0 and len(uniq) > 1:
-        i, j = _close_pairs(uniq, tol)
+        i, j = close_pairs(uniq, tol)
         root, _ = union_find(len(uniq), i, j)
     else:
         root = np.arange(len(uniq))
@@ -261,14 +104,6 @@ def weld(
     vmap = root[inverse]
     out_fi, out_fo = drop_collapsed(vmap[fi], fo, len(uniq))
     return compact(uniq, out_fi, out_fo)
-
-
-def _mix(x: np.ndarray) -> np.ndarray:
-    """The splitmix64 finalizer (Steele et al. 2014): a bijection of 64-bit words."""
-    with np.errstate(over="ignore"):
-        x = (x ^ (x >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
-        x = (x ^ (x >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
-        return x ^ (x >> np.uint64(31))
 
 
 def exact_duplicates(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -433,7 +268,9 @@ def orient(
         np.stack([np.bincount(part, weights=c, minlength=n_parts) for c in corner_sums], 1)
         / np.maximum(corners, 1)[:, None]
     )
-    vol = np.bincount(part, weights=sign * cone(part_centroid[part]), minlength=n_parts)
+    vol = np.bincount(
+        part, weights=sign * cone(np.take(part_centroid, part, axis=0)), minlength=n_parts
+    )
     kept = np.bincount(part, weights=sign * areas, minlength=n_parts)
     flat = np.abs(vol) <= 1e-9 * np.maximum(part_area, 1e-300) ** 1.5
     turn = np.where(part_open & flat, kept < 0, vol < 0)
