@@ -70,20 +70,27 @@ window.fgAfterDraw = function (fn, most) {  // after the first draw, or ``most``
   window.fgOnDraw.push(fn);
   setTimeout(fn, most);
 };
-window.fgLoadEditor = function (dir, ready) {
+window.fgLoadEditor = function (files, ready) {  // files: {styles, scripts, use}
   if (window.fgEditorAsked) return;
   window.fgEditorAsked = true;
-  const css = document.createElement('link');
-  css.rel = 'stylesheet';
-  css.href = dir + '/style.css';
-  document.head.appendChild(css);
-  const js = document.createElement('script');
-  js.src = dir + '/trame-code.umd.js';
-  js.onload = () => {
-    window.trame.app.use(window.trame_code, {serveDirectory: dir});
+  for (const href of files.styles) {
+    const css = document.createElement('link');
+    css.rel = 'stylesheet';
+    css.href = href;
+    document.head.appendChild(css);
+  }
+  const next = (i) => {
+    if (i < files.scripts.length) {
+      const js = document.createElement('script');
+      js.src = files.scripts[i];
+      js.onload = () => next(i + 1);
+      document.head.appendChild(js);
+      return;
+    }
+    for (const [name, ...options] of files.use) window.trame.app.use(window[name], ...options);
     ready();
   };
-  document.head.appendChild(js);
+  next(0);
 };
 """
 
@@ -126,7 +133,7 @@ def build(page: Any) -> tuple[Any, Any]:
         client.Style(CSS)
         client.Script(EDITOR_LOADER)
         ready = "() => trame.state.set('editor_ready', true)"
-        load = f"window.fgLoadEditor({_code_directory()!r}, {ready})"
+        load = f"window.fgLoadEditor(editor_files, {ready})"
         after_draw = f"window.fgAfterDraw(() => {load}, 8000)"
         # the first picture drawn (or sent and given 8 s to draw: a result with nothing to
         # draw), or the first problem shown: the editor's turn
@@ -261,24 +268,26 @@ def build(page: Any) -> tuple[Any, Any]:
     return layout, view
 
 
-def _code_directory() -> str:
+def _defer_editor(server: Any) -> None:
+    """Take trame-code's scripts, styles and Vue plugin out of what the page loads before
+    it starts (they stay served) into ``editor_files``, which :data:`EDITOR_LOADER` loads
+    after the first picture."""
     from trame_code.module import serve_directory
 
-    return serve_directory
-
-
-def _defer_editor(server: Any) -> None:
-    """Take trame-code's script and style out of what the page loads before it starts
-    (they stay served): :data:`EDITOR_LOADER` loads them after the first picture."""
-    directory = _code_directory()
     state = server.state
-    for key in ("trame__scripts", "trame__styles"):
-        state[key] = [u for u in state[key] if not str(u).startswith(directory)]
-    state.trame__vue_use = [
-        u
-        for u in state.trame__vue_use
-        if (u[0] if isinstance(u, (list, tuple)) else u) != "trame_code"
-    ]
+    mine = {"styles": [], "scripts": [], "use": []}
+    for key, kind in (("trame__styles", "styles"), ("trame__scripts", "scripts")):
+        mine[kind] = [u for u in state[key] if str(u).startswith(serve_directory)]
+        state[key] = [u for u in state[key] if not str(u).startswith(serve_directory)]
+    kept = []
+    for use in state.trame__vue_use:
+        name = use[0] if isinstance(use, (list, tuple)) else use
+        if name == "trame_code":
+            mine["use"].append(list(use) if isinstance(use, (list, tuple)) else [use])
+        else:
+            kept.append(use)
+    state.trame__vue_use = kept
+    state.editor_files = mine
 
 
 def _control_widgets(v: Any, html: Any) -> None:

@@ -16,6 +16,7 @@ from __future__ import annotations
 import asyncio
 import itertools
 import sys
+import threading
 import time
 from typing import Any
 
@@ -67,9 +68,11 @@ class Page:
         self.state, self.ctrl = self.server.state, self.server.controller
         self.plotter = make_plotter()
         self.scene = StudioScene(self.plotter)
+        self.loop: asyncio.AbstractEventLoop | None = None
+        self._handoff = threading.Lock()  # the loop, or results made before it ran
+        self._early: list[tuple[Any, ...]] = []
         self.worker = Worker(self._deliver, self._worker_error)
         session.progress = self.worker.check
-        self.loop: asyncio.AbstractEventLoop | None = None
         self.controls: list[Control] = []
         self._wanted: dict[str, Any] = {}  # the controls' values, as the page last set them
         self._editor_text = ""  # the editor's text as the loop last knew it
@@ -110,6 +113,7 @@ class Page:
         self.layout, self.view = build(self)
         self.ctrl.on_server_bind.add(self._bind)
         self.ctrl.on_server_ready.add(self._ready)
+        self.worker.submit("disk", self._open_disk)  # the first load, while the server starts
 
     # ------------------------------------------------------------------ state, layout
 
@@ -163,8 +167,11 @@ class Page:
         wslink_server.app.middlewares.append(self.guard.middleware)
 
     def _ready(self, **_: Any) -> None:
-        self.loop = asyncio.get_event_loop()
-        self.worker.submit("disk", self._open_disk)
+        with self._handoff:
+            self.loop = asyncio.get_event_loop()
+            early, self._early = self._early, []
+        for item in early:  # the first load, cooked while the server started
+            self._apply(*item)
         self.loop.create_task(self._poll())
 
     async def _poll(self) -> None:
@@ -240,8 +247,6 @@ class Page:
     def _deliver(self, kind: str, result: Any, seconds: float) -> None:
         """In the worker thread: what can be made away from the page's loop (the datasets
         of the picture, the graph's drawing), then the rest on the loop."""
-        if self.loop is None:
-            return
         t0 = time.perf_counter()
         prepared = None
         if isinstance(result, Cooked):
@@ -251,6 +256,10 @@ class Page:
             svg = self._drawing(result) if kind != "frame" else None  # the graph is as it was
             prepared = (datasets, svg, self._snapshot())
         seconds += time.perf_counter() - t0
+        with self._handoff:
+            if self.loop is None:  # the server is still starting: shown once it is ready
+                self._early.append((kind, result, seconds, prepared))
+                return
         self.loop.call_soon_threadsafe(self._apply, kind, result, seconds, prepared)
 
     def _snapshot(self) -> dict[str, Any]:
