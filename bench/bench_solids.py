@@ -6,9 +6,11 @@
   engine;
 - weld + orient + cap of a 1,000,000-triangle open tube given as a triangle soup (every
   triangle with its own 3 vertices, half of them flipped, as an unrepaired STL holds it)
-  against trimesh's ``merge_vertices`` + ``fix_normals`` + ``fill_holes``. trimesh's
-  ``fill_holes`` fills only holes of 3 or 4 edges, so its chain leaves the tube's two
-  1000-edge ends open, where ours caps them.
+  against pymeshlab's ``remove_duplicate_vertices`` + ``re_orient_faces_coherently`` +
+  ``close_holes`` (the same work: exact duplicates, as our weld's default tolerance finds
+  here, and both ends capped), and trimesh's ``merge_vertices`` + ``fix_normals`` +
+  ``fill_holes``. trimesh's ``fill_holes`` fills only holes of 3 or 4 edges, so its chain
+  leaves the tube's two 1000-edge ends open, where ours caps them.
 """
 
 from __future__ import annotations
