@@ -17,7 +17,11 @@ Cases:
   outlines as exact NURBS, laid out with kerning, one curve per contour — against
   matplotlib's ``TextPath`` of the same text and font (which gives one path of Bezier
   codes, no curves). The font is parsed once, as in a graph's process;
-* ``export.svg`` of those outlines (ours alone: the cost a curve).
+* ``export.svg`` of those outlines (ours alone: the cost a curve);
+* the offset of an offset (the nameplate's kerf): an 80 x 30 rectangle offset by 5 (a
+  rounded plate), then that result offset by 0.1, against the first offset and against a
+  fresh 90 x 40 rectangle offset by the same 0.1 (the same size and distance, from 4
+  vertices instead of the first offset's dense outline).
 """
 
 from __future__ import annotations
@@ -166,3 +170,36 @@ def run(table) -> None:  # noqa: ANN001 - the harness's Table
         )
     if seconds is not None:
         table.rows[-1].note = f"{seconds / len(glyphs) * 1e6:.0f} us a curve"
+
+    # the offset of an offset: the nameplate's kerf on its rounded plate
+    from formgraph.nodes import offset as offset_nodes
+
+    def rect(w: float, h: float) -> NurbsCurve:
+        x, y = w / 2, h / 2
+        return NurbsCurve.polyline([[-x, -y, 0], [x, -y, 0], [x, y, 0], [-x, y, 0]], closed=True)
+
+    plate = rect(80, 30)
+    rounded = offset_nodes.marching_squares([plate], 5.0, ctx=ctx)
+    case = "offset of an offset: 80 x 30 rectangle by 5, then the result by 0.1"
+    first = table.time(
+        case,
+        "formgraph, the first offset (by 5)",
+        lambda: offset_nodes.marching_squares([plate], 5.0, ctx=ctx),
+        repeat=5,
+    )
+    fresh = rect(90, 40)
+    table.time(
+        case,
+        "formgraph, a fresh 90 x 40 rectangle by 0.1",
+        lambda: offset_nodes.marching_squares([fresh], 0.1, ctx=ctx),
+        repeat=5,
+    )
+    again = table.time(
+        case,
+        "formgraph, the offset of the offset (by 0.1)",
+        lambda: offset_nodes.marching_squares(rounded, 0.1, ctx=ctx),
+        repeat=5,
+    )
+    if first and again:
+        n = sum(len(c.control_points) for c in rounded)
+        table.rows[-1].note = f"{again / first:.2f}x the first offset; its input {n:,} vertices"
