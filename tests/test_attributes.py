@@ -498,9 +498,11 @@ def test_onto_triangles_without_area():
     assert data["face_data"]["f"].tolist() == [2.0]  # centroid (5.3, 2.4, 2.7): the segment
 
 
-def test_onto_finds_the_closest_triangle_exactly():
+@pytest.mark.parametrize("rounds", [(32, 128), (2,), (4, 8)])
+def test_onto_finds_the_closest_triangle_exactly(rounds, monkeypatch):
     from formgraph.kernels.attributes import propagate as carry
 
+    monkeypatch.setattr(carry._Closest, "CANDIDATES", rounds)  # (2,): most via the tree
     tm = trimesh.creation.torus(2.0, 0.6, 40, 12)
     rng = np.random.default_rng(9)
     p = np.concatenate(
