@@ -19,6 +19,7 @@ import numpy as np
 
 from formgraph.geometry import Mesh
 from formgraph.kernels.mesh import boolean as kb
+from formgraph.kernels.mesh import memo
 from formgraph.kernels.mesh import primitives as kp
 from formgraph.kernels.mesh import repair as kr
 from formgraph.kernels.mesh.grid import grid_faces
@@ -67,6 +68,7 @@ def tube_soup(rows: int = 500, around: int = 1000, seed: int = 1):
 
 
 def _ours_repair(v, fi, fo):
+    memo.clear()  # a cold call: the memo only serves the same faces again (a slider step)
     w = kr.weld(v, fi, fo)
     o, _ = kr.orient(*w)
     return kr.cap(w[0], o, w[2])
