@@ -405,7 +405,7 @@ def run(
         threads = sum(w.get("nthreads", 1) for w in c.scheduler_info()["workers"].values())
         # a few variants to a task when there are many per thread: Dask's overhead per task
         # is paid once per few light variants, and the table still grows steadily
-        chunk = max(1, min(16, len(variants) // (8 * max(threads, 1))))
+        chunk = max(1, min(64, len(variants) // (8 * max(threads, 1))))
         dsk, rows, chunks, totals = build(g, bp_key, variants, targets, visible, chunk)
         if not rows:
             return totals
