@@ -36,6 +36,11 @@ CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 LOCAL = ("127.0.0.1", 8765)
 
 
+# how long a page waits for a state before the test fails: SwiftShader's WebGL, chromium and
+# the first cook share two cores with the other test worker, and a load spike made 30 s flaky
+WAIT_MS = 90_000
+
+
 def _guard() -> Guard:
     return Guard("s3cret-token")
 
@@ -489,7 +494,7 @@ def page(studio):
         )
         try:
             pg = browser.new_page(viewport={"width": 1400, "height": 850})
-            pg.set_default_timeout(30_000)
+            pg.set_default_timeout(WAIT_MS)
             pg.add_init_script(FIRST_DRAW)
             pg.goto(studio.url)
             pg.wait_for_function(
@@ -590,7 +595,7 @@ def test_a_page_loaded_after_steps_shows_them(page, studio):
     context = page.context.browser.new_context(viewport=page.viewport_size)
     try:
         other = context.new_page()  # a second tab, or the page reloaded
-        other.set_default_timeout(30_000)
+        other.set_default_timeout(WAIT_MS)
         other.goto(studio.url)
         other.wait_for_function("document.querySelector('#status')?.innerText.includes('cached')")
         end = time.monotonic() + 20
