@@ -119,12 +119,10 @@ _PACKED = 1 << 21  # cell numbers below this per axis pack into one int64 key (3
 _NEIGHBOURS = [(dx, dy, dz) for dx in (-1, 0, 1) for dy in (-1, 0, 1) for dz in (-1, 0, 1)][13:]
 
 
-def _close_pairs_packed(v: np.ndarray, q: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
-    """`close_pairs` where the cell numbers fit 21 bits an axis (a tolerance above about
-    1e-6 of the extent): each cell is one int64 key ``(x + 1) << 42 | (y + 1) << 21 | z + 1``,
-    so a neighbour's key is the cell's plus a constant. The cells sorted once, every
-    neighbour look-up is then a search of sorted keys in sorted keys (no hashing, no
-    collision check, and cache-friendly: the searches walk both arrays in order)."""
+def _packed_cells(q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Points grouped by their cell numbers ``q`` (n, 3), each cell one int64 key
+    ``(x + 1) << 42 | (y + 1) << 21 | z + 1``: the points' order sorted by key, the keys in
+    that order, and each occupied cell's first place in it and point count."""
     key = ((q[:, 0] + 1) << 42) | ((q[:, 1] + 1) << 21) | (q[:, 2] + 1)
     order = np.argsort(key, kind="stable")
     ks = key[order]
@@ -132,8 +130,17 @@ def _close_pairs_packed(v: np.ndarray, q: np.ndarray, tol: float) -> tuple[np.nd
     new_cell[0] = True
     np.not_equal(ks[1:], ks[:-1], out=new_cell[1:])
     starts = np.flatnonzero(new_cell)
+    return order, ks, starts, np.diff(np.r_[starts, len(q)])
+
+
+def _close_pairs_packed(v: np.ndarray, q: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
+    """`close_pairs` where the cell numbers fit 21 bits an axis (a tolerance above about
+    1e-6 of the extent): each cell is one int64 key ``(x + 1) << 42 | (y + 1) << 21 | z + 1``,
+    so a neighbour's key is the cell's plus a constant. The cells sorted once, every
+    neighbour look-up is then a search of sorted keys in sorted keys (no hashing, no
+    collision check, and cache-friendly: the searches walk both arrays in order)."""
+    order, ks, starts, counts = _packed_cells(q)
     cells = ks[starts]
-    counts = np.diff(np.r_[starts, len(v)])
     found = []
     for dx, dy, dz in _NEIGHBOURS:
         shift = (dx << 42) + (dy << 21) + dz
@@ -199,15 +206,8 @@ def _close_pairs_coarse(v: np.ndarray, lo: np.ndarray, side: float, tol: float):
     if qf.max(initial=0.0) >= _PACKED - 2:
         return None
     q = qf.astype(np.int64)
-    key = ((q[:, 0] + 1) << 42) | ((q[:, 1] + 1) << 21) | (q[:, 2] + 1)
-    order = np.argsort(key, kind="stable")
-    ks = key[order]
-    new_cell = np.empty(ks.size, dtype=bool)
-    new_cell[0] = True
-    np.not_equal(ks[1:], ks[:-1], out=new_cell[1:])
-    starts = np.flatnonzero(new_cell)
+    order, ks, starts, counts = _packed_cells(q)
     cells = ks[starts]
-    counts = np.diff(np.r_[starts, len(v)])
     if int(np.sum(counts * (counts - 1) // 2)) > 2 * len(v):
         return None
     # near a face: within two fine cells of it (a pair within tol is within one, and the
