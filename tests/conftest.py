@@ -23,3 +23,14 @@ import stubs  # noqa: E402,F401  (registers the stub.* node types for executor t
 def _clear_run_record():
     stubs.CALLS.clear()
     yield
+
+
+@pytest.fixture
+def keep_locale():
+    """lib3mf's writer sets the process's locale to "C" and leaves it there, which turns
+    Python's default text encoding into ASCII for every later test: put it back."""
+    import locale
+
+    saved = locale.setlocale(locale.LC_ALL, None)
+    yield
+    locale.setlocale(locale.LC_ALL, saved)

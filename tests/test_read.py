@@ -16,15 +16,7 @@ from formgraph.kernels.io.exporters import obj_bytes, ply_binary, stl_ascii, stl
 HEAD = "formgraph: 1\nnodes:\n"
 
 
-@pytest.fixture(autouse=True)
-def _keep_locale():
-    """lib3mf's writer sets the process's locale to "C" and leaves it there, which turns
-    Python's default text encoding into ASCII for every later test: put it back."""
-    import locale
-
-    saved = locale.setlocale(locale.LC_ALL, None)
-    yield
-    locale.setlocale(locale.LC_ALL, saved)
+pytestmark = pytest.mark.usefixtures("keep_locale")  # lib3mf writes: see conftest.py
 
 
 def _graph(folder: Path, body: str, name: str = "g.yaml") -> Path:
