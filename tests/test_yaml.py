@@ -219,3 +219,11 @@ def test_wire_to_param_and_bad_wire(tmp_path):
 def test_unreadable_file():
     with pytest.raises(fg.GraphError, match="cannot read the graph file"):
         fg.load("/nonexistent/graph.yaml")
+
+
+def test_source_text_is_the_file_until_the_graph_changes():
+    text = "formgraph: 1\n# a comment\nnodes:\n  a: {type: points.circle, radius: 2}\n"
+    g = fg.Graph.from_text(text)
+    assert g.source_text() == text  # sweep workers rebuild from it: the file's lines
+    g.set_input("a", "radius", 3)
+    assert g.source_text() == g.to_yaml() and "radius: 3" in g.source_text()

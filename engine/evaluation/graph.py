@@ -130,7 +130,8 @@ class Graph(Plans):
         self._pure_root: tuple[str, Path] | None = None  # out_dir -> its root, for plans
         self._step_params: tuple[str, dict[str, Any]] | None = None  # compute_step's last
         self._checked = False
-        self._source: tuple[str, str] | None = None  # (text read, its to_yaml()) from_text
+        # from_text: (the text read, its description and outputs); forgotten on any change
+        self._source: tuple[str, str, dict[str, Any]] | None = None
         self.stats: dict[str, NodeStat] = {}
         self.progress: Progress | None = None
 
@@ -146,6 +147,7 @@ class Graph(Plans):
         if not value:
             self._replay.clear()
             self._step_params = None
+            self._source = None
 
     # ----------------------------------------------------------------------- building
 
@@ -161,7 +163,7 @@ class Graph(Plans):
         g._parse_problems = doc.problems
         g.outputs = doc.outputs
         g._output_lines = doc.output_lines
-        g._source = (text, g.to_yaml())
+        g._source = (text, g.description, dict(g.outputs))
         if check:
             try:
                 g.check()
@@ -534,10 +536,10 @@ class Graph(Plans):
     def source_text(self) -> str:
         """Text that rebuilds this graph: the text it was read from while nothing has
         changed since (so its line numbers stay the file's), else :meth:`to_yaml`."""
-        text = self.to_yaml()
-        if self._source is not None and self._source[1] == text:
-            return self._source[0]
-        return text
+        src = self._source
+        if src is not None and (src[1], src[2]) == (self.description, self.outputs):
+            return src[0]  # (description and outputs are attributes, set without a trace)
+        return self.to_yaml()
 
     def save(self, path: str | os.PathLike[str]) -> None:
         """Write the graph as YAML (author order kept); ``load`` reads back an equal graph."""
