@@ -222,7 +222,7 @@ def test_unreadable_file():
 
 
 def test_source_text_is_the_file_until_the_graph_changes():
-    text = "formgraph: 1\n# a comment\nnodes:\n  a: {type: points.circle, radius: 2}\n"
+    text = "formgraph: 1\n# a comment\nnodes:\n  a: {type: points.circle, radius: 2, count: 8}\n"
     g = fg.Graph.from_text(text)
     assert g.source_text() == text  # sweep workers rebuild from it: the file's lines
     g.set_input("a", "radius", 3)
