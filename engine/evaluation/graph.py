@@ -5,7 +5,8 @@ Evaluation is pull-based: asking for a node evaluates only its ancestors. Each n
 key hashes its type, implementation version, resolved literal inputs and the identities of
 its wired inputs. A node's identity is its key, except that a node recomputed to an output
 identical to its previous one keeps its previous identity (early cutoff: its descendants stay
-cached). Outputs are hashed only for that comparison, never on a cold run.
+cached). Outputs are compared (to the previous output, content for content) only for that,
+never on a cold run.
 """
 
 from __future__ import annotations
@@ -117,7 +118,6 @@ class Graph(Plans):
         self._nodes: dict[str, NodeDef] = {}
         self._identity: dict[str, str] = {}  # cache key -> identity seen downstream
         self._last: dict[str, tuple[str, str]] = {}  # node -> (key, identity) of its last output
-        self._digests: dict[str, str | None] = {}  # cache key -> content digest, when computed
         self._written: dict[str, tuple[int, int] | None] = {}  # export key -> file stamp
         self._input_digests: dict[str, tuple[tuple[int, ...], str]] = {}  # input -> (stamp, hash)
         self._parse_problems: list[Problem] = []
@@ -275,11 +275,7 @@ class Graph(Plans):
             child._input_root = self.input_root  # its inputs beside its file, inside the root
             child.budget = self.budget
             child.memory, child.disk = self.memory, self.disk
-            child._identity, child._digests, child._written = (
-                self._identity,
-                self._digests,
-                self._written,
-            )
+            child._identity, child._written = self._identity, self._written
             child._input_digests = self._input_digests
             child._params, child._nodes, child.outputs = doc.params, doc.nodes, doc.outputs
             child._values = {n: p.default for n, p in doc.params.items()}

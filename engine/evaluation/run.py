@@ -42,6 +42,7 @@ from ..language.expr import FUNCTIONS_VERSION
 from ..language.model import FRAMES, STEP, Expr, Input, Items, Literal, NodeDef, Wire, wires_of
 from ..language.subgraph import SubgraphSpec
 from . import cache as _cache
+from .cutoff import same_content
 from .items import LanguageRun, file_stamp, input_names, reads_loop
 from .replay import Replay
 from .simulation import SimulationRun
@@ -64,7 +65,6 @@ class GraphView(Protocol):
     _nodes: dict[str, NodeDef]
     _subgraphs: dict[str, SubgraphSpec]
     _identity: dict[str, str]  # key -> identity of the value it holds
-    _digests: dict[str, str]  # key -> content digest of the value
     _written: dict[str, Any]  # key of an export -> (size, mtime) of the file it wrote
     _last: dict[str, tuple[str, str]]  # node -> (key, identity) of its last value
     _replay: dict[tuple[str, ...], Any]  # targets -> the keys of the last run (_Run.replay)
@@ -536,7 +536,6 @@ class _Run(LanguageRun, SimulationRun, Replay):
             self.g.disk.put(key, value, identity)
         if len(self.g._identity) > 1_000_000:  # bounded: forgetting only costs cache hits
             self.g._identity.clear()
-            self.g._digests.clear()
         self.g._identity[key] = identity
         if not self.pure:
             self.g._last[name] = (key, identity)
@@ -554,13 +553,7 @@ class _Run(LanguageRun, SimulationRun, Replay):
         hit, prev_value = self.g.memory.get(prev[0])
         if not hit:
             return key
-        new = self.digest(key, value)
-        return prev[1] if new is not None and new == self.digest(prev[0], prev_value) else key
-
-    def digest(self, key: str, value: Any) -> str | None:
-        if key not in self.g._digests:
-            self.g._digests[key] = _cache.digest(value)
-        return self.g._digests[key]
+        return prev[1] if same_content(value, prev_value) else key
 
     def bind_expression(
         self, name: str, port: str, pt: Any, text: Any, env: dict[str, Any] | None = None
