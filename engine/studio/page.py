@@ -14,6 +14,7 @@ come back to the event loop (``call_soon_threadsafe``) and are shown there.
 from __future__ import annotations
 
 import asyncio
+import gc
 import itertools
 import sys
 import threading
@@ -249,18 +250,28 @@ class Page:
         of the picture, the graph's drawing), then the rest on the loop."""
         t0 = time.perf_counter()
         prepared = None
+        # a slider step's drawing of the graph is sent once the steps settle: made after
+        # its picture is handed on, so the picture does not wait for it
+        later = kind == "params" and isinstance(result, Cooked)
         if isinstance(result, Cooked):
             datasets = None
             if result.ok and kind != "run":
                 datasets = self.scene.prepare(result.shown, self._color_by)
-            svg = self._drawing(result) if kind != "frame" else None  # the graph is as it was
+            drawn = kind != "frame" and not later  # (a frame: the graph is as it was)
+            svg = self._drawing(result) if drawn else None
             prepared = (datasets, svg, self._snapshot())
         seconds += time.perf_counter() - t0
         with self._handoff:
             if self.loop is None:  # the server is still starting: shown once it is ready
+                if later:
+                    prepared = (prepared[0], self._drawing(result), prepared[2])
                 self._early.append((kind, result, seconds, prepared))
                 return
         self.loop.call_soon_threadsafe(self._apply, kind, result, seconds, prepared)
+        if later:
+            svg = self._drawing(result)
+            if svg is not None:
+                self.loop.call_soon_threadsafe(self._settle_drawing, svg)
 
     def _snapshot(self) -> dict[str, Any]:
         """What the page shows of the session, read in the worker thread, between two of
@@ -398,6 +409,11 @@ class Page:
             self._settle_timer.cancel()
         self._settle_timer = self.loop.call_later(SETTLE_DELAY, self._settled)
 
+    def _settle_drawing(self, svg: str) -> None:
+        """A slider step's drawing of the graph, sent once the steps settle."""
+        self._settled_svg = svg
+        self._settle()
+
     def _settled(self) -> None:
         self._settle_timer = None
         if self._scene_stale:
@@ -444,6 +460,11 @@ class Page:
         if first or added or _camera_lost(self._framed, bounds):
             self._framed = bounds
         self.updates += 1
+        if first:
+            # what is loaded by now (trame, vtk, the first graph: some 230,000 objects) lives
+            # as long as the studio; out of the collector's sight, a full collection no
+            # longer takes 80 ms of some slider step (their cycles, if garbage later, stay)
+            gc.freeze()
 
     def _send_changes(self, immediately: bool = False) -> bool:
         """Send the page the scene's changes alone (False: not possible here).
