@@ -442,10 +442,11 @@ class Page:
     def _picture(self, datasets: Any) -> None:
         from formgraph.viewer.app import _camera_lost
 
-        from .scene import send_back_faces
+        from .scene import send_back_faces, send_cells_once
 
         added = self.scene.apply(datasets)
         send_back_faces()
+        send_cells_once()
         bounds = self.scene.bounds()
         first = self._framed is None
         if first:

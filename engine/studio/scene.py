@@ -23,7 +23,14 @@ import numpy as np
 from formgraph.viewer.datasets import colour_by, datasets_of, expand, geometry_items
 from formgraph.viewer.style import BACKGROUND, PALETTE, apply_material, mix, style
 
-__all__ = ["Prepared", "StudioScene", "make_plotter", "quantized_normals", "send_back_faces"]
+__all__ = [
+    "Prepared",
+    "StudioScene",
+    "make_plotter",
+    "quantized_normals",
+    "send_back_faces",
+    "send_cells_once",
+]
 
 DRAWN = ("meshes", "surfaces", "features", "curves", "points")  # control overlays left out
 COLOURED = ("meshes", "surfaces", "points")  # what an attribute colours (as in the viewer)
@@ -60,6 +67,88 @@ def send_back_faces() -> None:
 
         serializer.sends_back_faces = True  # type: ignore[attr-defined]
         registry.SERIALIZERS[name] = serializer
+
+
+def send_cells_once() -> None:
+    """Make trame-vtk's polydata serializer convert each cell array once per change.
+
+    trame-vtk sends a dataset's cells in vtk's legacy layout, which its serializer exports
+    into a new array, hashes (md5) and scans for its range each time the scene is sent;
+    a slider step sends the scene though the faces did not change (on the spiral tube,
+    660 KB exported and hashed for nothing at every step). This serializer, otherwise
+    trame-vtk's (its helpers, the same description), keeps each legacy array until its
+    cell array changes: an unchanged one is the same array at the same time, whose hash
+    trame-vtk has. Like :func:`send_back_faces`, called before each update.
+    """
+    from trame_vtk.modules.vtk.serializers import registry
+    from trame_vtk.modules.vtk.serializers.helpers import (
+        extract_required_fields,
+        get_array_description,
+    )
+    from trame_vtk.modules.vtk.serializers.utils import get_js_array_type, reference_id
+
+    original = registry.SERIALIZERS.get("vtkPolyData")
+    if original is None or getattr(original, "sends_cells_once", False):
+        return
+    legacy = _LegacyCells()
+
+    def serializer(parent, dataset, dataset_id, context, depth, requested_fields=None):
+        if not dataset or not dataset.GetPoints():
+            return original(parent, dataset, dataset_id, context, depth, requested_fields)
+        points = dataset.GetPoints().GetData()
+        js_type = get_js_array_type(points)
+        convert = {}
+        if js_type not in ("Float32Array", "Float64Array"):
+            convert["dataType"] = "Float32Array" if "32" in js_type else "Float64Array"
+        properties = {"points": get_array_description(points, context, **convert)}
+        properties["points"]["vtkClass"] = "vtkPoints"
+        for key, cells in (
+            ("verts", dataset.GetVerts()),
+            ("lines", dataset.GetLines()),
+            ("polys", dataset.GetPolys()),
+            ("strips", dataset.GetStrips()),
+        ):
+            if cells and cells.GetNumberOfCells():
+                properties[key] = get_array_description(legacy(cells), context)
+                properties[key]["vtkClass"] = "vtkCellArray"
+        properties["fields"] = []
+        wanted = ["Normals", "TCoords"] if requested_fields is None else requested_fields
+        extract_required_fields(properties["fields"], parent, dataset, context, wanted)
+        return {
+            "parent": reference_id(parent),
+            "id": dataset_id,
+            "type": registry.class_name(dataset),
+            "properties": properties,
+        }
+
+    serializer.sends_cells_once = True  # type: ignore[attr-defined]
+    registry.SERIALIZERS["vtkPolyData"] = serializer
+
+
+class _LegacyCells:
+    """The legacy-layout array of each cell array, exported again only when it changed.
+
+    Keyed by the cell array's address and modification time (vtk's global clock: a cell
+    array made later at a freed one's address has a later time); the few latest kept.
+    """
+
+    KEPT = 16
+
+    def __init__(self) -> None:
+        self._kept: dict[tuple[str, int], Any] = {}
+
+    def __call__(self, cells: Any) -> Any:
+        from vtkmodules.vtkCommonCore import vtkIdTypeArray
+
+        key = (cells.__this__, cells.GetMTime())
+        out = self._kept.get(key)
+        if out is None:
+            out = vtkIdTypeArray()
+            cells.ExportLegacyFormat(out)
+            self._kept[key] = out
+            while len(self._kept) > self.KEPT:
+                del self._kept[next(iter(self._kept))]
+        return out
 
 
 def make_plotter() -> Any:

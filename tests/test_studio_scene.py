@@ -1,0 +1,81 @@
+"""The studio's serialization of the scene (formgraph.studio.scene): what trame-vtk sends
+of a step, with its polydata serializer keeping each cell array's legacy export."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytest.importorskip("trame_vtk")
+pv = pytest.importorskip("pyvista")
+
+from formgraph.studio.session import StudioSession  # noqa: E402
+
+TUBE = Path(__file__).resolve().parents[1] / "graphs" / "spiral_tube.yaml"
+
+
+def _serializers():
+    from trame_vtk.modules.vtk.serializers import initialize_serializers, registry
+
+    initialize_serializers()  # trame-vtk's own, as its protocol does when it starts
+    return registry
+
+
+def _describe(serializer, data):
+    from trame_vtk.modules.vtk.serializers import SynchronizationContext
+
+    return serializer(None, data, "data", SynchronizationContext(), 1)
+
+
+def test_cells_once_describes_polydata_as_trame_vtk_does():
+    from formgraph.studio.scene import send_cells_once
+
+    registry = _serializers()
+    theirs = registry.SERIALIZERS["vtkPolyData"]
+    send_cells_once()
+    mine = registry.SERIALIZERS["vtkPolyData"]
+    assert mine is not theirs and getattr(mine, "sends_cells_once", False)
+    send_cells_once()  # once in place, nothing more
+    assert registry.SERIALIZERS["vtkPolyData"] is mine
+    verts = pv.PolyData(np.random.default_rng(0).random((5, 3)))
+    for data in (pv.Sphere(), pv.Cube().extract_all_edges(), verts, pv.Cube().triangulate()):
+        data.point_data["w"] = np.arange(data.n_points, dtype=float)
+        assert _describe(mine, data) == _describe(theirs, data)
+
+
+def test_unchanged_cells_keep_their_array_and_hash(tmp_path):
+    from trame_vtk.modules.vtk.serializers import SynchronizationContext
+
+    from formgraph.studio.scene import StudioScene, make_plotter, send_cells_once
+
+    registry = _serializers()
+    send_cells_once()
+    serializer = registry.SERIALIZERS["vtkPolyData"]
+    path = tmp_path / "tube.yaml"
+    shutil.copy(TUBE, path)
+    s = StudioSession(path, out_dir=tmp_path / "out")
+    plotter = make_plotter()
+    try:
+        scene = StudioScene(plotter)
+        scene.update(s.open().shown)
+        data = scene.parts[("solid", "meshes")].data
+        context = SynchronizationContext()
+        first = serializer(None, data, "d", context, 1)["properties"]
+        scene.update(s.set_params(thickness=0.4).shown)
+        second = serializer(None, data, "d", context, 1)["properties"]
+        assert second["polys"]["hash"] == first["polys"]["hash"]
+        assert second["points"]["hash"] != first["points"]["hash"]
+        # the array behind the hash is the one exported the first time
+        kept = context.data_array_cache[second["polys"]["hash"]]["array"]
+        assert kept.GetMTime() == context.data_array_cache[first["polys"]["hash"]]["mTime"]
+        # the faces changed (here: triangulated): exported again, a new hash
+        data.faces = data.triangulate().faces
+        third = serializer(None, data, "d", context, 1)["properties"]
+        assert third["polys"]["hash"] != first["polys"]["hash"]
+        legacy = context.data_array_cache[third["polys"]["hash"]]["array"]
+        assert np.array_equal(np.asarray(legacy), data.faces)
+    finally:
+        plotter.close()
