@@ -34,6 +34,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 STEPS = 9
+WAIT_MS = 90_000  # for the page's first load (as the studio tests wait)
 
 PROBE = """
 window.__fg = {ws: [], draws: [], keys: []};
@@ -90,7 +91,7 @@ def _start(graph: Path, out: Path) -> tuple[subprocess.Popen, str]:
     line: list[str] = []
     reader = threading.Thread(target=lambda: line.append(proc.stdout.readline()))
     reader.start()
-    reader.join(60)
+    reader.join(WAIT_MS / 1000)
     if not line or not line[0].startswith("http"):
         proc.kill()
         log.close()
@@ -99,7 +100,7 @@ def _start(graph: Path, out: Path) -> tuple[subprocess.Popen, str]:
     return proc, line[0].strip()
 
 
-def _quiet(page, since: float, seconds: float = 0.4, timeout: float = 20.0) -> None:
+def _quiet(page, since: float, seconds: float = 0.4, timeout: float = 60.0) -> None:
     """Wait until no message or draw call came for ``seconds`` (page clock)."""
     end = time.monotonic() + timeout
     while time.monotonic() < end:
@@ -138,16 +139,17 @@ def run(table) -> None:
             page = browser.new_page(viewport={"width": 1400, "height": 850})
             page.add_init_script(PROBE)
             page.goto(url)
-            page.wait_for_function("window.__fg && window.__fg.draws.length > 0", timeout=60000)
-            page.wait_for_function(
-                "document.querySelector('#status')?.innerText.includes('computed')"
+            page.wait_for_function("window.__fg && window.__fg.draws.length > 0", timeout=WAIT_MS)
+            page.wait_for_function(  # (a first run after a quiet spell imports slowly)
+                "document.querySelector('#status')?.innerText.includes('computed')",
+                timeout=WAIT_MS,
             )
             _quiet(page, 0.0)
             # the page is usable once the model is drawn: the last draw of the first load,
             # on the page's clock (which starts at the navigation)
             drawn = page.evaluate("window.__fg.draws[window.__fg.draws.length - 1]")
             table.add(case_load, "formgraph", drawn / 1000, "navigation to the model drawn")
-            page.wait_for_selector("#editor .view-lines", timeout=60000)
+            page.wait_for_selector("#editor .view-lines", timeout=WAIT_MS)
             editor = page.evaluate("performance.now()")  # (to within Playwright's polling)
             table.add(
                 "  the editor (Monaco, loaded after the picture)",
@@ -166,7 +168,8 @@ def run(table) -> None:
                 before = page.inner_text("#status")
                 page.keyboard.press("ArrowRight")  # each step a new value: no cache hit
                 page.wait_for_function(
-                    f"document.querySelector('#status').innerText != {json.dumps(before)}"
+                    f"document.querySelector('#status').innerText != {json.dumps(before)}",
+                    timeout=WAIT_MS,
                 )
                 key = page.evaluate("window.__fg.keys[window.__fg.keys.length - 1]")
                 _quiet(page, key)

@@ -268,7 +268,7 @@ class Page:
                 self._early.append((kind, result, seconds, prepared))
                 return
         self.loop.call_soon_threadsafe(self._apply, kind, result, seconds, prepared)
-        if later:
+        if later and not self.worker.waiting("params"):  # (a newer step draws its own)
             svg = self._drawing(result)
             if svg is not None:
                 self.loop.call_soon_threadsafe(self._settle_drawing, svg)
