@@ -144,3 +144,11 @@ def test_what_numpy_does_not_do_goes_through_the_filters(make):
     data = make()
     assert style._topology_of(data) is None
     style.shaded(data)  # (the filters' own output)
+
+
+def test_a_mesh_too_large_to_keep_goes_through_the_filters(monkeypatch):
+    plane = _clean(pv.Plane(i_resolution=10, j_resolution=10))  # 400 corners
+    assert style._topology_of(plane) is not None
+    monkeypatch.setattr(style, "_MAX_CORNERS", 399)
+    assert style._topology_of(plane) is None
+    assert_same(style.shaded(plane.copy())[0], style._shaded_vtk(plane.copy())[0])

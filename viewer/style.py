@@ -111,6 +111,10 @@ def _shaded_vtk(data: Any) -> tuple[Any, Any]:
 
 _TOPOLOGIES: list[_Topology] = []  # the last few meshes' face structure (newest last)
 _KEPT = 4
+# corners (face vertex entries) a mesh may have for the numpy path, whose face structure
+# costs about 100 bytes a corner: larger meshes (drawn once, not stepped) go through the
+# filters, as they did before
+_MAX_CORNERS = 1_000_000
 _LOCK = threading.Lock()
 
 
@@ -127,6 +131,8 @@ def _topology_of(data: Any) -> _Topology | None:
     if not (_numeric(pd) and _numeric(data.GetCellData())):
         return None  # strings or other arrays numpy does not copy: the filters
     polys = data.GetPolys()
+    if polys.GetNumberOfConnectivityIds() > _MAX_CORNERS:
+        return None  # (see _MAX_CORNERS)
     offsets = vtk_to_numpy(polys.GetOffsetsArray()).astype(np.int64, copy=False)
     conn = vtk_to_numpy(polys.GetConnectivityArray()).astype(np.int64, copy=False)
     n = data.n_points
