@@ -34,13 +34,14 @@ from formgraph.kernels.mesh import smooth as ksm
 SCALE = float(os.environ.get("BENCH_FIELD_SCALE", "1"))
 
 
-def _gyroid_box(side: float):
-    box = np.array([side] * 3)
+def _gyroid_box(side: float) -> Field:
+    """The gyroid sheet cut by a cube: ``max(tpms, box)``, as ``field.mesh`` meshes it."""
+    return Field.intersection([Field.tpms("gyroid", 10.0, 1.0), Field.box([side] * 3)])
 
-    def f(p):
-        return np.maximum(sdf.tpms(p, "gyroid", 10.0, 1.0), sdf.box(p, box, np.zeros(3)))
 
-    return f
+def _ours(f: Field, side: float, cell: float = 0.25):
+    lo, hi = [-side / 2] * 3, [side / 2] * 3
+    return mesher.mesh_field(f.evaluate, lo, hi, cell, 2.0, grid=f.evaluate_grid)
 
 
 def _dense_skimage(f, side: float, cell: float):
@@ -78,7 +79,7 @@ def run(table) -> None:
     table.time(
         case,
         "formgraph",
-        lambda: mesher.mesh_field(f, [-side / 2] * 3, [side / 2] * 3, 0.25, 2.0),
+        lambda: _ours(f, side),
         repeat=1,
     )
     table.time(
@@ -95,7 +96,7 @@ def run(table) -> None:
     table.time(
         case_m,
         "formgraph",
-        lambda: mesher.mesh_field(fs, [-small / 2] * 3, [small / 2] * 3, 0.25, 2.0),
+        lambda: _ours(fs, small),
         repeat=1,
     )
     table.time(case_m, "manifold3d level_set", lambda: _manifold(fs, small, 0.25), repeat=1)

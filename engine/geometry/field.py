@@ -105,6 +105,37 @@ class Field(Geometry):
         return self.evaluate(points)
 
     @functools.cached_property
+    def separable(self) -> bool:
+        """Whether :meth:`evaluate_grid` works on tables along the axes all through (no
+        point-wise fallback), so a lattice costs a fraction of its points."""
+        if self.op not in _GRID:
+            return False
+        if self.op == "transform" and not np.array_equal(self.args["matrix"], np.eye(3)):
+            return False
+        return all(c.separable for c in self.children)
+
+    def evaluate_grid(self, origin: Any, step: Any, shape: Any) -> np.ndarray:
+        """Values on lattices of points: ``origin + (i, j, k) * step`` for ``0 <= (i, j,
+        k) < shape``, one lattice per row of ``origin`` ((n, 3) -> (n, *shape); (3,) ->
+        shape). The same values as :meth:`evaluate` at those points (to rounding); the
+        field's key does not depend on which is used. Primitives whose distance is
+        separable in the coordinates (TPMS, boxes, spheres) and the blends, shells,
+        offsets and axis-aligned transforms of them work on tables along the axes; the
+        rest are sampled point by point."""
+        o = np.asarray(origin, dtype=np.float64)
+        single = o.ndim == 1
+        o = o.reshape(-1, 3)
+        h = np.broadcast_to(np.asarray(step, dtype=np.float64), (3,))
+        n = tuple(int(k) for k in shape)
+        if len(n) != 3 or min(n) < 1:
+            raise ValueError(f"shape must be three counts >= 1, got {shape!r}")
+        axes = [o[:, k, None] + np.arange(n[k]) * h[k] for k in range(3)]
+        with np.errstate(all="ignore"):
+            out = np.broadcast_to(_grid(self, axes), (len(o), *n))
+        out = np.ascontiguousarray(out, dtype=np.float64)
+        return out[0] if single else out
+
+    @functools.cached_property
     def _cache(self) -> dict[str, Any]:
         """Acceleration structures built on first use (k-d trees, winding-number trees)."""
         return {}
@@ -144,7 +175,8 @@ class Field(Geometry):
             return None
         lo, hi = field.bounds
         cell = float((hi - lo).max()) / 64 or 1.0
-        v, t = mesh_field(field.evaluate, lo, hi, cell, field.lipschitz)
+        grid = field.evaluate_grid if field.separable else None
+        v, t = mesh_field(field.evaluate, lo, hi, cell, field.lipschitz, grid=grid)
         return Mesh(v, t.reshape(-1), np.arange(0, 3 * len(t) + 1, 3))
 
     def to_pyvista(self) -> Any:
@@ -343,6 +375,52 @@ def _from_curves(field: Field, p: np.ndarray) -> np.ndarray:
         cache["nearest"] = meshdist.Nearest(field.args["segments"])
     return cache["nearest"].distance(p) - field.args["radius"]
 
+
+def _points_grid(field: Field, axes: list[np.ndarray]) -> np.ndarray:
+    """The point-wise fallback of :meth:`Field.evaluate_grid`."""
+    x, y, z = np.broadcast_arrays(
+        axes[0][:, :, None, None], axes[1][:, None, :, None], axes[2][:, None, None, :]
+    )
+    p = np.stack([x.reshape(-1), y.reshape(-1), z.reshape(-1)], axis=1)
+    return field.evaluate(p).reshape(x.shape)
+
+
+def _grid(field: Field, axes: list[np.ndarray]) -> np.ndarray:
+    op = _GRID.get(field.op)
+    return _points_grid(field, axes) if op is None else op(field, axes)
+
+
+def _blend_grid(field: Field, axes: list[np.ndarray], pick: str) -> np.ndarray:
+    sdf = _sdf()
+    k = field.args["smooth"]
+    values = [_grid(c, axes) for c in field.children]
+    out = values[0]
+    for v in values[1:]:
+        out = sdf.smooth_min(out, v, k) if pick == "min" else sdf.smooth_max(out, v, k)
+    return out
+
+
+def _transform_grid(field: Field, axes: list[np.ndarray]) -> np.ndarray:
+    a = field.args
+    if not np.array_equal(a["matrix"], np.eye(3)):  # a rotation mixes the axes
+        return _points_grid(field, axes)
+    local = [(x - t) / s for x, t, s in zip(axes, a["translate"], a["scale"], strict=True)]
+    return _grid(field.children[0], local) * float(a["scale"].min())
+
+
+_GRID: dict[str, Callable[[Field, list[np.ndarray]], np.ndarray]] = {
+    "sphere": lambda f, g: _sdf().sphere_grid(g, f.args["radius"], f.args["center"]),
+    "box": lambda f, g: _sdf().box_grid(g, f.args["size"], f.args["center"], f.args["radius"]),
+    "tpms": lambda f, g: _sdf().tpms_grid(g, f.args["kind"], f.args["period"], f.args["thickness"]),
+    "union": lambda f, g: _blend_grid(f, g, "min"),
+    "intersection": lambda f, g: _blend_grid(f, g, "max"),
+    "difference": lambda f, g: _sdf().smooth_max(
+        _grid(f.children[0], g), -_grid(f.children[1], g), f.args["smooth"]
+    ),
+    "shell": lambda f, g: np.abs(_grid(f.children[0], g)) - f.args["thickness"] / 2.0,
+    "offset": lambda f, g: _grid(f.children[0], g) - f.args["distance"],
+    "transform": _transform_grid,
+}
 
 _OPS: dict[str, Callable[[Field, np.ndarray], np.ndarray]] = {
     "sphere": lambda f, p: _sdf().sphere(p, f.args["radius"], f.args["center"]),

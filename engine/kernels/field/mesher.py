@@ -21,7 +21,7 @@ one rule on each face (:mod:`.mctable`: inside corners are separated), so neighb
 cubes draw the same segments on a shared face and the surface, a function of the signs
 at shared corners only, is watertight by construction; triangles point to the positive
 (outside) side. A vertex is identified by its edge (owner block, corner, axis): a perfect
-hash, numbered by marking and counting, no sort. Each vertex is put on its edge by
+hash, numbered by marking and ranking the marks, no sort. Each vertex is put on its edge by
 regula falsi (Illinois variant) on the field itself, not only by linear interpolation.
 
 Lorensen & Cline 1987; Nielson & Hamann 1991 (the ambiguous face); Dowson & Harrington's
@@ -167,7 +167,7 @@ class _Lattice:
     of 2. Blocks are worked on :data:`GROUP` at a time, so the arrays stay in the cache.
     """
 
-    def __init__(self, f: Fn, lo, hi, cell: float, lipschitz: float, max_cells: int):
+    def __init__(self, f: Fn, lo, hi, cell: float, lipschitz: float, max_cells: int, grid=None):
         self.f, self.cell = f, cell
         self.origin, levels, blocks = plan_grid(lo, hi, cell)
         g, vc = _kept_blocks(f, self.origin, levels, blocks, cell, lipschitz, max_cells)
@@ -202,6 +202,9 @@ class _Lattice:
         )
         self.touched, self.dims, self._remap = touched, dims, remap
         self.nbr = nbr = remap[at]
+        if grid is not None:
+            self._dense(grid, ns)
+            return
         values = np.full((ns, B, B, B), np.nan)
         need = np.zeros((ns, B, B, B), dtype=bool)
         known = np.zeros((ns, B, B, B), dtype=bool)
@@ -231,6 +234,18 @@ class _Lattice:
         values[todo] = self.sample(todo)
         inside[todo] = values[todo] < 0
         self.values, self.inside = values, inside.reshape(ns, B, B, B)
+
+    def _dense(self, grid, ns: int) -> None:
+        """Every corner of every slot sampled on its block's lattice by ``grid`` (a field
+        whose lattices cost a fraction of its points: no culling inside the blocks)."""
+        self.kept1 = None
+        at = self.origin + self.base * self.cell
+        values = np.empty((ns, B, B, B))
+        for s in range(0, ns, GROUP):
+            e = min(s + GROUP, ns)
+            values[s:e] = _check(grid(at[s:e], self.cell, (B, B, B))).reshape(e - s, B, B, B)
+        self.values = values.reshape(-1)
+        self.inside = values < 0
 
     def _levels(self, g, own, values, lipschitz: float) -> np.ndarray:
         """The levels of 4 and 2 cells inside blocks ``g`` (dense per-block arrays, their
@@ -297,8 +312,11 @@ class _Lattice:
         case = np.zeros((n, B, B, B), dtype=np.uint8)
         for c, (x, y, z) in enumerate(CORNERS):
             case |= ins9[:, x : x + B, y : y + B, z : z + B] << np.uint8(c)
-        up = np.broadcast_to(self.kept1[s:e, :, None, :, None, :, None], (n, 4, 2, 4, 2, 4, 2))
-        cells = np.flatnonzero(up.reshape(n, B, B, B) & (case != 0) & (case != 255))
+        mixed = (case != 0) & (case != 255)
+        if self.kept1 is not None:
+            up = self.kept1[s:e, :, None, :, None, :, None]
+            mixed &= np.broadcast_to(up, (n, 4, 2, 4, 2, 4, 2)).reshape(n, B, B, B)
+        cells = np.flatnonzero(mixed)
         return cells + s * B3, case.reshape(-1)[cells]
 
 
@@ -361,25 +379,13 @@ EDGE_PACK = EDGE_OWNER << 11 | EDGE_PLACE  # both in one gather (a place is belo
 TRI_ROWS = TRI_EDGES.reshape(-1, 3).astype(np.int32)  # case * 5 + triangle -> its edges
 
 
-POP16 = np.unpackbits(np.arange(1 << 16, dtype="<u2").view(np.uint8)).reshape(-1, 16).sum(1)
-
-
-def _ranks(used: np.ndarray, hashes: list[np.ndarray]) -> np.ndarray:
-    """Each hash's rank among the ``used`` ones (its vertex number), ``(t, 3)`` int64.
-
-    The rank is the count of used entries before it: a prefix sum over 16-bit words of
-    the packed bitmap plus the bits below it in its own word, so no array of the hash
-    space's size is ever written (its pages alone cost more than the counting).
-    """
-    words = np.packbits(used, bitorder="little").view("<u2")
-    pop = POP16[words]
-    before = np.cumsum(pop, dtype=np.int64) - pop
-    out = []
-    for h in hashes:
-        w = h >> 4
-        below = words[w] & (np.left_shift(1, h & 15, dtype=np.int32) - 1)
-        out.append(before[w] + POP16[below])
-    return np.concatenate(out)
+def _number(ue: np.ndarray, size: int, hashes: list[np.ndarray]) -> np.ndarray:
+    """Each hash's vertex number: its rank among the used hashes ``ue`` (sorted), from an
+    int32 table over the hash space that only the used entries of are written (its other
+    pages are never touched)."""
+    rank = np.empty(size, dtype=np.int32 if len(ue) < 2**31 else np.int64)
+    rank[ue] = np.arange(len(ue), dtype=rank.dtype)
+    return np.concatenate([rank[h] for h in hashes])
 
 
 def crossing_cells(f: Fn, lo, hi, cell: float, lipschitz: float = 1.0, max_cells=50_000_000):
@@ -421,6 +427,7 @@ def mesh_field(
     lipschitz: float = 1.0,
     max_cells: int = 50_000_000,
     root_steps: int = 8,
+    grid=None,
 ):
     """Triangles of the zero set of ``f`` inside ``[lo, hi]``, watertight and outward.
 
@@ -440,6 +447,10 @@ def mesh_field(
     root_steps : int
         Samples of the field per vertex at most before bisection takes over (most take
         one, see :func:`_roots`); 0 is linear interpolation.
+    grid : callable (origins (n, 3), step, shape) -> (n, *shape), optional
+        The same field on lattices of points (``Field.evaluate_grid``), for a field whose
+        lattices are cheaper than its points: then every corner of the blocks kept by the
+        coarse levels is sampled that way, none inferred.
 
     Returns
     -------
@@ -450,7 +461,7 @@ def mesh_field(
     if not (cell > 0 and np.isfinite(cell)):
         raise ValueError(f"cell must be > 0, got {cell:g}")
     empty = np.zeros((0, 3)), np.zeros((0, 3), np.int64)
-    lat = _Lattice(f, lo, hi, cell, lipschitz, max_cells)
+    lat = _Lattice(f, lo, hi, cell, lipschitz, max_cells, grid)
     nk = len(lat.blocks)
     if not nk:
         return empty
@@ -467,7 +478,7 @@ def mesh_field(
     ue = np.flatnonzero(used)
     if not len(ue):
         return empty
-    tri = _ranks(used, hashes)
+    tri = _number(ue, len(used), hashes)
     del used, hashes
     verts = np.empty((len(ue), 3))
     for i in range(0, len(ue), CHUNK):

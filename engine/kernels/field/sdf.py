@@ -120,3 +120,69 @@ def tpms(p: np.ndarray, kind: str, period: float, thickness: float) -> np.ndarra
     with np.errstate(divide="ignore", invalid="ignore"):
         d = np.where(gl > 0, np.abs(f) / gl, cap)
     return np.minimum(d, cap) - thickness / 2.0
+
+
+# ----------------------------------------------------------------- on lattices of points
+#
+# The same distances on a lattice of points given by its axes: ``axes`` is three arrays
+# ``(n, a)``, ``(n, b)``, ``(n, c)`` of coordinates (n boxes), the result ``(n, a, b, c)``.
+# Where a function is a sum or product of terms in one coordinate each, the terms are
+# tables along the axes and the lattice is their outer sums and products: a TPMS costs six
+# sines a box side instead of six a point.
+
+
+def _outer(axes):
+    """The axes as broadcastable (n, a, 1, 1), (n, 1, b, 1), (n, 1, 1, c)."""
+    x, y, z = axes
+    return x[:, :, None, None], y[:, None, :, None], z[:, None, None, :]
+
+
+def sphere_grid(axes, radius: float, center: np.ndarray) -> np.ndarray:
+    """:func:`sphere` on a lattice: ``sqrt(dx^2 + dy^2 + dz^2) - r`` from squared tables."""
+    x, y, z = _outer([a - c for a, c in zip(axes, center, strict=True)])
+    return np.sqrt((x * x + y * y) + z * z) - radius
+
+
+def box_grid(axes, size: np.ndarray, center: np.ndarray, radius: float = 0.0) -> np.ndarray:
+    """:func:`box` on a lattice: the clipped offsets per axis are tables."""
+    half = np.asarray(size, dtype=np.float64) / 2.0
+    r = float(min(max(radius, 0.0), half.min()))
+    q = [np.abs(a - c) - (h - r) for a, c, h in zip(axes, center, half, strict=True)]
+    mx, my, mz = _outer([np.maximum(v, 0.0) for v in q])
+    qx, qy, qz = _outer(q)
+    outside = np.sqrt((mx * mx + my * my) + mz * mz)
+    inside = np.minimum(np.maximum(np.maximum(qx, qy), qz), 0.0)
+    return outside + inside - r
+
+
+def tpms_grid(axes, kind: str, period: float, thickness: float) -> np.ndarray:
+    """:func:`tpms` on a lattice: the implicit function and its gradient are sums of
+    products of sines and cosines of one coordinate each, outer products of tables."""
+    w = 2.0 * np.pi / period
+    x, y, z = _outer([a * w for a in axes])
+    sx, sy, sz = np.sin(x), np.sin(y), np.sin(z)
+    cx, cy, cz = np.cos(x), np.cos(y), np.cos(z)
+    if kind == "gyroid":
+        # the six 2-D products each appear once in f and once in the gradient
+        a, b, c = sx * cy, sy * cz, sz * cx
+        d, e, g = cx * cy, cy * cz, cz * cx
+        sxsz, sxsy, sysz = sz * sx, sx * sy, sy * sz
+        f = (a + b) + c
+        gx, gy, gz = d - sxsz, e - sxsy, g - sysz
+    elif kind == "schwarz_p":
+        f = (cx + cy) + cz
+        gx, gy, gz = -sx, -sy, -sz
+    elif kind == "diamond":
+        sysz, cycz, cysz, sycz = sy * sz, cy * cz, cy * sz, sy * cz
+        f = ((sx * sysz + sx * cycz) + cx * sycz) + cx * cysz
+        gx = ((cx * sysz + cx * cycz) - sx * sycz) - sx * cysz
+        gy = ((sx * cysz - sx * sycz) + cx * cycz) - cx * sysz
+        gz = ((sx * sycz - sx * cysz) - cx * sysz) + cx * cycz
+    else:
+        raise ValueError(f"unknown TPMS kind {kind!r}; one of {', '.join(TPMS_KINDS)}")
+    gx, gy, gz = np.broadcast_arrays(gx, gy, gz)
+    gl = np.sqrt((gx * gx + gy * gy) + gz * gz) * w
+    cap = period / 4.0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        d = np.where(gl > 0, np.abs(f) / gl, cap)
+    return np.minimum(d, cap) - thickness / 2.0
