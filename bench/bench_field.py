@@ -41,7 +41,9 @@ def _gyroid_box(side: float) -> Field:
 
 def _ours(f: Field, side: float, cell: float = 0.25):
     lo, hi = [-side / 2] * 3, [side / 2] * 3
-    return mesher.mesh_field(f.evaluate, lo, hi, cell, 2.0, grid=f.evaluate_grid)
+    return mesher.mesh_field(
+        f.evaluate, lo, hi, cell, 2.0, grid=f.evaluate_grid, lines=f.evaluate_lines
+    )
 
 
 def _dense_skimage(f, side: float, cell: float):

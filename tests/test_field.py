@@ -236,12 +236,13 @@ def _lattice_fields():
         Field.transform(Field.intersection([d, ball]), np.eye(3), [1, 2, 3], [1, 2, 0.5]),
         Field.transform(ball, turn, [1, 2, 3], 1.5),
         Field.expression(lambda x, y, z: x * y - z),
+        Field.intersection([g, Field.box([30, 30, 30], [1, 0, 0])]),  # lattices in and out
     ]
 
 
 @settings(max_examples=30, deadline=None)
 @given(
-    st.integers(0, 11),
+    st.integers(0, 12),
     st.lists(st.floats(-20, 20), min_size=6, max_size=6),
     st.lists(st.floats(1e-3, 2.0), min_size=3, max_size=3),
     st.lists(st.integers(1, 9), min_size=3, max_size=3),
@@ -259,6 +260,13 @@ def test_lattice_values_are_the_point_values(which, origin, step, shape):
     assert lattice.shape == (2, *shape)
     np.testing.assert_allclose(lattice, points, rtol=0, atol=1e-12)
     assert field.evaluate_grid(o[0], step, shape).shape == tuple(shape)
+    # on the lattice's lines: two coordinates on it, the third anywhere along an edge
+    rng = np.random.default_rng(which)
+    ijk = rng.integers(-40, 40, (50, 3))
+    axis, t = rng.integers(0, 3, 50), rng.uniform(0, 1, 50)
+    on_lines = field.evaluate_lines(o[0], step, ijk, axis, t)
+    p = o[0] + (ijk + np.eye(3)[axis] * t[:, None]) * np.array(step)
+    np.testing.assert_allclose(on_lines, field.evaluate(p), rtol=0, atol=1e-12)
     assert digest(field) == key  # sampling does not change the key
 
 

@@ -167,8 +167,17 @@ def test_gyroid_cube_agrees_with_scikit_image_marching_cubes(lattices):
         axes = [origin[:, k, None] + np.arange(shape[k]) * step for k in range(3)]
         return np.maximum(sdf.tpms_grid(axes, "gyroid", 10.0, 1.0), sdf.box_grid(axes, box, O))
 
+    def lines(origin, step, ijk, axis, t):
+        at = sdf.Lines(origin, step, ijk, axis, t)
+        return np.maximum(sdf.tpms_lines(at, "gyroid", 10.0, 1.0), sdf.box_lines(at, box, O))
+
     lo, hi = [-side / 2] * 3, [side / 2] * 3
-    v, t = mesher.mesh_field(f, lo, hi, cell, 2.0, grid=grid if lattices else None)
+    if lattices:
+        v, t = mesher.mesh_field(f, lo, hi, cell, 2.0, grid=grid, lines=lines)
+        on_edges = f(v)
+        assert np.abs(on_edges).max() < 1e-3 * cell  # the roots are on the field's zero set
+    else:
+        v, t = mesher.mesh_field(f, lo, hi, cell, 2.0)
     ours = trimesh.Trimesh(v, t, process=False)
     n = int(round(side / cell)) + 3
     ax = (np.arange(n) - (n - 1) / 2) * cell

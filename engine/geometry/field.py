@@ -135,6 +135,20 @@ class Field(Geometry):
         out = np.ascontiguousarray(out, dtype=np.float64)
         return out[0] if single else out
 
+    def evaluate_lines(
+        self, origin: Any, step: Any, ijk: np.ndarray, axis: np.ndarray, t: np.ndarray
+    ) -> np.ndarray:
+        """Values at ``origin + (ijk + t e_axis) * step``: points on the lines of a lattice
+        (integer ``ijk (n, 3)``, ``axis (n,)`` in 0..2, ``t (n,)``), such as a mesher's
+        vertices on its cells' edges. The same values as :meth:`evaluate` (to rounding);
+        a separable field takes what depends on the lattice's coordinates from tables."""
+        lines = _sdf().Lines(
+            origin, step, np.asarray(ijk), np.asarray(axis), np.asarray(t, dtype=np.float64)
+        )
+        with np.errstate(all="ignore"):
+            out = np.broadcast_to(_grid(self, lines), (len(lines),))
+        return np.ascontiguousarray(out, dtype=np.float64)
+
     @functools.cached_property
     def _cache(self) -> dict[str, Any]:
         """Acceleration structures built on first use (k-d trees, winding-number trees)."""
@@ -176,7 +190,8 @@ class Field(Geometry):
         lo, hi = field.bounds
         cell = float((hi - lo).max()) / 64 or 1.0
         grid = field.evaluate_grid if field.separable else None
-        v, t = mesh_field(field.evaluate, lo, hi, cell, field.lipschitz, grid=grid)
+        lines = field.evaluate_lines if field.separable else None
+        v, t = mesh_field(field.evaluate, lo, hi, cell, field.lipschitz, grid=grid, lines=lines)
         return Mesh(v, t.reshape(-1), np.arange(0, 3 * len(t) + 1, 3))
 
     def to_pyvista(self) -> Any:
@@ -376,42 +391,59 @@ def _from_curves(field: Field, p: np.ndarray) -> np.ndarray:
     return cache["nearest"].distance(p) - field.args["radius"]
 
 
-def _points_grid(field: Field, axes: list[np.ndarray]) -> np.ndarray:
-    """The point-wise fallback of :meth:`Field.evaluate_grid`."""
+def _points_grid(field: Field, at: Any) -> np.ndarray:
+    """The point-wise fallback of :meth:`Field.evaluate_grid` and :meth:`evaluate_lines`."""
+    if isinstance(at, _sdf().Lines):
+        return field.evaluate(np.stack(at.columns(), axis=1))
     x, y, z = np.broadcast_arrays(
-        axes[0][:, :, None, None], axes[1][:, None, :, None], axes[2][:, None, None, :]
+        at[0][:, :, None, None], at[1][:, None, :, None], at[2][:, None, None, :]
     )
     p = np.stack([x.reshape(-1), y.reshape(-1), z.reshape(-1)], axis=1)
     return field.evaluate(p).reshape(x.shape)
 
 
-def _grid(field: Field, axes: list[np.ndarray]) -> np.ndarray:
+def _grid(field: Field, at: Any) -> np.ndarray:
+    """``field`` on a lattice (``at``: its three axes) or on lines of one (``at``: Lines)."""
     op = _GRID.get(field.op)
-    return _points_grid(field, axes) if op is None else op(field, axes)
+    return _points_grid(field, at) if op is None else op(field, at)
 
 
-def _blend_grid(field: Field, axes: list[np.ndarray], pick: str) -> np.ndarray:
+def _blend_grid(field: Field, at: Any, pick: str) -> np.ndarray:
     sdf = _sdf()
     k = field.args["smooth"]
-    values = [_grid(c, axes) for c in field.children]
+    values = [_grid(c, at) for c in field.children]
     out = values[0]
     for v in values[1:]:
         out = sdf.smooth_min(out, v, k) if pick == "min" else sdf.smooth_max(out, v, k)
     return out
 
 
-def _transform_grid(field: Field, axes: list[np.ndarray]) -> np.ndarray:
+def _transform_grid(field: Field, at: Any) -> np.ndarray:
     a = field.args
     if not np.array_equal(a["matrix"], np.eye(3)):  # a rotation mixes the axes
-        return _points_grid(field, axes)
-    local = [(x - t) / s for x, t, s in zip(axes, a["translate"], a["scale"], strict=True)]
+        return _points_grid(field, at)
+    if isinstance(at, _sdf().Lines):
+        local = at.moved(a["translate"], a["scale"])
+    else:
+        local = [(x - t) / s for x, t, s in zip(at, a["translate"], a["scale"], strict=True)]
     return _grid(field.children[0], local) * float(a["scale"].min())
 
 
-_GRID: dict[str, Callable[[Field, list[np.ndarray]], np.ndarray]] = {
-    "sphere": lambda f, g: _sdf().sphere_grid(g, f.args["radius"], f.args["center"]),
-    "box": lambda f, g: _sdf().box_grid(g, f.args["size"], f.args["center"], f.args["radius"]),
-    "tpms": lambda f, g: _sdf().tpms_grid(g, f.args["kind"], f.args["period"], f.args["thickness"]),
+def _leaf(name: str, *params: str) -> Callable[[Field, Any], np.ndarray]:
+    """A primitive on a lattice (``<name>_grid``) or on its lines (``<name>_lines``)."""
+
+    def run(field: Field, at: Any) -> np.ndarray:
+        sdf = _sdf()
+        kernel = getattr(sdf, f"{name}_lines" if isinstance(at, sdf.Lines) else f"{name}_grid")
+        return kernel(at, *(field.args[p] for p in params))
+
+    return run
+
+
+_GRID: dict[str, Callable[[Field, Any], np.ndarray]] = {
+    "sphere": _leaf("sphere", "radius", "center"),
+    "box": _leaf("box", "size", "center", "radius"),
+    "tpms": _leaf("tpms", "kind", "period", "thickness"),
     "union": lambda f, g: _blend_grid(f, g, "min"),
     "intersection": lambda f, g: _blend_grid(f, g, "max"),
     "difference": lambda f, g: _sdf().smooth_max(

@@ -30,6 +30,7 @@ Illinois method (1971).
 
 from __future__ import annotations
 
+import functools
 import itertools
 from collections.abc import Callable
 
@@ -241,8 +242,8 @@ class _Lattice:
         self.kept1 = None
         at = self.origin + self.base * self.cell
         values = np.empty((ns, B, B, B))
-        for s in range(0, ns, GROUP):
-            e = min(s + GROUP, ns)
+        for s in range(0, ns, GROUP // 4):  # 16,384 points a call: in the cache
+            e = min(s + GROUP // 4, ns)
             values[s:e] = _check(grid(at[s:e], self.cell, (B, B, B))).reshape(e - s, B, B, B)
         self.values = values.reshape(-1)
         self.inside = values < 0
@@ -379,13 +380,29 @@ EDGE_PACK = EDGE_OWNER << 11 | EDGE_PLACE  # both in one gather (a place is belo
 TRI_ROWS = TRI_EDGES.reshape(-1, 3).astype(np.int32)  # case * 5 + triangle -> its edges
 
 
-def _number(ue: np.ndarray, size: int, hashes: list[np.ndarray]) -> np.ndarray:
-    """Each hash's vertex number: its rank among the used hashes ``ue`` (sorted), from an
-    int32 table over the hash space that only the used entries of are written (its other
-    pages are never touched)."""
-    rank = np.empty(size, dtype=np.int32 if len(ue) < 2**31 else np.int64)
-    rank[ue] = np.arange(len(ue), dtype=rank.dtype)
-    return np.concatenate([rank[h] for h in hashes])
+def _number(used: np.ndarray, hashes: list[np.ndarray], nbr: np.ndarray) -> np.ndarray:
+    """Each hash's vertex number: its rank among the ``used`` hashes (the used edges
+    numbered in order), group by group.
+
+    A slot's used edges are numbered after all of the slots before it (a prefix sum of
+    the per-slot counts) and in their order within it; a group's triangles use the edges
+    of its own slots and their upper neighbours only (``nbr``, eight slots a block), so
+    the ranks come from a small table of those slots' running counts, in the cache.
+    """
+    per = used.reshape(-1, 3 * B3)
+    count = np.count_nonzero(per, axis=1)
+    first = np.cumsum(count) - count
+    dtype = np.int32 if count.sum() < 2**31 else np.int64
+    row = np.empty(len(per), dtype=np.int64)
+    out = []
+    for g, h in enumerate(hashes):
+        slots = np.unique(nbr[g * GROUP * 8 : (g + 1) * GROUP * 8])
+        row[slots] = np.arange(len(slots))
+        table = np.cumsum(per[slots], axis=1, dtype=dtype)
+        table += (first[slots] - 1).astype(dtype)[:, None]
+        owner, place = np.divmod(h, 3 * B3)
+        out.append(np.take(table, row[owner] * (3 * B3) + place))
+    return np.concatenate(out)
 
 
 def crossing_cells(f: Fn, lo, hi, cell: float, lipschitz: float = 1.0, max_cells=50_000_000):
@@ -428,6 +445,7 @@ def mesh_field(
     max_cells: int = 50_000_000,
     root_steps: int = 8,
     grid=None,
+    lines=None,
 ):
     """Triangles of the zero set of ``f`` inside ``[lo, hi]``, watertight and outward.
 
@@ -451,6 +469,9 @@ def mesh_field(
         The same field on lattices of points (``Field.evaluate_grid``), for a field whose
         lattices are cheaper than its points: then every corner of the blocks kept by the
         coarse levels is sampled that way, none inferred.
+    lines : callable (origin, step, ijk (n, 3), axis (n,), t (n,)) -> (n,), optional
+        The same field at ``origin + (ijk + t e_axis) * step`` (``Field.evaluate_lines``):
+        the first sample of every vertex on its edge is taken that way.
 
     Returns
     -------
@@ -478,7 +499,7 @@ def mesh_field(
     ue = np.flatnonzero(used)
     if not len(ue):
         return empty
-    tri = _number(ue, len(used), hashes)
+    tri = _number(used, hashes, nbr)
     del used, hashes
     verts = np.empty((len(ue), 3))
     for i in range(0, len(ue), CHUNK):
@@ -497,7 +518,12 @@ def mesh_field(
         pa = lat.point(start)
         pb = pa + np.eye(3)[axis] * cell
         guess = _guess(fm, fa, fb, fq) if root_steps else None
-        verts[i : i + CHUNK] = _roots(f, pa, pb, fa, fb, root_steps, cell, guess, lipschitz)
+        first = None
+        if lines is not None:
+            loc = start & (B3 - 1)
+            ijk = lat.base[slot] + np.stack([loc >> 6, (loc >> 3) & 7, loc & 7], axis=-1)
+            first = functools.partial(lines, lat.origin, cell, ijk, axis)
+        verts[i : i + CHUNK] = _roots(f, pa, pb, fa, fb, root_steps, cell, guess, lipschitz, first)
     return verts, tri.reshape(-1, 3)
 
 
@@ -525,7 +551,7 @@ def _guess(fm, fa, fb, fq) -> np.ndarray:
 
 
 def _roots(
-    f: Fn, pa, pb, fa, fb, steps: int, cell: float, guess=None, lipschitz: float = 1.0
+    f: Fn, pa, pb, fa, fb, steps: int, cell: float, guess=None, lipschitz: float = 1.0, first=None
 ) -> np.ndarray:
     """Points where ``f`` changes sign on segments ``pa -> pb``.
 
@@ -554,7 +580,10 @@ def _roots(
     for k in range(steps):
         at = slice(None) if k == 0 else idx  # every vertex takes the first step
         c = t[at]
-        fc = _eval(f, pa[at] + c[:, None] * d[at])
+        if k == 0 and first is not None:  # the field on the edges' lines: ``first(t)``
+            fc = _check(first(c))
+        else:
+            fc = _eval(f, pa[at] + c[:, None] * d[at])
         a, b, f_a, f_b = lo_t[at], hi_t[at], flo[at], fhi[at]
         with np.errstate(divide="ignore", invalid="ignore"):
             iqi = (

@@ -70,6 +70,8 @@ def smooth_min(a: np.ndarray, b: np.ndarray, k: float) -> np.ndarray:
 
 def smooth_max(a: np.ndarray, b: np.ndarray, k: float) -> np.ndarray:
     """Polynomial smooth maximum (an intersection blended over ``k``): ``-smin(-a, -b)``."""
+    if k <= 0:
+        return np.maximum(a, b)
     return -smooth_min(-a, -b, k)
 
 
@@ -144,43 +146,156 @@ def sphere_grid(axes, radius: float, center: np.ndarray) -> np.ndarray:
 
 
 def box_grid(axes, size: np.ndarray, center: np.ndarray, radius: float = 0.0) -> np.ndarray:
-    """:func:`box` on a lattice: the clipped offsets per axis are tables."""
+    """:func:`box` on a lattice: the clipped offsets per axis are tables. On a lattice
+    inside the shrunk box (every offset <= 0) the distance is the largest offset alone."""
     half = np.asarray(size, dtype=np.float64) / 2.0
     r = float(min(max(radius, 0.0), half.min()))
     q = [np.abs(a - c) - (h - r) for a, c, h in zip(axes, center, half, strict=True)]
+    inner = np.logical_and.reduce([v.max(axis=1, initial=-np.inf) <= 0 for v in q])
+    if inner.all():
+        return _box_inner(q, r)
+    if not inner.any():
+        return _box_outer(q, r)
+    out = np.empty((len(inner), *(v.shape[1] for v in q)))
+    out[inner] = _box_inner([v[inner] for v in q], r)
+    out[~inner] = _box_outer([v[~inner] for v in q], r)
+    return out
+
+
+def _box_inner(q, r: float) -> np.ndarray:
+    qx, qy, qz = _outer(q)
+    out = np.maximum(np.maximum(qx, qy), qz)
+    if r:
+        out -= r
+    return out
+
+
+def _box_outer(q, r: float) -> np.ndarray:
     mx, my, mz = _outer([np.maximum(v, 0.0) for v in q])
     qx, qy, qz = _outer(q)
     outside = np.sqrt((mx * mx + my * my) + mz * mz)
-    inside = np.minimum(np.maximum(np.maximum(qx, qy), qz), 0.0)
-    return outside + inside - r
+    outside += np.minimum(np.maximum(np.maximum(qx, qy), qz), 0.0)
+    outside -= r
+    return outside
 
 
 def tpms_grid(axes, kind: str, period: float, thickness: float) -> np.ndarray:
     """:func:`tpms` on a lattice: the implicit function and its gradient are sums of
-    products of sines and cosines of one coordinate each, outer products of tables."""
+    products of sines and cosines of one coordinate each, outer products of tables; the
+    lattice-sized work is a few sums and the distance, done in place."""
     w = 2.0 * np.pi / period
     x, y, z = _outer([a * w for a in axes])
     sx, sy, sz = np.sin(x), np.sin(y), np.sin(z)
     cx, cy, cz = np.cos(x), np.cos(y), np.cos(z)
     if kind == "gyroid":
-        # the six 2-D products each appear once in f and once in the gradient
-        a, b, c = sx * cy, sy * cz, sz * cx
-        d, e, g = cx * cy, cy * cz, cz * cx
-        sxsz, sxsy, sysz = sz * sx, sx * sy, sy * sz
-        f = (a + b) + c
-        gx, gy, gz = d - sxsz, e - sxsy, g - sysz
+        # f / w from the tables of sin / w (f / |grad f| = (f / w) / |grad f / w|)
+        u = 1.0 / w
+        f = (sx * u) * cy + (sy * u) * cz
+        f = f + (sz * u) * cx
+        g2 = np.square(cx * cy - sz * sx)
+        g2 += np.square(cy * cz - sx * sy)
+        g2 += np.square(cz * cx - sy * sz)
     elif kind == "schwarz_p":
-        f = (cx + cy) + cz
-        gx, gy, gz = -sx, -sy, -sz
+        f = ((cx + cy) + cz) / w
+        g2 = (sx * sx + sy * sy) + sz * sz
     elif kind == "diamond":
         sysz, cycz, cysz, sycz = sy * sz, cy * cz, cy * sz, sy * cz
         f = ((sx * sysz + sx * cycz) + cx * sycz) + cx * cysz
-        gx = ((cx * sysz + cx * cycz) - sx * sycz) - sx * cysz
-        gy = ((sx * cysz - sx * sycz) + cx * cycz) - cx * sysz
-        gz = ((sx * sycz - sx * cysz) - cx * sysz) + cx * cycz
+        f /= w
+        g2 = np.square(((cx * sysz + cx * cycz) - sx * sycz) - sx * cysz)
+        g2 += np.square(((sx * cysz - sx * sycz) + cx * cycz) - cx * sysz)
+        g2 += np.square(((sx * sycz - sx * cysz) - cx * sysz) + cx * cycz)
     else:
         raise ValueError(f"unknown TPMS kind {kind!r}; one of {', '.join(TPMS_KINDS)}")
-    gx, gy, gz = np.broadcast_arrays(gx, gy, gz)
+    np.abs(f, out=f)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        f /= np.sqrt(g2, out=g2)  # inf or NaN where the gradient vanishes: capped
+    np.fmin(f, period / 4.0, out=f)
+    f -= thickness / 2.0
+    return f
+
+
+# ------------------------------------------------------------ on the lines of a lattice
+
+
+class Lines:
+    """Points on the lines of a lattice: ``origin + (ijk + t e_axis) * step``, one per row
+    of the integer ``ijk (n, 3)``, ``axis (n,)`` and ``t (n,)``. Two of each point's
+    coordinates are lattice coordinates, so what depends on one coordinate (a sine) is a
+    table there; only the coordinate along the line is new (a mesher's vertices on its
+    cells' edges)."""
+
+    def __init__(self, origin, step, ijk: np.ndarray, axis: np.ndarray, t: np.ndarray):
+        self.origin = np.asarray(origin, dtype=np.float64).reshape(3)
+        self.step = np.broadcast_to(np.asarray(step, dtype=np.float64), (3,))
+        self.ijk, self.axis, self.t = ijk, axis, t
+
+    def __len__(self) -> int:
+        return len(self.t)
+
+    def moved(self, translate: np.ndarray, scale: np.ndarray) -> Lines:
+        """The same points in the frame ``(p - translate) / scale`` (per axis)."""
+        o = (self.origin - translate) / scale
+        return Lines(o, self.step / scale, self.ijk, self.axis, self.t)
+
+    def columns(self) -> list[np.ndarray]:
+        """The points' coordinates, one array an axis."""
+        return [
+            self.origin[k] + (self.ijk[:, k] + np.where(self.axis == k, self.t, 0.0)) * self.step[k]
+            for k in range(3)
+        ]
+
+    def sincos(self, w: float):
+        """``sin(w x_k)`` and ``cos(w x_k)`` for each axis: tables over the lattice's
+        indices where the coordinate is the lattice's, evaluated where it moves."""
+        along = (self.ijk[np.arange(len(self)), self.axis] + self.t) * self.step[self.axis]
+        m = w * (self.origin[self.axis] + along)
+        sm, cm = np.sin(m), np.cos(m)
+        s, c = [], []
+        for k in range(3):
+            i = self.ijk[:, k]
+            lo = int(i.min()) if len(i) else 0
+            span = (int(i.max()) - lo + 1) if len(i) else 1
+            x = w * (self.origin[k] + np.arange(lo, lo + span) * self.step[k])
+            here = self.axis == k
+            s.append(np.where(here, sm, np.sin(x)[i - lo]))
+            c.append(np.where(here, cm, np.cos(x)[i - lo]))
+        return s, c
+
+
+def sphere_lines(lines: Lines, radius: float, center: np.ndarray) -> np.ndarray:
+    """:func:`sphere` on :class:`Lines`."""
+    x, y, z = (a - c for a, c in zip(lines.columns(), center, strict=True))
+    return np.sqrt((x * x + y * y) + z * z) - radius
+
+
+def box_lines(lines: Lines, size: np.ndarray, center: np.ndarray, radius: float = 0.0):
+    """:func:`box` on :class:`Lines`, by columns."""
+    half = np.asarray(size, dtype=np.float64) / 2.0
+    r = float(min(max(radius, 0.0), half.min()))
+    q = [np.abs(a - c) - (h - r) for a, c, h in zip(lines.columns(), center, half, strict=True)]
+    mx, my, mz = (np.maximum(v, 0.0) for v in q)
+    outside = np.sqrt((mx * mx + my * my) + mz * mz)
+    return outside + np.minimum(np.maximum(np.maximum(q[0], q[1]), q[2]), 0.0) - r
+
+
+def tpms_lines(lines: Lines, kind: str, period: float, thickness: float) -> np.ndarray:
+    """:func:`tpms` on :class:`Lines`: two sines a point instead of six."""
+    w = 2.0 * np.pi / period
+    (sx, sy, sz), (cx, cy, cz) = lines.sincos(w)
+    if kind == "gyroid":
+        f = sx * cy + sy * cz + sz * cx
+        gx, gy, gz = cx * cy - sz * sx, cy * cz - sx * sy, cz * cx - sy * sz
+    elif kind == "schwarz_p":
+        f = cx + cy + cz
+        gx, gy, gz = -sx, -sy, -sz
+    elif kind == "diamond":
+        f = sx * sy * sz + sx * cy * cz + cx * sy * cz + cx * cy * sz
+        gx = cx * sy * sz + cx * cy * cz - sx * sy * cz - sx * cy * sz
+        gy = sx * cy * sz - sx * sy * cz + cx * cy * cz - cx * sy * sz
+        gz = sx * sy * cz - sx * cy * sz - cx * sy * sz + cx * cy * cz
+    else:
+        raise ValueError(f"unknown TPMS kind {kind!r}; one of {', '.join(TPMS_KINDS)}")
     gl = np.sqrt((gx * gx + gy * gy) + gz * gz) * w
     cap = period / 4.0
     with np.errstate(divide="ignore", invalid="ignore"):
