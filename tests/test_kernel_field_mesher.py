@@ -165,7 +165,8 @@ def test_gyroid_cube_agrees_with_scikit_image_marching_cubes(lattices):
 
     def grid(origin, step, shape):
         axes = [origin[:, k, None] + np.arange(shape[k]) * step for k in range(3)]
-        return np.maximum(sdf.tpms_grid(axes, "gyroid", 10.0, 1.0), sdf.box_grid(axes, box, O))
+        v = np.maximum(sdf.tpms_grid(axes, "gyroid", 10.0, 1.0), sdf.box_grid(axes, box, O))
+        return np.moveaxis(v, -1, 0)  # the kernels' (a, b, c, n) as (n, a, b, c)
 
     def lines(origin, step, ijk, axis, t):
         at = sdf.Lines(origin, step, ijk, axis, t)

@@ -131,8 +131,8 @@ class Field(Geometry):
             raise ValueError(f"shape must be three counts >= 1, got {shape!r}")
         axes = [o[:, k, None] + np.arange(n[k]) * h[k] for k in range(3)]
         with np.errstate(all="ignore"):
-            out = np.broadcast_to(_grid(self, axes), (len(o), *n))
-        out = np.ascontiguousarray(out, dtype=np.float64)
+            out = np.broadcast_to(_grid(self, axes), (*n, len(o)))  # (a, b, c, n) inside
+        out = np.ascontiguousarray(np.moveaxis(out, -1, 0), dtype=np.float64)
         return out[0] if single else out
 
     def evaluate_lines(
@@ -395,8 +395,8 @@ def _points_grid(field: Field, at: Any) -> np.ndarray:
     """The point-wise fallback of :meth:`Field.evaluate_grid` and :meth:`evaluate_lines`."""
     if isinstance(at, _sdf().Lines):
         return field.evaluate(np.stack(at.columns(), axis=1))
-    x, y, z = np.broadcast_arrays(
-        at[0][:, :, None, None], at[1][:, None, :, None], at[2][:, None, None, :]
+    x, y, z = np.broadcast_arrays(  # (a, b, c, n), as the tables' lattices are
+        at[0].T[:, None, None, :], at[1].T[None, :, None, :], at[2].T[None, None, :, :]
     )
     p = np.stack([x.reshape(-1), y.reshape(-1), z.reshape(-1)], axis=1)
     return field.evaluate(p).reshape(x.shape)

@@ -242,8 +242,8 @@ class _Lattice:
         self.kept1 = None
         at = self.origin + self.base * self.cell
         values = np.empty((ns, B, B, B))
-        for s in range(0, ns, GROUP // 4):  # 16,384 points a call: in the cache
-            e = min(s + GROUP // 4, ns)
+        for s in range(0, ns, GROUP):
+            e = min(s + GROUP, ns)
             values[s:e] = _check(grid(at[s:e], self.cell, (B, B, B))).reshape(e - s, B, B, B)
         self.values = values.reshape(-1)
         self.inside = values < 0

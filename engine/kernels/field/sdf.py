@@ -9,6 +9,8 @@ minimum, whose gradient is a convex combination of its arguments' gradients, so 
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 __all__ = [
@@ -127,16 +129,19 @@ def tpms(p: np.ndarray, kind: str, period: float, thickness: float) -> np.ndarra
 # ----------------------------------------------------------------- on lattices of points
 #
 # The same distances on a lattice of points given by its axes: ``axes`` is three arrays
-# ``(n, a)``, ``(n, b)``, ``(n, c)`` of coordinates (n boxes), the result ``(n, a, b, c)``.
-# Where a function is a sum or product of terms in one coordinate each, the terms are
-# tables along the axes and the lattice is their outer sums and products: a TPMS costs six
-# sines a box side instead of six a point.
+# ``(n, a)``, ``(n, b)``, ``(n, c)`` of coordinates (n boxes), the result ``(a, b, c, n)``:
+# the boxes' index innermost (see :func:`_outer`; ``formgraph.geometry.Field.evaluate_grid``
+# gives them as (n, a, b, c)). Where a function is a sum or product of terms in one
+# coordinate each, the terms are tables along the axes and the lattice is their outer sums
+# and products: a TPMS costs six sines a box side instead of six a point.
 
 
 def _outer(axes):
-    """The axes as broadcastable (n, a, 1, 1), (n, 1, b, 1), (n, 1, 1, c)."""
-    x, y, z = axes
-    return x[:, :, None, None], y[:, None, :, None], z[:, None, None, :]
+    """The axes (n, a), (n, b), (n, c) as broadcastable (a, 1, 1, n), (1, b, 1, n),
+    (1, 1, c, n): the lattices' values are worked on as (a, b, c, n), the boxes' index
+    innermost, so numpy's inner loops run over the n boxes, not over a short side."""
+    x, y, z = (np.ascontiguousarray(v.T) for v in axes)
+    return x[:, None, None, :], y[None, :, None, :], z[None, None, :, :]
 
 
 def sphere_grid(axes, radius: float, center: np.ndarray) -> np.ndarray:
@@ -156,9 +161,9 @@ def box_grid(axes, size: np.ndarray, center: np.ndarray, radius: float = 0.0) ->
         return _box_inner(q, r)
     if not inner.any():
         return _box_outer(q, r)
-    out = np.empty((len(inner), *(v.shape[1] for v in q)))
-    out[inner] = _box_inner([v[inner] for v in q], r)
-    out[~inner] = _box_outer([v[~inner] for v in q], r)
+    out = np.empty((*(v.shape[1] for v in q), len(inner)))
+    out[..., inner] = _box_inner([v[inner] for v in q], r)
+    out[..., ~inner] = _box_outer([v[~inner] for v in q], r)
     return out
 
 
@@ -238,29 +243,40 @@ class Lines:
         o = (self.origin - translate) / scale
         return Lines(o, self.step / scale, self.ijk, self.axis, self.t)
 
+    @functools.cached_property
+    def _index(self):
+        """The indices by axis ``(3, n)`` and where in that array each point moves."""
+        n = len(self)
+        return np.ascontiguousarray(self.ijk.T), self.axis * n + np.arange(n)
+
+    @functools.cached_property
+    def _columns(self) -> np.ndarray:
+        i, moving = self._index
+        q = i.astype(np.float64)
+        q.reshape(-1)[moving] += self.t
+        return self.origin[:, None] + q * self.step[:, None]
+
     def columns(self) -> list[np.ndarray]:
         """The points' coordinates, one array an axis."""
-        return [
-            self.origin[k] + (self.ijk[:, k] + np.where(self.axis == k, self.t, 0.0)) * self.step[k]
-            for k in range(3)
-        ]
+        return list(self._columns)
 
     def sincos(self, w: float):
         """``sin(w x_k)`` and ``cos(w x_k)`` for each axis: tables over the lattice's
         indices where the coordinate is the lattice's, evaluated where it moves."""
-        along = (self.ijk[np.arange(len(self)), self.axis] + self.t) * self.step[self.axis]
-        m = w * (self.origin[self.axis] + along)
-        sm, cm = np.sin(m), np.cos(m)
-        s, c = [], []
-        for k in range(3):
-            i = self.ijk[:, k]
-            lo = int(i.min()) if len(i) else 0
-            span = (int(i.max()) - lo + 1) if len(i) else 1
-            x = w * (self.origin[k] + np.arange(lo, lo + span) * self.step[k])
-            here = self.axis == k
-            s.append(np.where(here, sm, np.sin(x)[i - lo]))
-            c.append(np.where(here, cm, np.cos(x)[i - lo]))
-        return s, c
+        i, moving = self._index
+        if not len(self):
+            return [np.zeros(0)] * 3, [np.zeros(0)] * 3
+        lo, hi = i.min(axis=1), i.max(axis=1)
+        start = np.concatenate([[0], np.cumsum(hi - lo + 1)])
+        x = np.concatenate(
+            [self.origin[k] + np.arange(lo[k], hi[k] + 1) * self.step[k] for k in range(3)]
+        )
+        at = i - (lo - start[:3])[:, None]
+        s, c = np.sin(w * x)[at], np.cos(w * x)[at]
+        m = w * self._columns.reshape(-1)[moving]
+        s.reshape(-1)[moving] = np.sin(m)
+        c.reshape(-1)[moving] = np.cos(m)
+        return list(s), list(c)
 
 
 def sphere_lines(lines: Lines, radius: float, center: np.ndarray) -> np.ndarray:
