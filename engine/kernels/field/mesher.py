@@ -16,6 +16,13 @@ sampling where a sampled point of the level of 2 cells is farther from zero than
 field can change between them (``|f(q)| > L |p - q|``); the rest are sampled, in chunks
 that stay in the processor's cache.
 
+A field whose values on a lattice cost a fraction of its points (``grid``: a TPMS, a box,
+a sphere and their blends, on tables along the axes) is sampled instead at every corner
+of the kept blocks, block lattice by block lattice, none inferred: on a lattice the
+samples are cheaper than the bookkeeping that would avoid them; its vertices take their
+first sample on their edges' lines (``lines``), where only the coordinate along the edge
+is new.
+
 The cells with a sign change are polygonized by marching cubes with a table built from
 one rule on each face (:mod:`.mctable`: inside corners are separated), so neighbouring
 cubes draw the same segments on a shared face and the surface, a function of the signs
@@ -37,8 +44,10 @@ from collections.abc import Callable
 import numpy as np
 
 from .mctable import EDGE_AXIS, EDGE_START, TRI_COUNT, TRI_EDGES
+from .roots import guess, roots
 
 __all__ = ["BudgetExceeded", "crossing_cells", "mesh_field", "plan_grid"]
+
 
 Fn = Callable[[np.ndarray], np.ndarray]
 SQRT3_2 = np.sqrt(3.0) / 2.0
@@ -59,11 +68,6 @@ CORNERS = np.array(list(itertools.product((0, 1), repeat=3)), dtype=np.int64)  #
 # ---------------------------------------------------------------------------- the grid
 
 GRID_SHIFT = np.array([0.1234567, 0.2345678, 0.3456789]) * 0.5
-# a vertex stays this fraction of its edge off either end, so vertices never coincide, not
-# even as the float32 coordinates of an STL (at 2,000 cells from the origin an ulp of
-# float32 is 1e-4 of a cell)
-END_GAP = 5e-4
-ACCEPT = 5e-4  # a vertex is done once |f| there is surely below this (cells), see _roots
 BLOCK_LEVEL = 3
 B = 1 << BLOCK_LEVEL  # a block is B^3 finest cells and owns B^3 corners
 B3 = B**3
@@ -474,7 +478,7 @@ def mesh_field(
         Refuse (:class:`BudgetExceeded`) before making more cells or corners than this.
     root_steps : int
         Samples of the field per vertex at most before bisection takes over (most take
-        one, see :func:`_roots`); 0 is linear interpolation.
+        one, see :func:`.roots.roots`); 0 is linear interpolation.
     grid : callable (origins (n, 3), step, shape) -> (n, *shape), optional
         The same field on lattices of points (``Field.evaluate_grid``), for a field whose
         lattices are cheaper than its points: then every corner of the blocks kept by the
@@ -529,112 +533,11 @@ def mesh_field(
         fq = np.where(after >= 0, lat.values[after], np.nan)
         pa = lat.point(start)
         pb = pa + np.eye(3)[axis] * cell
-        guess = _guess(fm, fa, fb, fq) if root_steps else None
+        start_t = guess(fm, fa, fb, fq) if root_steps else None
         first = None
         if lines is not None:
             loc = start & (B3 - 1)
             ijk = lat.base[slot] + np.stack([loc >> 6, (loc >> 3) & 7, loc & 7], axis=-1)
             first = functools.partial(lines, lat.origin, cell, ijk, axis)
-        verts[i : i + CHUNK] = _roots(f, pa, pb, fa, fb, root_steps, cell, guess, lipschitz, first)
+        verts[i : i + CHUNK] = roots(f, pa, pb, fa, fb, root_steps, cell, start_t, lipschitz, first)
     return verts, tri.reshape(-1, 3)
-
-
-def _guess(fm, fa, fb, fq) -> np.ndarray:
-    """First guesses of the roots on edges (0, 1) from the values at -1, 0, 1, 2 along
-    them (``fm``, ``fq`` NaN where unknown): Newton's method on the cubic (or quadratic)
-    through the known ones, from the linear guess; linear where neither is known."""
-    has_m, has_q = ~np.isnan(fm), ~np.isnan(fq)
-    both = has_m & has_q
-    c1 = -fm / 3 - fa / 2 + fb - fq / 6  # the cubic through all four
-    c2 = fm / 2 - fa + fb / 2
-    c3 = -fm / 6 + fa / 2 - fb / 2 + fq / 6
-    if not both.all():
-        m, q = has_m & ~has_q, ~has_m & has_q
-        c1 = np.where(both, c1, fb - fa)
-        c2, c3 = np.where(both, c2, 0.0), np.where(both, c3, 0.0)
-        c1 = np.where(m, (fb - fm) / 2, np.where(q, (-3 * fa + 4 * fb - fq) / 2, c1))
-        c2 = np.where(m, (fb - 2 * fa + fm) / 2, np.where(q, (fa - 2 * fb + fq) / 2, c2))
-    den = fa - fb
-    lin = np.divide(fa, den, out=np.full(len(fa), 0.5), where=den != 0)
-    t = lin
-    with np.errstate(divide="ignore", invalid="ignore"):
-        for _ in range(2):  # two Newton steps: a third changes 0.3 % of the vertices' cost
-            p = fa + t * (c1 + t * (c2 + t * c3))
-            dp = c1 + t * (2 * c2 + 3 * t * c3)
-            t = np.clip(t - p / dp, 0.0, 1.0)
-    return np.where(np.isfinite(t), t, lin)
-
-
-def _roots(
-    f: Fn, pa, pb, fa, fb, steps: int, cell: float, guess=None, lipschitz: float = 1.0, first=None
-) -> np.ndarray:
-    """Points where ``f`` changes sign on segments ``pa -> pb``.
-
-    ``fa`` and ``fb`` have opposite signs (one is < 0, the other >= 0). From ``guess``
-    (the linear one if none), each step samples the field and moves to the inverse
-    quadratic interpolant's root through the bracket's ends and the new sample (exact for
-    a quadratic along the edge, Brent 1973), or to the regula falsi point of the shrunk
-    bracket where that root falls outside it. A step is taken without sampling it where
-    the Lipschitz bound already keeps ``|f|`` there below ``ACCEPT`` cells, so most
-    vertices cost one sample and every one ends within that (an L-Lipschitz field). What
-    is left after ``steps`` (a kink of a sharp union on the edge) is bisected. Points are
-    kept ``END_GAP`` off the ends, so edges meeting at a corner on the surface give
-    distinct vertices (and no triangle collapses to a point in a file of float32
-    coordinates).
-    """
-    n = len(pa)
-    lo_t, hi_t = np.zeros(n), np.ones(n)
-    flo, fhi = fa.copy(), fb.copy()
-    den = flo - fhi
-    if guess is None:
-        guess = np.divide(flo, den, out=np.full(n, 0.5), where=den != 0)
-    t = np.clip(guess, END_GAP, 1 - END_GAP)
-    tol = 1e-4 * cell
-    idx = np.arange(n)
-    d = pb - pa
-    for k in range(steps):
-        at = slice(None) if k == 0 else idx  # every vertex takes the first step
-        c = t[at]
-        if k == 0 and first is not None:  # the field on the edges' lines: ``first(t)``
-            fc = _check(first(c))
-        else:
-            fc = _eval(f, pa[at] + c[:, None] * d[at])
-        a, b, f_a, f_b = lo_t[at], hi_t[at], flo[at], fhi[at]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            iqi = (
-                a * f_b * fc / ((f_a - f_b) * (f_a - fc))
-                + b * f_a * fc / ((f_b - f_a) * (f_b - fc))
-                + c * f_a * f_b / ((fc - f_a) * (fc - f_b))
-            )
-        low = (fc < 0) == (f_a < 0)  # the sample replaces the end of its own sign
-        a, f_a = np.where(low, c, a), np.where(low, fc, f_a)
-        b, f_b = np.where(low, b, c), np.where(low, f_b, fc)
-        lo_t[at], flo[at], hi_t[at], fhi[at] = a, f_a, b, f_b
-        den = f_a - f_b
-        rf = a + np.divide(f_a, den, out=np.full(len(a), 0.5), where=den != 0) * (b - a)
-        inside = np.isfinite(iqi) & (iqi > a) & (iqi < b)
-        conv = np.abs(fc) <= tol
-        step = np.clip(np.where(inside, iqi, rf), END_GAP, 1 - END_GAP)
-        # a step not sampled moves the point by |t' - c| of the edge: for an L-Lipschitz
-        # field its value is then at most |f(c)| + L cell |t' - c|. Where that bound is
-        # within ACCEPT of a cell, take the step (on a smooth field it lands far closer);
-        # where only |f(c)| is, keep c; the rest sample again
-        bound = np.abs(fc) + lipschitz * cell * np.abs(step - c)
-        take = ~conv & (bound <= ACCEPT * cell)
-        keep = ~conv & ~take & (np.abs(fc) <= ACCEPT * cell)
-        t[at] = np.where(conv | keep, c, step)
-        idx = idx[~(conv | take | keep)]
-        if not len(idx):
-            break
-    # what is left (a kink of a sharp union on the edge converges only linearly):
-    # bisection of the bracket, which halves it every step whatever the field's shape
-    for _ in range(16 if steps else 0):
-        if not len(idx):
-            break
-        t[idx] = np.clip((lo_t[idx] + hi_t[idx]) / 2.0, END_GAP, 1 - END_GAP)
-        fp = _eval(f, pa[idx] + t[idx, None] * d[idx])
-        low = (fp < 0) == (flo[idx] < 0)
-        lo_t[idx[low]], flo[idx[low]] = t[idx[low]], fp[low]
-        hi_t[idx[~low]], fhi[idx[~low]] = t[idx[~low]], fp[~low]
-        idx = idx[np.abs(fp) > tol]
-    return pa + t[:, None] * d

@@ -1,8 +1,10 @@
 """Signed distance functions on point arrays: primitives, smooth blends, TPMS sheets.
 
 Every function takes points ``p`` of shape (n, 3) (or distances of shape (n,)) and returns
-(n,) float64, negative inside. The primitives are exact Euclidean distances (Quilez's
-formulas, "Distance functions", iquilezles.org); the blends are the polynomial smooth
+(n,) float64, negative inside; ``*_grid`` take the axes of lattices of points and
+``*_lines`` points on a lattice's lines (:class:`Lines`), the same values from tables.
+The primitives are exact Euclidean distances (Quilez's formulas, "Distance functions",
+iquilezles.org); the blends are the polynomial smooth
 minimum, whose gradient is a convex combination of its arguments' gradients, so a blend of
 1-Lipschitz fields stays 1-Lipschitz (what the mesher's culling relies on).
 """
