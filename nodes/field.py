@@ -409,7 +409,18 @@ def mesh_of(
     # a box n cells wide has at least n^2 surface cells; refuse a hopeless grid up front
     ctx.guard(((extent / cell) + 2) ** 2, "surface cells")
     try:
-        v, t = mesher.mesh_field(field.evaluate, box[0], box[1], cell, field.lipschitz, ctx.budget)
+        grid = field.evaluate_grid if field.separable else None  # lattices: tables
+        lines = field.evaluate_lines if field.separable else None
+        v, t = mesher.mesh_field(
+            field.evaluate,
+            box[0],
+            box[1],
+            cell,
+            field.lipschitz,
+            ctx.budget,
+            grid=grid,
+            lines=lines,
+        )
     except mesher.BudgetExceeded as exc:
         ctx.guard(exc.count, exc.what)
         raise

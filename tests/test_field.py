@@ -5,6 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import trimesh
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import formgraph as fg
 from formgraph.core.errors import BudgetError
@@ -213,3 +215,64 @@ def test_a_field_previews_as_a_mesh_and_a_tpms_in_two_periods():
     g = Field.tpms("schwarz_p", 4.0, 0.5).display_mesh()
     assert np.allclose(g.bounds, [[0, 0, 0], [8, 8, 8]], atol=0.2) and g.is_watertight
     assert Field.expression(lambda x, y, z: x).display_mesh() is None
+
+
+def _lattice_fields():
+    g = Field.tpms("gyroid", 7.3, 0.8)
+    p = Field.tpms("schwarz_p", 5.0, 0.5)
+    d = Field.tpms("diamond", 6.1, 1.2)
+    ball, box = Field.sphere(2.0, [0.3, -0.1, 0.2]), Field.box([1, 2, 3], [0.1, 0, 0], 0.3)
+    turn = [[0, 1, 0], [-1, 0, 0], [0, 0, 1]]
+    return [
+        g,
+        p,
+        d,
+        ball,
+        box,
+        Field.torus(2.0, 0.5),
+        Field.intersection([g, box], 0.2),
+        Field.union([ball, Field.offset(box, 0.1)], 0.5),
+        Field.difference(Field.shell(ball, 0.2), d, 0.1),
+        Field.transform(Field.intersection([d, ball]), np.eye(3), [1, 2, 3], [1, 2, 0.5]),
+        Field.transform(ball, turn, [1, 2, 3], 1.5),
+        Field.expression(lambda x, y, z: x * y - z),
+        Field.intersection([g, Field.box([30, 30, 30], [1, 0, 0])]),  # lattices in and out
+    ]
+
+
+@settings(max_examples=30, deadline=None)
+@given(
+    st.integers(0, 12),
+    st.lists(st.floats(-20, 20), min_size=6, max_size=6),
+    st.lists(st.floats(1e-3, 2.0), min_size=3, max_size=3),
+    st.lists(st.integers(1, 9), min_size=3, max_size=3),
+)
+def test_lattice_values_are_the_point_values(which, origin, step, shape):
+    # the separable tables (TPMS, box, sphere, their blends, axis-aligned transforms) and
+    # the point-wise fallback (rotations, tori, expressions) give what evaluate gives
+    field = _lattice_fields()[which]
+    key = digest(field)
+    o = np.array(origin).reshape(2, 3)
+    lattice = field.evaluate_grid(o, step, shape)
+    ijk = np.stack(np.meshgrid(*(np.arange(k) for k in shape), indexing="ij"), -1)
+    p = o[:, None, None, None, :] + ijk[None] * np.array(step)
+    points = field.evaluate(p.reshape(-1, 3)).reshape(2, *shape)
+    assert lattice.shape == (2, *shape)
+    np.testing.assert_allclose(lattice, points, rtol=0, atol=1e-12)
+    assert field.evaluate_grid(o[0], step, shape).shape == tuple(shape)
+    # on the lattice's lines: two coordinates on it, the third anywhere along an edge
+    rng = np.random.default_rng(which)
+    ijk = rng.integers(-40, 40, (50, 3))
+    axis, t = rng.integers(0, 3, 50), rng.uniform(0, 1, 50)
+    on_lines = field.evaluate_lines(o[0], step, ijk, axis, t)
+    p = o[0] + (ijk + np.eye(3)[axis] * t[:, None]) * np.array(step)
+    np.testing.assert_allclose(on_lines, field.evaluate(p), rtol=0, atol=1e-12)
+    assert digest(field) == key  # sampling does not change the key
+
+
+def test_separable_fields_are_the_ones_sampled_on_tables():
+    g = Field.tpms("gyroid", 10.0, 1.0)
+    assert Field.intersection([g, Field.box([5, 5, 5])]).separable
+    assert Field.transform(g, np.eye(3), [1, 0, 0], [1, 2, 3]).separable
+    assert not Field.transform(g, [[0, 1, 0], [-1, 0, 0], [0, 0, 1]], [0, 0, 0], 1).separable
+    assert not Field.union([g, Field.torus(2.0, 0.5)]).separable  # a torus is point-wise

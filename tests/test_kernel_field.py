@@ -8,7 +8,7 @@ import trimesh
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
-from formgraph.kernels.field import meshdist, mesher, sdf
+from formgraph.kernels.field import meshdist, mesher, roots, sdf
 
 O = np.zeros(3)
 
@@ -38,7 +38,7 @@ def test_root_finding_beats_linear_interpolation_on_a_curved_field():
     exact, _ = mesher.mesh_field(f, [-1] * 3, [1] * 3, 0.2, lipschitz=3.0)
     assert np.median(np.abs(f(exact))) < 1e-3 * np.median(np.abs(f(lin)))
     # at worst a vertex is held END_GAP of its edge off a corner that is on the surface
-    assert np.abs(f(exact)).max() <= 3.0 * mesher.END_GAP * 0.2 * 1.001
+    assert np.abs(f(exact)).max() <= 3.0 * roots.END_GAP * 0.2 * 1.001
 
 
 def test_rounded_box_volume_closed_form():

@@ -93,6 +93,17 @@ def _on_one_face(a: int, b: int) -> bool:
     return bool(np.any((pa == pb) & ((pa == 0) | (pa == 1))))
 
 
+def _lattices(f):
+    """A field's lattices sampled point by point: the mesher's dense-block path."""
+
+    def grid(origin, step, shape):
+        ijk = np.stack(np.meshgrid(*(np.arange(k) for k in shape), indexing="ij"), -1)
+        p = origin[:, None, None, None, :] + ijk[None] * step
+        return f(p.reshape(-1, 3)).reshape(len(origin), *shape)
+
+    return grid
+
+
 def _edge_use(t: np.ndarray) -> np.ndarray:
     e = np.sort(np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]]), axis=1)
     _, count = np.unique(e, axis=0, return_counts=True)
@@ -100,8 +111,8 @@ def _edge_use(t: np.ndarray) -> np.ndarray:
 
 
 @settings(max_examples=25, deadline=None)
-@given(st.integers(0, 2**32 - 1), st.floats(0.6, 2.0))
-def test_random_fields_are_two_manifold_closed_and_oriented(seed, scale):
+@given(st.integers(0, 2**32 - 1), st.floats(0.6, 2.0), st.booleans())
+def test_random_fields_are_two_manifold_closed_and_oriented(seed, scale, dense):
     # a random sum of bumps (many ambiguous faces at this cell), cut by a ball so the
     # surface closes: every edge on exactly two triangles, consistent winding, even Euler
     rng = np.random.default_rng(seed)
@@ -113,7 +124,8 @@ def test_random_fields_are_two_manifold_closed_and_oriented(seed, scale):
         g = (w * np.exp(-d2 * 4 * scale)).sum(1) - 0.05
         return np.maximum(g, sdf.sphere(p, 1.2, O))
 
-    v, t = mesher.mesh_field(f, [-1.3] * 3, [1.3] * 3, 0.1, lipschitz=8.0 * scale)
+    grid = _lattices(f) if dense else None
+    v, t = mesher.mesh_field(f, [-1.3] * 3, [1.3] * 3, 0.1, lipschitz=8.0 * scale, grid=grid)
     if not len(t):
         return
     assert (_edge_use(t) == 2).all()
@@ -124,7 +136,8 @@ def test_random_fields_are_two_manifold_closed_and_oriented(seed, scale):
     assert m.volume > 0
 
 
-def test_a_field_of_near_saddles_everywhere_meshes_closed():
+@pytest.mark.parametrize("dense", [False, True])
+def test_a_field_of_near_saddles_everywhere_meshes_closed(dense):
     # sin x sin y sin z at about two cells a half period: ambiguous faces on every side
     k = np.pi / 0.23
 
@@ -132,13 +145,17 @@ def test_a_field_of_near_saddles_everywhere_meshes_closed():
         s = np.sin(k * p[:, 0]) * np.sin(k * p[:, 1]) * np.sin(k * p[:, 2]) / k + 0.01
         return np.maximum(s, sdf.box(p, np.array([2.0, 2.0, 2.0]), O))
 
-    v, t = mesher.mesh_field(f, [-1] * 3, [1] * 3, 0.1, lipschitz=2.0)
+    grid = _lattices(f) if dense else None
+    v, t = mesher.mesh_field(f, [-1] * 3, [1] * 3, 0.1, lipschitz=2.0, grid=grid)
     assert (_edge_use(t) == 2).all()
     m = trimesh.Trimesh(v, t, process=False)
     assert m.is_watertight and m.is_winding_consistent and m.volume > 0
 
 
-def test_gyroid_cube_agrees_with_scikit_image_marching_cubes():
+@pytest.mark.parametrize("lattices", [False, True])
+def test_gyroid_cube_agrees_with_scikit_image_marching_cubes(lattices):
+    # point by point (signs inferred inside the blocks) and on the blocks' lattices
+    # (separable tables, every corner sampled): the same surface as a dense grid's
     skimage = pytest.importorskip("skimage.measure")
     side, cell = 10.0, 0.25
     box = np.array([side] * 3)
@@ -146,7 +163,22 @@ def test_gyroid_cube_agrees_with_scikit_image_marching_cubes():
     def f(p):
         return np.maximum(sdf.tpms(p, "gyroid", 10.0, 1.0), sdf.box(p, box, O))
 
-    v, t = mesher.mesh_field(f, [-side / 2] * 3, [side / 2] * 3, cell, 2.0)
+    def grid(origin, step, shape):
+        axes = [origin[:, k, None] + np.arange(shape[k]) * step for k in range(3)]
+        v = np.maximum(sdf.tpms_grid(axes, "gyroid", 10.0, 1.0), sdf.box_grid(axes, box, O))
+        return np.moveaxis(v, -1, 0)  # the kernels' (a, b, c, n) as (n, a, b, c)
+
+    def lines(origin, step, ijk, axis, t):
+        at = sdf.Lines(origin, step, ijk, axis, t)
+        return np.maximum(sdf.tpms_lines(at, "gyroid", 10.0, 1.0), sdf.box_lines(at, box, O))
+
+    lo, hi = [-side / 2] * 3, [side / 2] * 3
+    if lattices:
+        v, t = mesher.mesh_field(f, lo, hi, cell, 2.0, grid=grid, lines=lines)
+        on_edges = f(v)
+        assert np.abs(on_edges).max() < 1e-3 * cell  # the roots are on the field's zero set
+    else:
+        v, t = mesher.mesh_field(f, lo, hi, cell, 2.0)
     ours = trimesh.Trimesh(v, t, process=False)
     n = int(round(side / cell)) + 3
     ax = (np.arange(n) - (n - 1) / 2) * cell

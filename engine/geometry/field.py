@@ -105,6 +105,51 @@ class Field(Geometry):
         return self.evaluate(points)
 
     @functools.cached_property
+    def separable(self) -> bool:
+        """Whether :meth:`evaluate_grid` works on tables along the axes all through (no
+        point-wise fallback), so a lattice costs a fraction of its points."""
+        if self.op not in _GRID:
+            return False
+        if self.op == "transform" and not np.array_equal(self.args["matrix"], np.eye(3)):
+            return False
+        return all(c.separable for c in self.children)
+
+    def evaluate_grid(self, origin: Any, step: Any, shape: Any) -> np.ndarray:
+        """Values on lattices of points: ``origin + (i, j, k) * step`` for ``0 <= (i, j,
+        k) < shape``, one lattice per row of ``origin`` ((n, 3) -> (n, *shape); (3,) ->
+        shape). The same values as :meth:`evaluate` at those points (to rounding); the
+        field's key does not depend on which is used. Primitives whose distance is
+        separable in the coordinates (TPMS, boxes, spheres) and the blends, shells,
+        offsets and axis-aligned transforms of them work on tables along the axes; the
+        rest are sampled point by point."""
+        o = np.asarray(origin, dtype=np.float64)
+        single = o.ndim == 1
+        o = o.reshape(-1, 3)
+        h = np.broadcast_to(np.asarray(step, dtype=np.float64), (3,))
+        n = tuple(int(k) for k in shape)
+        if len(n) != 3 or min(n) < 1:
+            raise ValueError(f"shape must be three counts >= 1, got {shape!r}")
+        axes = [o[:, k, None] + np.arange(n[k]) * h[k] for k in range(3)]
+        with np.errstate(all="ignore"):
+            out = np.broadcast_to(_grid(self, axes), (*n, len(o)))  # (a, b, c, n) inside
+        out = np.ascontiguousarray(np.moveaxis(out, -1, 0), dtype=np.float64)
+        return out[0] if single else out
+
+    def evaluate_lines(
+        self, origin: Any, step: Any, ijk: np.ndarray, axis: np.ndarray, t: np.ndarray
+    ) -> np.ndarray:
+        """Values at ``origin + (ijk + t e_axis) * step``: points on the lines of a lattice
+        (integer ``ijk (n, 3)``, ``axis (n,)`` in 0..2, ``t (n,)``), such as a mesher's
+        vertices on its cells' edges. The same values as :meth:`evaluate` (to rounding);
+        a separable field takes what depends on the lattice's coordinates from tables."""
+        lines = _sdf().Lines(
+            origin, step, np.asarray(ijk), np.asarray(axis), np.asarray(t, dtype=np.float64)
+        )
+        with np.errstate(all="ignore"):
+            out = np.broadcast_to(_grid(self, lines), (len(lines),))
+        return np.ascontiguousarray(out, dtype=np.float64)
+
+    @functools.cached_property
     def _cache(self) -> dict[str, Any]:
         """Acceleration structures built on first use (k-d trees, winding-number trees)."""
         return {}
@@ -144,7 +189,9 @@ class Field(Geometry):
             return None
         lo, hi = field.bounds
         cell = float((hi - lo).max()) / 64 or 1.0
-        v, t = mesh_field(field.evaluate, lo, hi, cell, field.lipschitz)
+        grid = field.evaluate_grid if field.separable else None
+        lines = field.evaluate_lines if field.separable else None
+        v, t = mesh_field(field.evaluate, lo, hi, cell, field.lipschitz, grid=grid, lines=lines)
         return Mesh(v, t.reshape(-1), np.arange(0, 3 * len(t) + 1, 3))
 
     def to_pyvista(self) -> Any:
@@ -343,6 +390,69 @@ def _from_curves(field: Field, p: np.ndarray) -> np.ndarray:
         cache["nearest"] = meshdist.Nearest(field.args["segments"])
     return cache["nearest"].distance(p) - field.args["radius"]
 
+
+def _points_grid(field: Field, at: Any) -> np.ndarray:
+    """The point-wise fallback of :meth:`Field.evaluate_grid` and :meth:`evaluate_lines`."""
+    if isinstance(at, _sdf().Lines):
+        return field.evaluate(np.stack(at.columns(), axis=1))
+    x, y, z = np.broadcast_arrays(  # (a, b, c, n), as the tables' lattices are
+        at[0].T[:, None, None, :], at[1].T[None, :, None, :], at[2].T[None, None, :, :]
+    )
+    p = np.stack([x.reshape(-1), y.reshape(-1), z.reshape(-1)], axis=1)
+    return field.evaluate(p).reshape(x.shape)
+
+
+def _grid(field: Field, at: Any) -> np.ndarray:
+    """``field`` on a lattice (``at``: its three axes) or on lines of one (``at``: Lines)."""
+    op = _GRID.get(field.op)
+    return _points_grid(field, at) if op is None else op(field, at)
+
+
+def _blend_grid(field: Field, at: Any, pick: str) -> np.ndarray:
+    sdf = _sdf()
+    k = field.args["smooth"]
+    values = [_grid(c, at) for c in field.children]
+    out = values[0]
+    for v in values[1:]:
+        out = sdf.smooth_min(out, v, k) if pick == "min" else sdf.smooth_max(out, v, k)
+    return out
+
+
+def _transform_grid(field: Field, at: Any) -> np.ndarray:
+    a = field.args
+    if not np.array_equal(a["matrix"], np.eye(3)):  # a rotation mixes the axes
+        return _points_grid(field, at)
+    if isinstance(at, _sdf().Lines):
+        local = at.moved(a["translate"], a["scale"])
+    else:
+        local = [(x - t) / s for x, t, s in zip(at, a["translate"], a["scale"], strict=True)]
+    return _grid(field.children[0], local) * float(a["scale"].min())
+
+
+def _leaf(name: str, *params: str) -> Callable[[Field, Any], np.ndarray]:
+    """A primitive on a lattice (``<name>_grid``) or on its lines (``<name>_lines``)."""
+
+    def run(field: Field, at: Any) -> np.ndarray:
+        sdf = _sdf()
+        kernel = getattr(sdf, f"{name}_lines" if isinstance(at, sdf.Lines) else f"{name}_grid")
+        return kernel(at, *(field.args[p] for p in params))
+
+    return run
+
+
+_GRID: dict[str, Callable[[Field, Any], np.ndarray]] = {
+    "sphere": _leaf("sphere", "radius", "center"),
+    "box": _leaf("box", "size", "center", "radius"),
+    "tpms": _leaf("tpms", "kind", "period", "thickness"),
+    "union": lambda f, g: _blend_grid(f, g, "min"),
+    "intersection": lambda f, g: _blend_grid(f, g, "max"),
+    "difference": lambda f, g: _sdf().smooth_max(
+        _grid(f.children[0], g), -_grid(f.children[1], g), f.args["smooth"]
+    ),
+    "shell": lambda f, g: np.abs(_grid(f.children[0], g)) - f.args["thickness"] / 2.0,
+    "offset": lambda f, g: _grid(f.children[0], g) - f.args["distance"],
+    "transform": _transform_grid,
+}
 
 _OPS: dict[str, Callable[[Field, np.ndarray], np.ndarray]] = {
     "sphere": lambda f, p: _sdf().sphere(p, f.args["radius"], f.args["center"]),

@@ -2,7 +2,8 @@
 
 - ``sdf``: exact distances to spheres, boxes (rounded), cylinders, tori; polynomial smooth
   min/max (Lipschitz-preserving blends); TPMS sheets (gyroid, Schwarz P, diamond) of even
-  wall thickness;
+  wall thickness; the same on lattices of points (outer sums and products of tables along
+  the axes) and on the lines of a lattice;
 - ``meshdist``: exact distance to a triangle mesh (candidates from k-d trees of triangle
   centres and of clusters, pruned by disc and cylinder bounds), its sign by the
   angle-weighted pseudonormal on a closed mesh or the generalized winding number (a
@@ -10,7 +11,8 @@
 - ``mesher``: adaptive meshing of the zero set: octree culling by the Lipschitz reach
   down to blocks of 8^3 cells, then dense per-block levels, corners owned by one block and
   signs inferred where the Lipschitz bound decides them, marching cubes, vertices by
-  root-finding on the field;
+  root-finding on the field (``roots``: a cubic guess from the samples along the edge,
+  then inverse quadratic and regula falsi steps);
 - ``mctable``: the marching-cubes table, built from one rule on each face (inside corners
   separated), so shared faces agree and the surface is watertight.
 

@@ -16,12 +16,19 @@ sampling where a sampled point of the level of 2 cells is farther from zero than
 field can change between them (``|f(q)| > L |p - q|``); the rest are sampled, in chunks
 that stay in the processor's cache.
 
+A field whose values on a lattice cost a fraction of its points (``grid``: a TPMS, a box,
+a sphere and their blends, on tables along the axes) is sampled instead at every corner
+of the kept blocks, block lattice by block lattice, none inferred: on a lattice the
+samples are cheaper than the bookkeeping that would avoid them; its vertices take their
+first sample on their edges' lines (``lines``), where only the coordinate along the edge
+is new.
+
 The cells with a sign change are polygonized by marching cubes with a table built from
 one rule on each face (:mod:`.mctable`: inside corners are separated), so neighbouring
 cubes draw the same segments on a shared face and the surface, a function of the signs
 at shared corners only, is watertight by construction; triangles point to the positive
 (outside) side. A vertex is identified by its edge (owner block, corner, axis): a perfect
-hash, numbered by marking and counting, no sort. Each vertex is put on its edge by
+hash, numbered by marking and ranking the marks, no sort. Each vertex is put on its edge by
 regula falsi (Illinois variant) on the field itself, not only by linear interpolation.
 
 Lorensen & Cline 1987; Nielson & Hamann 1991 (the ambiguous face); Dowson & Harrington's
@@ -30,14 +37,17 @@ Illinois method (1971).
 
 from __future__ import annotations
 
+import functools
 import itertools
 from collections.abc import Callable
 
 import numpy as np
 
 from .mctable import EDGE_AXIS, EDGE_START, TRI_COUNT, TRI_EDGES
+from .roots import guess, roots
 
 __all__ = ["BudgetExceeded", "crossing_cells", "mesh_field", "plan_grid"]
+
 
 Fn = Callable[[np.ndarray], np.ndarray]
 SQRT3_2 = np.sqrt(3.0) / 2.0
@@ -58,11 +68,6 @@ CORNERS = np.array(list(itertools.product((0, 1), repeat=3)), dtype=np.int64)  #
 # ---------------------------------------------------------------------------- the grid
 
 GRID_SHIFT = np.array([0.1234567, 0.2345678, 0.3456789]) * 0.5
-# a vertex stays this fraction of its edge off either end, so vertices never coincide, not
-# even as the float32 coordinates of an STL (at 2,000 cells from the origin an ulp of
-# float32 is 1e-4 of a cell)
-END_GAP = 5e-4
-ACCEPT = 5e-4  # a vertex is done once |f| there is surely below this (cells), see _roots
 BLOCK_LEVEL = 3
 B = 1 << BLOCK_LEVEL  # a block is B^3 finest cells and owns B^3 corners
 B3 = B**3
@@ -167,7 +172,7 @@ class _Lattice:
     of 2. Blocks are worked on :data:`GROUP` at a time, so the arrays stay in the cache.
     """
 
-    def __init__(self, f: Fn, lo, hi, cell: float, lipschitz: float, max_cells: int):
+    def __init__(self, f: Fn, lo, hi, cell: float, lipschitz: float, max_cells: int, grid=None):
         self.f, self.cell = f, cell
         self.origin, levels, blocks = plan_grid(lo, hi, cell)
         g, vc = _kept_blocks(f, self.origin, levels, blocks, cell, lipschitz, max_cells)
@@ -202,6 +207,9 @@ class _Lattice:
         )
         self.touched, self.dims, self._remap = touched, dims, remap
         self.nbr = nbr = remap[at]
+        if grid is not None:
+            self._dense(grid, ns)
+            return
         values = np.full((ns, B, B, B), np.nan)
         need = np.zeros((ns, B, B, B), dtype=bool)
         known = np.zeros((ns, B, B, B), dtype=bool)
@@ -231,6 +239,28 @@ class _Lattice:
         values[todo] = self.sample(todo)
         inside[todo] = values[todo] < 0
         self.values, self.inside = values, inside.reshape(ns, B, B, B)
+
+    def _dense(self, grid, ns: int) -> None:
+        """Every corner the kept blocks use, sampled on lattices by ``grid`` (a field whose
+        lattices cost a fraction of its points: no culling inside the blocks): all of a
+        kept block's own, and of the other touched slots the three lower faces (the only
+        corners of theirs a kept block's cells reach; the rest stay NaN)."""
+        self.kept1 = None
+        nk, cell = len(self.blocks), self.cell
+        at = self.origin + self.base * cell
+        values = np.full((ns, B, B, B), np.nan)
+        for s in range(0, nk, GROUP):
+            e = min(s + GROUP, nk)
+            values[s:e] = _check(grid(at[s:e], cell, (B, B, B))).reshape(e - s, B, B, B)
+        for s in range(nk, ns, GROUP):
+            e = min(s + GROUP, ns)
+            for k in range(3):
+                face = (slice(s, e), *(0 if j == k else slice(None) for j in range(3)))
+                shape = tuple(1 if j == k else B for j in range(3))
+                values[face] = _check(grid(at[s:e], cell, shape)).reshape(values[face].shape)
+        self.values = values.reshape(-1)
+        with np.errstate(invalid="ignore"):
+            self.inside = values < 0
 
     def _levels(self, g, own, values, lipschitz: float) -> np.ndarray:
         """The levels of 4 and 2 cells inside blocks ``g`` (dense per-block arrays, their
@@ -297,8 +327,11 @@ class _Lattice:
         case = np.zeros((n, B, B, B), dtype=np.uint8)
         for c, (x, y, z) in enumerate(CORNERS):
             case |= ins9[:, x : x + B, y : y + B, z : z + B] << np.uint8(c)
-        up = np.broadcast_to(self.kept1[s:e, :, None, :, None, :, None], (n, 4, 2, 4, 2, 4, 2))
-        cells = np.flatnonzero(up.reshape(n, B, B, B) & (case != 0) & (case != 255))
+        mixed = (case != 0) & (case != 255)
+        if self.kept1 is not None:
+            up = self.kept1[s:e, :, None, :, None, :, None]
+            mixed &= np.broadcast_to(up, (n, 4, 2, 4, 2, 4, 2)).reshape(n, B, B, B)
+        cells = np.flatnonzero(mixed)
         return cells + s * B3, case.reshape(-1)[cells]
 
 
@@ -361,24 +394,28 @@ EDGE_PACK = EDGE_OWNER << 11 | EDGE_PLACE  # both in one gather (a place is belo
 TRI_ROWS = TRI_EDGES.reshape(-1, 3).astype(np.int32)  # case * 5 + triangle -> its edges
 
 
-POP16 = np.unpackbits(np.arange(1 << 16, dtype="<u2").view(np.uint8)).reshape(-1, 16).sum(1)
+def _number(used: np.ndarray, hashes: list[np.ndarray], nbr: np.ndarray) -> np.ndarray:
+    """Each hash's vertex number: its rank among the ``used`` hashes (the used edges
+    numbered in order), group by group.
 
-
-def _ranks(used: np.ndarray, hashes: list[np.ndarray]) -> np.ndarray:
-    """Each hash's rank among the ``used`` ones (its vertex number), ``(t, 3)`` int64.
-
-    The rank is the count of used entries before it: a prefix sum over 16-bit words of
-    the packed bitmap plus the bits below it in its own word, so no array of the hash
-    space's size is ever written (its pages alone cost more than the counting).
+    A slot's used edges are numbered after all of the slots before it (a prefix sum of
+    the per-slot counts) and in their order within it; a group's triangles use the edges
+    of its own slots and their upper neighbours only (``nbr``, eight slots a block), so
+    the ranks come from a small table of those slots' running counts, in the cache.
     """
-    words = np.packbits(used, bitorder="little").view("<u2")
-    pop = POP16[words]
-    before = np.cumsum(pop, dtype=np.int64) - pop
+    per = used.reshape(-1, 3 * B3)
+    count = np.count_nonzero(per, axis=1)
+    first = np.cumsum(count) - count
+    dtype = np.int32 if count.sum() < 2**31 else np.int64
+    row = np.empty(len(per), dtype=np.int64)
     out = []
-    for h in hashes:
-        w = h >> 4
-        below = words[w] & (np.left_shift(1, h & 15, dtype=np.int32) - 1)
-        out.append(before[w] + POP16[below])
+    for g, h in enumerate(hashes):
+        slots = np.unique(nbr[g * GROUP * 8 : (g + 1) * GROUP * 8])
+        row[slots] = np.arange(len(slots))
+        table = np.cumsum(per[slots], axis=1, dtype=dtype)
+        table += (first[slots] - 1).astype(dtype)[:, None]
+        owner, place = np.divmod(h, 3 * B3)
+        out.append(np.take(table, row[owner] * (3 * B3) + place))
     return np.concatenate(out)
 
 
@@ -421,6 +458,8 @@ def mesh_field(
     lipschitz: float = 1.0,
     max_cells: int = 50_000_000,
     root_steps: int = 8,
+    grid=None,
+    lines=None,
 ):
     """Triangles of the zero set of ``f`` inside ``[lo, hi]``, watertight and outward.
 
@@ -439,7 +478,14 @@ def mesh_field(
         Refuse (:class:`BudgetExceeded`) before making more cells or corners than this.
     root_steps : int
         Samples of the field per vertex at most before bisection takes over (most take
-        one, see :func:`_roots`); 0 is linear interpolation.
+        one, see :func:`.roots.roots`); 0 is linear interpolation.
+    grid : callable (origins (n, 3), step, shape) -> (n, *shape), optional
+        The same field on lattices of points (``Field.evaluate_grid``), for a field whose
+        lattices are cheaper than its points: then every corner of the blocks kept by the
+        coarse levels is sampled that way, none inferred.
+    lines : callable (origin, step, ijk (n, 3), axis (n,), t (n,)) -> (n,), optional
+        The same field at ``origin + (ijk + t e_axis) * step`` (``Field.evaluate_lines``):
+        the first sample of every vertex on its edge is taken that way.
 
     Returns
     -------
@@ -450,7 +496,7 @@ def mesh_field(
     if not (cell > 0 and np.isfinite(cell)):
         raise ValueError(f"cell must be > 0, got {cell:g}")
     empty = np.zeros((0, 3)), np.zeros((0, 3), np.int64)
-    lat = _Lattice(f, lo, hi, cell, lipschitz, max_cells)
+    lat = _Lattice(f, lo, hi, cell, lipschitz, max_cells, grid)
     nk = len(lat.blocks)
     if not nk:
         return empty
@@ -467,7 +513,7 @@ def mesh_field(
     ue = np.flatnonzero(used)
     if not len(ue):
         return empty
-    tri = _ranks(used, hashes)
+    tri = _number(used, hashes, nbr)
     del used, hashes
     verts = np.empty((len(ue), 3))
     for i in range(0, len(ue), CHUNK):
@@ -476,110 +522,22 @@ def mesh_field(
         start, axis = slot * B3 + rem // 3, rem % 3
         end = lat.step(start, axis, 1)  # an edge's end is always in a slot
         before, after = lat.step(start, axis, -1), lat.step(end, axis, 1)
-        ends = np.concatenate([start, end])
-        missing = np.unique(ends[np.isnan(lat.values[ends])])
-        if len(missing):  # an end whose sign was inferred: sample it now
-            lat.values[missing] = lat.sample(missing)
         fa, fb = lat.values[start], lat.values[end]
+        if grid is None:  # an end whose sign was inferred: sample it now
+            ends = np.concatenate([start, end])
+            missing = np.unique(ends[np.isnan(np.concatenate([fa, fb]))])
+            if len(missing):
+                lat.values[missing] = lat.sample(missing)
+                fa, fb = lat.values[start], lat.values[end]
         fm = np.where(before >= 0, lat.values[before], np.nan)
         fq = np.where(after >= 0, lat.values[after], np.nan)
         pa = lat.point(start)
         pb = pa + np.eye(3)[axis] * cell
-        guess = _guess(fm, fa, fb, fq) if root_steps else None
-        verts[i : i + CHUNK] = _roots(f, pa, pb, fa, fb, root_steps, cell, guess, lipschitz)
+        start_t = guess(fm, fa, fb, fq) if root_steps else None
+        first = None
+        if lines is not None:
+            loc = start & (B3 - 1)
+            ijk = lat.base[slot] + np.stack([loc >> 6, (loc >> 3) & 7, loc & 7], axis=-1)
+            first = functools.partial(lines, lat.origin, cell, ijk, axis)
+        verts[i : i + CHUNK] = roots(f, pa, pb, fa, fb, root_steps, cell, start_t, lipschitz, first)
     return verts, tri.reshape(-1, 3)
-
-
-def _guess(fm, fa, fb, fq) -> np.ndarray:
-    """First guesses of the roots on edges (0, 1) from the values at -1, 0, 1, 2 along
-    them (``fm``, ``fq`` NaN where unknown): Newton's method on the cubic (or quadratic)
-    through the known ones, from the linear guess; linear where neither is known."""
-    c1, c2, c3 = fb - fa, np.zeros_like(fa), np.zeros_like(fa)
-    has_m, has_q = ~np.isnan(fm), ~np.isnan(fq)
-    both, m, q = has_m & has_q, has_m & ~has_q, ~has_m & has_q
-    c1 = np.where(both, -fm / 3 - fa / 2 + fb - fq / 6, c1)
-    c2 = np.where(both, fm / 2 - fa + fb / 2, c2)
-    c3 = np.where(both, -fm / 6 + fa / 2 - fb / 2 + fq / 6, c3)
-    c1 = np.where(m, (fb - fm) / 2, np.where(q, (-3 * fa + 4 * fb - fq) / 2, c1))
-    c2 = np.where(m, (fb - 2 * fa + fm) / 2, np.where(q, (fa - 2 * fb + fq) / 2, c2))
-    den = fa - fb
-    lin = np.divide(fa, den, out=np.full(len(fa), 0.5), where=den != 0)
-    t = lin
-    with np.errstate(divide="ignore", invalid="ignore"):
-        for _ in range(4):
-            p = fa + t * (c1 + t * (c2 + t * c3))
-            dp = c1 + t * (2 * c2 + 3 * t * c3)
-            t = np.clip(t - p / dp, 0.0, 1.0)
-    return np.where(np.isfinite(t), t, lin)
-
-
-def _roots(
-    f: Fn, pa, pb, fa, fb, steps: int, cell: float, guess=None, lipschitz: float = 1.0
-) -> np.ndarray:
-    """Points where ``f`` changes sign on segments ``pa -> pb``.
-
-    ``fa`` and ``fb`` have opposite signs (one is < 0, the other >= 0). From ``guess``
-    (the linear one if none), each step samples the field and moves to the inverse
-    quadratic interpolant's root through the bracket's ends and the new sample (exact for
-    a quadratic along the edge, Brent 1973), or to the regula falsi point of the shrunk
-    bracket where that root falls outside it. A step is taken without sampling it where
-    the Lipschitz bound already keeps ``|f|`` there below ``ACCEPT`` cells, so most
-    vertices cost one sample and every one ends within that (an L-Lipschitz field). What
-    is left after ``steps`` (a kink of a sharp union on the edge) is bisected. Points are
-    kept ``END_GAP`` off the ends, so edges meeting at a corner on the surface give
-    distinct vertices (and no triangle collapses to a point in a file of float32
-    coordinates).
-    """
-    n = len(pa)
-    lo_t, hi_t = np.zeros(n), np.ones(n)
-    flo, fhi = fa.copy(), fb.copy()
-    den = flo - fhi
-    if guess is None:
-        guess = np.divide(flo, den, out=np.full(n, 0.5), where=den != 0)
-    t = np.clip(guess, END_GAP, 1 - END_GAP)
-    tol = 1e-4 * cell
-    idx = np.arange(n)
-    d = pb - pa
-    for k in range(steps):
-        at = slice(None) if k == 0 else idx  # every vertex takes the first step
-        c = t[at]
-        fc = _eval(f, pa[at] + c[:, None] * d[at])
-        a, b, f_a, f_b = lo_t[at], hi_t[at], flo[at], fhi[at]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            iqi = (
-                a * f_b * fc / ((f_a - f_b) * (f_a - fc))
-                + b * f_a * fc / ((f_b - f_a) * (f_b - fc))
-                + c * f_a * f_b / ((fc - f_a) * (fc - f_b))
-            )
-        low = (fc < 0) == (f_a < 0)  # the sample replaces the end of its own sign
-        a, f_a = np.where(low, c, a), np.where(low, fc, f_a)
-        b, f_b = np.where(low, b, c), np.where(low, f_b, fc)
-        lo_t[at], flo[at], hi_t[at], fhi[at] = a, f_a, b, f_b
-        den = f_a - f_b
-        rf = a + np.divide(f_a, den, out=np.full(len(a), 0.5), where=den != 0) * (b - a)
-        inside = np.isfinite(iqi) & (iqi > a) & (iqi < b)
-        conv = np.abs(fc) <= tol
-        step = np.clip(np.where(inside, iqi, rf), END_GAP, 1 - END_GAP)
-        # a step not sampled moves the point by |t' - c| of the edge: for an L-Lipschitz
-        # field its value is then at most |f(c)| + L cell |t' - c|. Where that bound is
-        # within ACCEPT of a cell, take the step (on a smooth field it lands far closer);
-        # where only |f(c)| is, keep c; the rest sample again
-        bound = np.abs(fc) + lipschitz * cell * np.abs(step - c)
-        take = ~conv & (bound <= ACCEPT * cell)
-        keep = ~conv & ~take & (np.abs(fc) <= ACCEPT * cell)
-        t[at] = np.where(conv | keep, c, step)
-        idx = idx[~(conv | take | keep)]
-        if not len(idx):
-            break
-    # what is left (a kink of a sharp union on the edge converges only linearly):
-    # bisection of the bracket, which halves it every step whatever the field's shape
-    for _ in range(16 if steps else 0):
-        if not len(idx):
-            break
-        t[idx] = np.clip((lo_t[idx] + hi_t[idx]) / 2.0, END_GAP, 1 - END_GAP)
-        fp = _eval(f, pa[idx] + t[idx, None] * d[idx])
-        low = (fp < 0) == (flo[idx] < 0)
-        lo_t[idx[low]], flo[idx[low]] = t[idx[low]], fp[low]
-        hi_t[idx[~low]], fhi[idx[~low]] = t[idx[~low]], fp[~low]
-        idx = idx[np.abs(fp) > tol]
-    return pa + t[:, None] * d
