@@ -139,7 +139,7 @@ def _catmull_clark_step(
     keep = np.where(k > 0, (k - 2.0) / np.maximum(k, 1), 1.0)  # unused vertices: carried
     vp = new[:n]
     vp *= scale[:, None]
-    vp += keep[:, None] * v
+    hard = None
     # sharp rules: a vertex on two sharp edges (boundary or crease) follows the cubic
     # B-spline curve rule 1/8, 6/8, 1/8; on more than two, or a boundary corner in a single
     # face (valence 2), it stays put
@@ -166,7 +166,10 @@ def _catmull_clark_step(
             on_crease = crease_v[hard]
             target[on_crease] = 0.125 * nb[hard[on_crease]] + 0.75 * target[on_crease]
             w = s_v[hard][:, None]
-            vp[hard] = (1.0 - w) * vp[hard] + w * target
+    v *= keep[:, None]  # the level's own copy of its vertices, spent after this
+    vp += v
+    if hard is not None and hard.size:
+        vp[hard] = (1.0 - w) * vp[hard] + w * target
     if last:
         return new, n_new, lv.quads(n, np.int64), None
     nxt = lv.refined(n)
