@@ -98,7 +98,7 @@ def _creases(mesh: Mesh, he: HalfEdges, crease_angle: float | None) -> np.ndarra
     return he.edge_vertices[angles > crease_angle]
 
 
-@node("mesh.catmull_clark", version=1)
+@node("mesh.catmull_clark", version=2)
 def catmull_clark(
     mesh: Mesh,
     levels: Annotated[int, Range(min=0)] = 1,
