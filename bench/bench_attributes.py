@@ -10,9 +10,10 @@
   Ours also at 1,000,000 scattered points;
 - ``mesh.catmull_clark`` of the 10,000-quad torus, 2 levels, with and without two point
   attributes (two scalars), and with a scalar, a 3-vector colour and a face attribute:
-  the attributes ride the same stencils as the coordinates, one column each, so the cost
-  is the extra columns only. The node is timed through a graph (``g.evaluate`` on a fresh
-  graph each call, no cache);
+  the attributes ride the same stencils as the coordinates (each level two sparse
+  products over all the point columns at once), so a column more costs a small part of a
+  level, plus its copy into the result. The node is timed through a graph (``g.evaluate``
+  on a fresh graph each call, no cache);
 - carrying attributes onto a surface made anew (``propagate.onto``: each new vertex's
   nearest input triangle and its barycentric weights, each new face's nearest input face),
   for the vertices of the torus decimated to 20 %, against trimesh's ``closest_point`` for

@@ -98,7 +98,7 @@ def _creases(mesh: Mesh, he: HalfEdges, crease_angle: float | None) -> np.ndarra
     return he.edge_vertices[angles > crease_angle]
 
 
-@node("mesh.catmull_clark", version=1)
+@node("mesh.catmull_clark", version=2)
 def catmull_clark(
     mesh: Mesh,
     levels: Annotated[int, Range(min=0)] = 1,
@@ -147,10 +147,12 @@ def catmull_clark(
         levels,
         creases=creases,
         sharpness=None if creases is None else sharpness,
+        halfedges=he,
     )
     v, point_data = carry.split_columns(v, mesh.point_data)
     faces = carry.copy(subdivision.catmull_clark_face_parents(mesh.face_offsets, levels))
-    return Mesh(v, fi, fo, point_data, carry.carried(mesh, face=faces)["face_data"])
+    face_data = carry.carried(mesh, face=faces)["face_data"]
+    return Mesh.trusted(v, fi, fo, point_data, face_data)  # all quads of valid indices
 
 
 @node("mesh.doo_sabin", version=1)

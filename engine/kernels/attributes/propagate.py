@@ -218,14 +218,32 @@ def columns(vertices: np.ndarray, data: Mapping[str, np.ndarray]) -> np.ndarray:
 def split_columns(
     stacked: np.ndarray, data: Mapping[str, np.ndarray]
 ) -> tuple[np.ndarray, dict[str, np.ndarray]]:
-    """Undo :func:`columns` on a kernel's output: (vertices (m, 3), attributes)."""
+    """Undo :func:`columns` on a kernel's output: (vertices (m, 3), attributes), each
+    copied once into a read-only array on an immutable buffer, which the Mesh keeps as it
+    is (no second copy)."""
+    stacked = np.ascontiguousarray(stacked, dtype=np.float64)
     out, at = {}, 3
     m = len(stacked)
     for name, a in data.items():
         k = int(np.prod(a.shape[1:], dtype=np.int64))
-        out[name] = stacked[:, at : at + k].reshape((m,) + a.shape[1:])
+        out[name] = _block(stacked, at, k).reshape((m,) + a.shape[1:])
         at += k
-    return stacked[:, :3], out  # views: the Mesh copies each once, into frozen buffers
+    return _block(stacked, 0, 3), out
+
+
+def _block(stacked: np.ndarray, at: int, k: int) -> np.ndarray:
+    """Columns ``at:at + k`` of a C-ordered float64 array as a frozen (m, k) array: each
+    row's k values are one item of a strided view, written straight into ``bytes`` (a
+    strided block's own copy goes value by value, several times slower)."""
+    m, d = stacked.shape
+    if k == d:
+        raw = stacked.tobytes()
+    else:
+        rows = np.ndarray(
+            (m,), np.dtype((np.void, 8 * k)), buffer=stacked, offset=8 * at, strides=(8 * d,)
+        )
+        raw = rows.tobytes()
+    return np.frombuffer(raw, dtype=np.float64).reshape(m, k)
 
 
 def by_position(source: np.ndarray, target: np.ndarray) -> np.ndarray:

@@ -3,6 +3,8 @@
 - ``halfedge``: vectorized half-edge build (twin, next, face, vertex fans), boundaries and
   non-manifold edges reported as :class:`MeshTopologyError`;
 - ``subdivision``: Catmull-Clark and Doo-Sabin with open boundaries;
+  ``catmull_clark_levels``: each Catmull-Clark level's connectivity in closed form and its
+  rules as sparse matrices;
 - ``meshops``: box, merge, transform, face normals, dihedral angles, triangulation;
 - ``polygon``: ear clipping of one polygon loop (O(k^2) at worst, vectorized rounds);
 - ``grid``: the quads of a structured grid (tessellation and ``surfaces.grid``), poles

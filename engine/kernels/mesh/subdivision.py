@@ -14,10 +14,9 @@ the connectivity of every later level follows in closed form from the previous o
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
+from .catmull_clark_levels import Level, index_type
 from .halfedge import HalfEdges, build_halfedges
 
 __all__ = [
@@ -46,6 +45,19 @@ def _check_levels(levels: int) -> int:
     return int(levels)
 
 
+def _halfedges_of(
+    face_indices: np.ndarray, face_offsets: np.ndarray, n: int, given: HalfEdges | None
+) -> HalfEdges:
+    if given is None:
+        return build_halfedges(face_indices, face_offsets, n)
+    if given.n_vertices != n or given.n_halfedges != np.size(face_indices):
+        raise ValueError(
+            f"the half-edges given are of {given.n_vertices} vertices and "
+            f"{given.n_halfedges} corners, the mesh has {n} and {np.size(face_indices)}"
+        )
+    return given
+
+
 def _scatter(index: np.ndarray, values: np.ndarray, size: int) -> np.ndarray:
     """Sum the rows of ``values`` (m, d) into ``size`` bins: one bincount per column."""
     columns = np.ascontiguousarray(values.T)  # bincount reads each column contiguously
@@ -58,45 +70,6 @@ def _scatter(index: np.ndarray, values: np.ndarray, size: int) -> np.ndarray:
 # --------------------------------------------------------------------------------------
 # Catmull-Clark
 # --------------------------------------------------------------------------------------
-
-
-@dataclass
-class _Level:
-    """Connectivity of one level, as much as the Catmull-Clark rules need.
-
-    Half-edge ``h`` is corner ``h`` of the flat face list; ``edge`` is its undirected edge,
-    ``prev`` the half-edge before it in its face; ``edge_vertices`` the two ends of each
-    edge (not sorted after the first level); ``edge_faces`` the two faces of each edge (a
-    boundary edge's one face twice).
-    """
-
-    face_indices: np.ndarray
-    face_offsets: np.ndarray
-    face: np.ndarray
-    edge: np.ndarray
-    prev: np.ndarray
-    edge_vertices: np.ndarray
-    quads: bool
-    edge_faces: np.ndarray | None = None
-
-    @classmethod
-    def from_halfedges(cls, he: HalfEdges) -> _Level:
-        sizes = he.face_sizes
-        one = (he.twin < 0) | (np.arange(he.twin.size) < he.twin)  # each edge once
-        e, h, t = he.edge[one], np.flatnonzero(one), he.twin[one]
-        edge_faces = np.empty((he.n_edges, 2), dtype=np.int64)
-        edge_faces[e, 0] = he.face[h]
-        edge_faces[e, 1] = he.face[np.where(t < 0, h, t)]
-        return cls(
-            face_indices=he.origin,
-            face_offsets=he.face_offsets,
-            face=he.face,
-            edge=he.edge,
-            prev=he.prev,
-            edge_vertices=he.edge_vertices,
-            quads=bool(sizes.size and (sizes == 4).all()),
-            edge_faces=edge_faces,
-        )
 
 
 def _edge_sharpness(
@@ -130,77 +103,43 @@ def _edge_sharpness(
 
 
 def _catmull_clark_step(
-    vt: np.ndarray, lv: _Level, sharp: np.ndarray | None, last: bool
-) -> tuple[np.ndarray, _Level, np.ndarray | None]:
-    """One level on column-major vertices ``vt`` (d, n); returns the new ones (d, n')
-    the same way. On the ``last`` level only the faces of the result are built.
+    x: np.ndarray, n: int, lv: Level, sharp: np.ndarray | None, last: bool
+) -> tuple[np.ndarray, int, Level | np.ndarray, np.ndarray | None]:
+    """One level on the ``n`` vertices ``x[:n]`` (d columns, C order), ``x`` having room
+    for the level's face points after them. Returns the same for the next level (the new
+    points, room for the next face points after them unless ``last``, and their count),
+    the next level's connectivity (on the ``last`` level only its quads, (F', 4) int64)
+    and the edges' sharpness there.
 
-    Column by column: every gather and ``bincount`` reads and writes one contiguous column,
-    the d columns (x, y, z and the point attributes) cost d times one, and no level
-    transposes anything. The sharp rules touch few vertices and work on row views.
+    Every rule is linear in the vertices, so a level is two sparse products
+    (:meth:`Level.stencil`): the face points from the vertices, then every new point from
+    the vertices and the face points. They read each vertex's d columns (x, y, z and the
+    point attributes) together, so a column more costs a small part of a level; the sharp
+    rules touch few vertices and are applied after, on their rows.
     """
-    d, n = vt.shape
-    fi, fo, face, edge, ev = lv.face_indices, lv.face_offsets, lv.face, lv.edge, lv.edge_vertices
-    n_edges = ev.shape[0]
-    n_faces = fo.size - 1
-    m = fi.size
-    new = np.empty((d, n + n_edges + n_faces))  # vertex points, edge points, face points
-    vp, ep, fp = new[:, :n], new[:, n : n + n_edges], new[:, n + n_edges :]
-
-    n_side = np.bincount(edge, minlength=n_edges)
-    boundary_edge = n_side == 1
-    on_boundary_edge = np.flatnonzero(boundary_edge)
-    k = np.bincount(fi, minlength=n).astype(np.float64)
-    kk = np.maximum(k, 1.0)
-    kk2, keep = kk**2, (kk - 2.0) / kk
-    e0, e1 = np.ascontiguousarray(ev[:, 0]), np.ascontiguousarray(ev[:, 1])
-    sizes = np.diff(fo)
-    corners = [np.ascontiguousarray(fi[j::4]) for j in range(4)] if lv.quads else []
-    ef0, ef1 = np.ascontiguousarray(lv.edge_faces[:, 0]), np.ascontiguousarray(lv.edge_faces[:, 1])
-    for c in range(d):
-        x, f = vt[c], fp[c]
-        # face points: centroids
-        if lv.quads:
-            g = [x[q] for q in corners]
-            np.add(g[0], g[1], out=f)
-            f += g[2]
-            f += g[3]
-            f *= 0.25
-        elif m:
-            np.divide(np.add.reduceat(x[fi], fo[:-1]), sizes, out=f)
-        # edge points: (v0 + v1 + f0 + f1) / 4 inside, the midpoint on a boundary
-        a, b = x[e0], x[e1]
-        ends = a + b
-        e = ep[c]
-        np.add(f[ef0], f[ef1], out=e)  # the two faces' points (a boundary's: replaced)
-        e += ends
-        e *= 0.25
-        if on_boundary_edge.size:
-            e[on_boundary_edge] = 0.5 * ends[on_boundary_edge]
-        # vertex points, smooth rule (Q + 2R + (n - 3) S) / n with n the valence:
-        # = (sum of face points + sum of edge neighbours) / n^2 + (n - 2) / n * S
-        if lv.quads:  # each quad gives each corner its face point and half of the two
-            # corners beside it: an inside edge lies in two quads, so every neighbour
-            # counts once (a boundary vertex's smooth value is replaced by its rule below)
-            ring = np.zeros(n)
-            for j in range(4):
-                t = g[(j + 1) % 4] + g[(j + 3) % 4]
-                t *= 0.5
-                t += f
-                ring += np.bincount(corners[j], t, n)
-        else:
-            ring = np.bincount(fi, np.repeat(f, sizes), n)  # fp[face]: faces in order
-            ring += np.bincount(e0, b, n)  # each edge adds its other end to both ends
-            ring += np.bincount(e1, a, n)
-        np.divide(ring, kk2, out=vp[c])
-        vp[c] += keep * x
-    v, epr, vpr = vt.T, ep.T, vp.T  # row views (n, d) for the few sharp elements
+    v = x[:n]
+    ev, eh = lv.edge_vertices, lv.edge_halfedges
+    n_edges, n_faces = ev.shape[0], lv.face_offsets.size - 1
+    boundary_edge = eh[:, 0] == eh[:, 1]
     creased = np.zeros(n_edges, dtype=bool) if sharp is None else sharp > 0
-    if creased.any():
-        w = np.minimum(sharp[creased], 1.0)[:, None]  # semi-sharp: blend (DeRose et al. 1998)
-        ce = ev[creased]
-        mid_c = 0.5 * (v[ce[:, 0]] + v[ce[:, 1]])
-        epr[creased] = (1.0 - w) * epr[creased] + w * mid_c
+    edge_weight = None
+    if boundary_edge.any() or creased.any():
+        # a boundary edge point is the midpoint; a crease's blends the smooth one and the
+        # midpoint by its sharpness (semi-sharp creases, DeRose et al. 1998)
+        edge_weight = boundary_edge.astype(np.float64)
+        if sharp is not None:
+            np.maximum(edge_weight, np.minimum(sharp, 1.0), out=edge_weight)
+    spare = 0 if last else lv.face_indices.size  # the next level has a face per corner
+    faces, points, scale = lv.stencil(n, edge_weight, spare)
+    x[n : n + n_faces] = faces @ v
+    new = points @ x  # vertex points, edge points, face points and spare rows (zero)
+    n_new = n + n_edges + n_faces
+    new[n + n_edges : n_new] = x[n : n + n_faces]
+    k = np.diff(lv.around_offsets)
+    keep = np.where(k > 0, (k - 2.0) / np.maximum(k, 1), 1.0)  # unused vertices: carried
+    vp = new[:n]
+    vp *= scale[:, None]
+    hard = None
     # sharp rules: a vertex on two sharp edges (boundary or crease) follows the cubic
     # B-spline curve rule 1/8, 6/8, 1/8; on more than two, or a boundary corner in a single
     # face (valence 2), it stays put
@@ -227,57 +166,17 @@ def _catmull_clark_step(
             on_crease = crease_v[hard]
             target[on_crease] = 0.125 * nb[hard[on_crease]] + 0.75 * target[on_crease]
             w = s_v[hard][:, None]
-            vpr[hard] = (1.0 - w) * vpr[hard] + w * target
-    unused = k == 0
-    if unused.any():
-        vpr[unused] = v[unused]  # vertices no face uses are carried along
-    new_v = new
-
-    # connectivity: one quad per half-edge h = (vertex, edge point, face point, edge point)
-    h = np.arange(m, dtype=np.int64)
-    pe = edge[lv.prev]
-    quad = np.stack([fi, n + edge, n + n_edges + face, n + pe], axis=1)
-    m4 = 4 * m
-    face_offsets = np.arange(0, m4 + 1, 4, dtype=np.int64)
+    v *= keep[:, None]  # the level's own copy of its vertices, spent after this
+    vp += v
+    if hard is not None and hard.size:
+        vp[hard] = (1.0 - w) * vp[hard] + w * target
     if last:
-        done = _Level(quad.reshape(-1), face_offsets, *(np.empty(0, np.int64),) * 4, True)
-        return new_v, done, None
-    # edges: old edge e splits into 2e (at ev[e, 0]) and 2e + 1 (at ev[e, 1]); the edge
-    # from the edge point of h to the face point is 2E + h
-    child = 2 * edge + (fi == ev[edge, 1])
-    child_prev = 2 * pe + (fi == ev[pe, 1])
-    new_edge = np.stack([child, 2 * n_edges + h, 2 * n_edges + lv.prev, child_prev], axis=1)
-    new_ev = np.empty((2 * n_edges + m, 2), dtype=np.int64)
-    new_ev[: 2 * n_edges, 0] = ev.ravel()
-    new_ev[: 2 * n_edges, 1] = np.repeat(n + np.arange(n_edges), 2)
-    new_ev[2 * n_edges :, 0] = n + edge
-    new_ev[2 * n_edges :, 1] = n + n_edges + face
-    prev4 = np.arange(m4, dtype=np.int64) - 1
-    prev4[::4] += 4
-    # each new edge's two quads (quad h is half-edge h's): a split edge lies in the quad of
-    # the half-edge leaving its end and in the quad after the one arriving there; the edge
-    # 2E + h in quad h and in the quad after it
-    new_ef = np.full((2 * n_edges + m, 2), -1, dtype=np.int64)
-    new_ef[child, 0] = h
-    new_ef[2 * n_edges + h, 0] = h
-    new_ef[child_prev, 1] = h
-    new_ef[2 * n_edges + lv.prev, 1] = h
-    for a, b in ((0, 1), (1, 0)):  # a boundary edge: its one quad twice
-        lone = new_ef[:, a] < 0
-        new_ef[lone, a] = new_ef[lone, b]
-    nxt = _Level(
-        face_indices=quad.reshape(-1),
-        face_offsets=face_offsets,
-        face=np.repeat(h, 4),
-        edge=new_edge.reshape(-1),
-        prev=prev4,
-        edge_vertices=new_ev,
-        quads=True,
-        edge_faces=new_ef,
-    )
+        return new, n_new, lv.quads(n, np.int64), None
+    nxt = lv.refined(n)
     if sharp is None or not (sharp > 1.0).any():
-        return new_v, nxt, None
-    return new_v, nxt, np.concatenate([np.repeat(np.maximum(sharp - 1.0, 0.0), 2), np.zeros(m)])
+        return new, n_new, nxt, None
+    later = np.concatenate([np.repeat(np.maximum(sharp - 1.0, 0.0), 2), np.zeros(spare)])
+    return new, n_new, nxt, later
 
 
 def catmull_clark(
@@ -287,6 +186,7 @@ def catmull_clark(
     levels: int = 1,
     creases: np.ndarray | None = None,
     sharpness: np.ndarray | float | None = None,
+    halfedges: HalfEdges | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Catmull-Clark subdivision of a polygon mesh (Catmull & Clark 1978).
 
@@ -324,6 +224,9 @@ def catmull_clark(
         ``s`` uses the sharp rules for ``floor(s)`` levels, blends sharp and smooth by the
         fractional part on the next, and is smooth afterwards; a vertex takes the mean
         sharpness of its sharp edges.
+    halfedges : HalfEdges, optional
+        The half-edges of these faces when the caller has them already (a ``Mesh``'s
+        ``halfedges``): not built a second time.
 
     vertices may carry extra columns beyond x, y, z (point attributes): every rule is
     linear in the vertices, so they follow exactly the same stencils (a linear attribute
@@ -334,8 +237,7 @@ def catmull_clark(
     -------
     vertices : (n', 3) float64
         The original vertices' new positions first (same indices), then one edge point per
-        edge, then one face point per face (with the extra columns, when given). Laid out
-        column by column (Fortran order), as the levels compute them.
+        edge, then one face point per face (with the extra columns, when given).
     face_indices : (4 * n_faces',) int64
     face_offsets : (n_faces' + 1,) int64
         All quads.
@@ -355,15 +257,22 @@ def catmull_clark(
     """
     v = _as_vertices(vertices)
     levels = _check_levels(levels)
-    he = build_halfedges(face_indices, face_offsets, v.shape[0])
+    he = _halfedges_of(face_indices, face_offsets, v.shape[0], halfedges)
     sharp = _edge_sharpness(he, creases, sharpness)
     if levels == 0:
         return v.copy(), np.array(he.origin), np.array(he.face_offsets)
-    lv = _Level.from_halfedges(he)
-    vt = np.ascontiguousarray(v.T)  # column-major through every level
+    v_last, _, _ = catmull_clark_counts(
+        he.n_vertices, he.n_edges, he.n_faces, he.n_halfedges, levels
+    )[-1]
+    lv = Level.from_halfedges(he, index_type(4**levels * he.n_halfedges + v_last))
+    # rows (the stencils read a vertex's columns together), room for the face points after
+    x = np.empty((v.shape[0] + he.n_faces, v.shape[1]))
+    x[: v.shape[0]] = v
+    n = v.shape[0]
     for level in range(levels):
-        vt, lv, sharp = _catmull_clark_step(vt, lv, sharp, last=level == levels - 1)
-    return vt.T, lv.face_indices, lv.face_offsets
+        x, n, lv, sharp = _catmull_clark_step(x, n, lv, sharp, last=level == levels - 1)
+    quads = lv.reshape(-1)
+    return x, quads, np.arange(0, quads.size + 1, 4, dtype=np.int64)
 
 
 def catmull_clark_face_parents(face_offsets: np.ndarray, levels: int) -> np.ndarray:
