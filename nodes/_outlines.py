@@ -7,6 +7,7 @@ as chord-length polylines.
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -58,11 +59,11 @@ def closes(c: Curve) -> bool:
     """Whether a curve closes: a clamped NURBS ends on its first and last control points
     (no evaluation needed); any other curve is asked."""
     if isinstance(c, NurbsCurve):
-        p, k = c.degree, np.asarray(c.knots)
+        p, k = c.degree, c.knots
         if k[0] == k[p] and k[-1] == k[-1 - p]:
-            cp = np.asarray(c.control_points)
-            scale = max(1.0, float(np.abs(cp[[0, -1]]).max()))
-            return bool(np.linalg.norm(cp[0] - cp[-1]) <= 1e-9 * scale)
+            first, last = c.control_points[0].tolist(), c.control_points[-1].tolist()
+            scale = max(1.0, *map(abs, first), *map(abs, last))
+            return math.dist(first, last) <= 1e-9 * scale
     return c.closed
 
 
@@ -120,14 +121,14 @@ def sample_rings(
         if poly:
             # a polyline is its own sampling: its control points in XY, closed as they are
             # (repeats left in: GEOS takes them and leaves none; a ring of fewer than 3
-            # distinct points is refused where the region is made, see _region)
+            # distinct points is refused where the region is made, see make_region)
             ring = kregions.planar(c.control_points)
             guard(len(ring))
             total += len(ring)
             rings.append(ring)
             sampled.append(None)
             continue
-        elif i in batched:
+        if i in batched:
             ring, t = batched[i]
             x, y = ring[:, 0], ring[:, 1]
             keep = np.r_[True, (x[1:] != x[:-1]) | (y[1:] != y[:-1])]
