@@ -351,6 +351,8 @@ def _flipped_steps(seg: np.ndarray, offsets: np.ndarray, flip: np.ndarray) -> np
     steps ``[a, b - 1)`` read backwards (the jumps between rings where they were)."""
     if not flip.any():
         return seg
+    if len(flip) == 1:
+        return seg[::-1]  # a view: the one ring's steps backwards
     if len(flip) <= _FEW:
         for i in np.flatnonzero(flip):  # one step per flipped ring
             a, b = offsets[i], offsets[i + 1] - 1
