@@ -95,6 +95,8 @@ def sample_rings(
         if isinstance(c, NurbsCurve) and c.degree >= 2:
             by_degree.setdefault(c.degree, []).append(i)
         z = np.asarray(c.control_points)[:, 2] if isinstance(c, NurbsCurve) else c.sample(65)[:, 2]
+        if not np.count_nonzero(z):  # on z = 0, the usual case: one pass, not two
+            continue
         lo, hi = float(z.min()), float(z.max())
         if hi - lo > 1e-9 * max(1.0, -lo, hi):
             tilted.append(i)
