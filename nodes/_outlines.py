@@ -31,6 +31,7 @@ __all__ = [
 ]
 
 _TOLERANCE = 1e-5  # default sampling tolerance of region booleans, relative to the extent
+_FEW = 64  # up to this many outlines, their knots are made a ring at a time
 _LARGEST = 1e150  # the largest extent whose areas (its square, times vertex counts) are finite
 
 
@@ -261,9 +262,10 @@ def chord_knots(seg: np.ndarray, offsets: np.ndarray) -> np.ndarray:
     the step from point j - 1 to j (as :func:`.regions.rings_of` gives them)."""
     m, r = offsets[-1], len(offsets) - 1
     knots = np.zeros(m + 2 * r)
-    if r == 1:  # the usual case, without the scatter: [0, 0, running length, last again]
-        np.cumsum(seg, out=knots[2 : m + 1])
-        knots[m + 1] = knots[m]
+    if r <= _FEW:  # a ring at a time, without the scatter: [0, 0, running length, last again]
+        for i, (a, b) in enumerate(zip(offsets[:-1].tolist(), offsets[1:].tolist(), strict=True)):
+            np.cumsum(seg[a : b - 1], out=knots[a + 2 * i + 2 : b + 2 * i + 1])
+            knots[b + 2 * i + 1] = knots[b + 2 * i]
         return knots
     # point j of ring i sits at j + 2 i + 1; the step into it (none into a ring's first
     # point, so each ring starts at 0 and its doubled ends repeat their neighbours)

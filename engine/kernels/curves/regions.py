@@ -264,7 +264,7 @@ def rings_of(
 
     Lines and points a boolean may leave (two squares that share an edge intersect in a
     segment) bound no area and are dropped. The points are read out in one call (straight
-    from the polygon when it is one without holes: no ring cloned), and every ring's
+    from the polygons when they have no holes: no ring cloned), and every ring's
     direction comes from one pass over their coordinate differences, which also give the
     repeated points and the steps' lengths: the sign of its area (the trapezoid sum
     relative to its first point, as GEOS's ``Area.ofRingSigned``). The rings the wrong
@@ -302,10 +302,11 @@ def rings_of(
         none = np.zeros((0, 3 if with_z else 2)), np.zeros(1, dtype=np.int64)
         return (*none, np.zeros(0, dtype=bool)) + ((np.zeros(0),) if steps else ())
     interiors = shapely.get_num_interior_rings(parts)
-    if len(parts) == 1 and interiors[0] == 0:  # one ring: the polygon's points are its own
-        xy = shapely.get_coordinates(parts[0])
-        offsets = np.array([0, len(xy)])
-        hole = np.zeros(1, dtype=bool)
+    if not interiors.any():  # no holes: each polygon's points are its ring's, none cloned
+        xy = shapely.get_coordinates(parts)
+        sizes = [len(xy)] if len(parts) == 1 else shapely.get_num_coordinates(parts)
+        offsets = np.concatenate([[0], np.cumsum(sizes)])
+        hole = np.zeros(len(parts), dtype=bool)
     else:
         rings = shapely.get_rings(parts)
         xy = shapely.get_coordinates(rings)
