@@ -4,9 +4,10 @@ Cases:
 
 * the union of two overlapping 10,000-vertex closed polylines (wiggly circles, their centres
   half a radius apart) through ``curves.union`` — sampling (a polyline is taken at its
-  vertices), the validity checks, GEOS's overlay, the orientation of the result and the
-  curves built from it — against shapely's ``union`` of the two ``Polygon``s of the same
-  vertices (GEOS alone, nothing checked or oriented);
+  vertices), each ring's simplicity check (the even-odd rule), GEOS's overlay, the
+  orientation of the result and the curves built from it — against shapely's ``union`` of
+  the two ``Polygon``s of the same vertices (GEOS alone, nothing checked or oriented), and
+  the overlay alone on polygons made once (the floor under both);
 * ``curves.boolean`` difference of the same pair;
 * the union of two exact circles, the arcs it cuts rebuilt exact, against shapely's union
   of the same samples (which gives a polygon);

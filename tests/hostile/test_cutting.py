@@ -104,3 +104,19 @@ def test_curves_out_of_the_xy_plane_are_projected_with_a_warning():
     with pytest.warns(fg.FormgraphWarning, match=r"curves: curve\(s\) 0 are not parallel"):
         (loop,) = g.evaluate("u")
     assert np.allclose(np.asarray(loop.control_points)[:, 2], 0)
+
+
+@pytest.mark.parametrize("node,port", [("curves.union", "curves"), ("curves.boolean", "b")])
+def test_a_polyline_of_one_point_is_refused_where_its_region_is_made(node, port):
+    # a closed polyline that stays on one point of the XY plane (its repeats are not
+    # dropped before GEOS, which calls such a ring simple): located, not an empty result
+    point = NurbsCurve(np.tile([2.0, 2.0, 0.0], (5, 1)), 1, [0, 0, 1, 2, 3, 4, 4])
+    there_and_back = NurbsCurve.polyline([[0, 0], [3, 1], [3, 1], [0, 0]])
+    square = NurbsCurve.polyline([[0, 0], [1, 0], [1, 1], [0, 1]], closed=True)
+    for bad in (point, there_and_back):
+        g = fg.Graph()
+        inputs = {"curves": [square, bad]} if port == "curves" else {"a": [square], "b": [bad]}
+        g.add("r", node, **inputs)
+        index = 1 if port == "curves" else 0
+        with pytest.raises(fg.NodeError, match=rf"input '{port}'.*curve {index} encloses no area"):
+            g.evaluate("r")
