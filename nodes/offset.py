@@ -14,7 +14,7 @@ from formgraph.kernels.offset import (
     WorkLimit,
     default_cell,
     grid_cells,
-    offset_polylines,
+    offset_loops,
 )
 
 _TOLERANCE = 1e-3  # the kernel's accuracy, as a fraction of the input's extent
@@ -89,6 +89,7 @@ def marching_squares(
             f"the offset distance {distance:g} is below 1e-9 of the input's size ({extent:g}): "
             "too small to resolve in double precision (the offset is the input itself)",
         )
+    grid = cell  # None: the GEOS path where it can promise the tolerance (see the notes)
     if cell is None:
         cell = default_cell(extent, distance)
     elif not cell > 0:
@@ -109,9 +110,9 @@ def marching_squares(
         polylines.append(p)
         closed.append(is_closed)
     try:
-        loops = offset_polylines(
-            polylines, closed, distance, cell, smooth, simplify, max_cells=ctx.budget
-        )
+        loops = offset_loops(
+            polylines, closed, distance, grid, smooth, simplify, max_cells=ctx.budget
+        ).loops
     except (OffsetTraceError, WorkLimit) as exc:
         raise InputError("curves", str(exc)) from None
     except ValueError as exc:
