@@ -320,7 +320,10 @@ def _check_shallow(
         np.divide(((p1 - p0) * ab).sum(1), den, out=np.zeros_like(den), where=den > 0), 0, 1
     )
     gap = np.hypot(*(p1 - p0 - s[:, None] * ab).T)
-    shallow = (gap > 1e-12 * scale) & (gap < limit)
+    # GEOS deletes a vertex only within the limit of the window's start (its sampled check
+    # measures the apex from the chord to each sample, the first being the start itself).
+    near = np.fmin(np.hypot(*(p1 - p0).T), np.hypot(*(p2 - p1).T)) < limit
+    shallow = (gap > 1e-12 * scale) & (gap < limit) & near
     if shallow.any():
         raise BufferDeclined(
             f"{int(shallow.sum())} vertices lie within 1 % of the distance ({limit:.3g}) of "
