@@ -78,17 +78,28 @@ def level_error(loops: list[np.ndarray], polylines, closed, d, step: float) -> f
 
 def reference(polylines, closed, d) -> list[np.ndarray]:
     """The offset as a set, built here from its definition with shapely at 64 chords a
-    quarter circle: the even-odd region (each ring made valid, the rings' symmetric
-    difference), with the band of half-width ``|d|`` around all the input's linework added
-    (``d > 0``) or taken away; the band alone for open input."""
+    quarter circle: the even-odd region (the faces of the noded rings whose points the rings
+    cross an odd number of times, to the right), with the band of half-width ``|d|`` around
+    all the input's linework added (``d > 0``) or taken away; the band alone for open input.
+    """
     lines = [np.r_[p, p[:1]] if c else p for p, c in zip(polylines, closed, strict=True)]
     lines = [np.r_[p, p] if len(p) == 1 else p for p in lines]
     band = shapely.MultiLineString(lines).buffer(abs(d), quad_segs=64)
     region = shapely.Polygon()
-    for p, c in zip(polylines, closed, strict=True):
-        if c and len(p) >= 3:
-            lobes = shapely.make_valid(shapely.Polygon(p), method="structure")
-            region = region.symmetric_difference(lobes)
+    rings = [p for p, c in zip(polylines, closed, strict=True) if c]
+    if rings:
+        # The faces of the noded linework inside by the crossing number of a point in each.
+        faces = shapely.get_parts(shapely.polygonize(shapely.get_parts(shapely.node(
+            shapely.MultiLineString([np.r_[p, p[:1]] for p in rings])))))  # fmt: skip
+        inner = shapely.get_coordinates(shapely.point_on_surface(faces))
+        a = np.concatenate(rings)
+        b = np.concatenate([np.roll(p, -1, axis=0) for p in rings])
+        x, y = inner[:, :1], inner[:, 1:]
+        spans = (a[:, 1] > y) != (b[:, 1] > y)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            cut = a[:, 0] + (y - a[:, 1]) * (b[:, 0] - a[:, 0]) / (b[:, 1] - a[:, 1])
+        odd = (spans & (cut > x)).sum(axis=1) % 2 == 1
+        region = shapely.union_all(faces[odd]) if odd.any() else region
     shape = region.union(band) if d > 0 else region.difference(band)
     rings = [shapely.get_coordinates(r)[:-1] for r in shapely.get_rings(shapely.get_parts(shape))]
     return [r for r in rings if len(r) >= 3]
