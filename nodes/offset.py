@@ -8,7 +8,7 @@ import numpy as np
 
 from formgraph.core.errors import InputError
 from formgraph.core.registry import Context, Range, node
-from formgraph.geometry import Curve, NurbsCurve
+from formgraph.geometry import Curve, NurbsCurve, frozen_array
 from formgraph.kernels.offset import (
     OffsetTraceError,
     WorkLimit,
@@ -121,7 +121,23 @@ def marching_squares(
         ) from None
     if not loops:
         ctx.warn(f"the offset at {distance} is empty (the inward offset removes everything)")
-    return [NurbsCurve.polyline(np.c_[lp, np.zeros(len(lp))], closed=True) for lp in loops]
+    return [_loop_curve(lp) for lp in loops]
+
+
+def _loop_curve(loop: np.ndarray) -> NurbsCurve:
+    """A loop (first vertex not repeated, no two in a row the same) as a closed degree-1
+    curve at z = 0, its parameter the running chord length: built valid, not re-checked."""
+    m = len(loop)
+    xyz = np.zeros((m + 1, 3))
+    xyz[:m, :2] = loop
+    xyz[m, :2] = loop[0]
+    seg = np.hypot(xyz[1:, 0] - xyz[:-1, 0], xyz[1:, 1] - xyz[:-1, 1])
+    if not (seg > 0).all():  # (never from either path; kept safe)
+        return NurbsCurve.polyline(xyz, closed=True)
+    knots = np.zeros(m + 3)
+    np.cumsum(seg, out=knots[2 : m + 2])
+    knots[m + 2] = knots[m + 1]
+    return NurbsCurve._of_valid(frozen_array(xyz), 1, frozen_array(knots))
 
 
 def _initial_samples(curve: Curve) -> tuple[np.ndarray | None, np.ndarray]:
