@@ -1,4 +1,5 @@
-"""Robust offsets: outlines at a distance from any curves, from a signed distance field."""
+"""Robust offsets: outlines at a distance from any curves, through GEOS's buffer or a signed
+distance field and marching squares (`formgraph.kernels.offset.offset_loops` picks)."""
 
 from __future__ import annotations
 
@@ -23,7 +24,7 @@ MAX_SMOOTH = 100  # smoothing passes: each costs a pass over every vertex; more 
 _SMALLEST = 1e-9  # the smallest |distance| and cell, relative to the input's extent
 
 
-@node("offset.marching_squares", version=1)
+@node("offset.marching_squares", version=2)
 def marching_squares(
     curves: list[Curve],
     distance: float,
@@ -42,11 +43,24 @@ def marching_squares(
     negative one shrinks it: the CNC tool path of a pocket, a wall thickness, a kerf.
 
     Each curve is sampled adaptively (a polyline exactly at its vertices) so the sampling
-    error stays a tenth of the result's; the exact signed distance to the samples is
-    evaluated only near the offset, on a quadtree of a grid, contoured by marching
-    squares, and every vertex is then moved exactly onto the offset, corners recovered
-    where two features' offsets meet. The error is below 0.1 % of the input's extent.
-    Parts of the result thinner than the grid's cell can be missed; pass a smaller cell.
+    error stays a tenth of the result's. Then one of two paths makes the offset; both give
+    the same set, within 0.1 % of the input's extent:
+
+    - GEOS's buffer (shapely), when no ``cell`` is given, ``smooth`` is 0 and the curves are
+      all closed or all open: the even-odd region is built as ``curves.boolean`` builds it
+      and buffered with round joins, their chords chosen so no arc strays more than 0.04 %
+      of the extent (never fewer than GEOS's 8 a quarter circle); straight parts are exact.
+      About 10 times faster than the other path on small inputs (a 1,000-vertex outline
+      in about a millisecond).
+    - A signed distance field and marching squares: the exact distance to the samples is
+      evaluated only near the offset, on a quadtree of a grid, contoured by marching
+      squares, and every vertex is moved exactly onto the offset, corners recovered where
+      two features' offsets meet. It runs for an explicit ``cell``, for ``smooth`` above
+      0, for open and closed curves mixed, and where the GEOS path declines: GEOS fails or
+      returns an invalid region; a tangle of thousands of self-crossings (GEOS's repair of
+      it costs more); a distance above 5 % of the extent where GEOS's dropping of shallow
+      vertices (1 % of the distance) could pass the tolerance. Parts of the result thinner
+      than the grid's cell can be missed there; pass a smaller cell.
 
     Outlines come back as closed degree-1 NurbsCurves: islands counter-clockwise, holes
     clockwise.
@@ -58,12 +72,14 @@ def marching_squares(
     distance : float
         Offset distance, nonzero: positive outward, negative inward.
     cell : float
-        Grid cell size. Default: chosen from the distance and the input's size (about
-        2 sqrt(|distance| * 0.001 * extent), at most |distance| / 2).
+        Grid cell size of the marching path (giving one chooses that path). Default: the
+        GEOS path where it can, else a cell chosen from the distance and the input's size
+        (about 2 sqrt(|distance| * 0.001 * extent), at most |distance| / 2).
     smooth : int
         Smoothing passes that even out the vertices along the offset (each vertex stays
         exactly on it; corners stay sharp); at most 100 (the vertices are even long
         before), and the passes over the vertices count against the element budget.
+        Above 0 the marching path runs.
     simplify : float
         Douglas-Peucker tolerance for the result (0: keep every vertex).
 
