@@ -96,8 +96,10 @@ def marching_squares(
 
     # A first, coarse sampling sizes the input; then each curve is sampled to a tolerance.
     rough = [_initial_samples(c) for c in curves]
-    pts = np.concatenate([r[1][:, :2] for r in rough])
-    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    pts = [r[1] for r in rough]
+    # (Per coordinate: numpy reduces an (n, 3) array along its long axis slowly.)
+    lo = np.array([min(float(p[:, k].min()) for p in pts) for k in range(2)])
+    hi = np.array([max(float(p[:, k].max()) for p in pts) for k in range(2)])
     extent = float((hi - lo).max())
     if extent > 0 and abs(distance) < _SMALLEST * extent:
         raise InputError(
@@ -127,7 +129,7 @@ def marching_squares(
         closed.append(is_closed)
     try:
         loops = offset_loops(
-            polylines, closed, distance, grid, smooth, simplify, max_cells=ctx.budget
+            polylines, closed, distance, grid, smooth, simplify, ctx.budget, _TOLERANCE * scale
         ).loops
     except (OffsetTraceError, WorkLimit) as exc:
         raise InputError("curves", str(exc)) from None

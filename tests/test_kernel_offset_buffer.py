@@ -358,10 +358,14 @@ def test_self_intersecting_loops_agree(points, d):
 
 
 @_SETTINGS
-@given(stars(), stars(), st.floats(0.1, 0.25), st.sampled_from([0.05, -0.03, -0.08]))
+@given(stars(), stars(), st.floats(0.3, 0.8), st.sampled_from([0.05, -0.03, -0.08]))
 def test_nested_stars_agree(outer, inner, shrink, d):
-    # A star with a star-shaped hole (well inside: the outer's smallest radius is 0.3).
-    agree([outer, inner * shrink], [True, True], d)
+    # A star with a star-shaped hole inside the circle the outer star's edges leave free
+    # (an edge between far-apart corners passes close to the centre: the rings would cross).
+    free = shapely.Polygon(outer).exterior.distance(shapely.Point(0.0, 0.0))
+    if free < 0.05:
+        return
+    agree([outer, inner * shrink * free], [True, True], d)
 
 
 @_SETTINGS

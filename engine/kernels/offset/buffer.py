@@ -144,13 +144,17 @@ def buffer_polylines(
     all_closed = bool(seg_closed.all())
     if not all_closed and seg_closed.any():
         raise ValueError("the GEOS offset takes polylines all closed or all open, not mixed")
-    lo = np.array([min(a[:, k].min(), b[:, k].min()) for k in range(2)])
-    hi = np.array([max(a[:, k].max(), b[:, k].max()) for k in range(2)])
-    extent = float((hi - lo).max())
-    scale = extent if extent > 0 else 2 * abs(distance)
-    tol = _TOLERANCE * scale if tolerance is None else float(tolerance)
-    if not (np.isfinite(tol) and tol > 0):
-        raise ValueError(f"tolerance must be a positive finite number, got {tolerance}")
+    if tolerance is None:
+        # (Per coordinate: numpy reduces an (n, 2) array along its long axis slowly.)
+        extent = max(
+            max(a[:, k].max(), b[:, k].max()) - min(a[:, k].min(), b[:, k].min()) for k in range(2)
+        )
+        tol = _TOLERANCE * (float(extent) if extent > 0 else 2 * abs(distance))
+    else:
+        tol = float(tolerance)
+        if not (np.isfinite(tol) and tol > 0):
+            raise ValueError(f"tolerance must be a positive finite number, got {tolerance}")
+    scale = tol / _TOLERANCE  # (the extent the tolerance is a share of)
     if not all_closed and distance < 0:
         return []  # an open polyline bounds nothing to shrink
     q = quad_segs(distance, tol)
@@ -172,7 +176,16 @@ def buffer_polylines(
     except shapely.errors.GEOSException as exc:
         raise BufferDeclined(f"GEOS failed: {exc}") from None
     coords, offsets, _ = rings_of(geom)
-    return [coords[offsets[i] : offsets[i + 1] - 1] for i in range(len(offsets) - 1)]
+    # An overlay can leave a ring of no area (a sliver hole of three collinear points);
+    # the field has none: dropped.
+    if len(offsets) < 2:
+        return []
+    x, y = coords[:, 0], coords[:, 1]
+    cross = x[:-1] * y[1:] - x[1:] * y[:-1]
+    twice = np.add.reduceat(cross, offsets[:-1])  # twice each ring's signed area, but
+    twice[:-1] -= cross[offsets[1:-1] - 1]  # without the step from one ring into the next
+    keep = np.abs(twice) > 1e-12 * scale * scale
+    return [coords[offsets[i] : offsets[i + 1] - 1] for i in range(len(offsets) - 1) if keep[i]]
 
 
 def _closed_offset(pts, simple, a, b, distance, q, tol, scale):
@@ -180,8 +193,8 @@ def _closed_offset(pts, simple, a, b, distance, q, tol, scale):
     rings = [p for p in pts if len(p) >= 3]
     region = even_odd_region(rings) if rings else shapely.Polygon()
     area = _areal(region)
-    given = float(np.hypot(*(b - a).T).sum())
-    if given <= (1 + 1e-9) * float(shapely.length(area)):
+    # Rings that neither cross nor touch bound their region with all their linework.
+    if simple or float(np.hypot(*(b - a).T).sum()) <= (1 + 1e-9) * float(shapely.length(area)):
         # The region's boundary is all the linework: its buffer is the level set.
         if abs(distance) > SIMPLIFY_SHARE * tol / GEOS_SIMPLIFY_FACTOR:
             coords, offsets, _ = rings_of(area)
@@ -339,13 +352,15 @@ def offset_loops(
     smooth: int = 0,
     simplify: float = 0.0,
     max_cells: int = DEFAULT_MAX_CELLS,
+    tolerance: float | None = None,
 ) -> Offset:
     """The offset of polylines by the path that suits them: GEOS's buffer when no ``cell``
     is given, ``smooth`` is 0 and the input is all closed or all open (and the GEOS path
     does not decline), else the distance field and marching squares.
 
     Parameters and errors as :func:`~formgraph.kernels.offset.marching.offset_polylines`;
-    ``max_cells`` also bounds the GEOS path's raw offset curve.
+    ``max_cells`` also bounds the GEOS path's raw offset curve, and ``tolerance`` is the
+    GEOS path's (default 0.1 % of the input's extent).
 
     Returns
     -------
@@ -357,7 +372,7 @@ def offset_loops(
     if cell is None and smooth == 0 and (all(closed) or not any(closed)):
         check_options(distance, smooth, simplify)
         try:
-            loops = buffer_polylines(polylines, closed, distance, max_vertices=max_cells)
+            loops = buffer_polylines(polylines, closed, distance, tolerance, max_cells)
         except BufferDeclined as exc:
             declined = str(exc)
         else:
