@@ -1,4 +1,5 @@
-"""Robust offsets: outlines at a distance from any curves, from a signed distance field."""
+"""Robust offsets: outlines at a distance from any curves, through GEOS's buffer or a signed
+distance field and marching squares (`formgraph.kernels.offset.offset_loops` picks)."""
 
 from __future__ import annotations
 
@@ -8,13 +9,13 @@ import numpy as np
 
 from formgraph.core.errors import InputError
 from formgraph.core.registry import Context, Range, node
-from formgraph.geometry import Curve, NurbsCurve
+from formgraph.geometry import Curve, NurbsCurve, frozen_array
 from formgraph.kernels.offset import (
     OffsetTraceError,
     WorkLimit,
     default_cell,
     grid_cells,
-    offset_polylines,
+    offset_loops,
 )
 
 _TOLERANCE = 1e-3  # the kernel's accuracy, as a fraction of the input's extent
@@ -23,7 +24,7 @@ MAX_SMOOTH = 100  # smoothing passes: each costs a pass over every vertex; more 
 _SMALLEST = 1e-9  # the smallest |distance| and cell, relative to the input's extent
 
 
-@node("offset.marching_squares", version=1)
+@node("offset.marching_squares", version=2)
 def marching_squares(
     curves: list[Curve],
     distance: float,
@@ -42,11 +43,24 @@ def marching_squares(
     negative one shrinks it: the CNC tool path of a pocket, a wall thickness, a kerf.
 
     Each curve is sampled adaptively (a polyline exactly at its vertices) so the sampling
-    error stays a tenth of the result's; the exact signed distance to the samples is
-    evaluated only near the offset, on a quadtree of a grid, contoured by marching
-    squares, and every vertex is then moved exactly onto the offset, corners recovered
-    where two features' offsets meet. The error is below 0.1 % of the input's extent.
-    Parts of the result thinner than the grid's cell can be missed; pass a smaller cell.
+    error stays a tenth of the result's. Then one of two paths makes the offset; both give
+    the same set, within 0.1 % of the input's extent:
+
+    - GEOS's buffer (shapely), when no ``cell`` is given, ``smooth`` is 0 and the curves are
+      all closed or all open: the even-odd region is built as ``curves.boolean`` builds it
+      and buffered with round joins, their chords chosen so no arc strays more than 0.04 %
+      of the extent (never fewer than GEOS's 8 a quarter circle); straight parts are exact.
+      About 10 times faster than the other path on small inputs (a 1,000-vertex outline
+      in about a millisecond).
+    - A signed distance field and marching squares: the exact distance to the samples is
+      evaluated only near the offset, on a quadtree of a grid, contoured by marching
+      squares, and every vertex is moved exactly onto the offset, corners recovered where
+      two features' offsets meet. It runs for an explicit ``cell``, for ``smooth`` above
+      0, for open and closed curves mixed, and where the GEOS path declines: GEOS fails or
+      returns an invalid region; a tangle of thousands of self-crossings (GEOS's repair of
+      it costs more); a distance above 5 % of the extent where GEOS's dropping of shallow
+      vertices (1 % of the distance) could pass the tolerance. Parts of the result thinner
+      than the grid's cell can be missed there; pass a smaller cell.
 
     Outlines come back as closed degree-1 NurbsCurves: islands counter-clockwise, holes
     clockwise.
@@ -58,12 +72,14 @@ def marching_squares(
     distance : float
         Offset distance, nonzero: positive outward, negative inward.
     cell : float
-        Grid cell size. Default: chosen from the distance and the input's size (about
-        2 sqrt(|distance| * 0.001 * extent), at most |distance| / 2).
+        Grid cell size of the marching path (giving one chooses that path). Default: the
+        GEOS path where it can, else a cell chosen from the distance and the input's size
+        (about 2 sqrt(|distance| * 0.001 * extent), at most |distance| / 2).
     smooth : int
         Smoothing passes that even out the vertices along the offset (each vertex stays
         exactly on it; corners stay sharp); at most 100 (the vertices are even long
         before), and the passes over the vertices count against the element budget.
+        Above 0 the marching path runs.
     simplify : float
         Douglas-Peucker tolerance for the result (0: keep every vertex).
 
@@ -80,8 +96,10 @@ def marching_squares(
 
     # A first, coarse sampling sizes the input; then each curve is sampled to a tolerance.
     rough = [_initial_samples(c) for c in curves]
-    pts = np.concatenate([r[1][:, :2] for r in rough])
-    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    pts = [r[1] for r in rough]
+    # (Per coordinate: numpy reduces an (n, 3) array along its long axis slowly.)
+    lo = np.array([min(float(p[:, k].min()) for p in pts) for k in range(2)])
+    hi = np.array([max(float(p[:, k].max()) for p in pts) for k in range(2)])
     extent = float((hi - lo).max())
     if extent > 0 and abs(distance) < _SMALLEST * extent:
         raise InputError(
@@ -89,6 +107,7 @@ def marching_squares(
             f"the offset distance {distance:g} is below 1e-9 of the input's size ({extent:g}): "
             "too small to resolve in double precision (the offset is the input itself)",
         )
+    grid = cell  # None: the GEOS path where it can promise the tolerance (see the notes)
     if cell is None:
         cell = default_cell(extent, distance)
     elif not cell > 0:
@@ -109,9 +128,9 @@ def marching_squares(
         polylines.append(p)
         closed.append(is_closed)
     try:
-        loops = offset_polylines(
-            polylines, closed, distance, cell, smooth, simplify, max_cells=ctx.budget
-        )
+        loops = offset_loops(
+            polylines, closed, distance, grid, smooth, simplify, ctx.budget, _TOLERANCE * scale
+        ).loops
     except (OffsetTraceError, WorkLimit) as exc:
         raise InputError("curves", str(exc)) from None
     except ValueError as exc:
@@ -120,7 +139,23 @@ def marching_squares(
         ) from None
     if not loops:
         ctx.warn(f"the offset at {distance} is empty (the inward offset removes everything)")
-    return [NurbsCurve.polyline(np.c_[lp, np.zeros(len(lp))], closed=True) for lp in loops]
+    return [_loop_curve(lp) for lp in loops]
+
+
+def _loop_curve(loop: np.ndarray) -> NurbsCurve:
+    """A loop (first vertex not repeated, no two in a row the same) as a closed degree-1
+    curve at z = 0, its parameter the running chord length: built valid, not re-checked."""
+    m = len(loop)
+    xyz = np.zeros((m + 1, 3))
+    xyz[:m, :2] = loop
+    xyz[m, :2] = loop[0]
+    seg = np.hypot(xyz[1:, 0] - xyz[:-1, 0], xyz[1:, 1] - xyz[:-1, 1])
+    if not (seg > 0).all():  # (never from either path; kept safe)
+        return NurbsCurve.polyline(xyz, closed=True)
+    knots = np.zeros(m + 3)
+    np.cumsum(seg, out=knots[2 : m + 2])
+    knots[m + 2] = knots[m + 1]
+    return NurbsCurve._of_valid(frozen_array(xyz), 1, frozen_array(knots))
 
 
 def _initial_samples(curve: Curve) -> tuple[np.ndarray | None, np.ndarray]:

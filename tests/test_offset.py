@@ -1,4 +1,9 @@
-"""The offset.marching_squares node, run through graphs (against shapely's buffers)."""
+"""The offset.marching_squares node, run through graphs (against shapely's buffers).
+
+Every test runs on the node's default path (GEOS's buffer where it can promise the
+tolerance) and again with that path declined, so the distance field and marching squares
+do the same offsets.
+"""
 
 from __future__ import annotations
 
@@ -7,8 +12,21 @@ import pytest
 import shapely
 
 import formgraph as fg
+from formgraph.kernels.offset import buffer as kbuffer
 
 SQUARE = [[0, 0], [4, 0], [4, 4], [0, 4]]
+
+
+@pytest.fixture(autouse=True, params=["default", "marching"])
+def path(request, monkeypatch):
+    """The node's default path, then the marching path alone (the GEOS path declined)."""
+    if request.param == "marching":
+
+        def declined(*args, **kwargs):
+            raise kbuffer.BufferDeclined("declined by the test")
+
+        monkeypatch.setattr(kbuffer, "buffer_polylines", declined)
+    return request.param
 
 
 def area(curve) -> float:

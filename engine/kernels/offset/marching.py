@@ -39,7 +39,16 @@ from .loops import simplify as simplify_loops
 from .refine import exact_loops
 from .refine import smooth as smooth_loops
 
-__all__ = ["OffsetTraceError", "WorkLimit", "default_cell", "grid_cells", "offset_polylines"]
+__all__ = [
+    "DEFAULT_MAX_CELLS",
+    "OffsetTraceError",
+    "WorkLimit",
+    "check_options",
+    "default_cell",
+    "grid_cells",
+    "offset_polylines",
+    "polyline_segments",
+]
 
 
 class OffsetTraceError(ValueError):
@@ -86,7 +95,7 @@ def default_cell(extent: float, distance: float, tolerance: float = 1e-3) -> flo
     return float(min(d / 2, 2 * np.sqrt(d * tolerance * scale)))
 
 
-def _segments(
+def polyline_segments(
     polylines: Sequence[np.ndarray], closed: Sequence[bool]
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Concatenated segments ``a -> b`` and whether each belongs to a closed polyline."""
@@ -112,6 +121,18 @@ def _segments(
         b.append(p[1:])
         c.append(np.full(p.shape[0] - 1, bool(is_closed)))
     return np.concatenate(a), np.concatenate(b), np.concatenate(c)
+
+
+def check_options(distance: float, smooth: int, simplify: float) -> float:
+    """``distance`` as a float, after checking it and the smoothing and simplification."""
+    distance = float(distance)
+    if not np.isfinite(distance) or distance == 0:
+        raise ValueError(f"distance must be a nonzero finite number, got {distance}")
+    if isinstance(smooth, bool) or int(smooth) != smooth or smooth < 0:
+        raise ValueError(f"smooth must be a whole number of passes >= 0, got {smooth}")
+    if not (np.isfinite(simplify) and simplify >= 0):
+        raise ValueError(f"simplify must be a tolerance >= 0, got {simplify}")
+    return distance
 
 
 def grid_cells(lo: np.ndarray, hi: np.ndarray, distance: float, cell: float) -> int:
@@ -252,14 +273,8 @@ def offset_polylines(
     >>> bool(np.isclose(np.abs(loop).max(), 1.25, atol=1e-3))
     True
     """
-    a, b, seg_closed = _segments(polylines, closed)
-    distance = float(distance)
-    if not np.isfinite(distance) or distance == 0:
-        raise ValueError(f"distance must be a nonzero finite number, got {distance}")
-    if isinstance(smooth, bool) or int(smooth) != smooth or smooth < 0:
-        raise ValueError(f"smooth must be a whole number of passes >= 0, got {smooth}")
-    if not (np.isfinite(simplify) and simplify >= 0):
-        raise ValueError(f"simplify must be a tolerance >= 0, got {simplify}")
+    a, b, seg_closed = polyline_segments(polylines, closed)
+    distance = check_options(distance, smooth, simplify)
     # (Per coordinate: numpy reduces an (n, 2) array along its long axis slowly.)
     lo = np.array([min(a[:, k].min(), b[:, k].min()) for k in range(2)])
     hi = np.array([max(a[:, k].max(), b[:, k].max()) for k in range(2)])
