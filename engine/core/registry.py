@@ -83,8 +83,52 @@ class NodeSpec:
         return self.outputs[output]
 
 
-_REGISTRY: dict[str, NodeSpec] = {}
-_SORTED: dict[str, NodeSpec] = {}  # _REGISTRY in name order, rebuilt after a registration
+class _Registry(dict):
+    """The registered node types: a dict that counts its changes, so :func:`node_types`
+    knows in one comparison whether its sorted copy is still current (a test may replace
+    an entry in place, e.g. with ``monkeypatch.setitem``)."""
+
+    changes = 0
+
+    def _changed(self) -> None:
+        self.changes += 1
+
+    def __setitem__(self, key: str, value: NodeSpec) -> None:
+        super().__setitem__(key, value)
+        self._changed()
+
+    def __delitem__(self, key: str) -> None:
+        super().__delitem__(key)
+        self._changed()
+
+    def pop(self, *args: Any) -> Any:
+        self._changed()
+        return super().pop(*args)
+
+    def popitem(self) -> tuple[str, NodeSpec]:
+        self._changed()
+        return super().popitem()
+
+    def setdefault(self, key: str, default: Any = None) -> Any:
+        self._changed()
+        return super().setdefault(key, default)
+
+    def update(self, *args: Any, **kwargs: Any) -> None:
+        super().update(*args, **kwargs)
+        self._changed()
+
+    def clear(self) -> None:
+        super().clear()
+        self._changed()
+
+    def __ior__(self, other: Any) -> _Registry:
+        self.update(other)
+        return self
+
+
+_REGISTRY: _Registry = _Registry()
+_SORTED: dict[str, NodeSpec] = {}  # _REGISTRY in name order, rebuilt after a change
+_SORTED_AT = [-1]  # the _REGISTRY.changes that _SORTED was built at
 
 
 def node(name: str, *, version: int = 1) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
@@ -99,7 +143,6 @@ def node(name: str, *, version: int = 1) -> Callable[[Callable[..., Any]], Calla
         if name in _REGISTRY and _REGISTRY[name].func.__qualname__ != func.__qualname__:
             raise ValueError(f"node type {name!r} is registered twice")
         _REGISTRY[name] = _spec_from_function(name, version, func)
-        _SORTED.clear()
         return func
 
     return register
@@ -109,11 +152,12 @@ def node_types() -> dict[str, NodeSpec]:
     """Every registered node type, by name (importing the node families first)."""
     import formgraph.nodes  # noqa: F401  (registers the families on import)
 
-    # Sorted once per change of the registry (every run asks; a sweep, once per variant);
-    # the entries are compared too, since a test may replace one in place.
-    if len(_SORTED) != len(_REGISTRY) or any(_SORTED.get(k) is not v for k, v in _REGISTRY.items()):
+    # Sorted once per change of the registry (every run asks; a sweep, once per variant and
+    # again in the worker): one comparison of the change count, not a walk of the entries.
+    if _SORTED_AT[0] != _REGISTRY.changes:
         _SORTED.clear()
         _SORTED.update(sorted(_REGISTRY.items()))
+        _SORTED_AT[0] = _REGISTRY.changes
     return dict(_SORTED)
 
 

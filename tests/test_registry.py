@@ -1,0 +1,44 @@
+"""The node registry: its sorted copy follows every change, however it is made."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import formgraph as fg
+from formgraph.core import registry
+
+
+def test_node_types_sorted_and_a_copy():
+    types = fg.node_types()
+    assert list(types) == sorted(types)
+    types.pop("points.circle")
+    assert "points.circle" in fg.node_types()  # the caller's dict is its own
+
+
+def test_in_place_replacement_and_removal_are_seen(monkeypatch):
+    spec = registry._REGISTRY["points.circle"]
+    monkeypatch.setitem(registry._REGISTRY, "points.circle", dataclasses.replace(spec, version=99))
+    assert fg.node_types()["points.circle"].version == 99
+    monkeypatch.delitem(registry._REGISTRY, "points.circle")
+    assert "points.circle" not in fg.node_types()
+    monkeypatch.undo()
+    assert fg.node_types()["points.circle"] is spec
+
+
+def test_registration_is_seen():
+    @registry.node("stub.registry_probe")
+    def probe(x: float = 1.0) -> float:
+        """A probe.
+
+        Parameters
+        ----------
+        x : float
+            Anything.
+        """
+        return x
+
+    try:
+        assert "stub.registry_probe" in fg.node_types()
+    finally:
+        del registry._REGISTRY["stub.registry_probe"]
+    assert "stub.registry_probe" not in fg.node_types()
