@@ -82,17 +82,13 @@ def close_pairs(v: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
         na, nb = counts[ca], counts[cb]
         same = (dx, dy, dz) == (0, 0, 0)
         total += int(np.sum(na * (nb - 1) // 2 if same else na * nb))
-    if total > MAX_PAIRS:
-        why = (
-            "use a smaller tolerance"
-            if side < 2 * tol
-            else f"the coordinates' float spacing ({side - tol:.3g}) is coarser than the "
-            "tolerance, so the cells cannot be smaller"
-        )
-        raise ValueError(
-            f"weld tolerance {tol:g} is too coarse for this mesh: {total:,} vertex pairs fall "
-            f"within a cell of each other (limit {MAX_PAIRS:,}); {why}"
-        )
+    why = (
+        "use a smaller tolerance"
+        if side < 2 * tol
+        else f"the coordinates' float spacing ({side - tol:.3g}) is coarser than the "
+        "tolerance, so the cells cannot be smaller"
+    )
+    _check_pairs(total, tol, why)
     ii, jj = [], []
     for dx, dy, dz, ca, cb in found:
         if ca.size == 0:
@@ -165,11 +161,7 @@ def _pairs_within(v, tol, order, found):
     total = 0
     for same, _, na, _, nb in found:
         total += int(np.sum(na * (nb - 1) // 2 if same else na * nb))
-    if total > MAX_PAIRS:
-        raise ValueError(
-            f"weld tolerance {tol:g} is too coarse for this mesh: {total:,} vertex pairs fall "
-            f"within a cell of each other (limit {MAX_PAIRS:,}); use a smaller tolerance"
-        )
+    _check_pairs(total, tol, "use a smaller tolerance")
     ii, jj = [], []
     for same, sa, na, sb, nb in found:
         if sa.size == 0:
@@ -229,3 +221,12 @@ def _close_pairs_coarse(v: np.ndarray, lo: np.ndarray, side: float, tol: float):
         c = c[hit]
         found.append((False, pos[hit], np.ones(c.size, np.int64), starts[c], counts[c]))
     return _pairs_within(v, tol, order, found)
+
+
+def _check_pairs(total: int, tol: float, why: str) -> None:
+    """Refuse a search that would compare more than ``MAX_PAIRS`` vertex pairs."""
+    if total > MAX_PAIRS:
+        raise ValueError(
+            f"weld tolerance {tol:g} is too coarse for this mesh: {total:,} vertex pairs fall "
+            f"within a cell of each other (limit {MAX_PAIRS:,}); {why}"
+        )
