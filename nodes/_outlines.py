@@ -2,7 +2,8 @@
 sampled into rings, the rings made regions (:mod:`formgraph.kernels.curves.regions`), and a
 region's boundary made curves again — input curves the operation left whole as themselves,
 the arcs it cut of exact curves as arcs (:mod:`formgraph.kernels.curves.arcs`), the rest
-as chord-length polylines.
+as chord-length polylines. Also the division of a curve at equal arc length that
+``curves.divide`` and ``curves.resample`` share (:func:`even_parameters`).
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ import numpy as np
 from formgraph.core.errors import InputError
 from formgraph.core.registry import Context
 from formgraph.geometry import Curve, NurbsCurve, frozen_array
+from formgraph.kernels import curves as kc
 from formgraph.kernels.curves import arcs as karcs
 from formgraph.kernels.curves import regions as kregions
 from formgraph.kernels.curves import sampling as ksampling
@@ -22,6 +24,8 @@ from formgraph.kernels.curves import sampling as ksampling
 __all__ = [
     "chord_knots",
     "closes",
+    "divisions",
+    "even_parameters",
     "kernel",
     "make_region",
     "outline_curves",
@@ -66,6 +70,44 @@ def closes(c: Curve) -> bool:
             scale = max(1.0, *map(abs, first), *map(abs, last))
             return math.dist(first, last) <= 1e-9 * scale
     return c.closed
+
+
+def divisions(
+    length: float, count: int | None, spacing: float | None, closed: bool, ctx: Context, verb: str
+) -> int:
+    """How many points divide a curve of ``length``: ``count``, or from ``spacing``; checked
+    and charged to the budget. ``verb`` ("divide", "resample") words the errors."""
+    if not length > 0.0:
+        raise InputError("curve", f"cannot {verb} a curve of zero length")
+    n = (
+        count
+        if count is not None
+        else kernel("spacing", kc.resample_count, length, spacing, closed)
+    )
+    if closed and n < 3:
+        raise InputError("count", f"{verb[:-1]}ing a closed curve needs count >= 3, got {n}")
+    ctx.guard(n, "points")
+    return int(n)
+
+
+def even_parameters(
+    curve: Curve, closed: bool, count: int | None, spacing: float | None, ctx: Context, verb: str
+) -> np.ndarray:
+    """Parameters at equal arc length along any curve (:func:`kc.even_arc_parameters`):
+    quadrature on every knot span of a NURBS (in 16 pieces unless it is straight), on the
+    ``samples`` intervals (at least 64) of any other curve."""
+    if isinstance(curve, NurbsCurve):
+        breaks = np.unique(curve.knots[curve.degree : len(curve.control_points) + 1])
+        pieces = 1 if curve.degree == 1 else 16
+    else:
+        breaks, pieces = np.array(curve.domain), max(64, getattr(curve, "samples", 256))
+    return kc.even_arc_parameters(
+        curve.derivative,
+        breaks,
+        lambda length: divisions(length, count, spacing, closed, ctx, verb),
+        closed,
+        pieces,
+    )
 
 
 def sample_rings(

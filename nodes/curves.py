@@ -14,6 +14,7 @@ from formgraph.geometry import Curve, NurbsCurve, ParametricCurve, Points
 from formgraph.kernels import curves as kc
 from formgraph.kernels.curves import measure as kmeasure
 from formgraph.kernels.curves.adaptive import refine_breaks
+from formgraph.nodes import _outlines as _o
 
 
 @node("curves.polyline", version=1)
@@ -247,36 +248,11 @@ def resample(
     if isinstance(curve, NurbsCurve) and curve.degree == 1:
         p, _ = _control_polygon(curve)
         length = _kernel("curve", kc.polyline_length, p, closed)
-        n = (
-            count
-            if count is not None
-            else _kernel("spacing", kc.resample_count, length, spacing, closed)
-        )
-        ctx.guard(n, "points")
+        n = _o.divisions(length, count, spacing, closed, ctx, "resample")
         out = _kernel("curve", kc.resample_polyline, p, count=n, closed=closed)
         return _polyline(out, closed=closed)
 
-    def speed(tt: np.ndarray) -> np.ndarray:
-        return np.linalg.norm(curve.derivative(tt), axis=-1)
-
-    if isinstance(curve, NurbsCurve):
-        breaks, pieces = np.unique(curve.knots[curve.degree : len(curve.control_points) + 1]), 16
-    else:
-        breaks, pieces = np.array(curve.domain), max(64, getattr(curve, "samples", 256))
-    edges, cum = kc.arc_length_table(speed, breaks, pieces)
-    length = float(cum[-1])
-    if not length > 0.0:
-        raise InputError("curve", "cannot resample a curve of zero length")
-    n = (
-        count
-        if count is not None
-        else _kernel("spacing", kc.resample_count, length, spacing, closed)
-    )
-    if closed and n < 3:
-        raise InputError("count", f"resampling a closed curve needs count >= 3, got {n}")
-    ctx.guard(n, "points")
-    s = np.arange(n) * (length / n) if closed else np.linspace(0.0, length, n)
-    t = kc.parameters_at_lengths(speed, edges, cum, s)
+    t = _o.even_parameters(curve, closed, count, spacing, ctx, "resample")
     return _polyline(curve.evaluate(t), closed=closed)
 
 

@@ -335,44 +335,13 @@ def divide(
     if isinstance(curve, NurbsCurve) and curve.degree == 1 and k0 == k1:  # clamped polyline
         cp = np.asarray(curve.control_points)
         length = float(np.sum(np.linalg.norm(np.diff(cp, axis=0), axis=1)))
-        n = _divisions(length, count, spacing, closed, ctx)
-        s = np.arange(n) * (length / n) if closed else np.linspace(0.0, length, n)
+        n = _o.divisions(length, count, spacing, closed, ctx, "divide")
+        s = kc.even_lengths(length, n, closed)
         t, xyz, tangent, _ = ksampling.polyline_at_lengths(cp, curve.knots, s)
         return Points(xyz, point_data={"tangent": tangent, "t": t})
-    if isinstance(curve, NurbsCurve):
-        k = np.asarray(curve.knots)
-        breaks = np.unique(k[curve.degree : len(curve.control_points) + 1])
-        pieces = 1 if curve.degree == 1 else 16
-    else:
-        breaks, pieces = np.array(curve.domain), max(64, getattr(curve, "samples", 256))
-
-    def speed(tt: np.ndarray) -> np.ndarray:
-        return np.linalg.norm(curve.derivative(tt), axis=-1)
-
-    edges, cum = kc.arc_length_table(speed, breaks, pieces)
-    length = float(cum[-1])
-    n = _divisions(length, count, spacing, closed, ctx)
-    s = np.arange(n) * (length / n) if closed else np.linspace(0.0, length, n)
-    t = kc.parameters_at_lengths(speed, edges, cum, s)
+    t = _o.even_parameters(curve, closed, count, spacing, ctx, "divide")
     xyz = np.asarray(curve.evaluate(t))
     d = np.asarray(curve.derivative(t))
     norm = np.linalg.norm(d, axis=1)
     tangent = np.divide(d, norm[:, None], out=np.zeros_like(d), where=norm[:, None] > 0)
     return Points(xyz, point_data={"tangent": tangent, "t": t})
-
-
-def _divisions(
-    length: float, count: int | None, spacing: float | None, closed: bool, ctx: Context
-) -> int:
-    """How many points divide a curve of ``length``: ``count``, or from ``spacing``."""
-    if not length > 0.0:
-        raise InputError("curve", "cannot divide a curve of zero length")
-    n = (
-        count
-        if count is not None
-        else _o.kernel("spacing", kc.resample_count, length, spacing, closed)
-    )
-    if closed and n < 3:
-        raise InputError("count", f"dividing a closed curve needs count >= 3, got {n}")
-    ctx.guard(n, "points")
-    return int(n)

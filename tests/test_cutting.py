@@ -427,6 +427,42 @@ def test_divide_needs_one_of_count_and_spacing():
         run("curves.divide", curve=circle(1.0), count=2)
 
 
+def _helix() -> fg.ParametricCurve:
+    g = fg.Graph()
+    g.add("p", "curves.parametric", x="=2*cos(t)", y="=sin(3*t)", z="=0.2*t", t=[0, 6])
+    return g.evaluate("p")
+
+
+@pytest.mark.parametrize(
+    "make",
+    [
+        lambda: circle(2.0, 1.0, -1.0),
+        lambda: NurbsCurve(
+            np.c_[np.random.default_rng(2).normal(size=(7, 2)), np.zeros(7)],
+            3,
+            nurbs.clamped_uniform_knots(7, 3),
+        ),
+        lambda: NurbsCurve.polyline([[0, 0], [6, 0], [6, 4], [1, 5]]),
+        lambda: NurbsCurve.polyline([[0, 0], [6, 0], [6, 4], [1, 5]], closed=True),
+        _helix,
+    ],
+    ids=["circle", "cubic", "polyline", "closed-polyline", "parametric"],
+)
+@pytest.mark.parametrize("how", [{"count": 13}, {"spacing": 0.7}])
+def test_divide_and_resample_place_the_same_points(make, how):
+    """Their contract is the same division: ``curves.divide`` gives the points,
+    ``curves.resample`` the polyline through them (closed: the first point again last)."""
+    curve = make()
+    points = run("curves.divide", curve=curve, **how).xyz
+    poly = np.asarray(run("curves.resample", curve=curve, **how).control_points)
+    if curve.closed:
+        np.testing.assert_allclose(poly[-1], poly[0], atol=0)
+        poly = poly[:-1]
+    assert poly.shape == points.shape
+    exact = not (isinstance(curve, NurbsCurve) and curve.degree == 1)  # one kernel
+    np.testing.assert_allclose(poly, points, rtol=0, atol=0 if exact else 1e-12)
+
+
 def test_batch_sampling_is_the_sampling_of_each_curve():
     glyphs = run("curves.text", text="Sg", size=7)
     rect = run("curves.rectangle", size=[5, 3], radius=1, center=[9, 0])

@@ -2,20 +2,26 @@
 
 - ``splines``: exact cubic NURBS from Bezier chains and Catmull-Rom points (curves and
   bicubic surfaces);
-- ``polylines``: B-spline subdivision of a control polygon, arc length and even
-  resampling, the bisector offset.
+- ``polylines``: B-spline subdivision of a control polygon, length and even
+  resampling, the bisector offset;
+- ``arclength``: the arc length of any curve from its derivative, its inverse, and even
+  division by it.
 
 The whole family is one import: ``from formgraph.kernels import curves``.
 """
 
 from __future__ import annotations
 
-from .polylines import (
+from .arclength import (
     arc_length_table,
+    even_arc_parameters,
+    even_lengths,
+    parameters_at_lengths,
+)
+from .polylines import (
     bisector_offset,
     drop_repeats,
     offset_folds,
-    parameters_at_lengths,
     polyline_length,
     resample_count,
     resample_polyline,
@@ -48,6 +54,8 @@ __all__ = [
     "resample_polyline",
     "arc_length_table",
     "parameters_at_lengths",
+    "even_lengths",
+    "even_arc_parameters",
     "bisector_offset",
     "drop_repeats",
 ]

@@ -1,4 +1,4 @@
-"""Polyline kernels: B-spline subdivision, arc length and resampling, bisector offset.
+"""Polyline kernels: B-spline subdivision, length and resampling, bisector offset.
 
 Pure array functions (numpy in, numpy out, inputs never modified), also the point-array
 helpers the spline kernels in :mod:`formgraph.kernels.curves.splines` share. Point arrays may be
@@ -9,9 +9,10 @@ first point (a repeat is dropped).
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 
 import numpy as np
+
+from .arclength import even_lengths
 
 __all__ = [
     "as_points",
@@ -24,8 +25,6 @@ __all__ = [
     "polyline_length",
     "resample_count",
     "resample_polyline",
-    "arc_length_table",
-    "parameters_at_lengths",
     "bisector_offset",
 ]
 
@@ -250,90 +249,13 @@ def resample_polyline(
     if count < need:
         kind = "closed" if closed else "open"
         raise ValueError(f"resampling an {kind} polyline needs count >= {need}, got {count}")
-    if closed:
-        s = np.arange(count) * (total / count)
-    else:
-        s = np.linspace(0.0, total, count)
+    s = even_lengths(total, count, closed)
     i = np.clip(np.searchsorted(cum, s, side="right") - 1, 0, len(seg) - 1)
     f = ((s - cum[i]) / seg[i])[:, None]
     out = p[i] + f * d[i]
     if not closed:
         out[-1] = p[-1]
     return out
-
-
-_GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(8)
-
-
-def arc_length_table(
-    speed: Callable[[np.ndarray], np.ndarray], breaks: np.ndarray, pieces: int = 16
-) -> tuple[np.ndarray, np.ndarray]:
-    """Cumulative arc length of a curve at a fine partition of its domain.
-
-    Each interval between consecutive ``breaks`` (knot spans, where the speed may have a
-    kink) is cut into ``pieces`` equal pieces, and each piece's length, the integral of the
-    speed |C'(t)|, is taken by 8-point Gauss-Legendre quadrature: exact for polynomial
-    speeds up to degree 15 and accurate to ~1e-12 relative for smooth curves.
-
-    Parameters
-    ----------
-    speed : callable, (m,) float -> (m,) float
-        |C'(t)|, vectorized.
-    breaks : (k,) float
-        Increasing parameters, the domain's ends first and last.
-    pieces : int
-        Pieces per interval, >= 1.
-
-    Returns
-    -------
-    edges : (k - 1) * pieces + 1 float
-        The partition.
-    cumulative : same shape
-        Arc length from ``edges[0]`` to each edge; ``cumulative[-1]`` is the length.
-    """
-    b = np.unique(np.asarray(breaks, dtype=np.float64))
-    f = np.linspace(0.0, 1.0, pieces + 1)[:-1]
-    edges = np.append((b[:-1, None] + np.diff(b)[:, None] * f).ravel(), b[-1])
-    lo, hi = edges[:-1], edges[1:]
-    half = 0.5 * (hi - lo)
-    tq = (lo + half)[:, None] + half[:, None] * _GAUSS_X
-    length = half * (speed(tq.ravel()).reshape(tq.shape) @ _GAUSS_W)
-    return edges, np.concatenate([[0.0], np.cumsum(length)])
-
-
-def parameters_at_lengths(
-    speed: Callable[[np.ndarray], np.ndarray],
-    edges: np.ndarray,
-    cumulative: np.ndarray,
-    lengths: np.ndarray,
-    iterations: int = 4,
-) -> np.ndarray:
-    """Parameters where the arc length from ``edges[0]`` equals each of ``lengths``.
-
-    Inverse of :func:`arc_length_table`: the piece holding each length is found by binary
-    search, the parameter is guessed linearly within it and refined by safeguarded Newton
-    steps on s(t) - s = 0, s'(t) = |C'(t)| (each step integrates from the piece start by
-    Gauss-Legendre; a step is kept inside its piece and skipped where the speed vanishes).
-
-    Returns
-    -------
-    (m,) float
-        Non-decreasing when ``lengths`` is.
-    """
-    s = np.asarray(lengths, dtype=np.float64)
-    k = np.clip(np.searchsorted(cumulative, s, side="right") - 1, 0, len(edges) - 2)
-    lo, hi = edges[k], edges[k + 1]
-    piece = cumulative[k + 1] - cumulative[k]
-    frac = np.divide(s - cumulative[k], piece, out=np.zeros_like(s), where=piece > 0.0)
-    t = lo + (hi - lo) * np.clip(frac, 0.0, 1.0)
-    for _ in range(iterations):
-        half = 0.5 * (t - lo)
-        tq = (lo + half)[:, None] + half[:, None] * _GAUSS_X
-        s_t = cumulative[k] + half * (speed(tq.ravel()).reshape(tq.shape) @ _GAUSS_W)
-        v = speed(t)
-        step = np.divide(s_t - s, v, out=np.zeros_like(s), where=v > 1e-300)
-        t = np.clip(t - step, lo, hi)
-    return t
 
 
 # --------------------------------------------------------------------------- offset
