@@ -323,14 +323,11 @@ class FanColumns:
     @classmethod
     def of(cls, v: np.ndarray, fi: np.ndarray, fo: np.ndarray) -> FanColumns | None:
         """The columns of a mesh whose faces have at most :data:`COLUMN_CORNERS` corners."""
-        sizes = np.diff(fo)
-        if sizes.size == 0 or fo[-1] != fi.size:
+        corners = by_faces("fan corners", fi, fo, len(v), lambda: _corner_table(fi, fo))
+        if corners is None:
             return None
-        k = int(sizes.max())
-        if k > COLUMN_CORNERS or int(sizes.min()) < 3:
-            return None
-        pos = np.minimum(fo[:-1] + np.arange(k)[:, None], fo[1:] - 1)  # (K, n_faces)
-        return cls(np.ascontiguousarray(v.T).take(fi[pos], axis=1), sizes)
+        ids, sizes = corners
+        return cls(np.ascontiguousarray(v.T).take(ids, axis=1), sizes)
 
     def _fan(self, p: np.ndarray) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
         """Cross products ``p[:, j] x p[:, j + 1]`` for j = 1 .. K-2 (componentwise as
@@ -360,11 +357,12 @@ class FanColumns:
             signed.append(np.where(along < 0, -1.0, 1.0) * np.sqrt(t0 * t0 + t1 * t1 + t2 * t2))
         return 0.5 * _sum(signed)
 
-    def volumes(self, origin: np.ndarray) -> np.ndarray:
+    def volumes(self, origin: np.ndarray, overwrite: bool = False) -> np.ndarray:
         """(n_faces,) signed volume of the cone from ``origin`` ((3,), or (n_faces, 3))
-        over each face's fan triangles (see :func:`signed_volume`)."""
-        o = origin[:, None] if origin.ndim == 1 else origin.T
-        p = self.xyz - o[:, None, :]
+        over each face's fan triangles (see :func:`signed_volume`); ``overwrite`` moves the
+        corners to the origin in place (no copy of the columns; they are not used again)."""
+        o = (origin[:, None] if origin.ndim == 1 else origin.T)[:, None, :]
+        p = np.subtract(self.xyz, o, out=self.xyz) if overwrite else self.xyz - o
         x0, y0, z0 = p[:, 0]
         dets = [((x0 * c0 + z0 * c2) + y0 * c1) / 6.0 for c0, c1, c2 in self._fan(p)]
         return _sum(dets)
@@ -379,6 +377,19 @@ class FanColumns:
             for c in range(3):
                 sums[c] += np.where(real, x[c, k], 0.0)
         return sums
+
+
+def _corner_table(fi: np.ndarray, fo: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """(K, n_faces) vertex ids (row k: corner k of every face, a short face repeating its
+    last corner) and the faces' sizes; None if a face has more than COLUMN_CORNERS."""
+    sizes = np.diff(fo)
+    if sizes.size == 0 or fo[-1] != fi.size:
+        return None
+    k = int(sizes.max())
+    if k > COLUMN_CORNERS or int(sizes.min()) < 3:
+        return None
+    pos = np.minimum(fo[:-1] + np.arange(k)[:, None], fo[1:] - 1)
+    return fi[pos], sizes
 
 
 def _sum(terms: list[np.ndarray]) -> np.ndarray:
@@ -486,13 +497,15 @@ def flat_open_parts(
     fo = np.asarray(face_offsets, dtype=np.int64)
     if fi.size == 0:
         return 0
-    used, part, count, order, starts, has_open = by_faces(
+    used, part, count, starts, has_open = by_faces(
         "sheets", fi, fo, len(v), lambda: _vertex_parts(fi, fo, len(v))
     )
     if not has_open.any():
         return 0
     n_parts = count.size
-    p = np.ascontiguousarray(v.T).take(used, axis=1)  # (3, used): one row per coordinate
+    # the used vertices run part by part, each part in vertex order (so every sum over a
+    # part adds what a sum in vertex order adds, in the same order)
+    p = np.ascontiguousarray(v.T).take(used, axis=1)
     mean = [np.bincount(part, p[k], n_parts) / count for k in range(3)]
     d = [p[k] - mean[k].take(part) for k in range(3)]
     cov = np.zeros((n_parts, 3, 3))
@@ -501,31 +514,25 @@ def flat_open_parts(
             cov[:, a, b] = cov[:, b, a] = np.bincount(part, d[a] * d[b], n_parts)
     normal = np.linalg.eigh(cov)[1][:, :, 0]  # eigenvalues ascending: the plane's normal
     n0, n1, n2 = (normal[:, k].take(part) for k in range(3))
-    dist = np.abs((d[0] * n0 + d[2] * n2) + d[1] * n1)
-    # the largest distance and the box of each part: one reduction over its run of the
-    # vertices sorted by part (the order comes with the connectivity)
-    far = np.maximum.reduceat(dist.take(order), starts)
-    sorted_p = p.take(order, axis=1)
-    extent = np.maximum.reduceat(sorted_p, starts, axis=1) - np.minimum.reduceat(
-        sorted_p, starts, axis=1
-    )
+    far = np.maximum.reduceat(np.abs((d[0] * n0 + d[2] * n2) + d[1] * n1), starts)
+    extent = np.maximum.reduceat(p, starts, axis=1) - np.minimum.reduceat(p, starts, axis=1)
     flat = far <= planar_tolerance * np.linalg.norm(extent.T, axis=1)
     return int(np.count_nonzero(flat & has_open))
 
 
 def _vertex_parts(fi: np.ndarray, fo: np.ndarray, n_vertices: int) -> tuple:
-    """The used vertices (their ids), the part each joins (by shared vertices, numbered by
-    their roots), the vertices per part, an order of the used vertices by part with where
-    each part's run starts, and which parts have a boundary edge."""
+    """The used vertices sorted by the part they join (by shared vertices; parts numbered
+    by their roots, vertices in order within a part), each one's part, the vertices per
+    part, where each part's run starts, and which parts have a boundary edge."""
     root, _ = union_find(n_vertices, fi, fi[next_corner(fo)])
     used = np.zeros(n_vertices, dtype=bool)
     used[fi] = True
     parts, part = np.unique(root[used], return_inverse=True)
-    count = np.bincount(part, minlength=parts.size)
     order = np.argsort(part, kind="stable")
+    count = np.bincount(part, minlength=parts.size)
     starts = np.concatenate([[0], np.cumsum(count)[:-1]])
     t = edge_table(fi, fo, n_vertices)
     open_vertex = t.vertices[t.counts == 1, 0]
     has_open = np.zeros(parts.size, dtype=bool)
     has_open[np.searchsorted(parts, root[open_vertex])] = True
-    return np.flatnonzero(used), part, count, order, starts, has_open
+    return np.flatnonzero(used)[order], part[order], count, starts, has_open

@@ -264,6 +264,9 @@ def orient(
     # decide each part's overall direction with the faces as they would be after the flips
     sign = np.where(flip, -1.0, 1.0)
     areas, corner_sums, cone = _face_measures(v, fi, fo, triangles)
+    # only an open part can be flat, and only a flat one needs areas (taken before the
+    # cones, which may reuse the corners' memory)
+    face_area = areas() if part_open.any() else None
     corners = np.bincount(part, weights=sizes, minlength=n_parts)
     part_centroid = (
         np.stack([np.bincount(part, weights=c, minlength=n_parts) for c in corner_sums], 1)
@@ -273,8 +276,7 @@ def orient(
         part, weights=sign * cone(np.take(part_centroid, part, axis=0)), minlength=n_parts
     )
     turn = vol < 0
-    if part_open.any():  # only an open part can be flat, and only a flat one needs areas
-        face_area = areas()
+    if face_area is not None:
         part_area = np.bincount(part, weights=face_area, minlength=n_parts)
         kept = np.bincount(part, weights=sign * face_area, minlength=n_parts)
         flat = np.abs(vol) <= 1e-9 * np.maximum(part_area, 1e-300) ** 1.5
@@ -333,7 +335,7 @@ def _orient_topology(fi: np.ndarray, fo: np.ndarray, n_vertices: int) -> tuple:
 def _face_measures(v: np.ndarray, fi: np.ndarray, fo: np.ndarray, triangles: bool):
     """Per face: a function giving the areas (of the exported fan), the sums of its
     corners' coordinates (3 arrays) and a function giving the signed volume of the cone
-    from one point per face.
+    from one point per face (called last, once: it may move the gathered corners).
 
     Triangles take one pass over contiguous coordinate columns: ``N = (b - a) x (c - a)``
     gives the area ``|N| / 2`` and the cone from ``o``, ``(a - o) . N / 6``. Faces of a few
@@ -342,7 +344,11 @@ def _face_measures(v: np.ndarray, fi: np.ndarray, fo: np.ndarray, triangles: boo
     if not triangles:
         columns = FanColumns.of(v, fi, fo)
         if columns is not None:
-            return columns.areas, columns.corner_sums(), columns.volumes
+            return (
+                columns.areas,
+                columns.corner_sums(),
+                lambda origin: columns.volumes(origin, overwrite=True),
+            )
         face = np.repeat(np.arange(fo.size - 1), np.diff(fo))
         sums = [np.bincount(face, weights=v[fi, k], minlength=fo.size - 1) for k in range(3)]
         return (
