@@ -271,7 +271,8 @@ def orient(mesh: Mesh, *, ctx: Context) -> Mesh:
             f"part of the mesh cannot be oriented (it is one-sided, like a Moebius strip): "
             f"faces still disagree across {conflicts} of its edges"
         )
-    return Mesh(mesh.vertices, fi, mesh.face_offsets, mesh.point_data, mesh.face_data)
+    # the same faces, some reversed: valid by construction (and shared when none turned)
+    return Mesh.trusted(mesh.vertices, fi, mesh.face_offsets, mesh.point_data, mesh.face_data)
 
 
 @node("mesh.flip", version=1)
@@ -312,7 +313,8 @@ def cap(mesh: Mesh, *, ctx: Context) -> Mesh:
         An oriented manifold mesh (mesh.weld and mesh.orient make one).
     """
     v, fi, fo = _topology("mesh", _clipping, ctx, kr.cap, *_arrays(mesh))
-    out = Mesh(v, fi, fo, **carry.carried(mesh, *_cap_rules(mesh, v, fi, fo)))
+    # the old faces and triangles of their own loops' vertices: valid by construction
+    out = Mesh.trusted(v, fi, fo, **carry.carried(mesh, *_cap_rules(mesh, v, fi, fo)))
     if out.n_faces > mesh.n_faces:
         flat = kr.flat_open_parts(*_arrays(mesh))
         if flat:

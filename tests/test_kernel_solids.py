@@ -548,7 +548,7 @@ def test_triangle_measures_of_orient_match_the_polygon_ones():
     origin = np.random.default_rng(1).normal(size=(fo.size - 1, 3)) + v.mean(axis=0)
     fast = kr._face_measures(v, fi, fo, True)
     slow = kr._face_measures(v, fi, fo, False)
-    np.testing.assert_allclose(fast[0], slow[0], rtol=1e-9)
+    np.testing.assert_allclose(fast[0](), slow[0](), rtol=1e-9)
     np.testing.assert_allclose(fast[1], slow[1], rtol=1e-12)
     np.testing.assert_allclose(fast[2](origin), slow[2](origin), rtol=1e-9, atol=1e-9)
 

@@ -235,4 +235,4 @@ def _indices(values: Any, what: str) -> np.ndarray:
         raise ValueError(f"{what} must be whole numbers")
     if a.size and a.dtype.kind not in "iuf":
         raise ValueError(f"{what} must be whole numbers, got {a.dtype}")
-    return a.astype(np.int64).ravel()
+    return a.astype(np.int64, copy=False).ravel()  # (frozen_array copies it once, if need be)

@@ -37,7 +37,7 @@ def grid_faces(
     i1 = (i0 + 1) % nu
     j1 = (j0 + 1) % nv
     quads = np.stack([i0 * nv + j0, i1 * nv + j0, i1 * nv + j1, i0 * nv + j1], axis=-1)
-    face_indices = quads.reshape(-1).astype(np.int64)
+    face_indices = quads.reshape(-1).astype(np.int64, copy=False)
     face_offsets = np.arange(0, face_indices.size + 1, 4, dtype=np.int64)
     return face_indices, face_offsets
 

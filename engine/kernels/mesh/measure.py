@@ -23,7 +23,9 @@ from .keys import sort_keys
 from .memo import by_faces
 
 __all__ = [
+    "COLUMN_CORNERS",
     "EdgeTable",
+    "FanColumns",
     "SolidReport",
     "edge_table",
     "face_areas",
@@ -184,6 +186,9 @@ def face_vectors(
     n_faces = fo.size - 1
     if fi.size == 3 * n_faces and fo[-1] == fi.size and (np.diff(fo) == 3).all():
         return _triangle_vectors(v, fi.reshape(-1, 3))
+    columns = FanColumns.of(v, fi, fo)
+    if columns is not None:
+        return columns.newell().T
     # about the first corner of each face, for conditioning far from the origin
     base = np.repeat(v[fi[fo[:-1]]], np.diff(fo), axis=0)
     p = v[fi] - base
@@ -227,6 +232,9 @@ def face_areas(
         n = _triangle_vectors(v, fi.reshape(-1, 3))  # a triangle is its own fan
         x, y, z = n[:, 0], n[:, 1], n[:, 2]
         return 0.5 * np.sqrt(x * x + y * y + z * z)
+    columns = FanColumns.of(v, fi, fo)
+    if columns is not None:
+        return columns.areas()
     base = np.repeat(v[fi[fo[:-1]]], sizes, axis=0)
     cross = np.cross(v[fi] - base, v[fi[next_corner(fo)]] - base)  # fan triangles, doubled
     newell = np.add.reduceat(cross, fo[:-1], axis=0)
@@ -253,10 +261,18 @@ def signed_volume(
     n_faces = fo.size - 1
     if n_faces == 0:
         return np.zeros(0)
+    columns = None
+    if not (fi.size == 3 * n_faces and fo[-1] == fi.size and (np.diff(fo) == 3).all()):
+        columns = FanColumns.of(v, fi, fo)
     if origin is None:
-        used = v[fi]
-        origin = 0.5 * (used.min(axis=0) + used.max(axis=0))
+        if columns is not None:  # the same corners, so the same box
+            origin = 0.5 * (columns.xyz.min(axis=(1, 2)) + columns.xyz.max(axis=(1, 2)))
+        else:
+            used = v[fi]
+            origin = 0.5 * (used.min(axis=0) + used.max(axis=0))
     origin = np.asarray(origin, dtype=np.float64)
+    if columns is not None:
+        return columns.volumes(origin)
     if fi.size == 3 * n_faces and fo[-1] == fi.size and (np.diff(fo) == 3).all():
         # Triangles: one cone each, on contiguous coordinate columns (no fan, no bincount).
         tri = fi.reshape(-1, 3)
@@ -272,6 +288,120 @@ def signed_volume(
     p0, p1, p2 = v[tris[:, 0]] - o, v[tris[:, 1]] - o, v[tris[:, 2]] - o
     det = np.einsum("ij,ij->i", p0, np.cross(p1, p2)) / 6.0
     return np.bincount(face, weights=det, minlength=n_faces)
+
+
+#: faces of up to this many corners take the column path (:class:`FanColumns`); beyond it
+#: numpy's sums over a face switch to pairwise blocks, which the columns would not follow
+COLUMN_CORNERS = 8
+
+
+class FanColumns:
+    """The corners of every face gathered once, one contiguous row per coordinate and
+    corner, for the measures of the fan triangles ``(a, b, c), (a, c, d), ...``.
+
+    A face with fewer corners than the widest (``K``) repeats its last corner; the extra
+    fan triangles it gets, ``(a, z, z)``, have an exactly zero cross product, so they add
+    exact zeros. Every sum over a face then runs in the order of the per-corner path
+    (``reduceat`` and ``bincount`` over the corners, whose first and last terms are the zero
+    crosses of the corner at ``a``), and the measures come out the same to the bit, for
+    quads and triangles together, without the ``(m, 3)`` cross products with their short
+    last axis, the repeats and the reductions of that path. Faces of more than
+    :data:`COLUMN_CORNERS` corners are left to it (:meth:`of` gives None).
+
+    Attributes
+    ----------
+    xyz : (3, K, n_faces) float64
+        ``xyz[c, k, f]``: coordinate ``c`` of corner ``k`` of face ``f``.
+    sizes : (n_faces,) int64
+        Corners of each face.
+    """
+
+    def __init__(self, xyz: np.ndarray, sizes: np.ndarray):
+        self.xyz = xyz
+        self.sizes = sizes
+
+    @classmethod
+    def of(cls, v: np.ndarray, fi: np.ndarray, fo: np.ndarray) -> FanColumns | None:
+        """The columns of a mesh whose faces have at most :data:`COLUMN_CORNERS` corners."""
+        corners = by_faces("fan corners", fi, fo, len(v), lambda: _corner_table(fi, fo))
+        if corners is None:
+            return None
+        ids, sizes = corners
+        return cls(np.ascontiguousarray(v.T).take(ids, axis=1), sizes)
+
+    def _fan(self, p: np.ndarray) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+        """Cross products ``p[:, j] x p[:, j + 1]`` for j = 1 .. K-2 (componentwise as
+        :func:`numpy.cross` computes them)."""
+        out = []
+        for j in range(1, p.shape[1] - 1):
+            (a0, a1, a2), (b0, b1, b2) = p[:, j], p[:, j + 1]
+            out.append((a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0))
+        return out
+
+    def _edges(self) -> np.ndarray:
+        x = self.xyz
+        return x - x[:, :1]  # (the first column, zeros, is never used)
+
+    def newell(self) -> np.ndarray:
+        """(3, n_faces) Newell vectors (twice the area times the unit normal)."""
+        return _total(self._fan(self._edges()))
+
+    def areas(self) -> np.ndarray:
+        """(n_faces,) area of each face's fan, each triangle signed by its agreement with
+        the Newell normal (see :func:`face_areas`)."""
+        crosses = self._fan(self._edges())
+        n0, n1, n2 = _total(crosses)
+        signed = []
+        for t0, t1, t2 in crosses:
+            along = (t0 * n0 + t2 * n2) + t1 * n1  # the order numpy's einsum sums in
+            signed.append(np.where(along < 0, -1.0, 1.0) * np.sqrt(t0 * t0 + t1 * t1 + t2 * t2))
+        return 0.5 * _sum(signed)
+
+    def volumes(self, origin: np.ndarray, overwrite: bool = False) -> np.ndarray:
+        """(n_faces,) signed volume of the cone from ``origin`` ((3,), or (n_faces, 3))
+        over each face's fan triangles (see :func:`signed_volume`); ``overwrite`` moves the
+        corners to the origin in place (no copy of the columns; they are not used again)."""
+        o = (origin[:, None] if origin.ndim == 1 else origin.T)[:, None, :]
+        p = np.subtract(self.xyz, o, out=self.xyz) if overwrite else self.xyz - o
+        x0, y0, z0 = p[:, 0]
+        dets = [((x0 * c0 + z0 * c2) + y0 * c1) / 6.0 for c0, c1, c2 in self._fan(p)]
+        return _sum(dets)
+
+    def corner_sums(self) -> list[np.ndarray]:
+        """The sums of each face's corners' coordinates (3 arrays of n_faces), added in
+        corner order; the repeated corners of short faces add exact zeros."""
+        x = self.xyz
+        sums = [x[c, 0] + x[c, 1] + x[c, 2] for c in range(3)]
+        for k in range(3, x.shape[1]):
+            real = k < self.sizes
+            for c in range(3):
+                sums[c] += np.where(real, x[c, k], 0.0)
+        return sums
+
+
+def _corner_table(fi: np.ndarray, fo: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """(K, n_faces) vertex ids (row k: corner k of every face, a short face repeating its
+    last corner) and the faces' sizes; None if a face has more than COLUMN_CORNERS."""
+    sizes = np.diff(fo)
+    if sizes.size == 0 or fo[-1] != fi.size:
+        return None
+    k = int(sizes.max())
+    if k > COLUMN_CORNERS or int(sizes.min()) < 3:
+        return None
+    pos = np.minimum(fo[:-1] + np.arange(k)[:, None], fo[1:] - 1)
+    return fi[pos], sizes
+
+
+def _sum(terms: list[np.ndarray]) -> np.ndarray:
+    """Terms added one after another (the order of a per-face ``reduceat``)."""
+    out = terms[0].copy()
+    for t in terms[1:]:
+        out += t
+    return out
+
+
+def _total(crosses: list[tuple[np.ndarray, np.ndarray, np.ndarray]]) -> np.ndarray:
+    return np.stack([_sum([t[c] for t in crosses]) for c in range(3)])
 
 
 @dataclass(frozen=True)
@@ -367,38 +497,42 @@ def flat_open_parts(
     fo = np.asarray(face_offsets, dtype=np.int64)
     if fi.size == 0:
         return 0
-    used, parts, part, has_open = by_faces(
+    used, part, count, starts, has_open = by_faces(
         "sheets", fi, fo, len(v), lambda: _vertex_parts(fi, fo, len(v))
     )
-    p = v[used]
-    count = np.bincount(part, minlength=parts.size)[:, None]
-    mean = np.stack([np.bincount(part, p[:, k], parts.size) for k in range(3)], 1) / count
-    d = p - mean[part]
-    cov = np.zeros((parts.size, 3, 3))
+    if not has_open.any():
+        return 0
+    n_parts = count.size
+    # the used vertices run part by part, each part in vertex order (so every sum over a
+    # part adds what a sum in vertex order adds, in the same order)
+    p = np.ascontiguousarray(v.T).take(used, axis=1)
+    mean = [np.bincount(part, p[k], n_parts) / count for k in range(3)]
+    d = [p[k] - mean[k].take(part) for k in range(3)]
+    cov = np.zeros((n_parts, 3, 3))
     for a in range(3):
         for b in range(a, 3):
-            cov[:, a, b] = cov[:, b, a] = np.bincount(part, d[:, a] * d[:, b], parts.size)
+            cov[:, a, b] = cov[:, b, a] = np.bincount(part, d[a] * d[b], n_parts)
     normal = np.linalg.eigh(cov)[1][:, :, 0]  # eigenvalues ascending: the plane's normal
-    dist = np.abs(np.einsum("ij,ij->i", d, normal[part]))
-    far = np.zeros(parts.size)
-    np.maximum.at(far, part, dist)
-    hi = np.full((parts.size, 3), -np.inf)
-    lo = np.full((parts.size, 3), np.inf)
-    np.maximum.at(hi, part, p)
-    np.minimum.at(lo, part, p)
-    flat = far <= planar_tolerance * np.linalg.norm(hi - lo, axis=1)
+    n0, n1, n2 = (normal[:, k].take(part) for k in range(3))
+    far = np.maximum.reduceat(np.abs((d[0] * n0 + d[2] * n2) + d[1] * n1), starts)
+    extent = np.maximum.reduceat(p, starts, axis=1) - np.minimum.reduceat(p, starts, axis=1)
+    flat = far <= planar_tolerance * np.linalg.norm(extent.T, axis=1)
     return int(np.count_nonzero(flat & has_open))
 
 
 def _vertex_parts(fi: np.ndarray, fo: np.ndarray, n_vertices: int) -> tuple:
-    """The used vertices, the parts they join into (by shared vertices; each part's root
-    and each used vertex's part) and which parts have a boundary edge."""
+    """The used vertices sorted by the part they join (by shared vertices; parts numbered
+    by their roots, vertices in order within a part), each one's part, the vertices per
+    part, where each part's run starts, and which parts have a boundary edge."""
     root, _ = union_find(n_vertices, fi, fi[next_corner(fo)])
     used = np.zeros(n_vertices, dtype=bool)
     used[fi] = True
     parts, part = np.unique(root[used], return_inverse=True)
+    order = np.argsort(part, kind="stable")
+    count = np.bincount(part, minlength=parts.size)
+    starts = np.concatenate([[0], np.cumsum(count)[:-1]])
     t = edge_table(fi, fo, n_vertices)
     open_vertex = t.vertices[t.counts == 1, 0]
     has_open = np.zeros(parts.size, dtype=bool)
     has_open[np.searchsorted(parts, root[open_vertex])] = True
-    return used, parts, part, has_open
+    return np.flatnonzero(used)[order], part[order], count, starts, has_open

@@ -20,6 +20,7 @@ from .halfedge import boundary_loops
 from .keys import mix64 as _mix
 from .keys import sort_keys
 from .measure import (
+    FanColumns,
     edge_table,
     face_areas,
     flat_open_parts,
@@ -243,7 +244,8 @@ def orient(
     Returns
     -------
     face_indices : (m,) int64
-        Faces reversed where needed (first corner kept).
+        Faces reversed where needed (first corner kept); a read-only ``face_indices`` that
+        needs no change is handed back as it is (shared, not copied).
     conflicts : int
         Links that no orientation satisfies (non-orientable parts, e.g. a Moebius strip);
         0 for an orientable mesh.
@@ -262,7 +264,9 @@ def orient(
     # decide each part's overall direction with the faces as they would be after the flips
     sign = np.where(flip, -1.0, 1.0)
     areas, corner_sums, cone = _face_measures(v, fi, fo, triangles)
-    part_area = np.bincount(part, weights=areas, minlength=n_parts)
+    # only an open part can be flat, and only a flat one needs areas (taken before the
+    # cones, which may reuse the corners' memory)
+    face_area = areas() if part_open.any() else None
     corners = np.bincount(part, weights=sizes, minlength=n_parts)
     part_centroid = (
         np.stack([np.bincount(part, weights=c, minlength=n_parts) for c in corner_sums], 1)
@@ -271,11 +275,17 @@ def orient(
     vol = np.bincount(
         part, weights=sign * cone(np.take(part_centroid, part, axis=0)), minlength=n_parts
     )
-    kept = np.bincount(part, weights=sign * areas, minlength=n_parts)
-    flat = np.abs(vol) <= 1e-9 * np.maximum(part_area, 1e-300) ** 1.5
-    turn = np.where(part_open & flat, kept < 0, vol < 0)
-    flip = flip ^ turn[part]
-    if triangles:  # (a, b, c) -> (a, c, b) where flipped
+    turn = vol < 0
+    if face_area is not None:
+        part_area = np.bincount(part, weights=face_area, minlength=n_parts)
+        kept = np.bincount(part, weights=sign * face_area, minlength=n_parts)
+        flat = np.abs(vol) <= 1e-9 * np.maximum(part_area, 1e-300) ** 1.5
+        turn = np.where(part_open & flat, kept < 0, turn)
+    if turn.any():
+        flip = flip ^ turn[part]
+    if not flip.any():  # every face agrees and faces out already
+        out = fi if not fi.flags.writeable else fi.copy()
+    elif triangles:  # (a, b, c) -> (a, c, b) where flipped
         out = fi.reshape(-1, 3).copy()
         turned = np.flatnonzero(flip)
         sub = out[turned]
@@ -323,15 +333,29 @@ def _orient_topology(fi: np.ndarray, fo: np.ndarray, n_vertices: int) -> tuple:
 
 
 def _face_measures(v: np.ndarray, fi: np.ndarray, fo: np.ndarray, triangles: bool):
-    """Per face: the area (of the exported fan), the sums of its corners' coordinates (3
-    arrays) and a function giving the signed volume of the cone from one point per face.
+    """Per face: a function giving the areas (of the exported fan), the sums of its
+    corners' coordinates (3 arrays) and a function giving the signed volume of the cone
+    from one point per face (called last, once: it may move the gathered corners).
 
     Triangles take one pass over contiguous coordinate columns: ``N = (b - a) x (c - a)``
-    gives the area ``|N| / 2`` and the cone from ``o``, ``(a - o) . N / 6``."""
+    gives the area ``|N| / 2`` and the cone from ``o``, ``(a - o) . N / 6``. Faces of a few
+    corners (quads with triangles, as a capped tube has) gather their corners once
+    (:class:`~formgraph.kernels.mesh.measure.FanColumns`) for all three."""
     if not triangles:
+        columns = FanColumns.of(v, fi, fo)
+        if columns is not None:
+            return (
+                columns.areas,
+                columns.corner_sums(),
+                lambda origin: columns.volumes(origin, overwrite=True),
+            )
         face = np.repeat(np.arange(fo.size - 1), np.diff(fo))
         sums = [np.bincount(face, weights=v[fi, k], minlength=fo.size - 1) for k in range(3)]
-        return face_areas(v, fi, fo), sums, lambda origin: signed_volume(v, fi, fo, origin)
+        return (
+            lambda: face_areas(v, fi, fo),
+            sums,
+            lambda origin: signed_volume(v, fi, fo, origin),
+        )
     tri = fi.reshape(-1, 3)
     cols = [np.ascontiguousarray(v[:, k]) for k in range(3)]
     a = [np.take(c, tri[:, 0]) for c in cols]
@@ -348,7 +372,7 @@ def _face_measures(v: np.ndarray, fi: np.ndarray, fo: np.ndarray, triangles: boo
     def cone(origin: np.ndarray) -> np.ndarray:
         return sum((a[k] - origin[:, k]) * n[k] for k in range(3)) / 6.0
 
-    return areas, sums, cone
+    return lambda: areas, sums, cone
 
 
 def _nested_inside(
