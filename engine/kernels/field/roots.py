@@ -43,26 +43,37 @@ def guess(fm, fa, fb, fq) -> np.ndarray:
     them (``fm``, ``fq`` NaN where unknown): Newton's method on the cubic (or quadratic)
     through the known ones, from the linear guess; linear where neither is known. Kept
     :data:`END_GAP` off the ends."""
-    has_m, has_q = ~np.isnan(fm), ~np.isnan(fq)
-    both = has_m & has_q
-    c1 = -fm / 3 - fa / 2 + fb - fq / 6  # the cubic through all four
-    c2 = fm / 2 - fa + fb / 2
-    c3 = -fm / 6 + fa / 2 - fb / 2 + fq / 6
-    if not both.all():
-        m, q = has_m & ~has_q, ~has_m & has_q
-        c1 = np.where(both, c1, fb - fa)
-        c2, c3 = np.where(both, c2, 0.0), np.where(both, c3, 0.0)
-        c1 = np.where(m, (fb - fm) / 2, np.where(q, (-3 * fa + 4 * fb - fq) / 2, c1))
-        c2 = np.where(m, (fb - 2 * fa + fm) / 2, np.where(q, (fa - 2 * fb + fq) / 2, c2))
+    c1 = fb - fa / 2 - fm / 3 - fq / 6  # the cubic through all four
+    c2 = (fm + fb) / 2 - fa
+    c3 = (fq - fm) / 6 + (fa - fb) / 2
+    lack = np.flatnonzero(np.isnan(c1))  # fm or fq unknown: the quadratic or the line
+    if len(lack):
+        m, a, b, q = fm[lack], fa[lack], fb[lack], fq[lack]
+        has_m, has_q = ~np.isnan(m), ~np.isnan(q)
+        c1[lack] = np.where(has_m, (b - m) / 2, np.where(has_q, (-3 * a + 4 * b - q) / 2, b - a))
+        c2[lack] = np.where(has_m, (b - 2 * a + m) / 2, np.where(has_q, (a - 2 * b + q) / 2, 0.0))
+        c3[lack] = 0.0
     den = fa - fb
     lin = np.divide(fa, den, out=np.full(len(fa), 0.5), where=den != 0)
-    t = lin
+    t = lin.copy()
+    c2x2, c3x3 = 2 * c2, 3 * c3
     with np.errstate(divide="ignore", invalid="ignore"):
         for _ in range(2):  # two Newton steps: a third changes 0.3 % of the vertices' cost
-            p = fa + t * (c1 + t * (c2 + t * c3))
-            dp = c1 + t * (2 * c2 + 3 * t * c3)
-            t = np.clip(t - p / dp, 0.0, 1.0)
-    t = np.where(np.isfinite(t), t, lin)
+            p = c3 * t
+            p += c2
+            p *= t
+            p += c1
+            p *= t
+            p += fa
+            dp = c3x3 * t
+            dp += c2x2
+            dp *= t
+            dp += c1
+            p /= dp
+            t -= p
+            np.clip(t, 0.0, 1.0, out=t)
+    bad = np.flatnonzero(~np.isfinite(t))
+    t[bad] = lin[bad]
     return np.clip(t, END_GAP, 1 - END_GAP, out=t)
 
 
