@@ -99,9 +99,8 @@ HALO_STEP = np.array([HALO * HALO, HALO, 1])  # one corner along each axis in th
 
 
 class _Vertices:
-    """The mesher's vertices, numbered in the order they are given (the used edges of a
-    group's own slots as soon as they are complete, then the touched slots' that are not
-    kept) and placed on their edges.
+    """The mesher's ``count`` vertices, placed on their edges in number order (the used
+    edges of the kept slots group by group, then the touched slots' that are not kept).
 
     The samples at -1, 0, 1 and 2 along an edge come from the group's corner values with
     a halo of its six face neighbours' (one gather each, no per-vertex search); the first
@@ -110,11 +109,11 @@ class _Vertices:
     together at the end (:func:`.roots.roots`).
     """
 
-    def __init__(self, lat: Lattice, f: Fn, steps: int, lipschitz: float, lines, dense: bool):
+    def __init__(self, lat: Lattice, f: Fn, count: int, steps: int, lipschitz, lines, dense):
         self.lat, self.f, self.steps, self.lipschitz = lat, f, steps, lipschitz
         self.lines, self.dense = lines, dense
-        self.count = self.placed = 0  # edges numbered, placed
-        self.parts: list[np.ndarray] = []
+        self.verts = np.empty((count, 3))
+        self.placed = 0
         self.brackets = Brackets()
         self.pending: list[tuple[np.ndarray, ...]] = []
         self.waiting = 0  # edges pending
@@ -215,7 +214,6 @@ class _Vertices:
         at a time (a group's are too few to be worth the calls)."""
         self.pending.append(edges)
         self.waiting += len(edges[0])
-        self.count += len(edges[0])
         if self.waiting >= CHUNK:
             self._flush()
 
@@ -237,13 +235,13 @@ class _Vertices:
             den = fa - fb
             t = np.divide(fa, den, out=np.full(n, 0.5), where=den != 0)
             t = np.clip(t, END_GAP, 1 - END_GAP, out=t)
-        self.parts.append(self._points(ijk, axis, t))
+        self.verts[self.placed : self.placed + n] = self._points(ijk, axis, t)
         self.placed += n
 
     def finish(self) -> np.ndarray:
         """Every vertex, in number order."""
         self._flush()
-        verts = np.concatenate(self.parts) if self.parts else np.zeros((0, 3))
+        verts = self.verts
         arrays = self.brackets.arrays()
         if len(arrays[0]):
             ijk, axis = arrays[6:]
@@ -311,11 +309,10 @@ def mesh_field(
     nbr = lat.nbr.astype(idx).reshape(-1)
     # the used edges and their numbers: a slot's edges are used only by its own block's
     # cells and its lower neighbours' (earlier in the order), so once a group is through,
-    # its own slots are complete and numbered (no second pass, no sort)
+    # its own slots are complete and numbered (no ranking pass, no sort)
     used = np.zeros(ns * edges, dtype=bool)
     number = np.empty(ns * edges, dtype=idx)  # written where used
-    vertices = _Vertices(lat, f, root_steps, lipschitz, lines, grid is not None)
-    hashes = []
+    hashes, owns, count = [], [], 0
     for s in range(0, nk, GROUP):
         e = min(s + GROUP, nk)
         cells, case = lat.mixed_cells(s, e)
@@ -323,18 +320,24 @@ def mesh_field(
         used[edge] = True
         hashes.append(edge)
         own = np.flatnonzero(used[s * edges : e * edges])
-        if len(own):
-            number[s * edges + own] = np.arange(vertices.count, vertices.count + len(own))
-            vertices.own(s, e, own)
+        number[s * edges + own] = np.arange(count, count + len(own))
+        owns.append(own)
+        count += len(own)
     rest = np.flatnonzero(used[nk * edges :]) + nk * edges
-    if len(rest):
-        number[rest] = np.arange(vertices.count, vertices.count + len(rest))
-        vertices.others(rest)
-    if not vertices.count:
+    number[rest] = np.arange(count, count + len(rest))
+    count += len(rest)
+    if not count:
         return empty
     tri = np.empty(sum(h.size for h in hashes), dtype=idx)
     at = 0
     for h in hashes:
         np.take(number, h.reshape(-1), out=tri[at : at + h.size])
         at += h.size
+    del used, number, hashes
+    vertices = _Vertices(lat, f, count, root_steps, lipschitz, lines, grid is not None)
+    for s, own in zip(range(0, nk, GROUP), owns, strict=True):
+        if len(own):
+            vertices.own(s, min(s + GROUP, nk), own)
+    if len(rest):
+        vertices.others(rest)
     return vertices.finish(), tri.reshape(-1, 3)
