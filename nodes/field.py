@@ -432,7 +432,7 @@ def mesh_of(
     return Mesh(v, t.reshape(-1), np.arange(0, 3 * len(t) + 1, 3))
 
 
-@node("field.mesh", version=1)
+@node("field.mesh", version=2)
 def mesh(
     field: Field,
     cell: Annotated[float | None, Range(min=0)] = None,
@@ -466,7 +466,7 @@ def mesh(
     return mesh_of(field, cell, bounds, ctx)
 
 
-@node("mesh.offset", version=2)
+@node("mesh.offset", version=3)
 def mesh_offset(
     mesh: Mesh,
     distance: float,

@@ -40,7 +40,7 @@ def test_roots_land_on_the_sphere_within_the_accepted_error():
     f = lambda p: np.linalg.norm(p, axis=1) - 1.0  # noqa: E731
     fa, fb = f(pa), f(pb)
     ok = (fa < 0) != (fb < 0)
-    v = roots.roots(f, pa[ok], pb[ok], fa[ok], fb[ok], 8, cell)
+    v = roots.roots_on_segments(f, pa[ok], pb[ok], fa[ok], fb[ok], 8, cell)
     assert np.abs(f(v)).max() <= roots.ACCEPT * cell
     t = np.einsum("ij,ij->i", v - pa[ok], (pb - pa)[ok]) / cell**2
     assert (t >= roots.END_GAP - 1e-12).all() and (t <= 1 - roots.END_GAP + 1e-12).all()

@@ -8,11 +8,13 @@
   centres and of clusters, pruned by disc and cylinder bounds), its sign by the
   angle-weighted pseudonormal on a closed mesh or the generalized winding number (a
   Barnes-Hut tree of dipoles, Barill et al. 2018), and the distance to polylines;
-- ``mesher``: adaptive meshing of the zero set: octree culling by the Lipschitz reach
-  down to blocks of 8^3 cells, then dense per-block levels, corners owned by one block and
-  signs inferred where the Lipschitz bound decides them, marching cubes, vertices by
-  root-finding on the field (``roots``: a cubic guess from the samples along the edge,
-  then inverse quadratic and regula falsi steps);
+- ``lattice``: the mesher's blocks: octree culling by the Lipschitz reach down to blocks
+  of 8^3 cells, then dense per-block levels, corners owned by one block and signs
+  inferred where the Lipschitz bound decides them (or every corner sampled on lattices);
+- ``mesher``: marching cubes on the lattice's cells, vertices numbered by their edges'
+  perfect hash group by group, placed by root-finding on the field (``roots``: a cubic
+  guess from the samples along the edge, one sample, then inverse quadratic and regula
+  falsi steps for the few it does not decide);
 - ``mctable``: the marching-cubes table, built from one rule on each face (inside corners
   separated), so shared faces agree and the surface is watertight.
 

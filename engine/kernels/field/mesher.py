@@ -1,391 +1,58 @@
 """Adaptive meshing of the zero set of a distance field: octree culling, marching cubes.
 
-The finest grid has cells of size ``cell``; only the cells the surface can reach are ever
-made. Starting from a coarse grid, each level keeps the cells whose centre value is
-within the field's Lipschitz reach of zero (``|f(c)| <= L * half-diagonal``: a cell
-farther than that from the surface cannot hold any of it, nor any sign change among the
-grid corners in it) and splits them into eight. Down to blocks of 8^3 finest cells this
-is a list of cells; inside the kept blocks it goes on as dense per-block arrays (levels
-of 4 and 2 cells), so the work is in the surface's area: halving the cell makes about
-four times the cells, not eight.
-
-Every grid corner is owned by one block (a block owns its 8^3 lower corners; the corners
-on its upper faces belong to its neighbours), so a corner is sampled once and its sign
-decided once, in one place, whichever cells use it. A corner's sign is inferred without
-sampling where a sampled point of the level of 2 cells is farther from zero than the
-field can change between them (``|f(q)| > L |p - q|``); the rest are sampled, in chunks
-that stay in the processor's cache.
-
-A field whose values on a lattice cost a fraction of its points (``grid``: a TPMS, a box,
-a sphere and their blends, on tables along the axes) is sampled instead at every corner
-of the kept blocks, block lattice by block lattice, none inferred: on a lattice the
-samples are cheaper than the bookkeeping that would avoid them; its vertices take their
-first sample on their edges' lines (``lines``), where only the coordinate along the edge
-is new.
+The culling, the blocks of cells it keeps and the signs at their corners are
+:mod:`.lattice`'s: the work is in the surface's area, halving the cell makes about four
+times the cells, not eight.
 
 The cells with a sign change are polygonized by marching cubes with a table built from
 one rule on each face (:mod:`.mctable`: inside corners are separated), so neighbouring
 cubes draw the same segments on a shared face and the surface, a function of the signs
 at shared corners only, is watertight by construction; triangles point to the positive
-(outside) side. A vertex is identified by its edge (owner block, corner, axis): a perfect
-hash, numbered by marking and ranking the marks, no sort. Each vertex is put on its edge by
-regula falsi (Illinois variant) on the field itself, not only by linear interpolation.
+(outside) side. A vertex is identified by its edge (owner block, axis, corner): a perfect
+hash, marked where used; a slot's edges are used only by its own block and its lower
+neighbours, which come first, so each group of blocks numbers its own slots' marks as
+soon as it is through, in order, no sort. Each vertex is put on its edge by root-finding
+on the field itself (:mod:`.roots`: a cubic first guess from the samples along the edge's
+grid line, then one sample, which decides nine vertices in ten on a smooth field), not
+only by linear interpolation; a field sampled on lattices takes those samples on its
+edges' lines (``lines``), where only the coordinate along the edge is new.
 
-Lorensen & Cline 1987; Nielson & Hamann 1991 (the ambiguous face); Dowson & Harrington's
-Illinois method (1971).
+Lorensen & Cline 1987; Nielson & Hamann 1991 (the ambiguous face).
 """
 
 from __future__ import annotations
 
-import functools
-import itertools
-from collections.abc import Callable
-
 import numpy as np
 
+from .lattice import (
+    B3,
+    CHUNK,
+    CORNERS,
+    GROUP,
+    LOCAL,
+    B,
+    BudgetExceeded,
+    Fn,
+    Lattice,
+    checked,
+    plan_grid,
+)
 from .mctable import EDGE_AXIS, EDGE_START, TRI_COUNT, TRI_EDGES
-from .roots import guess, roots
+from .roots import END_GAP, Brackets, guess, roots
 
-__all__ = ["BudgetExceeded", "crossing_cells", "mesh_field", "plan_grid"]
-
-
-Fn = Callable[[np.ndarray], np.ndarray]
-SQRT3_2 = np.sqrt(3.0) / 2.0
-CHUNK = 1 << 16  # points per call of the field: its temporaries stay in the cache
-
-
-class BudgetExceeded(Exception):
-    """More cells or points would be made than the caller allows (``count`` of ``what``)."""
-
-    def __init__(self, count: int, what: str):
-        super().__init__(f"{count} {what}")
-        self.count = count
-        self.what = what
-
-
-CORNERS = np.array(list(itertools.product((0, 1), repeat=3)), dtype=np.int64)  # (8, 3) xyz
-
-# ---------------------------------------------------------------------------- the grid
-
-GRID_SHIFT = np.array([0.1234567, 0.2345678, 0.3456789]) * 0.5
-BLOCK_LEVEL = 3
-B = 1 << BLOCK_LEVEL  # a block is B^3 finest cells and owns B^3 corners
-B3 = B**3
-GROUP = 128  # kept blocks worked on at a time (65,536 cells)
-C2 = 4 * CORNERS + 2  # the centres of a block's cells of 4, in corners
-LOCAL = np.stack(np.unravel_index(np.arange(B3), (B, B, B)), axis=-1).astype(np.float64)
-
-
-def plan_grid(lo: np.ndarray, hi: np.ndarray, cell: float, coarse: int = 16):
-    """The finest grid over ``[lo, hi]`` (padded by a cell) and its octree depth.
-
-    Returns ``origin (3,)``, ``levels`` (at least the block level, 3) and ``blocks (3,)``:
-    the coarse grid has ``blocks`` cells a side, each ``2^levels`` finest cells, and the
-    finest grid covers the padded box.
-    """
-    lo = np.asarray(lo, dtype=np.float64) - cell
-    hi = np.asarray(hi, dtype=np.float64) + cell
-    n = np.maximum(np.ceil((hi - lo) / cell).astype(np.int64), 1)
-    levels = max(BLOCK_LEVEL, int(np.ceil(np.log2(max(n.max() / coarse, 1.0)))))
-    blocks = -(-n // (1 << levels))
-    size = blocks * (1 << levels)
-    # centre the grid on the box, shifted by a generic fraction of a cell: the planes of
-    # boxes and cuts at round coordinates then never pass exactly through grid corners
-    origin = (lo + hi) / 2.0 - size * cell / 2.0 + cell * GRID_SHIFT
-    return origin, levels, blocks
-
-
-def _check(values: np.ndarray) -> np.ndarray:
-    v = np.asarray(values, dtype=np.float64).reshape(-1)
-    if not np.isfinite(v).all():
-        raise ValueError("the field is not finite at some points (NaN or infinity)")
-    return v
-
-
-def _eval(f: Fn, p: np.ndarray) -> np.ndarray:
-    """``f`` at points ``(n, 3)``, checked, in chunks of :data:`CHUNK` points."""
-    if len(p) <= CHUNK:
-        return _check(f(p))
-    return np.concatenate([_check(f(p[i : i + CHUNK])) for i in range(0, len(p), CHUNK)])
-
-
-def _eval_ijk(f: Fn, origin, cell: float, ijk: np.ndarray, size: float = 1.0) -> np.ndarray:
-    """``f`` at grid points ``origin + ijk * cell * size``, the coordinates made per chunk."""
-    out = np.empty(len(ijk))
-    step = cell * size
-    for i in range(0, len(ijk), CHUNK):
-        out[i : i + CHUNK] = _check(f(origin + ijk[i : i + CHUNK] * step))
-    return out
-
-
-def _reach(lipschitz: float, size: float) -> float:
-    """How far from zero a value at the centre of a cell of ``size`` may be while the
-    surface still reaches a point of the closed cell."""
-    return lipschitz * SQRT3_2 * size * (1.0 + 1e-9) + 1e-12 * size
-
-
-def _kept_blocks(f: Fn, origin, levels: int, blocks, cell: float, lipschitz: float, max_cells):
-    """Integer (i, j, k) of the blocks (level 3) the surface may reach, and the values
-    at their centres."""
-    g = np.stack(np.meshgrid(*(np.arange(b) for b in blocks), indexing="ij"), axis=-1)
-    g = g.reshape(-1, 3)
-    if len(g) > max_cells:
-        raise BudgetExceeded(len(g), "coarse cells")
-    for level in range(levels, BLOCK_LEVEL - 1, -1):
-        size = float(1 << level)
-        val = _eval_ijk(f, origin, cell, g + 0.5, size)
-        keep = np.abs(val) <= _reach(lipschitz, size * cell)
-        g, val = g[keep], val[keep]
-        if level == BLOCK_LEVEL or not len(g):
-            break
-        if 8 * len(g) > max_cells:
-            raise BudgetExceeded(8 * len(g), "cells")
-        g = (2 * g[:, None, :] + CORNERS[None, :, :]).reshape(-1, 3)
-    return g, val
-
-
-# ------------------------------------------------------- blocks, their slots, their signs
-
-
-def _key(c: np.ndarray, dims: np.ndarray) -> np.ndarray:
-    return (c[..., 0] * dims[1] + c[..., 1]) * dims[2] + c[..., 2]
-
-
-def _region(w: int):
-    """For the neighbour ``w`` (a CORNERS code) of a block: where its owned corners sit in
-    the block's (9, 9, 9) corner grid, and where they sit in the neighbour's own slot."""
-    up = CORNERS[w]
-    here = tuple(B if u else slice(0, B) for u in up)
-    there = tuple(0 if u else slice(0, B) for u in up)
-    return (slice(None), *here), there
-
-
-REGIONS = [_region(w) for w in range(8)]
-
-
-class _Lattice:
-    """The kept blocks, the slots of the corners they use, and every needed corner's sign.
-
-    ``nbr (nk, 8)``: the slots of each kept block and its seven upper neighbours (its own
-    slot first); ``inside (ns, 8, 8, 8)``: the decided signs; ``values``: the sampled values
-    (NaN where a sign was inferred or not needed); ``kept1 (nk, 4, 4, 4)``: the kept cells
-    of 2. Blocks are worked on :data:`GROUP` at a time, so the arrays stay in the cache.
-    """
-
-    def __init__(self, f: Fn, lo, hi, cell: float, lipschitz: float, max_cells: int, grid=None):
-        self.f, self.cell = f, cell
-        self.origin, levels, blocks = plan_grid(lo, hi, cell)
-        g, vc = _kept_blocks(f, self.origin, levels, blocks, cell, lipschitz, max_cells)
-        self.blocks = g
-        nk = len(g)
-        if not nk:
-            return
-        if nk * B3 > max_cells:
-            raise BudgetExceeded(nk * B3, "cells")
-        # slots: every kept block and its upper neighbours own their lower 8^3 corners
-        dims = (blocks << (levels - BLOCK_LEVEL)) + 1
-        order = np.argsort(_key(g, dims))  # neighbouring blocks, neighbouring slots
-        g, vc = g[order], vc[order]
-        self.blocks = g
-        keys = _key(g[:, None, :] + CORNERS[None, :, :], dims)
-        touched = np.unique(keys)
-        ns = len(touched)
-        if ns * B3 > 4 * max_cells:
-            raise BudgetExceeded(ns * B3, "corner slots")
-        # the kept blocks take slots 0..nk-1 in their order (a group's own slots are a
-        # slice), the other touched blocks the rest
-        at = np.searchsorted(touched, keys)
-        remap = np.empty(ns, dtype=np.int64)
-        remap[at[:, 0]] = np.arange(nk)
-        rest = np.ones(ns, dtype=bool)
-        rest[at[:, 0]] = False
-        remap[rest] = np.arange(nk, ns)
-        d1, d2 = int(dims[1]), int(dims[2])
-        self.base = np.empty((ns, 3), dtype=np.int64)
-        self.base[remap] = (
-            np.stack([touched // (d1 * d2), touched // d2 % d1, touched % d2], -1) * B
-        )
-        self.touched, self.dims, self._remap = touched, dims, remap
-        self.nbr = nbr = remap[at]
-        if grid is not None:
-            self._dense(grid, ns)
-            return
-        values = np.full((ns, B, B, B), np.nan)
-        need = np.zeros((ns, B, B, B), dtype=bool)
-        known = np.zeros((ns, B, B, B), dtype=bool)
-        inside = np.zeros((ns, B, B, B), dtype=bool)
-        self.kept1 = np.zeros((nk, 4, 4, 4), dtype=bool)
-        values[nbr[:, 0], 4, 4, 4] = vc
-        for s in range(0, nk, GROUP):
-            e = min(s + GROUP, nk)
-            val1 = self._levels(g[s:e], np.arange(s, e), values, lipschitz)
-            with np.errstate(invalid="ignore"):
-                kept1 = np.abs(val1) <= _reach(lipschitz, 2 * cell)
-            self.kept1[s:e] = kept1
-            # the corners of the kept cells of 2 (3^3 each), marked in their owners' slots
-            need9 = np.zeros((e - s, B + 1, B + 1, B + 1), dtype=bool)
-            for i, j, k in itertools.product(range(3), repeat=3):
-                need9[:, i : i + B : 2, j : j + B : 2, k : k + B : 2] |= kept1
-            for w, (here, there) in enumerate(REGIONS):
-                need[(slice(s, e) if w == 0 else nbr[s:e, w], *there)] |= need9[here]
-            # signs inferred from the centres of the cells of 2: |f(q)| > L |p - q|
-            inferred, negative = _infer(val1, lipschitz * cell)
-            own = values[s:e]
-            sampled = ~np.isnan(own)
-            known[s:e] = inferred | sampled
-            inside[s:e] = np.where(sampled, own < 0, negative)
-        values, need, known, inside = (a.reshape(-1) for a in (values, need, known, inside))
-        todo = np.flatnonzero(need & ~known)
-        values[todo] = self.sample(todo)
-        inside[todo] = values[todo] < 0
-        self.values, self.inside = values, inside.reshape(ns, B, B, B)
-
-    def _dense(self, grid, ns: int) -> None:
-        """Every corner the kept blocks use, sampled on lattices by ``grid`` (a field whose
-        lattices cost a fraction of its points: no culling inside the blocks): all of a
-        kept block's own, and of the other touched slots the three lower faces (the only
-        corners of theirs a kept block's cells reach; the rest stay NaN)."""
-        self.kept1 = None
-        nk, cell = len(self.blocks), self.cell
-        at = self.origin + self.base * cell
-        values = np.full((ns, B, B, B), np.nan)
-        for s in range(0, nk, GROUP):
-            e = min(s + GROUP, nk)
-            values[s:e] = _check(grid(at[s:e], cell, (B, B, B))).reshape(e - s, B, B, B)
-        for s in range(nk, ns, GROUP):
-            e = min(s + GROUP, ns)
-            for k in range(3):
-                face = (slice(s, e), *(0 if j == k else slice(None) for j in range(3)))
-                shape = tuple(1 if j == k else B for j in range(3))
-                values[face] = _check(grid(at[s:e], cell, shape)).reshape(values[face].shape)
-        self.values = values.reshape(-1)
-        with np.errstate(invalid="ignore"):
-            self.inside = values < 0
-
-    def _levels(self, g, own, values, lipschitz: float) -> np.ndarray:
-        """The levels of 4 and 2 cells inside blocks ``g`` (dense per-block arrays, their
-        own slots ``own``): their centres sampled into ``values``; returns the values at
-        the centres of the cells of 2 ``(n, 4, 4, 4)`` (NaN where the cell of 4 was
-        culled)."""
-        n, cell = len(g), self.cell
-        v2 = _eval_ijk(self.f, self.origin, cell, (B * g[:, None, :] + C2).reshape(-1, 3))
-        b2, q2 = np.nonzero(np.abs(v2.reshape(n, 8)) <= _reach(lipschitz, 4 * cell))
-        r1 = (2 * CORNERS[q2][:, None, :] + CORNERS[None, :, :]).reshape(-1, 3)
-        b1 = np.repeat(b2, 8)
-        v1 = _eval_ijk(self.f, self.origin, cell, B * g[b1] + 2 * r1 + 1)
-        val1 = np.full((n, 4, 4, 4), np.nan)
-        val1[b1, r1[:, 0], r1[:, 1], r1[:, 2]] = v1
-        values[(np.repeat(own, 8), *np.tile(C2, (n, 1)).T)] = v2
-        values[(own[b1], *(2 * r1 + 1).T)] = v1
-        return val1
-
-    def sample(self, corners: np.ndarray) -> np.ndarray:
-        """The field at corner numbers (slot * 512 + local corner), chunk by chunk."""
-        out = np.empty(len(corners))
-        for i in range(0, len(corners), CHUNK):
-            out[i : i + CHUNK] = _check(self.f(self.point(corners[i : i + CHUNK])))
-        return out
-
-    def point(self, corner: np.ndarray) -> np.ndarray:
-        """The coordinates of corner numbers."""
-        if not hasattr(self, "_at"):
-            self._at = self.origin + self.base * self.cell  # each slot's corner 0
-            self._local = LOCAL * self.cell
-        # np.take gathers rows faster than fancy indexing does
-        return np.take(self._at, corner >> 9, axis=0) + np.take(
-            self._local, corner & (B3 - 1), axis=0
-        )
-
-    def step(self, corner: np.ndarray, axis: np.ndarray, by: int) -> np.ndarray:
-        """The corners one step (``by`` = 1 or -1) along ``axis`` from ``corner``; -1 where
-        that corner has no slot."""
-        if not hasattr(self, "_next"):
-            unit = np.array([-1, 1])[None, :, None, None] * np.eye(3, dtype=np.int64)
-            there = self.base[:, None, None, :] // B + unit
-            key = _key(there, self.dims)
-            at = np.minimum(np.searchsorted(self.touched, key), len(self.touched) - 1)
-            self._next = np.where(self.touched[at] == key, self._remap[at], -1)  # (ns, 2, 3)
-        slot, loc = corner >> 9, corner & (B3 - 1)
-        bit = 6 - 3 * axis
-        coord = ((loc >> bit) & 7) + by
-        wrap = (coord < 0) | (coord >= B)
-        out = np.where(wrap, 0, corner + np.left_shift(by, bit))
-        if wrap.any():
-            nxt = self._next[slot[wrap], (by + 1) // 2, axis[wrap]]
-            moved = nxt * B3 + (loc[wrap] & ~(7 << bit[wrap])) + ((coord[wrap] & 7) << bit[wrap])
-            out[wrap] = np.where(nxt >= 0, moved, -1)
-        return out
-
-    def mixed_cells(self, s: int, e: int):
-        """The cells with a sign change in kept blocks ``s:e``: flat indices (block * 512 +
-        local cell) and their cases."""
-        n, nbr = e - s, self.nbr[s:e]
-        ins9 = np.empty((n, B + 1, B + 1, B + 1), dtype=bool)
-        for w, (here, there) in enumerate(REGIONS):
-            ins9[here] = self.inside[(slice(s, e) if w == 0 else nbr[:, w], *there)]
-        ins9 = ins9.view(np.uint8)
-        case = np.zeros((n, B, B, B), dtype=np.uint8)
-        for c, (x, y, z) in enumerate(CORNERS):
-            case |= ins9[:, x : x + B, y : y + B, z : z + B] << np.uint8(c)
-        mixed = (case != 0) & (case != 255)
-        if self.kept1 is not None:
-            up = self.kept1[s:e, :, None, :, None, :, None]
-            mixed &= np.broadcast_to(up, (n, 4, 2, 4, 2, 4, 2)).reshape(n, B, B, B)
-        cells = np.flatnonzero(mixed)
-        return cells + s * B3, case.reshape(-1)[cells]
-
-
-def _with_previous(a: np.ndarray, axis: int, pick) -> np.ndarray:
-    """``pick`` (np.fmax or np.fmin) of each entry and the one before it along ``axis``
-    (of the last three: 1, 2, 3), the first against nothing."""
-    out = a.copy()
-    here = [slice(None)] * 4
-    before = [slice(None)] * 4
-    here[axis], before[axis] = slice(1, None), slice(None, -1)
-    out[tuple(here)] = pick(a[tuple(here)], a[tuple(before)])
-    return out
-
-
-def _infer(val1: np.ndarray, step: float):
-    """Which of a block's 8^3 corners have a sign known from the sampled centres of the
-    cells of 2 (``val1 (nk, 4, 4, 4)``, NaN where not sampled), and whether it is negative.
-
-    A corner with ``e`` even coordinates is ``step * sqrt(e)`` from each of its ``2^e``
-    nearest centres (``step`` is the Lipschitz bound times the cell); the largest and
-    smallest of them are running maxima along the even axes, one axis at a time.
-    """
-    nk = len(val1)
-    inferred = np.zeros((nk, B, B, B), dtype=bool)
-    negative = np.zeros((nk, B, B, B), dtype=bool)
-    hi: dict[tuple, np.ndarray] = {(): val1}
-    lo: dict[tuple, np.ndarray] = {(): val1}
-    with np.errstate(invalid="ignore"):
-        for parity in CORNERS:
-            # an odd coordinate 2a + 1 is centre a's; an even one 2a lies between a - 1 and a
-            even = tuple(k for k in range(3) if not parity[k])
-            for n in range(1, len(even) + 1):
-                sub, parent = even[:n], even[: n - 1]
-                if sub not in hi:
-                    hi[sub] = _with_previous(hi[parent], 1 + sub[-1], np.fmax)
-                    lo[sub] = _with_previous(lo[parent], 1 + sub[-1], np.fmin)
-            reach = step * np.sqrt(len(even)) * (1 + 1e-9)
-            pos, neg = hi[even] > reach, lo[even] < -reach
-            at = (slice(None), *(slice(int(p), B, 2) for p in parity))
-            inferred[at] = pos | neg
-            negative[at] = neg & ~pos
-    return inferred, negative
+__all__ = ["CHUNK", "BudgetExceeded", "crossing_cells", "mesh_field", "plan_grid"]
 
 
 def _edge_tables():
     """Per (local cell, cube edge): the neighbour code (CORNERS index) of the block owning
-    the edge's start, and ``local corner * 3 + axis`` there; the same for the end corner."""
+    the edge's start, and ``axis * 512 + local corner`` there."""
     loc = np.arange(B3)
     cellxyz = np.stack([loc >> 6, (loc >> 3) & 7, loc & 7], axis=-1)
     start = cellxyz[:, None, :] + CORNERS[EDGE_START][None, :, :]  # (512, 12, 3)
     w = (start[..., 0] >> 3) << 2 | (start[..., 1] >> 3) << 1 | (start[..., 2] >> 3)
     s = start & (B - 1)
     lin = (s[..., 0] << 6) | (s[..., 1] << 3) | s[..., 2]
-    place = lin * 3 + EDGE_AXIS[None, :]
+    place = EDGE_AXIS[None, :] * B3 + lin
     return w.reshape(-1).astype(np.int32), place.reshape(-1).astype(np.int32)
 
 
@@ -394,35 +61,10 @@ EDGE_PACK = EDGE_OWNER << 11 | EDGE_PLACE  # both in one gather (a place is belo
 TRI_ROWS = TRI_EDGES.reshape(-1, 3).astype(np.int32)  # case * 5 + triangle -> its edges
 
 
-def _number(used: np.ndarray, hashes: list[np.ndarray], nbr: np.ndarray) -> np.ndarray:
-    """Each hash's vertex number: its rank among the ``used`` hashes (the used edges
-    numbered in order), group by group.
-
-    A slot's used edges are numbered after all of the slots before it (a prefix sum of
-    the per-slot counts) and in their order within it; a group's triangles use the edges
-    of its own slots and their upper neighbours only (``nbr``, eight slots a block), so
-    the ranks come from a small table of those slots' running counts, in the cache.
-    """
-    per = used.reshape(-1, 3 * B3)
-    count = np.count_nonzero(per, axis=1)
-    first = np.cumsum(count) - count
-    dtype = np.int32 if count.sum() < 2**31 else np.int64
-    row = np.empty(len(per), dtype=np.int64)
-    out = []
-    for g, h in enumerate(hashes):
-        slots = np.unique(nbr[g * GROUP * 8 : (g + 1) * GROUP * 8])
-        row[slots] = np.arange(len(slots))
-        table = np.cumsum(per[slots], axis=1, dtype=dtype)
-        table += (first[slots] - 1).astype(dtype)[:, None]
-        owner, place = np.divmod(h, 3 * B3)
-        out.append(np.take(table, row[owner] * (3 * B3) + place))
-    return np.concatenate(out)
-
-
 def crossing_cells(f: Fn, lo, hi, cell: float, lipschitz: float = 1.0, max_cells=50_000_000):
     """Global (i, j, k) of the finest cells :func:`mesh_field` polygonizes (those with a
     sign change among their corners), on the grid of :func:`plan_grid`."""
-    lat = _Lattice(f, lo, hi, cell, lipschitz, max_cells)
+    lat = Lattice(f, lo, hi, cell, lipschitz, max_cells)
     out = [np.zeros((0, 3), np.int64)]
     for s in range(0, len(lat.blocks), GROUP):
         cells, _ = lat.mixed_cells(s, min(s + GROUP, len(lat.blocks)))
@@ -434,8 +76,8 @@ def crossing_cells(f: Fn, lo, hi, cell: float, lipschitz: float = 1.0, max_cells
 
 def _edge_hashes(cells: np.ndarray, case: np.ndarray, nbr: np.ndarray) -> np.ndarray:
     """The triangles of mixed ``cells`` (flat block * 512 + local indices) as ``(t, 3)``
-    edge hashes: owner slot * 1536 + owner's local corner * 3 + axis (``nbr`` flattened,
-    eight slots a block)."""
+    edge hashes: owner slot * 1536 + axis * 512 + owner's local corner (``nbr``
+    flattened, eight slots a block)."""
     count = TRI_COUNT[case]
     first = np.cumsum(count) - count
     n_tri = int(count.sum())
@@ -448,6 +90,168 @@ def _edge_hashes(cells: np.ndarray, case: np.ndarray, nbr: np.ndarray) -> np.nda
     packed = np.take(EDGE_PACK, key)
     owner = np.take(nbr, ((cw >> 9) * 8)[:, None] + (packed >> 11))
     return owner * (3 * B3) + (packed & 2047)
+
+
+HALO = B + 3  # a block's corners -1..9 along each axis: its edges' samples at -1, 0, 1, 2
+LOCAL_IJK = LOCAL.astype(np.int64)
+HALO_AT = (LOCAL_IJK + 1) @ np.array([HALO * HALO, HALO, 1])  # local corner -> halo position
+HALO_STEP = np.array([HALO * HALO, HALO, 1])  # one corner along each axis in the halo
+
+
+class _Vertices:
+    """The mesher's ``count`` vertices, placed on their edges in number order (the used
+    edges of the kept slots group by group, then the touched slots' that are not kept).
+
+    The samples at -1, 0, 1 and 2 along an edge come from the group's corner values with
+    a halo of its six face neighbours' (one gather each, no per-vertex search); the first
+    guess is their cubic's root (:func:`.roots.guess`), the first sample on the edge's
+    line follows group by group, and the few vertices that need more are stepped all
+    together at the end (:func:`.roots.roots`).
+    """
+
+    def __init__(self, lat: Lattice, f: Fn, count: int, steps: int, lipschitz, lines, dense):
+        self.lat, self.f, self.steps, self.lipschitz = lat, f, steps, lipschitz
+        self.lines, self.dense = lines, dense
+        self.verts = np.empty((count, 3))
+        self.placed = 0
+        self.brackets = Brackets()
+        self.pending: list[tuple[np.ndarray, ...]] = []
+        self.waiting = 0  # edges pending
+        self.halo = np.full((min(GROUP, len(lat.blocks)), HALO, HALO, HALO), np.nan)
+        self.corners = lat.values.reshape(-1, B, B, B)
+
+    def own(self, s: int, e: int, used: np.ndarray) -> None:
+        """The used edges of kept slots ``s:e``, as positions in their edge range (slot,
+        axis, corner: ``(slot - s) * 1536 + axis * 512 + corner``), in order."""
+        q = used >> 9
+        b = q // 3
+        axis, loc = q - 3 * b, used & (B3 - 1)
+        halo = self._halo(s, e).reshape(-1)
+        at = b * HALO**3 + np.take(HALO_AT, loc)
+        step = np.take(HALO_STEP, axis)
+        fa, fb = np.take(halo, at), np.take(halo, at + step)
+        fm, fq = np.take(halo, at - step), np.take(halo, at + 2 * step)
+        if not self.dense:  # an end whose sign was inferred: sample it now
+            start = (b + s) * B3 + loc
+            for v, m in ((fa, np.isnan(fa)), (fb, np.isnan(fb))):
+                if m.any():
+                    corner = start[m] if v is fa else self.lat.step(start[m], axis[m], 1)
+                    v[m] = self._corners(corner)
+        ijk = np.take(self.lat.base, b + s, axis=0) + np.take(LOCAL_IJK, loc, axis=0)
+        self._queue(ijk, axis, fm, fa, fb, fq)
+
+    def others(self, edges: np.ndarray) -> None:
+        """Used edges of the touched slots that are not kept (``slot * 1536 + axis * 512
+        + corner``): the kept blocks' upper faces, found by searching for the neighbours."""
+        lat = self.lat
+        slot, rem = np.divmod(edges, 3 * B3)
+        axis, loc = rem >> 9, rem & (B3 - 1)
+        start = slot * B3 + loc
+        end = lat.step(start, axis, 1)  # an edge's end is always in a slot
+        before, after = lat.step(start, axis, -1), lat.step(end, axis, 1)
+        fa, fb = self._corners(start), self._corners(end)
+        fm = np.where(before >= 0, lat.values[before], np.nan)
+        fq = np.where(after >= 0, lat.values[after], np.nan)
+        self._queue(lat.base[slot] + LOCAL_IJK[loc], axis, fm, fa, fb, fq)
+        self._flush()
+
+    def _corners(self, corner: np.ndarray) -> np.ndarray:
+        """The values at corners, those not sampled yet sampled now (once each)."""
+        values = self.lat.values
+        v = values[corner]
+        if not self.dense:
+            missing = np.unique(corner[np.isnan(v)])
+            if len(missing):
+                values[missing] = self.lat.sample(missing)
+                v = values[corner]
+        return v
+
+    def _halo(self, s: int, e: int) -> np.ndarray:
+        """Blocks ``s:e``'s corner values with one layer of the lower and two of the upper
+        face neighbours' along each axis, ``(n, 11, 11, 11)`` (the halo's edges unused)."""
+        n, lat, corners = e - s, self.lat, self.corners
+        halo = self.halo[:n]
+        inner = slice(1, B + 1)
+        halo[:, inner, inner, inner] = corners[s:e]
+        below = lat.neighbours()[s:e, 0]
+        for axis, code in ((0, 4), (1, 2), (2, 1)):
+            up = [slice(None), inner, inner, inner]
+            down = list(up)
+            up[1 + axis], down[1 + axis] = slice(B + 1, B + 3), slice(0, 1)
+            src_up = [slice(None)] * 3
+            src_down = list(src_up)
+            src_up[axis], src_down[axis] = slice(0, 2), slice(B - 1, B)
+            halo[tuple(up)] = corners[(lat.nbr[s:e, code], *src_up)]
+            low = below[:, axis]
+            halo[tuple(down)] = corners[(low, *src_down)]
+            if (low < 0).any():
+                down[0] = low < 0
+                halo[tuple(down)] = np.nan
+        return halo
+
+    def _along(self, ijk: np.ndarray, axis: np.ndarray, t: np.ndarray) -> np.ndarray:
+        """The field at parameters ``t`` on edges ``(ijk, axis)``, chunk by chunk."""
+        lat, out = self.lat, np.empty(len(t))
+        # the lines of a batch of placed edges in one call; points as the field is promised
+        n = CHUNK if self.lines is None else 2 * CHUNK
+        for i in range(0, len(t), n):
+            j, a, u = (v[i : i + n] for v in (ijk, axis, t))
+            if self.lines is not None:  # on the lattice's lines: only the moving coordinate
+                out[i : i + n] = checked(self.lines(lat.origin, lat.cell, j, a, u))
+            else:
+                out[i : i + n] = checked(self.f(self._points(j, a, u)))
+        return out
+
+    def _points(self, ijk: np.ndarray, axis: np.ndarray, t: np.ndarray) -> np.ndarray:
+        p = ijk.astype(np.float64)
+        p[np.arange(len(p)), axis] += t
+        p *= self.lat.cell
+        p += self.lat.origin
+        return p
+
+    def _queue(self, *edges: np.ndarray) -> None:
+        """Edges to place, ``(ijk, axis, fm, fa, fb, fq)``: placed :data:`CHUNK` or more
+        at a time (a group's are too few to be worth the calls)."""
+        self.pending.append(edges)
+        self.waiting += len(edges[0])
+        if self.waiting >= CHUNK:
+            self._flush()
+
+    def _flush(self) -> None:
+        if self.pending:
+            edges = [np.concatenate(a) for a in zip(*self.pending, strict=True)]
+            self.pending, self.waiting = [], 0
+            self._place(*edges)
+
+    def _place(self, ijk, axis, fm, fa, fb, fq) -> None:
+        n = len(fa)
+        if self.steps:
+            t = guess(fm, fa, fb, fq)
+            fc = self._along(ijk, axis, t)
+            num = np.arange(self.placed, self.placed + n)
+            args = (self.lat.cell, self.lipschitz, ijk, axis)
+            t = self.brackets.first(num, t, fc, fa, fb, *args)
+        else:  # linear interpolation
+            den = fa - fb
+            t = np.divide(fa, den, out=np.full(n, 0.5), where=den != 0)
+            t = np.clip(t, END_GAP, 1 - END_GAP, out=t)
+        self.verts[self.placed : self.placed + n] = self._points(ijk, axis, t)
+        self.placed += n
+
+    def finish(self) -> np.ndarray:
+        """Every vertex, in number order."""
+        self._flush()
+        verts = self.verts
+        arrays = self.brackets.arrays()
+        if len(arrays[0]):
+            ijk, axis = arrays[6:]
+
+            def along(i, t):
+                return self._along(ijk[i], axis[i], t)
+
+            idx, t = roots(along, self.brackets, self.steps, self.lat.cell, self.lipschitz)
+            verts[idx] = self._points(ijk, axis, t)
+        return verts
 
 
 def mesh_field(
@@ -478,66 +282,62 @@ def mesh_field(
         Refuse (:class:`BudgetExceeded`) before making more cells or corners than this.
     root_steps : int
         Samples of the field per vertex at most before bisection takes over (most take
-        one, see :func:`.roots.roots`); 0 is linear interpolation.
+        one, see :mod:`.roots`); 0 is linear interpolation.
     grid : callable (origins (n, 3), step, shape) -> (n, *shape), optional
         The same field on lattices of points (``Field.evaluate_grid``), for a field whose
         lattices are cheaper than its points: then every corner of the blocks kept by the
         coarse levels is sampled that way, none inferred.
     lines : callable (origin, step, ijk (n, 3), axis (n,), t (n,)) -> (n,), optional
         The same field at ``origin + (ijk + t e_axis) * step`` (``Field.evaluate_lines``):
-        the first sample of every vertex on its edge is taken that way.
+        every sample of a vertex on its edge is taken that way.
 
     Returns
     -------
     vertices : (n, 3) float64
-    triangles : (m, 3) int64
+    triangles : (m, 3) int
         Oriented so that normals point toward positive values.
     """
     if not (cell > 0 and np.isfinite(cell)):
         raise ValueError(f"cell must be > 0, got {cell:g}")
     empty = np.zeros((0, 3)), np.zeros((0, 3), np.int64)
-    lat = _Lattice(f, lo, hi, cell, lipschitz, max_cells, grid)
+    lat = Lattice(f, lo, hi, cell, lipschitz, max_cells, grid)
     nk = len(lat.blocks)
     if not nk:
         return empty
-    ns = len(lat.touched)
-    idx = np.int32 if ns * 3 * B3 < 2**31 else np.int64
+    ns, edges = len(lat.touched), 3 * B3
+    idx = np.int32 if ns * edges < 2**31 else np.int64
     nbr = lat.nbr.astype(idx).reshape(-1)
-    used = np.zeros(ns * 3 * B3, dtype=bool)
-    hashes = []
+    # the used edges and their numbers: a slot's edges are used only by its own block's
+    # cells and its lower neighbours' (earlier in the order), so once a group is through,
+    # its own slots are complete and numbered (no ranking pass, no sort)
+    used = np.zeros(ns * edges, dtype=bool)
+    number = np.empty(ns * edges, dtype=idx)  # written where used
+    hashes, owns, count = [], [], 0
     for s in range(0, nk, GROUP):
-        cells, case = lat.mixed_cells(s, min(s + GROUP, nk))
+        e = min(s + GROUP, nk)
+        cells, case = lat.mixed_cells(s, e)
         edge = _edge_hashes(cells.astype(idx), case, nbr)  # a perfect hash of the edge
         used[edge] = True
         hashes.append(edge)
-    ue = np.flatnonzero(used)
-    if not len(ue):
+        own = np.flatnonzero(used[s * edges : e * edges])
+        number[s * edges + own] = np.arange(count, count + len(own))
+        owns.append(own)
+        count += len(own)
+    rest = np.flatnonzero(used[nk * edges :]) + nk * edges
+    number[rest] = np.arange(count, count + len(rest))
+    count += len(rest)
+    if not count:
         return empty
-    tri = _number(used, hashes, nbr)
-    del used, hashes
-    verts = np.empty((len(ue), 3))
-    for i in range(0, len(ue), CHUNK):
-        v = ue[i : i + CHUNK]
-        slot, rem = v // (3 * B3), v % (3 * B3)
-        start, axis = slot * B3 + rem // 3, rem % 3
-        end = lat.step(start, axis, 1)  # an edge's end is always in a slot
-        before, after = lat.step(start, axis, -1), lat.step(end, axis, 1)
-        fa, fb = lat.values[start], lat.values[end]
-        if grid is None:  # an end whose sign was inferred: sample it now
-            ends = np.concatenate([start, end])
-            missing = np.unique(ends[np.isnan(np.concatenate([fa, fb]))])
-            if len(missing):
-                lat.values[missing] = lat.sample(missing)
-                fa, fb = lat.values[start], lat.values[end]
-        fm = np.where(before >= 0, lat.values[before], np.nan)
-        fq = np.where(after >= 0, lat.values[after], np.nan)
-        pa = lat.point(start)
-        pb = pa + np.eye(3)[axis] * cell
-        start_t = guess(fm, fa, fb, fq) if root_steps else None
-        first = None
-        if lines is not None:
-            loc = start & (B3 - 1)
-            ijk = lat.base[slot] + np.stack([loc >> 6, (loc >> 3) & 7, loc & 7], axis=-1)
-            first = functools.partial(lines, lat.origin, cell, ijk, axis)
-        verts[i : i + CHUNK] = roots(f, pa, pb, fa, fb, root_steps, cell, start_t, lipschitz, first)
-    return verts, tri.reshape(-1, 3)
+    tri = np.empty(sum(h.size for h in hashes), dtype=idx)
+    at = 0
+    for h in hashes:
+        np.take(number, h.reshape(-1), out=tri[at : at + h.size])
+        at += h.size
+    del used, number, hashes
+    vertices = _Vertices(lat, f, count, root_steps, lipschitz, lines, grid is not None)
+    for s, own in zip(range(0, nk, GROUP), owns, strict=True):
+        if len(own):
+            vertices.own(s, min(s + GROUP, nk), own)
+    if len(rest):
+        vertices.others(rest)
+    return vertices.finish(), tri.reshape(-1, 3)

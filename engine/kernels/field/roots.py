@@ -2,10 +2,16 @@
 edge's grid line, then root-finding on the field itself.
 
 The guess is Newton's method on the cubic through the (up to) four samples at -1, 0, 1, 2
-along the edge; each step after it samples the field and moves to the inverse quadratic
-interpolant's root through the bracket's ends and the new sample (Brent 1973), or to the
-regula falsi point (Illinois variant, Dowson & Harrington 1971) where that root falls
-outside the bracket; a kink left after that is bisected.
+along the edge; the field is sampled there, and a sample within :data:`ACCEPT` of a cell
+of zero is the vertex (on a smooth field at mesher cells, nine in ten). Each step after
+it moves to the inverse quadratic interpolant's root through the bracket's ends and the
+new sample (Brent 1973), or to the regula falsi point (Illinois variant, Dowson &
+Harrington 1971) where that root falls outside the bracket; a kink left after that is
+bisected.
+
+Edges are parametrized by ``t`` in [0, 1]; the field is reached through ``along(idx, t)``
+(its values at parameters ``t`` on edges ``idx``), so a mesher can sample on its
+lattice's lines rather than at points.
 """
 
 from __future__ import annotations
@@ -14,9 +20,10 @@ from collections.abc import Callable
 
 import numpy as np
 
-__all__ = ["ACCEPT", "END_GAP", "guess", "roots"]
+__all__ = ["ACCEPT", "END_GAP", "Brackets", "guess", "roots", "roots_on_segments"]
 
 Fn = Callable[[np.ndarray], np.ndarray]
+Along = Callable[[np.ndarray, np.ndarray], np.ndarray]
 # a vertex stays this fraction of its edge off either end, so vertices never coincide, not
 # even as the float32 coordinates of an STL (at 2,000 cells from the origin an ulp of
 # float32 is 1e-4 of a cell)
@@ -31,108 +38,177 @@ def _check(values: np.ndarray) -> np.ndarray:
     return v
 
 
-def _eval(f: Fn, p: np.ndarray, chunk: int = 1 << 16) -> np.ndarray:
-    if len(p) <= chunk:
-        return _check(f(p))
-    return np.concatenate([_check(f(p[i : i + chunk])) for i in range(0, len(p), chunk)])
-
-
 def guess(fm, fa, fb, fq) -> np.ndarray:
     """First guesses of the roots on edges (0, 1) from the values at -1, 0, 1, 2 along
     them (``fm``, ``fq`` NaN where unknown): Newton's method on the cubic (or quadratic)
-    through the known ones, from the linear guess; linear where neither is known."""
-    has_m, has_q = ~np.isnan(fm), ~np.isnan(fq)
-    both = has_m & has_q
-    c1 = -fm / 3 - fa / 2 + fb - fq / 6  # the cubic through all four
-    c2 = fm / 2 - fa + fb / 2
-    c3 = -fm / 6 + fa / 2 - fb / 2 + fq / 6
-    if not both.all():
-        m, q = has_m & ~has_q, ~has_m & has_q
-        c1 = np.where(both, c1, fb - fa)
-        c2, c3 = np.where(both, c2, 0.0), np.where(both, c3, 0.0)
-        c1 = np.where(m, (fb - fm) / 2, np.where(q, (-3 * fa + 4 * fb - fq) / 2, c1))
-        c2 = np.where(m, (fb - 2 * fa + fm) / 2, np.where(q, (fa - 2 * fb + fq) / 2, c2))
+    through the known ones, from the linear guess; linear where neither is known. Kept
+    :data:`END_GAP` off the ends."""
+    c1 = fb - fa / 2 - fm / 3 - fq / 6  # the cubic through all four
+    c2 = (fm + fb) / 2 - fa
+    c3 = (fq - fm) / 6 + (fa - fb) / 2
+    lack = np.flatnonzero(np.isnan(c1))  # fm or fq unknown: the quadratic or the line
+    if len(lack):
+        m, a, b, q = fm[lack], fa[lack], fb[lack], fq[lack]
+        has_m, has_q = ~np.isnan(m), ~np.isnan(q)
+        c1[lack] = np.where(has_m, (b - m) / 2, np.where(has_q, (-3 * a + 4 * b - q) / 2, b - a))
+        c2[lack] = np.where(has_m, (b - 2 * a + m) / 2, np.where(has_q, (a - 2 * b + q) / 2, 0.0))
+        c3[lack] = 0.0
     den = fa - fb
     lin = np.divide(fa, den, out=np.full(len(fa), 0.5), where=den != 0)
-    t = lin
+    t = lin.copy()
+    c2x2, c3x3 = 2 * c2, 3 * c3
     with np.errstate(divide="ignore", invalid="ignore"):
         for _ in range(2):  # two Newton steps: a third changes 0.3 % of the vertices' cost
-            p = fa + t * (c1 + t * (c2 + t * c3))
-            dp = c1 + t * (2 * c2 + 3 * t * c3)
-            t = np.clip(t - p / dp, 0.0, 1.0)
-    return np.where(np.isfinite(t), t, lin)
+            p = c3 * t
+            p += c2
+            p *= t
+            p += c1
+            p *= t
+            p += fa
+            dp = c3x3 * t
+            dp += c2x2
+            dp *= t
+            dp += c1
+            p /= dp
+            t -= p
+            np.clip(t, 0.0, 1.0, out=t)
+    bad = np.flatnonzero(~np.isfinite(t))
+    t[bad] = lin[bad]
+    return np.clip(t, END_GAP, 1 - END_GAP, out=t)
 
 
-def roots(
-    f: Fn, pa, pb, fa, fb, steps: int, cell: float, guess=None, lipschitz: float = 1.0, first=None
-) -> np.ndarray:
-    """Points where ``f`` changes sign on segments ``pa -> pb``.
+class Brackets:
+    """Edges whose vertex is not found yet, gathered chunk by chunk (:meth:`first`) and
+    then stepped all together (:func:`roots`), so the field is called on few, large
+    arrays: their numbers (``idx``, the caller's), the next point to sample (``t``), the
+    bracket ``[lo, hi]`` with the values there, and what the caller needs to sample them
+    (``extra``)."""
 
-    ``fa`` and ``fb`` have opposite signs (one is < 0, the other >= 0). From ``guess``
-    (the linear one if none), each step samples the field and moves to the inverse
-    quadratic interpolant's root through the bracket's ends and the new sample (exact for
-    a quadratic along the edge, Brent 1973), or to the regula falsi point of the shrunk
-    bracket where that root falls outside it. A step is taken without sampling it where
-    the Lipschitz bound already keeps ``|f|`` there below ``ACCEPT`` cells, so most
-    vertices cost one sample and every one ends within that (an L-Lipschitz field). What
-    is left after ``steps`` (a kink of a sharp union on the edge) is bisected. Points are
-    kept ``END_GAP`` off the ends, so edges meeting at a corner on the surface give
-    distinct vertices (and no triangle collapses to a point in a file of float32
-    coordinates).
+    def __init__(self):
+        self.parts: list[tuple[np.ndarray, ...]] = []
+        self._arrays = None
+
+    def first(self, idx, t, fc, fa, fb, cell: float, lipschitz: float, *extra) -> np.ndarray:
+        """The first sample ``fc`` at ``t`` on edges ``idx`` with end values ``fa`` (t =
+        0) and ``fb`` (t = 1), of opposite signs: the vertices' ``t`` where that sample
+        decides them; the edges that need more are kept with the rows of ``extra`` (their
+        entries in the returned ``t`` are provisional)."""
+        n = len(t)
+        done, nxt, lo, hi, flo, fhi = _step(t, fc, np.zeros(n), np.ones(n), fa, fb, cell, lipschitz)
+        if not done.all():
+            more = np.flatnonzero(~done)
+            part = (idx, nxt, lo, hi, flo, fhi, *extra)
+            self.parts.append(tuple(np.take(a, more, axis=0) for a in part))
+            self._arrays = None
+        return nxt
+
+    def arrays(self) -> tuple[np.ndarray, ...]:
+        """``(idx, t, lo, hi, flo, fhi, *extra)`` of every edge kept, concatenated."""
+        if self._arrays is None:
+            if not self.parts:
+                return (np.zeros(0, np.int64), *(np.zeros(0) for _ in range(5)))
+            self._arrays = tuple(np.concatenate(a) for a in zip(*self.parts, strict=True))
+        return self._arrays
+
+
+def _step(c, fc, a, b, f_a, f_b, cell: float, lipschitz: float):
+    """One root step from the sample ``fc`` at ``c`` inside brackets ``[a, b]`` (values
+    ``f_a``, ``f_b`` of opposite signs): whether the vertex is found (then it is the
+    returned ``t``), the next point otherwise, and the shrunk brackets.
+
+    A sample within ACCEPT of a cell of zero is the vertex. Otherwise the step is the
+    inverse quadratic interpolant's root through the bracket's ends and the sample, or
+    the regula falsi point where that falls outside the shrunk bracket. A step not
+    sampled moves the point by ``|t' - c|`` of the edge: for an L-Lipschitz field its
+    value is then at most ``|f(c)| + L cell |t' - c|``; where that bound is within ACCEPT
+    of a cell the step is taken without sampling it (on a smooth field it lands far
+    closer); the rest are sampled there.
     """
-    n = len(pa)
-    lo_t, hi_t = np.zeros(n), np.ones(n)
-    flo, fhi = fa.copy(), fb.copy()
-    den = flo - fhi
-    if guess is None:
-        guess = np.divide(flo, den, out=np.full(n, 0.5), where=den != 0)
-    t = np.clip(guess, END_GAP, 1 - END_GAP)
+    accept = ACCEPT * cell
+    done = np.abs(fc) <= accept
+    t = c.copy()
+    rest = np.flatnonzero(~done)
+    if not len(rest):
+        return done, t, a, b, f_a, f_b
+    a, b, f_a, f_b = a.copy(), b.copy(), f_a.copy(), f_b.copy()
+    cr, fr, ar, br, far, fbr = c[rest], fc[rest], a[rest], b[rest], f_a[rest], f_b[rest]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        iqi = (
+            ar * fbr * fr / ((far - fbr) * (far - fr))
+            + br * far * fr / ((fbr - far) * (fbr - fr))
+            + cr * far * fbr / ((fr - far) * (fr - fbr))
+        )
+    low = (fr < 0) == (far < 0)  # the sample replaces the end of its own sign
+    ar, far = np.where(low, cr, ar), np.where(low, fr, far)
+    br, fbr = np.where(low, br, cr), np.where(low, fbr, fr)
+    a[rest], f_a[rest], b[rest], f_b[rest] = ar, far, br, fbr
+    den = far - fbr
+    rf = ar + np.divide(far, den, out=np.full(len(ar), 0.5), where=den != 0) * (br - ar)
+    inside = np.isfinite(iqi) & (iqi > ar) & (iqi < br)
+    step = np.clip(np.where(inside, iqi, rf), END_GAP, 1 - END_GAP)
+    t[rest] = step
+    done[rest] = np.abs(fr) + lipschitz * cell * np.abs(step - cr) <= accept
+    return done, t, a, b, f_a, f_b
+
+
+def roots(along: Along, brackets: Brackets, steps: int, cell: float, lipschitz: float = 1.0):
+    """The vertices left in ``brackets`` after their first sample: ``(idx, t)``.
+
+    ``along(i, t)`` samples the field at parameters ``t`` on edges ``i`` (rows of the
+    brackets' :meth:`~Brackets.arrays`, whose ``extra`` say where the edges are). Up to
+    ``steps - 1`` more steps (see :func:`_step`) sample and step; what is left after them
+    (a kink of a sharp union on the edge converges only linearly) is bisected, which
+    halves the bracket every step whatever the field's shape, to ``1e-4`` of a cell of
+    zero.
+    """
+    idx, t, lo, hi, flo, fhi = brackets.arrays()[:6]
     tol = 1e-4 * cell
-    idx = np.arange(n)
+    live = np.arange(len(t))
+    for _ in range(steps - 1):
+        if not len(live):
+            break
+        c = t[live]
+        fc = _check(along(live, c))
+        done, nxt, a, b, f_a, f_b = _step(
+            c, fc, lo[live], hi[live], flo[live], fhi[live], cell, lipschitz
+        )
+        lo[live], hi[live], flo[live], fhi[live] = a, b, f_a, f_b
+        t[live] = nxt
+        live = live[~done]
+    for _ in range(16 if len(live) else 0):
+        t[live] = np.clip((lo[live] + hi[live]) / 2.0, END_GAP, 1 - END_GAP)
+        fp = _check(along(live, t[live]))
+        low = (fp < 0) == (flo[live] < 0)
+        lo[live[low]], flo[live[low]] = t[live[low]], fp[low]
+        hi[live[~low]], fhi[live[~low]] = t[live[~low]], fp[~low]
+        live = live[np.abs(fp) > tol]
+        if not len(live):
+            break
+    return idx, t
+
+
+def roots_on_segments(
+    f: Fn, pa, pb, fa, fb, steps: int, cell: float, start=None, lipschitz: float = 1.0
+) -> np.ndarray:
+    """Points where ``f`` changes sign on segments ``pa -> pb`` (``fa``, ``fb`` of
+    opposite signs: one < 0, the other >= 0), from first guesses ``start`` (linear if
+    none) by :func:`roots`; each ends where ``|f| <= ACCEPT * cell`` for an L-Lipschitz
+    ``f`` (``lipschitz``), ``END_GAP`` off the ends, so edges meeting at a corner on the
+    surface give distinct vertices. ``steps = 0`` is linear interpolation."""
     d = pb - pa
-    for k in range(steps):
-        at = slice(None) if k == 0 else idx  # every vertex takes the first step
-        c = t[at]
-        if k == 0 and first is not None:  # the field on the edges' lines: ``first(t)``
-            fc = _check(first(c))
-        else:
-            fc = _eval(f, pa[at] + c[:, None] * d[at])
-        a, b, f_a, f_b = lo_t[at], hi_t[at], flo[at], fhi[at]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            iqi = (
-                a * f_b * fc / ((f_a - f_b) * (f_a - fc))
-                + b * f_a * fc / ((f_b - f_a) * (f_b - fc))
-                + c * f_a * f_b / ((fc - f_a) * (fc - f_b))
-            )
-        low = (fc < 0) == (f_a < 0)  # the sample replaces the end of its own sign
-        a, f_a = np.where(low, c, a), np.where(low, fc, f_a)
-        b, f_b = np.where(low, b, c), np.where(low, f_b, fc)
-        lo_t[at], flo[at], hi_t[at], fhi[at] = a, f_a, b, f_b
-        den = f_a - f_b
-        rf = a + np.divide(f_a, den, out=np.full(len(a), 0.5), where=den != 0) * (b - a)
-        inside = np.isfinite(iqi) & (iqi > a) & (iqi < b)
-        conv = np.abs(fc) <= tol
-        step = np.clip(np.where(inside, iqi, rf), END_GAP, 1 - END_GAP)
-        # a step not sampled moves the point by |t' - c| of the edge: for an L-Lipschitz
-        # field its value is then at most |f(c)| + L cell |t' - c|. Where that bound is
-        # within ACCEPT of a cell, take the step (on a smooth field it lands far closer);
-        # where only |f(c)| is, keep c; the rest sample again
-        bound = np.abs(fc) + lipschitz * cell * np.abs(step - c)
-        take = ~conv & (bound <= ACCEPT * cell)
-        keep = ~conv & ~take & (np.abs(fc) <= ACCEPT * cell)
-        t[at] = np.where(conv | keep, c, step)
-        idx = idx[~(conv | take | keep)]
-        if not len(idx):
-            break
-    # what is left (a kink of a sharp union on the edge converges only linearly):
-    # bisection of the bracket, which halves it every step whatever the field's shape
-    for _ in range(16 if steps else 0):
-        if not len(idx):
-            break
-        t[idx] = np.clip((lo_t[idx] + hi_t[idx]) / 2.0, END_GAP, 1 - END_GAP)
-        fp = _eval(f, pa[idx] + t[idx, None] * d[idx])
-        low = (fp < 0) == (flo[idx] < 0)
-        lo_t[idx[low]], flo[idx[low]] = t[idx[low]], fp[low]
-        hi_t[idx[~low]], fhi[idx[~low]] = t[idx[~low]], fp[~low]
-        idx = idx[np.abs(fp) > tol]
+    if start is None:
+        den = fa - fb
+        start = np.divide(fa, den, out=np.full(len(fa), 0.5), where=den != 0)
+    t = np.clip(start, END_GAP, 1 - END_GAP)
+    if steps:
+        br = Brackets()
+        fc = _check(f(pa + t[:, None] * d))
+        t = br.first(np.arange(len(t)), t, fc, fa, fb, cell, lipschitz, pa, d)
+
+        def along(i, s):
+            p, dp = br.arrays()[6:]
+            return f(p[i] + s[:, None] * dp[i])
+
+        idx, tr = roots(along, br, steps, cell, lipschitz)
+        t[idx] = tr
     return pa + t[:, None] * d

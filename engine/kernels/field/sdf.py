@@ -292,18 +292,36 @@ def box_lines(lines: Lines, size: np.ndarray, center: np.ndarray, radius: float 
     half = np.asarray(size, dtype=np.float64) / 2.0
     r = float(min(max(radius, 0.0), half.min()))
     q = [np.abs(a - c) - (h - r) for a, c, h in zip(lines.columns(), center, half, strict=True)]
-    mx, my, mz = (np.maximum(v, 0.0) for v in q)
-    outside = np.sqrt((mx * mx + my * my) + mz * mz)
-    return outside + np.minimum(np.maximum(np.maximum(q[0], q[1]), q[2]), 0.0) - r
+    out = np.maximum(np.maximum(q[0], q[1]), q[2])
+    # inside the shrunk box (most points of a lattice cut by it) the largest offset is
+    # the distance; outside it, the length of the clipped offsets
+    far = np.flatnonzero(out > 0)
+    if len(far):
+        mx, my, mz = (np.maximum(v[far], 0.0) for v in q)
+        out[far] = np.sqrt((mx * mx + my * my) + mz * mz)
+    if r:
+        out -= r
+    return out
 
 
 def tpms_lines(lines: Lines, kind: str, period: float, thickness: float) -> np.ndarray:
     """:func:`tpms` on :class:`Lines`: two sines a point instead of six."""
     w = 2.0 * np.pi / period
     (sx, sy, sz), (cx, cy, cz) = lines.sincos(w)
-    if kind == "gyroid":
-        f = sx * cy + sy * cz + sz * cx
-        gx, gy, gz = cx * cy - sz * sx, cy * cz - sx * sy, cz * cx - sy * sz
+    if kind == "gyroid":  # in place: the lines of a mesher are many
+        f = sx * cy
+        f += sy * cz
+        f += sz * cx
+        g2 = np.square(cx * cy - sz * sx)
+        g2 += np.square(cy * cz - sx * sy)
+        g2 += np.square(cz * cx - sy * sz)
+        np.abs(f, out=f)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            f /= np.sqrt(g2, out=g2)  # inf or NaN where the gradient vanishes: capped
+        f /= w
+        np.fmin(f, period / 4.0, out=f)
+        f -= thickness / 2.0
+        return f
     elif kind == "schwarz_p":
         f = cx + cy + cz
         gx, gy, gz = -sx, -sy, -sz
