@@ -178,6 +178,24 @@ class _Run(LanguageRun, SimulationRun, Replay):
             return self.keys[name]
         nd = self.g._nodes[name]
         spec = self.registry[nd.type]
+        parts = self.key_parts(name, nd, spec)
+        if nd.simulate is not None:
+            return self.step_keys(name, parts)
+        if nd.repeat is None:
+            self.keys[name] = _cache.key_of(parts)
+            return self.keys[name]
+        base = _cache.key_of(parts)
+        _, tokens = self.repeat_items(name)
+        items = [_cache.key_of({"node": base, "item": t}) for t in tokens]
+        self.item_keys[name] = items
+        self.keys[name] = _cache.key_of({"repeat": items})
+        return self.keys[name]
+
+    def key_parts(
+        self, name: str, nd: NodeDef, spec: NodeSpec, slots: dict[str, Any] | None = None
+    ) -> dict[str, Any]:
+        """What a node's key hashes; ``slots`` stands in for some ports' parts (a sweep's
+        plans splice each variant's parts of the ports that vary into one text)."""
         parts: dict[str, Any] = {
             "type": nd.type,
             "version": spec.version,
@@ -206,28 +224,22 @@ class _Run(LanguageRun, SimulationRun, Replay):
                 if port in spec.input_paths:  # a file per item, read when the item runs:
                     parts["inputs"][port]["unkeyed"] = os.urandom(8).hex()  # never trusted
                 continue
-            parts["inputs"][port] = self.key_part(name, port, spec, value)
-            if port in spec.input_paths:
-                if wires_of(value):  # a path known only when its wire runs: never trusted
-                    parts["inputs"][port] = {
-                        "wired": parts["inputs"][port],
-                        "unkeyed": os.urandom(8).hex(),
-                    }
-                else:
-                    parts["inputs"][port] = self.input_file(name, port, parts["inputs"][port])
+            if slots is not None and port in slots:
+                parts["inputs"][port] = slots[port]
+                continue
+            parts["inputs"][port] = self.port_part(name, port, spec, value)
         if spec.is_export:
             parts["out_dir"] = self.out_dir
-        if sim is not None:
-            return self.step_keys(name, parts)
-        if nd.repeat is None:
-            self.keys[name] = _cache.key_of(parts)
-            return self.keys[name]
-        base = _cache.key_of(parts)
-        _, tokens = self.repeat_items(name)
-        items = [_cache.key_of({"node": base, "item": t}) for t in tokens]
-        self.item_keys[name] = items
-        self.keys[name] = _cache.key_of({"repeat": items})
-        return self.keys[name]
+        return parts
+
+    def port_part(self, name: str, port: str, spec: NodeSpec, value: Input) -> Any:
+        """One port's part of a node's key (a file's the hash of its bytes)."""
+        part = self.key_part(name, port, spec, value)
+        if port not in spec.input_paths:
+            return part
+        if wires_of(value):  # a path known only when its wire runs: never trusted
+            return {"wired": part, "unkeyed": os.urandom(8).hex()}
+        return self.input_file(name, port, part)
 
     def input_file(self, name: str, port: str, relpath: Any) -> Any:
         """The key part of an input file: its path and a hash of its bytes (kept for the

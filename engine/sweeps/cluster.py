@@ -40,6 +40,7 @@ from ..language.yamlio import MAX_BYTES
 from .tasks import (
     Blueprint,
     Job,
+    Packed,
     RowChunk,
     RowJob,
     RowPlan,
@@ -221,7 +222,7 @@ def build(
         group = tuple(row_plans[i : i + chunk])
         keys = tuple(dict.fromkeys(k for p in group for _, k in p.shared))
         task_key = group[0].key if len(group) == 1 else "rows-" + key_of([p.key for p in group])
-        dsk[task_key] = (run_rows, bp_key, job, RowChunk(group, keys), *keys)
+        dsk[task_key] = (run_rows, bp_key, job, Packed.of(RowChunk(group, keys)), *keys)
         chunks[task_key] = [p.key for p in group]
     totals.needed = len(users)
     return dsk, rows, chunks, totals
@@ -249,6 +250,8 @@ def _workers_ignore_interrupts() -> Iterator[None]:
     finally:
         signal.signal(signal.SIGINT, previous)
 
+
+CHUNK_CAP = 64  # variants to a row task at most
 
 HANDSHAKE_SECONDS = 10.0
 _HANDSHAKE_BYTES = 1 << 16  # a scheduler's greeting is some 60 bytes
@@ -353,9 +356,15 @@ def connect(client: Any, workers: int | None) -> Iterator[Any]:
     n = workers or os.cpu_count() or 1
     # distributed sets MALLOC_TRIM_THRESHOLD_ in workers to hand memory back early; for
     # numpy kernels whose temporaries are megabytes that costs a page-fault storm (the spiral
-    # tube builds 1.4x slower), and a sweep's workers end with the sweep anyway
+    # tube builds 1.4x slower), and a sweep's workers end with the sweep anyway. Dask's own
+    # profiler (a thread reading each worker's stacks every 10 ms, for a dashboard that is
+    # off here) is off too.
+    settings = {
+        "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
+        "distributed.worker.profile.enabled": False,
+    }
     with (
-        dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}),
+        dask.config.set(settings),
         _workers_ignore_interrupts(),
     ):
         cluster = LocalCluster(
@@ -405,7 +414,7 @@ def run(
         threads = sum(w.get("nthreads", 1) for w in c.scheduler_info()["workers"].values())
         # a few variants to a task when there are many per thread: Dask's overhead per task
         # is paid once per few light variants, and the table still grows steadily
-        chunk = max(1, min(64, len(variants) // (8 * max(threads, 1))))
+        chunk = max(1, min(CHUNK_CAP, len(variants) // (8 * max(threads, 1))))
         dsk, rows, chunks, totals = build(g, bp_key, variants, targets, visible, chunk)
         if not rows:
             return totals
@@ -431,7 +440,7 @@ def run(
                         pending.add(again)
                         continue
                     if fut.key in results:
-                        finished = results[fut.key]
+                        finished = results[fut.key].rows
                     else:
                         finished = _chunk_result(fut, chunks[fut.key])
                     fut.release()
@@ -448,7 +457,7 @@ def run(
 
 def _chunk_result(fut: Any, row_keys: list[str]) -> list[tuple[str, RowResult]]:
     try:
-        return fut.result()
+        return fut.result().rows
     except Exception as exc:  # KilledWorker after too many deaths, or a bug of ours
         if type(exc).__name__ == "KilledWorker":
             msg = "the Dask workers running this variant kept dying (out of memory?)"

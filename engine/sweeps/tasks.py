@@ -10,6 +10,7 @@ dependents finish at once with the same error and the sweep goes on.
 from __future__ import annotations
 
 import importlib
+import pickle
 import sys
 import tempfile
 import time
@@ -23,7 +24,7 @@ from ..core.errors import FormgraphError, FormgraphWarning
 from ..evaluation.cache import default_cache_dir, key_of
 from ..evaluation.graph import Graph, Step
 
-__all__ = ["Blueprint", "Outcome", "RowResult", "run_rows", "run_step"]
+__all__ = ["Blueprint", "Outcome", "RowResult", "RowResults", "run_rows", "run_step"]
 
 
 @dataclass(frozen=True)
@@ -71,6 +72,27 @@ class RowResult:
     exports: dict[str, tuple[str, dict[str, bytes]]]  # node -> (main file, {file: bytes})
     image: bytes | None
     costs: dict[str, tuple[float, str]]
+
+    def __reduce__(self) -> Any:  # a plain tuple: a dataclass's state dict costs more
+        return RowResult, (
+            self.error,
+            self.seconds,
+            self.values,
+            self.exports,
+            self.image,
+            self.costs,
+        )
+
+
+@dataclass
+class RowResults:
+    """What a row task hands back: (row key, result) for each of its variants.
+
+    One object, not a list: Dask serialises a list element by element (a header and a
+    pickle frame each), which cost more than the light variants themselves.
+    """
+
+    rows: list[tuple[str, RowResult]]
 
 
 _GRAPHS: dict[str, Graph] = {}
@@ -278,18 +300,75 @@ class RowChunk:
     def __dask_tokenize__(self) -> str:
         return key_of([p.key for p in self.plans])
 
+    def __reduce__(self) -> Any:
+        """Pickled as each distinct shape of plan once (its nodes' names, wires and kinds,
+        the shared nodes' names) and per variant only its keys and params: a chunk is
+        pickled and unpickled twice on its way to a worker (client, scheduler, worker)."""
+        shapes: dict[Any, int] = {}
+        rows = []
+        for p in self.plans:
+            shape = (
+                tuple((s.name, s.upstream, s.export) for s in p.steps),
+                tuple(n for n, _ in p.shared),
+            )
+            rows.append(
+                (
+                    shapes.setdefault(shape, len(shapes)),
+                    tuple(s.key for s in p.steps),
+                    tuple(s.upstream_keys for s in p.steps),
+                    tuple(k for _, k in p.shared),
+                    p.params,
+                    p.key,
+                )
+            )
+        return _chunk, (tuple(shapes), tuple(rows), self.keys)
 
-def run_rows(
-    bp: Blueprint, job: RowJob, chunk: RowChunk, *shared: Outcome
-) -> list[tuple[str, RowResult]]:
+
+@dataclass(frozen=True)
+class Packed:
+    """A row task's :class:`RowChunk`, pickled once on the client: the scheduler receives
+    and forwards its bytes as they are, and only the worker that runs it unpacks it."""
+
+    data: bytes
+    token: str
+
+    @classmethod
+    def of(cls, chunk: RowChunk) -> Packed:
+        return cls(pickle.dumps(chunk, protocol=pickle.HIGHEST_PROTOCOL), chunk.__dask_tokenize__())
+
+    def unpack(self) -> RowChunk:
+        return pickle.loads(self.data)
+
+    def __dask_tokenize__(self) -> str:
+        return self.token
+
+    def __reduce__(self) -> Any:
+        return Packed, (self.data, self.token)
+
+
+def _chunk(shapes: Any, rows: Any, keys: tuple[str, ...]) -> RowChunk:
+    """A :class:`RowChunk` from its pickled form (:meth:`RowChunk.__reduce__`)."""
+    plans = []
+    for shape, step_keys, upstream_keys, shared_keys, params, key in rows:
+        steps, shared = shapes[shape]
+        plan_steps = tuple(
+            Step(name, k, up, export, ups)
+            for (name, up, export), k, ups in zip(steps, step_keys, upstream_keys, strict=True)
+        )
+        plans.append(RowPlan(plan_steps, tuple(zip(shared, shared_keys, strict=True)), params, key))
+    return RowChunk(tuple(plans), keys)
+
+
+def run_rows(bp: Blueprint, job: RowJob, packed: Packed, *shared: Outcome) -> RowResults:
     """Task: a few variants' rows, each from its own nodes and the shared ones' outcomes.
 
     Fusing variants' private chains into one task is Dask's own linear fusion, keyed by what
     the variants need: the per-task overhead is paid once per few variants, while every node
     that variants share stays a task of its own under its cache key.
     """
+    chunk = packed.unpack()
     by_key = dict(zip(chunk.keys, shared, strict=True))
-    return [(plan.key, run_row(bp, job, plan, by_key)) for plan in chunk.plans]
+    return RowResults([(plan.key, run_row(bp, job, plan, by_key)) for plan in chunk.plans])
 
 
 def run_row(bp: Blueprint, job: RowJob, plan: RowPlan, shared: dict[str, Outcome]) -> RowResult:
