@@ -457,9 +457,18 @@ def test_wrong_host_and_origin_are_refused(studio):
 # ---------------------------------------------------------------------------- browser
 
 
-# the time of the page's first WebGL draw call (page clock), put in before the page loads
+# the time of the page's first WebGL draw call (page clock), and what the page sends on its
+# websocket (and the socket's binaryType then), put in before the page loads
 FIRST_DRAW = """
 (() => {
+  window.__fgWire = {sent: [], binaryType: null};
+  const send = WebSocket.prototype.send;
+  WebSocket.prototype.send = function (data) {
+    const out = send.call(this, data);
+    window.__fgWire.sent.push(new TextDecoder('latin1').decode(data));
+    window.__fgWire.binaryType = this.binaryType;
+    return out;
+  };
   const getContext = HTMLCanvasElement.prototype.getContext;
   HTMLCanvasElement.prototype.getContext = function (type, ...rest) {
     const ctx = getContext.call(this, type, ...rest);
@@ -575,6 +584,25 @@ def test_slider_recooks_and_redraws(page):
     m = re.search(r"(\d+) computed, (\d+) cached", _status(page))
     assert m and (int(m.group(1)), int(m.group(2))) == (5, 1)  # the section circle stays
     assert _turns(page) == (turns + 1 if turns < 12 else turns - 1)
+
+
+def test_a_step_sends_its_arrays_ahead_of_its_scene(page):
+    """vtk.js gets a step's new arrays with its scene and asks for none; the websocket
+    delivers ArrayBuffers, not Blobs (which the browser reads back asynchronously); the
+    graph's drawing, with the step's times, follows once the steps settle."""
+    before, drawing = _canvas(page), page.inner_html("#graph")
+    timing = page.inner_text("#timing")
+    n = page.evaluate("window.__fgWire.sent.length")
+    page.locator(".fg-slider-thickness .v-slider-thumb").focus()
+    page.keyboard.press("ArrowRight")
+    page.wait_for_function(f"document.querySelector('#timing').innerText != {timing!r}")
+    _wait_picture(page, before)
+    sent = page.evaluate(f"window.__fgWire.sent.slice({n})")
+    assert any("set_param" in m and "thickness" in m for m in sent)
+    assert not any("viewport.geometry.array.get" in m for m in sent)
+    assert page.evaluate("window.__fgWire.binaryType") == "arraybuffer"
+    page.wait_for_function(f"document.querySelector('#graph').innerHTML != {drawing!r}")
+    assert page.locator("#graph [data-node='tube']").count() == 1  # still clickable
 
 
 def _aspect(img: np.ndarray) -> float:

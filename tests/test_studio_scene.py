@@ -79,3 +79,68 @@ def test_unchanged_cells_keep_their_array_and_hash(tmp_path):
         assert np.array_equal(np.asarray(legacy), data.faces)
     finally:
         plotter.close()
+
+
+def test_a_step_sends_only_its_new_arrays(tmp_path):
+    """SentArrays picks, from trame-vtk's own descriptions of the scene, the arrays a page
+    has not been sent: all of a first scene, only the moved points of a step."""
+    from trame_vtk.modules.vtk.serializers import SynchronizationContext, serialize
+    from trame_vtk.modules.vtk.serializers.utils import reference_id
+
+    from formgraph.studio.scene import (
+        SentArrays,
+        StudioScene,
+        make_plotter,
+        send_back_faces,
+        send_cells_once,
+    )
+
+    _serializers()
+    send_back_faces()
+    send_cells_once()
+    path = tmp_path / "tube.yaml"
+    shutil.copy(TUBE, path)
+    s = StudioSession(path, out_dir=tmp_path / "out")
+    plotter = make_plotter()
+    try:
+        scene = StudioScene(plotter)
+        scene.update(s.open().shown)
+        window = plotter.render_window
+        context = SynchronizationContext()
+
+        def describe():
+            return serialize(None, window, reference_id(window), context, 1)
+
+        sent = SentArrays()
+        first = sent.fresh(describe())
+        mesh = scene.parts[("solid", "meshes")].data
+        lines = scene.parts[("solid", "features")].data
+        assert len(first) == len(set(first)) >= 4  # points, normals, faces, lines' points...
+        assert sent.fresh(describe()) == []  # the same scene: nothing new
+        scene.update(s.set_params(thickness=0.4).shown)
+        step = sent.fresh(describe())
+        # the tube's points and its feature lines' points moved; its faces, its normals
+        # (a thicker tube's normals are the same) and the lines' cells did not
+        assert len(step) == 2
+        moved = {context.get_cached_data_array(h, True) for h in step}
+        assert moved == {
+            np.ascontiguousarray(mesh.points, dtype=np.float32).tobytes(),
+            np.ascontiguousarray(lines.points, dtype=np.float32).tobytes(),
+        }
+        assert sent.fresh(describe()) == []
+    finally:
+        plotter.close()
+
+
+def test_sent_arrays_forget_the_oldest():
+    from formgraph.studio.scene import SentArrays
+
+    def scene(*hashes):  # the shape of trame-vtk's descriptions, one array per dependency
+        deps = [{"properties": {"p": {"vtkClass": "vtkPoints", "hash": h}}} for h in hashes]
+        return {"dependencies": deps, "properties": {"n": {"vtkClass": "x"}}}
+
+    sent = SentArrays()
+    assert sent.fresh(scene("a", "b", "a")) == ["a", "b"]  # each once, in order
+    assert sent.fresh(scene("b", "c")) == ["c"]
+    sent.fresh(scene(*(f"h{i}" for i in range(SentArrays.KEPT - 1))))  # "a" the oldest
+    assert sent.fresh(scene("a", "c")) == ["a"]

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from typing import Any
 
-__all__ = ["CSS", "EDITOR_LOADER", "build", "clickable_svg"]
+__all__ = ["ARRAYS", "CSS", "EDITOR_LOADER", "build", "clickable_svg"]
 
 CSS = """
 html, body { overflow: hidden; }
@@ -95,6 +95,82 @@ window.fgLoadEditor = function (files, ready) {  // files: {styles, scripts, use
 """
 
 
+# How a step's arrays reach vtk.js (this runs before the 3-D view is set up). trame's client
+# reads each binary websocket message as a Blob, whose bytes the browser hands back
+# asynchronously, and wraps each array vtk.js asks for in a Blob again (read with a
+# FileReader): some 20 ms of the page's time for a step of the spiral tube, and a wait
+# for each read. Here the websocket delivers ArrayBuffers instead (its binaryType is set
+# when trame's client first sends on it, and each message reaches wslink's reader through
+# a Chunk, the part of the Blob interface it uses); the arrays a step sends ahead of its
+# scene (formgraph.studio.scene.ARRAYS_TOPIC) are kept by hash until vtk.js asks for them,
+# and any other array is asked for as before, its bytes handed on as an ArrayBuffer.
+ARRAYS = """
+(() => {
+  class Chunk {  // what wslink's client reads of a message: size, slice, arrayBuffer
+    constructor(buffer, start = 0, end = buffer.byteLength) {
+      this.buffer = buffer;
+      this.start = start;
+      this.end = end;
+    }
+    get size() { return this.end - this.start; }
+    slice(a = 0, b = this.size) {
+      const n = this.size;
+      const at = (i) => Math.min(Math.max(i < 0 ? n + i : i, 0), n);
+      const lo = at(a);
+      return new Chunk(this.buffer, this.start + lo, this.start + Math.max(lo, at(b)));
+    }
+    arrayBuffer() {
+      const whole = this.start === 0 && this.end === this.buffer.byteLength;
+      return Promise.resolve(whole ? this.buffer : this.buffer.slice(this.start, this.end));
+    }
+  }
+  const send = WebSocket.prototype.send;
+  WebSocket.prototype.send = function (data) {
+    if (!this.fgBuffers && typeof this.onmessage === 'function') {
+      this.fgBuffers = true;
+      const handle = this.onmessage;
+      this.binaryType = 'arraybuffer';
+      this.onmessage = (event) => handle(
+        event.data instanceof ArrayBuffer ? {data: new Chunk(event.data)} : event);
+    }
+    return send.call(this, data);
+  };
+  const asBuffer = (data) => {  // msgpack's bytes (a view) as an ArrayBuffer of their own
+    if (!data || !(data.buffer instanceof ArrayBuffer)) return data;  // text: base64
+    const whole = data.byteOffset === 0 && data.byteLength === data.buffer.byteLength;
+    return whole ? data.buffer
+      : data.buffer.slice(data.byteOffset, data.byteOffset + data.byteLength);
+  };
+  const sent = new Map();  // hash -> ArrayBuffer, until vtk.js asks for it
+  const client = window.trame.client;
+  const session = client.getConnection().getSession();
+  session.subscribe('%(topic)s', ([arrays]) => {
+    for (const [hash, data] of Object.entries(arrays)) sent.set(hash, asBuffer(data));
+    while (sent.size > 64) sent.delete(sent.keys().next().value);  // (the oldest first)
+  });
+  client.registerProtocol('SyncView', (s) => ({  // trame's own, but for getArray
+    getArray(hash, binary = true) {
+      if (sent.has(hash)) {
+        const buffer = sent.get(hash);
+        sent.delete(hash);
+        return Promise.resolve(buffer);
+      }
+      return s.call('viewport.geometry.array.get', [hash, binary]).then(asBuffer);
+    },
+    getViewState(id, fresh = false) {
+      return s.call('viewport.geometry.view.get.state', [id, fresh]);
+    },
+    addViewObserver(id) { return s.call('viewport.geometry.view.observer.add', [id]); },
+    removeViewObserver(id) { return s.call('viewport.geometry.view.observer.remove', [id]); },
+    subscribeToViewChange(fn) {
+      return s.subscribe('viewport.geometry.view.subscription', fn);
+    },
+    unsubscribe(subscription) { return s.unsubscribe(subscription); },
+  }));
+})();
+"""
+
+
 def clickable_svg(drawing: Any) -> str:
     """The drawing's SVG with an invisible rectangle over each node box, ``data-node`` set
     to the node's name (the page's click handler reads it)."""
@@ -128,10 +204,13 @@ def build(page: Any) -> tuple[Any, Any]:
     from trame.widgets import vuetify3 as v
     from trame_pyvista.widgets import PyVistaLocalView
 
+    from .scene import ARRAYS_TOPIC
+
     page.state.editor_ready = False
     with VAppLayout(page.server, full_height=True) as layout:
         client.Style(CSS)
         client.Script(EDITOR_LOADER)
+        client.Script(ARRAYS % {"topic": ARRAYS_TOPIC})
         ready = "() => trame.state.set('editor_ready', true)"
         load = f"window.fgLoadEditor(editor_files, {ready})"
         after_draw = f"window.fgAfterDraw(() => {load}, 8000)"

@@ -24,6 +24,7 @@ from typing import Any
 from formgraph.core.errors import Problem
 
 from .layout import build
+from .scene import ARRAYS_TOPIC
 from .session import Control, Cooked, StudioSession, controls_of, plain
 from .worker import Worker
 
@@ -61,7 +62,7 @@ class Page:
     def __init__(self, session: StudioSession, guard: Any):
         from trame.app import get_server
 
-        from .scene import StudioScene, make_plotter
+        from .scene import SentArrays, StudioScene, make_plotter
 
         self.session = session
         self.guard = guard
@@ -84,6 +85,9 @@ class Page:
         self.updates = 0  # view updates sent
         self._settle_timer: Any = None
         self._settled_svg: str | None = None  # the drawing to send once steps settle
+        self._to_draw: Cooked | None = None  # a step to draw the graph of once they settle
+        self._drawings = 0  # drawings of the graph shown (a late one must not cover a newer)
+        self._sent = SentArrays()  # the data arrays the pages have
         self._scene_stale = False  # the state's whole scene is older than the picture
         from formgraph.viewer.watch import _Watched
 
@@ -248,10 +252,15 @@ class Page:
     def _deliver(self, kind: str, result: Any, seconds: float) -> None:
         """In the worker thread: what can be made away from the page's loop (the datasets
         of the picture, the graph's drawing), then the rest on the loop."""
+        if kind == "drawing":  # a slider step's drawing of the graph, once steps settled
+            if result is not None and self.loop is not None:
+                self.loop.call_soon_threadsafe(self._show_drawing, *result)
+            return
         t0 = time.perf_counter()
         prepared = None
-        # a slider step's drawing of the graph is sent once the steps settle: made after
-        # its picture is handed on, so the picture does not wait for it
+        # a slider step's drawing of the graph is made and sent once the steps settle
+        # (:meth:`_settled`): made now, it would hold the interpreter while the page's loop
+        # sends the picture
         later = kind == "params" and isinstance(result, Cooked)
         if isinstance(result, Cooked):
             datasets = None
@@ -268,10 +277,6 @@ class Page:
                 self._early.append((kind, result, seconds, prepared))
                 return
         self.loop.call_soon_threadsafe(self._apply, kind, result, seconds, prepared)
-        if later and not self.worker.waiting("params"):  # (a newer step draws its own)
-            svg = self._drawing(result)
-            if svg is not None:
-                self.loop.call_soon_threadsafe(self._settle_drawing, svg)
 
     def _snapshot(self) -> dict[str, Any]:
         """What the page shows of the session, read in the worker thread, between two of
@@ -346,6 +351,8 @@ class Page:
                 s.status += f"{self.session.out_dir}"
                 s.status_bad = False
                 if svg is not None:
+                    self._to_draw, self._settled_svg = None, None
+                    self._drawings += 1
                     s.graph_svg = svg
                 return
             s.problems = _problem_lines(cooked.problems)
@@ -367,7 +374,11 @@ class Page:
                 s.params = {c.name: plain(c.value) for c in self.controls}
             if svg is not None and kind == "params":
                 self._settled_svg = svg  # a slider step: the drawing once the steps settle
+            elif kind == "params":
+                self._to_draw = cooked  # drawn once the steps settle
             elif svg is not None:
+                self._to_draw, self._settled_svg = None, None
+                self._drawings += 1
                 s.graph_svg = svg
             s.shown = snap["shown_text"]
             if cooked.ok:
@@ -398,30 +409,49 @@ class Page:
         }
         with s:
             s.cook_id = s.cook_id + 1
+            timing["step"] = s.cook_id  # (so that two steps' timings always differ)
             s.timing = timing
         self._settle()
 
     def _settle(self) -> None:
         """Send what the picture did not need (see SETTLE_DELAY), once steps pause."""
-        if self.loop is None or (self._settled_svg is None and not self._scene_stale):
+        if self.loop is None:
+            return
+        if self._settled_svg is None and self._to_draw is None and not self._scene_stale:
             return
         if self._settle_timer is not None:
             self._settle_timer.cancel()
         self._settle_timer = self.loop.call_later(SETTLE_DELAY, self._settled)
 
-    def _settle_drawing(self, svg: str) -> None:
-        """A slider step's drawing of the graph, sent once the steps settle."""
-        self._settled_svg = svg
-        self._settle()
-
     def _settled(self) -> None:
         self._settle_timer = None
         if self._scene_stale:
             self._send_whole_scene()
+        if self._to_draw is not None:  # drawn in the worker, shown by _show_drawing
+            cooked, self._to_draw = self._to_draw, None
+            graph = self.session.graph
+            self.worker.submit("drawing", self._draw_step, cooked, graph, self._drawings)
         if self._settled_svg is not None:
             svg, self._settled_svg = self._settled_svg, None
+            self._drawings += 1
             with self.state:
                 self.state.graph_svg = svg
+
+    def _draw_step(self, cooked: Cooked, graph: Any, drawings: int) -> tuple[str, int] | None:
+        """In the worker: a settled step's drawing of the graph (None: the graph is no
+        longer the one it cooked)."""
+        if self.session.graph is not graph:
+            return None
+        svg = self._drawing(cooked)
+        return None if svg is None else (svg, drawings)
+
+    def _show_drawing(self, svg: str, drawings: int) -> None:
+        """A settled step's drawing, unless a newer one was shown since it was asked for."""
+        if drawings != self._drawings or self._to_draw is not None:
+            return
+        self._drawings += 1
+        with self.state:
+            self.state.graph_svg = svg
 
     def _drawing(self, cooked: Cooked) -> str | None:
         """The graph's drawing, coloured by the last evaluation (None: nothing to draw)."""
@@ -483,6 +513,11 @@ class Page:
         delta = view._helper.scene(
             window, new_state=False, widgets=view._widgets, orientation_axis=0
         )
+        fresh = self._sent.fresh(delta)
+        if fresh:  # the new arrays ahead of the scene: vtk.js need not ask for them
+            get = self.server.protocol_call
+            arrays = {h: get("viewport.geometry.array.get", h, True) for h in fresh}
+            protocol.publish(ARRAYS_TOPIC, arrays)
         protocol.publish("trame.vtk.delta", delta)
         self._scene_stale = True
         if immediately:  # a first picture, or new actors: a page loading now needs them
@@ -497,6 +532,7 @@ class Page:
         full = view._helper.scene(
             view._VtkLocalView__view, new_state=True, widgets=view._widgets, orientation_axis=0
         )
+        self._sent.fresh(full)  # (a page loading it asks for its arrays)
         self.state[view._VtkLocalView__scene_id] = full
 
 

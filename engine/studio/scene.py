@@ -24,7 +24,9 @@ from formgraph.viewer.datasets import colour_by, datasets_of, expand, geometry_i
 from formgraph.viewer.style import BACKGROUND, PALETTE, apply_material, mix, style
 
 __all__ = [
+    "ARRAYS_TOPIC",
     "Prepared",
+    "SentArrays",
     "StudioScene",
     "make_plotter",
     "quantized_normals",
@@ -35,6 +37,43 @@ __all__ = [
 DRAWN = ("meshes", "surfaces", "features", "curves", "points")  # control overlays left out
 COLOURED = ("meshes", "surfaces", "points")  # what an attribute colours (as in the viewer)
 INTERNAL = {"Normals", "vtkOriginalPointIds", "vtkOriginalCellIds", "TCoords"}
+ARRAYS_TOPIC = "formgraph.arrays"  # a step's new data arrays, sent ahead of its scene
+
+
+class SentArrays:
+    """The data arrays the pages were sent or told of, by hash, to send a step's new ones
+    with it.
+
+    vtk.js asks for each array of a scene it has not seen (one request per array, answered
+    once the server's loop gets to it); the studio sends a step's new arrays ahead of its
+    scene instead (:data:`ARRAYS_TOPIC`; the page's script hands them to vtk.js when it
+    asks, see :data:`formgraph.studio.layout.ARRAYS`). An array the page holds already
+    costs bytes when sent again, one it lacks a request: :meth:`fresh` errs neither way
+    for the arrays of recent scenes, and the page asks for any it misses.
+    """
+
+    KEPT = 256  # hashes remembered (a scene has a few per actor)
+
+    def __init__(self) -> None:
+        self._seen: dict[str, None] = {}
+
+    def fresh(self, scene: dict[str, Any]) -> list[str]:
+        """The hashes of ``scene``'s arrays not in an earlier scene; all of them are
+        remembered from now on."""
+        from trame_vtk.modules.vtk.serializers import extract_array_hash
+
+        out: dict[str, None] = {}
+        for entry in extract_array_hash(scene):
+            digest = entry.get("hash")
+            if not digest:
+                continue
+            if digest not in self._seen:
+                out[digest] = None
+            self._seen.pop(digest, None)
+            self._seen[digest] = None  # the newest last
+        while len(self._seen) > self.KEPT:
+            del self._seen[next(iter(self._seen))]
+        return list(out)
 
 
 def send_back_faces() -> None:
