@@ -79,17 +79,18 @@ def _edge_hashes(cells: np.ndarray, case: np.ndarray, nbr: np.ndarray) -> np.nda
     edge hashes: owner slot * 1536 + axis * 512 + owner's local corner (``nbr``
     flattened, eight slots a block)."""
     count = TRI_COUNT[case]
-    first = np.cumsum(count) - count
-    n_tri = int(count.sum())
-    which = np.repeat(np.arange(len(cells), dtype=cells.dtype), count)
-    row = case[which].astype(cells.dtype) * 5 + (np.arange(n_tri, dtype=cells.dtype) - first[which])
-    cw = cells[which]
-    key = ((cw & (B3 - 1)) * 12)[:, None] + np.take(
-        TRI_ROWS, row, axis=0
-    )  # (t, 3): local cell, cube edge
+    dt = cells.dtype
+    # each triangle's row of the table (case * 5 + its rank in the cell) and its cell
+    row = np.repeat(case.astype(dt) * 5 - (np.cumsum(count, dtype=dt) - count), count)
+    row += np.arange(len(row), dtype=dt)
+    cw = np.repeat(cells, count)
+    key = np.take(TRI_ROWS, row, axis=0)  # (t, 3): the cube edges, then (local cell, edge)
+    key += ((cw & (B3 - 1)) * 12)[:, None]
     packed = np.take(EDGE_PACK, key)
     owner = np.take(nbr, ((cw >> 9) * 8)[:, None] + (packed >> 11))
-    return owner * (3 * B3) + (packed & 2047)
+    owner *= 3 * B3
+    owner += packed & 2047
+    return owner
 
 
 HALO = B + 3  # a block's corners -1..9 along each axis: its edges' samples at -1, 0, 1, 2
@@ -202,9 +203,11 @@ class _Vertices:
                 out[i : i + n] = checked(self.f(self._points(j, a, u)))
         return out
 
-    def _points(self, ijk: np.ndarray, axis: np.ndarray, t: np.ndarray) -> np.ndarray:
-        p = ijk.astype(np.float64)
-        p[np.arange(len(p)), axis] += t
+    def _points(self, ijk: np.ndarray, axis: np.ndarray, t: np.ndarray, out=None) -> np.ndarray:
+        """The points at parameters ``t`` on edges ``(ijk, axis)`` (into ``out``)."""
+        p = np.empty((len(t), 3)) if out is None else out
+        p[...] = ijk
+        p.reshape(-1)[np.arange(0, 3 * len(t), 3) + axis] += t
         p *= self.lat.cell
         p += self.lat.origin
         return p
@@ -235,7 +238,7 @@ class _Vertices:
             den = fa - fb
             t = np.divide(fa, den, out=np.full(n, 0.5), where=den != 0)
             t = np.clip(t, END_GAP, 1 - END_GAP, out=t)
-        self.verts[self.placed : self.placed + n] = self._points(ijk, axis, t)
+        self._points(ijk, axis, t, out=self.verts[self.placed : self.placed + n])
         self.placed += n
 
     def finish(self) -> np.ndarray:
