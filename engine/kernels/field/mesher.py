@@ -94,8 +94,10 @@ def _edge_hashes(cells: np.ndarray, case: np.ndarray, nbr: np.ndarray) -> np.nda
 
 
 HALO = B + 3  # a block's corners -1..9 along each axis: its edges' samples at -1, 0, 1, 2
-LOCAL_IJK = LOCAL.astype(np.int64)
-HALO_AT = (LOCAL_IJK + 1) @ np.array([HALO * HALO, HALO, 1])  # local corner -> halo position
+LOCAL_T = np.ascontiguousarray(LOCAL.T.astype(np.int32))  # (3, 512): a corner's x, y, z
+HALO_AT = (LOCAL.astype(np.int64) + 1) @ np.array(
+    [HALO * HALO, HALO, 1]
+)  # local corner -> halo position
 HALO_STEP = np.array([HALO * HALO, HALO, 1])  # one corner along each axis in the halo
 
 
@@ -120,6 +122,7 @@ class _Vertices:
         self.waiting = 0  # edges pending
         self.halo = np.full((min(GROUP, len(lat.blocks)), HALO, HALO, HALO), np.nan)
         self.corners = lat.values.reshape(-1, B, B, B)
+        self.base_t = np.ascontiguousarray(lat.base.T.astype(np.int32))  # slots' corner 0
 
     def own(self, s: int, e: int, used: np.ndarray) -> None:
         """The used edges of kept slots ``s:e``, as positions in their edge range (slot,
@@ -138,8 +141,9 @@ class _Vertices:
                 if m.any():
                     corner = start[m] if v is fa else self.lat.step(start[m], axis[m], 1)
                     v[m] = self._corners(corner)
-        ijk = np.take(self.lat.base, b + s, axis=0) + np.take(LOCAL_IJK, loc, axis=0)
-        self._queue(ijk, axis, fm, fa, fb, fq)
+        ijk_t = np.take(self.base_t, b + s, axis=1)
+        ijk_t += np.take(LOCAL_T, loc, axis=1)
+        self._queue(ijk_t, axis, fm, fa, fb, fq)
 
     def others(self, edges: np.ndarray) -> None:
         """Used edges of the touched slots that are not kept (``slot * 1536 + axis * 512
@@ -153,7 +157,7 @@ class _Vertices:
         fa, fb = self._corners(start), self._corners(end)
         fm = np.where(before >= 0, lat.values[before], np.nan)
         fq = np.where(after >= 0, lat.values[after], np.nan)
-        self._queue(lat.base[slot] + LOCAL_IJK[loc], axis, fm, fa, fb, fq)
+        self._queue(self.base_t[:, slot] + LOCAL_T[:, loc], axis, fm, fa, fb, fq)
         self._flush()
 
     def _corners(self, corner: np.ndarray) -> np.ndarray:
@@ -213,7 +217,8 @@ class _Vertices:
         return p
 
     def _queue(self, *edges: np.ndarray) -> None:
-        """Edges to place, ``(ijk, axis, fm, fa, fb, fq)``: placed :data:`CHUNK` or more
+        """Edges to place, ``(ijk (3, n), axis, fm, fa, fb, fq)`` (the lattice indices by
+        columns: the lines' tables take them so without a copy): placed :data:`CHUNK` or more
         at a time (a group's are too few to be worth the calls)."""
         self.pending.append(edges)
         self.waiting += len(edges[0])
@@ -222,9 +227,10 @@ class _Vertices:
 
     def _flush(self) -> None:
         if self.pending:
-            edges = [np.concatenate(a) for a in zip(*self.pending, strict=True)]
+            ijk_t, *edges = zip(*self.pending, strict=True)
+            edges = [np.concatenate(a) for a in edges]
             self.pending, self.waiting = [], 0
-            self._place(*edges)
+            self._place(np.concatenate(ijk_t, axis=1).T, *edges)
 
     def _place(self, ijk, axis, fm, fa, fb, fq) -> None:
         n = len(fa)
