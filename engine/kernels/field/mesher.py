@@ -61,6 +61,33 @@ EDGE_PACK = EDGE_OWNER << 11 | EDGE_PLACE  # both in one gather (a place is belo
 TRI_ROWS = TRI_EDGES.reshape(-1, 3).astype(np.int32)  # case * 5 + triangle -> its edges
 
 
+def _ranks(used: np.ndarray, hashes: list[np.ndarray], dtype) -> tuple[np.ndarray, int]:
+    """Each hash's rank among the ``used`` ones (its vertex number), flat, and their count.
+
+    The rank is the count of used entries before it: a prefix sum over 16-bit words of
+    the packed marks plus the bits below it in its own word, so no array of the hash
+    space's size is ever written (its pages alone cost more than the counting).
+    """
+    words = np.packbits(used, bitorder="little").view("<u2")
+    pop = np.bitwise_count(words).astype(np.int64)
+    # the count before each word and the word itself in one int64: one gather a hash
+    packed = np.cumsum(pop)
+    count = int(packed[-1]) if len(packed) else 0
+    packed -= pop
+    packed <<= 16
+    packed |= words
+    out = np.empty(sum(h.size for h in hashes), dtype=dtype)
+    at = 0
+    for h in hashes:
+        h = h.reshape(-1)
+        word = np.take(packed, h >> 4)
+        word &= (np.left_shift(1, h & 15, dtype=np.int64) - 1) | ~np.int64(0xFFFF)
+        out[at : at + h.size] = word >> 16
+        out[at : at + h.size] += np.bitwise_count(word & 0xFFFF)
+        at += h.size
+    return out.reshape(-1, 3), count
+
+
 def crossing_cells(f: Fn, lo, hi, cell: float, lipschitz: float = 1.0, max_cells=50_000_000):
     """Global (i, j, k) of the finest cells :func:`mesh_field` polygonizes (those with a
     sign change among their corners), on the grid of :func:`plan_grid`."""
@@ -316,37 +343,28 @@ def mesh_field(
     ns, edges = len(lat.touched), 3 * B3
     idx = np.int32 if ns * edges < 2**31 else np.int64
     nbr = lat.nbr.astype(idx).reshape(-1)
-    # the used edges and their numbers: a slot's edges are used only by its own block's
-    # cells and its lower neighbours' (earlier in the order), so once a group is through,
-    # its own slots are complete and numbered (no ranking pass, no sort)
+    # the used edges, marked; their numbers are their ranks among the marks (hash order:
+    # slot by slot, the kept ones first). A slot's edges are used only by its own block's
+    # cells and its lower neighbours' (earlier in the order), so the vertices are placed
+    # group by group in number order
     used = np.zeros(ns * edges, dtype=bool)
-    number = np.empty(ns * edges, dtype=idx)  # written where used
-    hashes, owns, count = [], [], 0
+    hashes = []
     for s in range(0, nk, GROUP):
         e = min(s + GROUP, nk)
         cells, case = lat.mixed_cells(s, e)
         edge = _edge_hashes(cells.astype(idx), case, nbr)  # a perfect hash of the edge
         used[edge] = True
         hashes.append(edge)
-        own = np.flatnonzero(used[s * edges : e * edges])
-        number[s * edges + own] = np.arange(count, count + len(own))
-        owns.append(own)
-        count += len(own)
-    rest = np.flatnonzero(used[nk * edges :]) + nk * edges
-    number[rest] = np.arange(count, count + len(rest))
-    count += len(rest)
+    tri, count = _ranks(used, hashes, idx)
+    del hashes
     if not count:
         return empty
-    tri = np.empty(sum(h.size for h in hashes), dtype=idx)
-    at = 0
-    for h in hashes:
-        np.take(number, h.reshape(-1), out=tri[at : at + h.size])
-        at += h.size
-    del used, number, hashes
     vertices = _Vertices(lat, f, count, root_steps, lipschitz, lines, grid is not None)
-    for s, own in zip(range(0, nk, GROUP), owns, strict=True):
+    for s in range(0, nk, GROUP):
+        own = np.flatnonzero(used[s * edges : (s + GROUP) * edges])
         if len(own):
             vertices.own(s, min(s + GROUP, nk), own)
+    rest = np.flatnonzero(used[nk * edges :])
     if len(rest):
-        vertices.others(rest)
+        vertices.others(rest + nk * edges)
     return vertices.finish(), tri.reshape(-1, 3)
