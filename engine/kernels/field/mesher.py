@@ -361,9 +361,10 @@ def mesh_field(
         return empty
     vertices = _Vertices(lat, f, count, root_steps, lipschitz, lines, grid is not None)
     for s in range(0, nk, GROUP):
-        own = np.flatnonzero(used[s * edges : (s + GROUP) * edges])
+        e = min(s + GROUP, nk)
+        own = np.flatnonzero(used[s * edges : e * edges])
         if len(own):
-            vertices.own(s, min(s + GROUP, nk), own)
+            vertices.own(s, e, own)
     rest = np.flatnonzero(used[nk * edges :])
     if len(rest):
         vertices.others(rest + nk * edges)
