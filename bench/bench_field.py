@@ -94,23 +94,18 @@ def run(table) -> None:
     case = (
         f"gyroid lattice, {side:g} mm cube at 0.25 mm cells ({(side / 0.25) ** 3 / 1e6:.1f}M dense)"
     )
-    table.time(
+    table.time_together(  # alternating rounds: a burst of load falls on all three
         case,
-        "formgraph",
-        lambda: _ours(f, side),
-        repeat=1,
-    )
-    table.time(
-        case,
-        "numpy dense + skimage marching_cubes",
-        lambda: _dense_skimage(f, side, 0.25),
-        repeat=1,
-    )
-    table.time(
-        case,
-        "numpy dense on the lattice tables + skimage (not the target's reference)",
-        lambda: _dense_tables_skimage(f, side, 0.25),
-        repeat=1,
+        [
+            ("formgraph", lambda: _ours(f, side), ""),
+            ("numpy dense + skimage marching_cubes", lambda: _dense_skimage(f, side, 0.25), ""),
+            (
+                "numpy dense on the lattice tables + skimage (not the target's reference)",
+                lambda: _dense_tables_skimage(f, side, 0.25),
+                "",
+            ),
+        ],
+        rounds=3,
     )
     small = 10.0
     case_m = (

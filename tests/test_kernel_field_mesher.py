@@ -10,7 +10,7 @@ import trimesh
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from formgraph.kernels.field import mctable, mesher, sdf
+from formgraph.kernels.field import lattice, mctable, mesher, sdf
 
 O = np.zeros(3)
 
@@ -209,3 +209,25 @@ def test_samples_grow_with_the_area_not_the_volume():
     # halving the cell: 4x the surface's cells; a dense grid would sample 8x
     assert 3.5 < counts[1] / counts[0] < 4.8
     assert max(calls) <= mesher.CHUNK  # the field is sampled in chunks that stay cached
+
+
+@pytest.mark.parametrize("dense", [False, True])
+def test_many_groups_of_blocks_number_every_vertex_once(dense):
+    # more kept blocks than one group holds, the last group partial, and a surface that
+    # leaves the box (a field not positive on its boundary), so the touched slots that
+    # are not kept hold used edges too: every vertex numbered and placed once
+    def ball(p):
+        return sdf.sphere(p, 1.0, O)
+
+    lo, hi, cell = [-0.8] * 3, [0.8] * 3, 0.03
+    lat = lattice.Lattice(ball, lo, hi, cell, 1.0, 10**8)
+    nk = len(lat.blocks)
+    assert nk > mesher.GROUP and nk % mesher.GROUP and len(lat.touched) > nk
+    grid = _lattices(ball) if dense else None
+    v, t = mesher.mesh_field(ball, lo, hi, cell, grid=grid)
+    use = _edge_use(t)
+    assert use.max() == 2 and len(np.unique(t)) == len(v)
+    assert np.abs(np.linalg.norm(v, axis=1) - 1).max() <= 5e-4 * cell  # ACCEPT of a cell
+    # the open sphere's rims (where it leaves the grid) are its only edges used once
+    m = trimesh.Trimesh(v, t, process=False)
+    assert m.is_winding_consistent and (use == 1).any()

@@ -243,7 +243,8 @@ class Lattice:
         self.kept1 = None
         nk, cell = len(self.blocks), self.cell
         at = self.origin + self.base * cell
-        values = np.full((ns, B, B, B), np.nan)
+        values = np.empty((ns, B, B, B))  # each block written once (one pass of memory)
+        values[nk:] = np.nan
         for s in range(0, nk, GROUP):
             e = min(s + GROUP, nk)
             values[s:e] = checked(grid(at[s:e], cell, (B, B, B))).reshape(e - s, B, B, B)

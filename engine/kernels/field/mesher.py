@@ -61,6 +61,33 @@ EDGE_PACK = EDGE_OWNER << 11 | EDGE_PLACE  # both in one gather (a place is belo
 TRI_ROWS = TRI_EDGES.reshape(-1, 3).astype(np.int32)  # case * 5 + triangle -> its edges
 
 
+def _ranks(used: np.ndarray, hashes: list[np.ndarray], dtype) -> tuple[np.ndarray, int]:
+    """Each hash's rank among the ``used`` ones (its vertex number), flat, and their count.
+
+    The rank is the count of used entries before it: a prefix sum over 16-bit words of
+    the packed marks plus the bits below it in its own word, so no array of the hash
+    space's size is ever written (its pages alone cost more than the counting).
+    """
+    words = np.packbits(used, bitorder="little").view("<u2")
+    pop = np.bitwise_count(words).astype(np.int64)
+    # the count before each word and the word itself in one int64: one gather a hash
+    packed = np.cumsum(pop)
+    count = int(packed[-1]) if len(packed) else 0
+    packed -= pop
+    packed <<= 16
+    packed |= words
+    out = np.empty(sum(h.size for h in hashes), dtype=dtype)
+    at = 0
+    for h in hashes:
+        h = h.reshape(-1)
+        word = np.take(packed, h >> 4)
+        word &= (np.left_shift(1, h & 15, dtype=np.int64) - 1) | ~np.int64(0xFFFF)
+        out[at : at + h.size] = word >> 16
+        out[at : at + h.size] += np.bitwise_count(word & 0xFFFF)
+        at += h.size
+    return out.reshape(-1, 3), count
+
+
 def crossing_cells(f: Fn, lo, hi, cell: float, lipschitz: float = 1.0, max_cells=50_000_000):
     """Global (i, j, k) of the finest cells :func:`mesh_field` polygonizes (those with a
     sign change among their corners), on the grid of :func:`plan_grid`."""
@@ -79,22 +106,25 @@ def _edge_hashes(cells: np.ndarray, case: np.ndarray, nbr: np.ndarray) -> np.nda
     edge hashes: owner slot * 1536 + axis * 512 + owner's local corner (``nbr``
     flattened, eight slots a block)."""
     count = TRI_COUNT[case]
-    first = np.cumsum(count) - count
-    n_tri = int(count.sum())
-    which = np.repeat(np.arange(len(cells), dtype=cells.dtype), count)
-    row = case[which].astype(cells.dtype) * 5 + (np.arange(n_tri, dtype=cells.dtype) - first[which])
-    cw = cells[which]
-    key = ((cw & (B3 - 1)) * 12)[:, None] + np.take(
-        TRI_ROWS, row, axis=0
-    )  # (t, 3): local cell, cube edge
+    dt = cells.dtype
+    # each triangle's row of the table (case * 5 + its rank in the cell) and its cell
+    row = np.repeat(case.astype(dt) * 5 - (np.cumsum(count, dtype=dt) - count), count)
+    row += np.arange(len(row), dtype=dt)
+    cw = np.repeat(cells, count)
+    key = np.take(TRI_ROWS, row, axis=0)  # (t, 3): the cube edges, then (local cell, edge)
+    key += ((cw & (B3 - 1)) * 12)[:, None]
     packed = np.take(EDGE_PACK, key)
     owner = np.take(nbr, ((cw >> 9) * 8)[:, None] + (packed >> 11))
-    return owner * (3 * B3) + (packed & 2047)
+    owner *= 3 * B3
+    owner += packed & 2047
+    return owner
 
 
 HALO = B + 3  # a block's corners -1..9 along each axis: its edges' samples at -1, 0, 1, 2
-LOCAL_IJK = LOCAL.astype(np.int64)
-HALO_AT = (LOCAL_IJK + 1) @ np.array([HALO * HALO, HALO, 1])  # local corner -> halo position
+LOCAL_T = np.ascontiguousarray(LOCAL.T.astype(np.int32))  # (3, 512): a corner's x, y, z
+HALO_AT = (LOCAL.astype(np.int64) + 1) @ np.array(
+    [HALO * HALO, HALO, 1]
+)  # local corner -> halo position
 HALO_STEP = np.array([HALO * HALO, HALO, 1])  # one corner along each axis in the halo
 
 
@@ -119,6 +149,7 @@ class _Vertices:
         self.waiting = 0  # edges pending
         self.halo = np.full((min(GROUP, len(lat.blocks)), HALO, HALO, HALO), np.nan)
         self.corners = lat.values.reshape(-1, B, B, B)
+        self.base_t = np.ascontiguousarray(lat.base.T.astype(np.int32))  # slots' corner 0
 
     def own(self, s: int, e: int, used: np.ndarray) -> None:
         """The used edges of kept slots ``s:e``, as positions in their edge range (slot,
@@ -137,8 +168,9 @@ class _Vertices:
                 if m.any():
                     corner = start[m] if v is fa else self.lat.step(start[m], axis[m], 1)
                     v[m] = self._corners(corner)
-        ijk = np.take(self.lat.base, b + s, axis=0) + np.take(LOCAL_IJK, loc, axis=0)
-        self._queue(ijk, axis, fm, fa, fb, fq)
+        ijk_t = np.take(self.base_t, b + s, axis=1)
+        ijk_t += np.take(LOCAL_T, loc, axis=1)
+        self._queue(ijk_t, axis, fm, fa, fb, fq)
 
     def others(self, edges: np.ndarray) -> None:
         """Used edges of the touched slots that are not kept (``slot * 1536 + axis * 512
@@ -152,7 +184,7 @@ class _Vertices:
         fa, fb = self._corners(start), self._corners(end)
         fm = np.where(before >= 0, lat.values[before], np.nan)
         fq = np.where(after >= 0, lat.values[after], np.nan)
-        self._queue(lat.base[slot] + LOCAL_IJK[loc], axis, fm, fa, fb, fq)
+        self._queue(self.base_t[:, slot] + LOCAL_T[:, loc], axis, fm, fa, fb, fq)
         self._flush()
 
     def _corners(self, corner: np.ndarray) -> np.ndarray:
@@ -202,15 +234,18 @@ class _Vertices:
                 out[i : i + n] = checked(self.f(self._points(j, a, u)))
         return out
 
-    def _points(self, ijk: np.ndarray, axis: np.ndarray, t: np.ndarray) -> np.ndarray:
-        p = ijk.astype(np.float64)
-        p[np.arange(len(p)), axis] += t
+    def _points(self, ijk: np.ndarray, axis: np.ndarray, t: np.ndarray, out=None) -> np.ndarray:
+        """The points at parameters ``t`` on edges ``(ijk, axis)`` (into ``out``)."""
+        p = np.empty((len(t), 3)) if out is None else out
+        p[...] = ijk
+        p.reshape(-1)[np.arange(0, 3 * len(t), 3) + axis] += t
         p *= self.lat.cell
         p += self.lat.origin
         return p
 
     def _queue(self, *edges: np.ndarray) -> None:
-        """Edges to place, ``(ijk, axis, fm, fa, fb, fq)``: placed :data:`CHUNK` or more
+        """Edges to place, ``(ijk (3, n), axis, fm, fa, fb, fq)`` (the lattice indices by
+        columns: the lines' tables take them so without a copy): placed :data:`CHUNK` or more
         at a time (a group's are too few to be worth the calls)."""
         self.pending.append(edges)
         self.waiting += len(edges[0])
@@ -219,9 +254,10 @@ class _Vertices:
 
     def _flush(self) -> None:
         if self.pending:
-            edges = [np.concatenate(a) for a in zip(*self.pending, strict=True)]
+            ijk_t, *edges = zip(*self.pending, strict=True)
+            edges = [np.concatenate(a) for a in edges]
             self.pending, self.waiting = [], 0
-            self._place(*edges)
+            self._place(np.concatenate(ijk_t, axis=1).T, *edges)
 
     def _place(self, ijk, axis, fm, fa, fb, fq) -> None:
         n = len(fa)
@@ -235,7 +271,7 @@ class _Vertices:
             den = fa - fb
             t = np.divide(fa, den, out=np.full(n, 0.5), where=den != 0)
             t = np.clip(t, END_GAP, 1 - END_GAP, out=t)
-        self.verts[self.placed : self.placed + n] = self._points(ijk, axis, t)
+        self._points(ijk, axis, t, out=self.verts[self.placed : self.placed + n])
         self.placed += n
 
     def finish(self) -> np.ndarray:
@@ -307,37 +343,29 @@ def mesh_field(
     ns, edges = len(lat.touched), 3 * B3
     idx = np.int32 if ns * edges < 2**31 else np.int64
     nbr = lat.nbr.astype(idx).reshape(-1)
-    # the used edges and their numbers: a slot's edges are used only by its own block's
-    # cells and its lower neighbours' (earlier in the order), so once a group is through,
-    # its own slots are complete and numbered (no ranking pass, no sort)
+    # the used edges, marked; their numbers are their ranks among the marks (hash order:
+    # slot by slot, the kept ones first). A slot's edges are used only by its own block's
+    # cells and its lower neighbours' (earlier in the order), so the vertices are placed
+    # group by group in number order
     used = np.zeros(ns * edges, dtype=bool)
-    number = np.empty(ns * edges, dtype=idx)  # written where used
-    hashes, owns, count = [], [], 0
+    hashes = []
     for s in range(0, nk, GROUP):
         e = min(s + GROUP, nk)
         cells, case = lat.mixed_cells(s, e)
         edge = _edge_hashes(cells.astype(idx), case, nbr)  # a perfect hash of the edge
         used[edge] = True
         hashes.append(edge)
-        own = np.flatnonzero(used[s * edges : e * edges])
-        number[s * edges + own] = np.arange(count, count + len(own))
-        owns.append(own)
-        count += len(own)
-    rest = np.flatnonzero(used[nk * edges :]) + nk * edges
-    number[rest] = np.arange(count, count + len(rest))
-    count += len(rest)
+    tri, count = _ranks(used, hashes, idx)
+    del hashes
     if not count:
         return empty
-    tri = np.empty(sum(h.size for h in hashes), dtype=idx)
-    at = 0
-    for h in hashes:
-        np.take(number, h.reshape(-1), out=tri[at : at + h.size])
-        at += h.size
-    del used, number, hashes
     vertices = _Vertices(lat, f, count, root_steps, lipschitz, lines, grid is not None)
-    for s, own in zip(range(0, nk, GROUP), owns, strict=True):
+    for s in range(0, nk, GROUP):
+        e = min(s + GROUP, nk)
+        own = np.flatnonzero(used[s * edges : e * edges])
         if len(own):
-            vertices.own(s, min(s + GROUP, nk), own)
+            vertices.own(s, e, own)
+    rest = np.flatnonzero(used[nk * edges :])
     if len(rest):
-        vertices.others(rest)
+        vertices.others(rest + nk * edges)
     return vertices.finish(), tri.reshape(-1, 3)

@@ -247,16 +247,21 @@ class Lines:
 
     @functools.cached_property
     def _index(self):
-        """The indices by axis ``(3, n)`` and where in that array each point moves."""
+        """The indices by axis ``(3, n)`` and where in that array each point moves (an
+        ``ijk`` stored by columns, a transposed ``(3, n)`` array, is not copied)."""
         n = len(self)
-        return np.ascontiguousarray(self.ijk.T), self.axis * n + np.arange(n)
+        moving = self.axis * n
+        moving += np.arange(n, dtype=moving.dtype)
+        return np.ascontiguousarray(self.ijk.T), moving
 
     @functools.cached_property
     def _columns(self) -> np.ndarray:
         i, moving = self._index
         q = i.astype(np.float64)
         q.reshape(-1)[moving] += self.t
-        return self.origin[:, None] + q * self.step[:, None]
+        q *= self.step[:, None]
+        q += self.origin[:, None]
+        return q
 
     def columns(self) -> list[np.ndarray]:
         """The points' coordinates, one array an axis."""
@@ -273,9 +278,11 @@ class Lines:
         x = np.concatenate(
             [self.origin[k] + np.arange(lo[k], hi[k] + 1) * self.step[k] for k in range(3)]
         )
-        at = i - (lo - start[:3])[:, None]
-        s, c = np.sin(w * x)[at], np.cos(w * x)[at]
-        m = w * self._columns.reshape(-1)[moving]
+        at = i - (lo - start[:3]).astype(i.dtype)[:, None]
+        x *= w
+        s, c = np.take(np.sin(x), at), np.take(np.cos(x), at)
+        m = np.take(self._columns, moving)
+        m *= w
         s.reshape(-1)[moving] = np.sin(m)
         c.reshape(-1)[moving] = np.cos(m)
         return list(s), list(c)
