@@ -259,10 +259,7 @@ def build(page: Any) -> tuple[Any, Any]:
                             language="yaml",
                             theme="vs",
                             markers=("markers",),
-                            options=(
-                                "{ minimap: { enabled: false }, fontSize: 13, "
-                                "automaticLayout: true, scrollBeyondLastLine: false }",
-                            ),
+                            options=("editor_options",),
                         )
                         # resolved by name when it renders: it is registered after the
                         # page's template was compiled
@@ -333,7 +330,7 @@ def build(page: Any) -> tuple[Any, Any]:
                     v.VSelect(
                         v_show=("attributes.length",),
                         label="colour by",
-                        items=("['none', ...attributes]",),
+                        items=("colour_items",),
                         model_value=("color_by",),
                         update_modelValue="color_by = $event; trigger('colour_by', [$event])",
                         density="compact",
