@@ -10,9 +10,11 @@ then split into:
 - server: the rest of the server's time, from the request reaching the worker to the
   scene's changes sent (the queue, the datasets drawn, the arrays copied in place, the
   page's state), also its own measure;
-- transfer: the rest of the time until the step's last websocket message (the trigger
-  sent, the state and the changed arrays fetched by hash, decoded);
-- drawing: from the last message to the last draw call (vtk.js uploading and drawing).
+- transfer: the rest of the time until the step's last websocket message before the
+  picture (the trigger sent; the step's new arrays, its scene and the page's state
+  received and decoded: the arrays go ahead of the scene, vtk.js asks for none);
+- drawing: from that message to the last draw call (vtk.js building its buffers and
+  issuing the draw; SwiftShader's rasterizing runs in chromium's GPU process after it).
 
 The step is the ``thickness`` slider (the section circle and all below it recompute, the
 spiral is cached), moved by one key press; median of the steps. Measured on a busy machine:
@@ -234,7 +236,7 @@ def run(table) -> None:
     parts = [
         ("recook", "the engine's evaluation"),
         ("server", "the rest of the server: queue, datasets, arrays in place, scene sent"),
-        ("transfer", "the rest until the last message: trigger in, arrays out by hash"),
+        ("transfer", "the rest until the last message: trigger in, arrays and scene out"),
         ("draw", "last message to last draw call (vtk.js)"),
     ]
     for key, note in parts:

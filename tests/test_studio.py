@@ -541,6 +541,12 @@ def _status(pg) -> str:
     return pg.inner_text("#status")
 
 
+def _timing(pg) -> str:
+    """The last step's timing, which names the step: two steps can have the same status
+    ("5 computed, 1 cached in 41 ms"), so a wait for the status to change can hang."""
+    return pg.inner_text("#timing")
+
+
 def test_page_shows_the_model(page):
     end = time.monotonic() + 20
     while _shows_model(_canvas(page)) < 0.02 and time.monotonic() < end:
@@ -591,7 +597,7 @@ def test_a_step_sends_its_arrays_ahead_of_its_scene(page):
     delivers ArrayBuffers, not Blobs (which the browser reads back asynchronously); the
     graph's drawing, with the step's times, follows once the steps settle."""
     before, drawing = _canvas(page), page.inner_html("#graph")
-    timing = page.inner_text("#timing")
+    timing = _timing(page)
     n = page.evaluate("window.__fgWire.sent.length")
     page.locator(".fg-slider-thickness .v-slider-thumb").focus()
     page.keyboard.press("ArrowRight")
@@ -614,10 +620,10 @@ def _aspect(img: np.ndarray) -> float:
 def test_a_page_loaded_after_steps_shows_them(page, studio):
     """A step sends the open page its changes alone; the whole scene, which a page that
     loads later starts from, follows once the steps settle."""
-    turns, before = _turns(page), _status(page)
+    turns, before = _turns(page), _timing(page)
     page.locator(".fg-slider-turns .v-slider-thumb").focus()
     page.keyboard.press("ArrowRight" if turns < 12 else "ArrowLeft")  # away from the start
-    page.wait_for_function(f"document.querySelector('#status').innerText != {before!r}")
+    page.wait_for_function(f"document.querySelector('#timing').innerText != {before!r}")
     assert _turns(page) not in (turns, 3)
     time.sleep(1.0)  # past the settle delay
     context = page.context.browser.new_context(viewport=page.viewport_size)
@@ -686,10 +692,10 @@ def test_click_a_node_shows_it(page):
 
 def test_an_edit_on_disk_reloads(page, studio):
     # turns set by its control (whatever ran before on this page): a reload keeps it
-    before, turns = _status(page), _turns(page)
+    before, turns = _timing(page), _turns(page)
     page.locator(".fg-slider-turns .v-slider-thumb").focus()
     page.keyboard.press("ArrowRight" if turns < 12 else "ArrowLeft")
-    page.wait_for_function(f"document.querySelector('#status').innerText != {before!r}")
+    page.wait_for_function(f"document.querySelector('#timing').innerText != {before!r}")
     page.wait_for_function(
         f"!document.querySelector('#controls').innerText.includes('turns = {turns}\\n')"
     )

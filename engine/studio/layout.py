@@ -126,7 +126,8 @@ ARRAYS = """
   }
   const send = WebSocket.prototype.send;
   WebSocket.prototype.send = function (data) {
-    if (!this.fgBuffers && typeof this.onmessage === 'function') {
+    // (a client that reads ArrayBuffers itself, or has no handler yet: left as it is)
+    if (!this.fgBuffers && this.binaryType === 'blob' && typeof this.onmessage === 'function') {
       this.fgBuffers = true;
       const handle = this.onmessage;
       this.binaryType = 'arraybuffer';
@@ -142,8 +143,9 @@ ARRAYS = """
       : data.buffer.slice(data.byteOffset, data.byteOffset + data.byteLength);
   };
   const sent = new Map();  // hash -> ArrayBuffer, until vtk.js asks for it
-  const client = window.trame.client;
-  const session = client.getConnection().getSession();
+  const client = window.trame && window.trame.client;
+  const session = client && client.getConnection && client.getConnection().getSession();
+  if (!session || !client.registerProtocol) return;  // (the arrays are then asked for)
   session.subscribe('%(topic)s', ([arrays]) => {
     for (const [hash, data] of Object.entries(arrays)) sent.set(hash, asBuffer(data));
     while (sent.size > 64) sent.delete(sent.keys().next().value);  // (the oldest first)
@@ -259,10 +261,7 @@ def build(page: Any) -> tuple[Any, Any]:
                             language="yaml",
                             theme="vs",
                             markers=("markers",),
-                            options=(
-                                "{ minimap: { enabled: false }, fontSize: 13, "
-                                "automaticLayout: true, scrollBeyondLastLine: false }",
-                            ),
+                            options=("editor_options",),
                         )
                         # resolved by name when it renders: it is registered after the
                         # page's template was compiled
@@ -333,7 +332,7 @@ def build(page: Any) -> tuple[Any, Any]:
                     v.VSelect(
                         v_show=("attributes.length",),
                         label="colour by",
-                        items=("['none', ...attributes]",),
+                        items=("colour_items",),
                         model_value=("color_by",),
                         update_modelValue="color_by = $event; trigger('colour_by', [$event])",
                         density="compact",

@@ -138,6 +138,13 @@ class Page:
         s.cook_id = 0  # bumped after each picture sent (the bench waits on it)
         s.timing = {}  # where the last request's time went (read by bench/bench_studio.py)
         s.attributes = []  # the attributes of what is shown, to colour by
+        s.colour_items = ["none"]  # (a list in the template would be new at each render)
+        s.editor_options = {  # (likewise: a new object would make Monaco lay out again)
+            "minimap": {"enabled": False},
+            "fontSize": 13,
+            "automaticLayout": True,
+            "scrollBeyondLastLine": False,
+        }
         s.color_by = "none"
         s.frames_n = 0  # the steps of the shown simulated nodes (0: no frame scrubber)
         s.frame_k = 0  # the step the scrubber shows
@@ -318,14 +325,14 @@ class Page:
         if snap is None:
             snap = self._snapshot()  # (a request with no Cooked result: not reached)
         s = self.state
-        if datasets is not None:  # the picture first: its arrays are what takes longest
+        # the picture first, its arrays ahead of the state: then the state, in one message
+        # (each message the page gets makes it render its template again)
+        if datasets is not None:
             self._picture(datasets)
-            with s:
-                s.attributes = datasets.attributes
-                s.color_by = datasets.color_by or "none"
         t1 = time.perf_counter()
         if kind == "frame":
             with s:
+                self._attributes(datasets)
                 if cooked.frame is not None:
                     s.frame_k = cooked.frame
                     s.status = (
@@ -338,6 +345,7 @@ class Page:
             self._settle()
             return
         with s:
+            self._attributes(datasets)
             if kind == "disk":
                 self._disk_text = snap["text"]
                 if snap["text"] != s.text:
@@ -399,19 +407,25 @@ class Page:
                 s.status = f"{name}: {lines[0]}{more}{kept}"
                 s.status_bad = True
             s.busy = not self.worker.idle()
-        t2 = time.perf_counter()
-        timing = {
-            "cook_ms": round(cooked.seconds * 1000, 2),
-            # in the worker: queue, recook, datasets and drawing prepared
-            "asked_to_done_ms": round(seconds * 1000, 2),
-            "scene_ms": round((t1 - t0) * 1000, 2),  # arrays in place + serialization
-            "state_ms": round((t2 - t1) * 1000, 2),  # status, controls, problems, drawing
-        }
-        with s:
             s.cook_id = s.cook_id + 1
-            timing["step"] = s.cook_id  # (so that two steps' timings always differ)
-            s.timing = timing
+            s.timing = {
+                "cook_ms": round(cooked.seconds * 1000, 2),
+                # in the worker: queue, recook, datasets and drawing prepared
+                "asked_to_done_ms": round(seconds * 1000, 2),
+                "scene_ms": round((t1 - t0) * 1000, 2),  # arrays in place + serialization
+                # status, controls, problems, drawing
+                "state_ms": round((time.perf_counter() - t1) * 1000, 2),
+                "step": s.cook_id,  # (so that two steps' timings always differ)
+            }
         self._settle()
+
+    def _attributes(self, datasets: Any) -> None:
+        """The attributes to colour by, in the state (in a ``with state`` block)."""
+        if datasets is not None:
+            s = self.state
+            s.attributes = datasets.attributes
+            s.colour_items = ["none", *datasets.attributes]
+            s.color_by = datasets.color_by or "none"
 
     def _settle(self) -> None:
         """Send what the picture did not need (see SETTLE_DELAY), once steps pause."""

@@ -373,22 +373,62 @@ def _copy_into(target: Any, new: Any) -> None:
     """Overwrite ``target``'s geometry with ``new``'s, keeping arrays that are equal.
 
     An array handed to vtk again with the same bytes keeps its hash in trame-vtk's
-    serializer, but copying it still costs; the points, normals and cells are replaced
-    only where they differ.
+    serializer, but copying it still costs; the points, cells and arrays are replaced
+    only where they differ, by ``new``'s own vtk objects (``new`` is not used after).
     """
     if target.n_points != new.n_points or not np.array_equal(target.points, new.points):
-        target.points = new.points
-    for cells in ("faces", "lines", "verts"):
-        a, b = getattr(target, cells), getattr(new, cells)
-        if len(a) != len(b) or not np.array_equal(a, b):
-            setattr(target, cells, b)
-    for mine, theirs in ((target.point_data, new.point_data), (target.cell_data, new.cell_data)):
-        old_names = set(mine.keys())
-        for name in theirs.keys():
-            arr = theirs[name]
-            if name not in old_names or not np.array_equal(mine[name], arr):
-                mine[name] = arr
-        for name in old_names - set(theirs.keys()):
-            mine.remove(name)
-    if "Normals" in new.point_data.keys():
-        target.point_data.active_normals_name = "Normals"
+        target.SetPoints(new.GetPoints())
+    for get, put in (
+        ("GetPolys", "SetPolys"),
+        ("GetLines", "SetLines"),
+        ("GetVerts", "SetVerts"),
+        ("GetStrips", "SetStrips"),
+    ):
+        theirs = getattr(new, get)()
+        if not _same_cells(getattr(target, get)(), theirs):
+            getattr(target, put)(theirs)
+    for mine, theirs in (
+        (target.GetPointData(), new.GetPointData()),
+        (target.GetCellData(), new.GetCellData()),
+    ):
+        names = set()
+        for i in range(theirs.GetNumberOfArrays()):
+            arr = theirs.GetAbstractArray(i)
+            names.add(arr.GetName())
+            old = mine.GetAbstractArray(arr.GetName())
+            if old is None or not _same_array(old, arr):
+                mine.AddArray(arr)  # (in place of the one of that name: its role kept)
+        for name in [mine.GetArrayName(i) for i in range(mine.GetNumberOfArrays())]:
+            if name not in names:
+                mine.RemoveArray(name)
+    if new.GetPointData().GetNormals() is not None:
+        target.GetPointData().SetActiveNormals("Normals")
+
+
+def _same_cells(a: Any, b: Any) -> bool:
+    """Whether two vtkCellArrays hold the same cells (compared in place, not exported)."""
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+
+    if a.GetNumberOfCells() != b.GetNumberOfCells():
+        return False
+    if not a.GetNumberOfCells():
+        return True
+    return np.array_equal(
+        vtk_to_numpy(a.GetOffsetsArray()), vtk_to_numpy(b.GetOffsetsArray())
+    ) and np.array_equal(
+        vtk_to_numpy(a.GetConnectivityArray()), vtk_to_numpy(b.GetConnectivityArray())
+    )
+
+
+def _same_array(a: Any, b: Any) -> bool:
+    """Whether two vtk data arrays hold the same values, in the same type and shape."""
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+
+    if (
+        a.GetDataType() != b.GetDataType()
+        or a.GetNumberOfComponents() != b.GetNumberOfComponents()
+        or a.GetNumberOfTuples() != b.GetNumberOfTuples()
+        or not (a.IsNumeric() and b.IsNumeric())
+    ):
+        return False
+    return np.array_equal(vtk_to_numpy(a), vtk_to_numpy(b))
