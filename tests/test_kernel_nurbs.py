@@ -124,6 +124,25 @@ def test_surface_points_and_partials_match_geomdl(pu, pv, rational):
     assert np.abs(np.sum(n * Su, axis=-1)).max() < 1e-9 * scale
 
 
+@pytest.mark.parametrize("nu,nv", [(4, 40), (40, 4)])  # either direction summed first
+@pytest.mark.parametrize("rational", [True, False])
+def test_grid_sums_of_the_band_match_the_dense_collocation_product(nu, nv, rational):
+    rng = np.random.default_rng(nu + 7 * rational)
+    pu, pv = 2, 3
+    cp = rng.normal(size=(nu, nv, 3)) * 5.0
+    w = rng.uniform(0.3, 3.0, (nu, nv)) if rational else np.ones((nu, nv))
+    ku = random_curve(rng, pu, n=nu)[2]
+    kv = random_curve(rng, pv, n=nv)[2]
+    # the ends, interior knots (where a span starts) and points between
+    u = np.r_[0.0, ku[pu + 1 : nu][:3], rng.uniform(0, 1, 30), 1.0]
+    v = np.r_[0.0, kv[pv + 1 : nv][:3], rng.uniform(0, 1, 50), 1.0]
+    grid = K.surface_evaluate_grid(cp, pu, pv, ku, kv, w if rational else None, u, v)
+    bu, bv = K.basis_matrix(pu, ku, u, nu), K.basis_matrix(pv, kv, v, nv)
+    num = np.einsum("ai,ijc,bj->abc", bu, cp * w[..., None], bv)
+    den = np.einsum("ai,ij,bj->ab", bu, w, bv)
+    np.testing.assert_allclose(grid, num / den[..., None], rtol=1e-13, atol=1e-13)
+
+
 def test_surface_evaluate_broadcasts():
     rng = np.random.default_rng(5)
     cp = rng.normal(size=(4, 5, 3))

@@ -1,8 +1,8 @@
 """Tensor-product NURBS surfaces: evaluation, grids, first partials and normals.
 
 Points at scattered (u, v) use A3.5/A4.3 of The NURBS Book vectorized over all parameter
-pairs; grids use the two basis ("collocation") matrices and two matrix products, which is
-the same sum ordered for BLAS. Rational surfaces are evaluated in homogeneous coordinates.
+pairs; grids sum the same non-zero basis terms one direction at a time, over whole rows
+and columns of the grid. Rational surfaces are evaluated in homogeneous coordinates.
 """
 
 from __future__ import annotations
@@ -164,8 +164,13 @@ def surface_evaluate_grid(
 ) -> np.ndarray:
     """Surface points on the grid ``u x v``: ``S[i, j] = S(u[i], v[j])``.
 
-    Computed as ``Bu @ Pw @ Bv^T`` per coordinate with the collocation matrices of
-    :func:`basis_matrix` (the tensor-product form of A3.5/A4.3).
+    The tensor-product form of A3.5/A4.3, one direction at a time: each grid column is a
+    sum of the ``degree_v + 1`` control columns its basis functions touch, then each row
+    of the ``degree_u + 1`` rows of that (both as whole-array operations over the grid).
+    Only the non-zero basis functions count, so the work is ``O((p + 1) a b)``, not the
+    ``O(a n b)`` of a product with the dense collocation matrices, and there is no BLAS
+    call whose threads a busy machine would keep waiting. The direction that leaves the
+    smaller intermediate grid goes first.
 
     Parameters
     ----------
@@ -182,18 +187,42 @@ def surface_evaluate_grid(
     """
     u = np.asarray(u, dtype=np.float64).reshape(-1)
     v = np.asarray(v, dtype=np.float64).reshape(-1)
+    ku = np.asarray(knots_u, dtype=np.float64)
+    kv = np.asarray(knots_v, dtype=np.float64)
     pw = homogeneous(control_points, weights)
     nu, nv, d = pw.shape
-    bu = basis_matrix(degree_u, knots_u, u, nu)
-    bv = basis_matrix(degree_v, knots_v, v, nv)
-    # coordinates first, (d, nu, nv): two BLAS products per coordinate, and the rational
-    # division then runs along contiguous rows (a trailing axis of 3 or 4 would make
-    # numpy's inner loops 3 elements long)
+    # coordinates first, (d, nu, nv): the sums run along contiguous rows (a trailing axis
+    # of 3 or 4 would make numpy's inner loops 3 elements long)
     per_coord = np.ascontiguousarray(np.moveaxis(pw, -1, 0))
-    out = bu @ per_coord @ bv.T  # (d, a, b)
+    along_u = _band(degree_u, ku, u, axis=1)
+    along_v = _band(degree_v, kv, v, axis=2)
+    if nu * v.size * (degree_v + 1) + u.size * v.size * (degree_u + 1) <= (
+        u.size * nv * (degree_u + 1) + u.size * v.size * (degree_v + 1)
+    ):
+        out = along_u(along_v(per_coord))
+    else:
+        out = along_v(along_u(per_coord))
     if weights is not None:
         out = out[:3] / out[3]
     return np.moveaxis(out, 0, -1)
+
+
+def _band(degree: int, knots: np.ndarray, t: np.ndarray, axis: int):
+    """The sum over ``axis`` with the basis functions at ``t`` (A2.2): a function taking
+    an array whose ``axis`` runs over the control points to one whose ``axis`` runs over
+    ``t``, adding the ``degree + 1`` non-zero terms in order."""
+    spans = find_spans(degree, knots, t)
+    rows = _basis_rows(degree, knots, spans, t)
+    shape = [1, 1, 1]
+    shape[axis] = t.size
+
+    def apply(a: np.ndarray) -> np.ndarray:
+        out = a.take(spans - degree, axis=axis) * rows[0].reshape(shape)
+        for k in range(1, degree + 1):
+            out += a.take(spans - degree + k, axis=axis) * rows[k].reshape(shape)
+        return out
+
+    return apply
 
 
 def surface_derivatives(
