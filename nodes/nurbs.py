@@ -575,7 +575,7 @@ def _auto_stations(path: Curve) -> int:
     return 256
 
 
-@node("nurbs.tessellate", version=2)
+@node("nurbs.tessellate", version=3)
 def tessellate(
     surface: Surface,
     u: Annotated[int, Range(min=1)] = 32,

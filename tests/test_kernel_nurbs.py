@@ -124,6 +124,49 @@ def test_surface_points_and_partials_match_geomdl(pu, pv, rational):
     assert np.abs(np.sum(n * Su, axis=-1)).max() < 1e-9 * scale
 
 
+PLANS = [
+    ((first, b1), (second, b2))
+    for first, second in (("u", "v"), ("v", "u"))
+    for b1 in (False, True)
+    for b2 in (False, True)
+]
+
+
+@pytest.mark.parametrize("plan", PLANS)
+@pytest.mark.parametrize("rational", [True, False])
+def test_every_plan_of_a_grid_matches_the_dense_collocation_product(monkeypatch, plan, rational):
+    from formgraph.kernels.nurbs import surface
+
+    rng = np.random.default_rng(7 * rational)
+    nu, nv, pu, pv = 6, 30, 2, 3
+    cp = rng.normal(size=(nu, nv, 3)) * 5.0
+    w = rng.uniform(0.3, 3.0, (nu, nv)) if rational else np.ones((nu, nv))
+    ku = random_curve(rng, pu, n=nu)[2]
+    kv = random_curve(rng, pv, n=nv)[2]
+    # the ends, interior knots (where a span starts) and points between
+    u = np.r_[0.0, ku[pu + 1 : nu][:3], rng.uniform(0, 1, 30), 1.0]
+    v = np.r_[0.0, kv[pv + 1 : nv][:3], rng.uniform(0, 1, 50), 1.0]
+    monkeypatch.setattr(surface, "_plan", lambda *_: plan)
+    grid = K.surface_evaluate_grid(cp, pu, pv, ku, kv, w if rational else None, u, v)
+    bu, bv = K.basis_matrix(pu, ku, u, nu), K.basis_matrix(pv, kv, v, nv)
+    num = np.einsum("ai,ijc,bj->abc", bu, cp * w[..., None], bv)
+    den = np.einsum("ai,ij,bj->ab", bu, w, bv)
+    np.testing.assert_allclose(grid, num / den[..., None], rtol=1e-13, atol=1e-13)
+
+
+@pytest.mark.parametrize(
+    "shape,plan",
+    [
+        ((20, 20, 300, 300, 3, 3), (("u", False), ("v", False))),  # the plain products
+        ((9, 256, 65, 257, 2, 3), (("v", True), ("u", False))),  # a sweep: its band first
+    ],
+)
+def test_the_grid_plan_sums_a_long_direction_over_its_band(shape, plan):
+    from formgraph.kernels.nurbs import surface
+
+    assert surface._plan(*shape) == plan
+
+
 def test_surface_evaluate_broadcasts():
     rng = np.random.default_rng(5)
     cp = rng.normal(size=(4, 5, 3))
