@@ -23,6 +23,7 @@ is Dask's business: the scheduler reruns its tasks elsewhere (``distributed``'s
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import logging
 import os
 import time
@@ -34,7 +35,7 @@ from typing import Any
 
 from ..core import safety
 from ..core.errors import FormgraphError
-from ..evaluation.cache import DiskCache, default_cache_dir, key_of
+from ..evaluation.cache import DiskCache, default_cache_dir, key_of, key_text
 from ..evaluation.graph import Graph, Step
 from ..language.yamlio import MAX_BYTES
 from .tasks import (
@@ -174,12 +175,14 @@ def build(
     cached: set[str] = set()
     totals = Totals(variants=len(variants))
     planned = g.plans(names, [params for _, params in variants])
+    # the row key is key_of([target keys..., size, camera]); its text written directly
+    tail = key_text([list(targets.size), list(targets.camera or ())])[1:]
+    order = [s.name for s in planned[0]] if planned else []  # the same for every variant
+    where = [order.index(n) for n in names]
     for (index, params), steps in zip(variants, planned, strict=True):
         totals.naive += len(steps)
-        by_name = {s.name: s for s in steps}
-        row_key = "row-" + key_of(
-            [by_name[n].key for n in names] + [list(targets.size), list(targets.camera or ())]
-        )
+        text = "[" + "".join([key_text(steps[i].key) + "," for i in where]) + tail
+        row_key = "row-" + hashlib.blake2b(text.encode(), digest_size=20).hexdigest()
         if row_key in rows:
             rows[row_key].append(index)
             continue
@@ -251,7 +254,9 @@ def _workers_ignore_interrupts() -> Iterator[None]:
         signal.signal(signal.SIGINT, previous)
 
 
-CHUNK_CAP = 64  # variants to a row task at most
+CHUNK_CAP = 128  # variants to a row task at most (Dask's cost per task is ~ms of CPU)
+FILES_CHUNK_CAP = 16  # ... when each variant brings files back (exports, a drawn cell): a
+# task's results are held whole on the worker and the client until it ends
 
 HANDSHAKE_SECONDS = 10.0
 _HANDSHAKE_BYTES = 1 << 16  # a scheduler's greeting is some 60 bytes
@@ -378,7 +383,7 @@ def connect(client: Any, workers: int | None) -> Iterator[Any]:
             env=BLAS_ENV,
         )
     try:
-        c = Client(cluster)
+        c = Client(cluster, direct_to_workers=True)  # results straight from the workers
         try:
             yield c
         finally:
@@ -414,7 +419,8 @@ def run(
         threads = sum(w.get("nthreads", 1) for w in c.scheduler_info()["workers"].values())
         # a few variants to a task when there are many per thread: Dask's overhead per task
         # is paid once per few light variants, and the table still grows steadily
-        chunk = max(1, min(CHUNK_CAP, len(variants) // (8 * max(threads, 1))))
+        cap = FILES_CHUNK_CAP if targets.exports or targets.render else CHUNK_CAP
+        chunk = max(1, min(cap, len(variants) // (8 * max(threads, 1))))
         dsk, rows, chunks, totals = build(g, bp_key, variants, targets, visible, chunk)
         if not rows:
             return totals
