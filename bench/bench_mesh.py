@@ -1,4 +1,5 @@
-"""Mesh benchmark: Catmull-Clark and Doo-Sabin of a 10,000-quad torus; ear clipping of a
+"""Mesh benchmark: Catmull-Clark and Doo-Sabin of a 10,000-quad torus (Doo-Sabin's new
+points also alone, against the per-size einsum they were computed by before); ear clipping of a
 concave star of 1,200 and 10,000 corners (against mapbox_earcut, compiled C++ ear clipping
 with z-order hashing, and shapely's constrained Delaunay triangulation).
 
@@ -19,7 +20,7 @@ from formgraph.kernels.mesh.subdivision import catmull_clark, doo_sabin
 
 # the benchmarks measure the tests' canonical shapes
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-from mesh_shapes import torus  # noqa: E402
+from mesh_shapes import prism, torus  # noqa: E402
 
 
 def _opensubdiv(levels: int, verts: list, faces: list, flat: list, sizes: list):
@@ -63,11 +64,66 @@ def run(table) -> None:
         table.time(case, "formgraph", lambda xy=xy: triangulate_polygon(xy), repeat=3)
         table.time(case, "mapbox_earcut", lambda xy=xy: _earcut(xy), repeat=3)
         table.time(case, "shapely (constrained Delaunay)", lambda xy=xy: _shapely_cdt(xy), repeat=3)
-    case = "doo_sabin 10k-quad torus, 1 lvl -> 30k faces"
+    case = "doo_sabin 10k-quad torus, 1 lvl -> 40k faces"
     table.time(case, "formgraph", lambda: doo_sabin(v, fi, fo, 1))
     table.time(
-        case, "pymeshlab", lambda: _pymeshlab(v, fi, "meshing_surface_subdivision_doo_sabin", 1)
+        case,
+        "pymeshlab",
+        lambda: _pymeshlab(v, fi, "meshing_surface_subdivision_doo_sabin", 1),
+        note="80k triangles (the 40k quads split)",
     )
+    # pymeshlab's Doo-Sabin does one level whatever its iterations: ours alone at two
+    table.time(
+        "doo_sabin 10k-quad torus, 2 lvl -> 160k faces",
+        "formgraph",
+        lambda: doo_sabin(v, fi, fo, 2),
+    )
+    _doo_sabin_points(table, v, fi, fo)
+
+
+def _doo_sabin_points(table, v: np.ndarray, fi: np.ndarray, fo: np.ndarray) -> None:  # noqa: ANN001
+    """The new points of a Doo-Sabin level alone (the connectivity is the same code in
+    both): the kernel's two sparse products in the cosine form against the per-size
+    circulant weights by einsum it replaced (tests/doo_sabin_reference.py), interleaved.
+    On the level-1 torus (40k faces, 3 and 5 columns) and on a 4,000-gon prism, where the
+    circulant has k^2 entries a face."""
+    from doo_sabin_reference import doo_sabin_points
+
+    from formgraph.kernels.mesh import build_halfedges
+    from formgraph.kernels.mesh import subdivision as sd
+
+    def ours(x: np.ndarray, he) -> np.ndarray:  # noqa: ANN001 - HalfEdges
+        fans = he.fans
+        corner = ~fans.closed & (fans.sizes == 1) & he.is_manifold_vertex[fans.vertex]
+        sums, points = sd._doo_sabin_points(he, x.shape[0], fans.vertex[corner])
+        stacked = np.empty((x.shape[0] + sums.shape[0], x.shape[1]))
+        stacked[: x.shape[0]] = x
+        stacked[x.shape[0] :] = sums @ x
+        return points @ stacked
+
+    v1, fi1, fo1 = doo_sabin(v, fi, fo, 1)
+    cases = [
+        ("doo_sabin points, level 2 of the torus (160k corners)", v1, fi1, fo1),
+        ("the same with 2 point attributes (5 columns)", np.c_[v1, v1[:, :2]], fi1, fo1),
+        ("doo_sabin points of a 4,000-gon prism", *prism(4000)),
+    ]
+    for case, x, f, o in cases:
+        x = np.asarray(x, dtype=np.float64)
+        he = build_halfedges(f, o, len(x))
+        he.fans, he.is_manifold_vertex, he.boundary_halfedges, he.face  # noqa: B018 - cached
+        assert np.allclose(ours(x, he), doo_sabin_points(x, he), rtol=0, atol=1e-12 * abs(x).max())
+        table.time_together(
+            case,
+            [
+                ("formgraph", lambda x=x, he=he: ours(x, he), "cosine form, 2 sparse products"),
+                (
+                    "per-size einsum",
+                    lambda x=x, he=he: doo_sabin_points(x, he),
+                    "the kernel before",
+                ),
+            ],
+            rounds=5,
+        )
 
 
 def _star(k: int) -> np.ndarray:

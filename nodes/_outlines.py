@@ -26,7 +26,6 @@ __all__ = [
     "closes",
     "divisions",
     "even_parameters",
-    "kernel",
     "make_region",
     "outline_curves",
     "sample_rings",
@@ -37,14 +36,6 @@ __all__ = [
 _TOLERANCE = 1e-5  # default sampling tolerance of region booleans, relative to the extent
 _FEW = 64  # up to this many outlines, their knots are made a ring at a time
 _LARGEST = 1e150  # the largest extent whose areas (its square, times vertex counts) are finite
-
-
-def kernel(port: str, fn: Any, *args: Any, **kwargs: Any) -> Any:
-    """Call a kernel; its ValueError names the node input it is about."""
-    try:
-        return fn(*args, **kwargs)
-    except ValueError as exc:
-        raise InputError(port, str(exc)) from None
 
 
 def span_of(curves: list[Curve]) -> float:
@@ -82,7 +73,7 @@ def divisions(
     n = (
         count
         if count is not None
-        else kernel("spacing", kc.resample_count, length, spacing, closed)
+        else InputError.call("spacing", kc.resample_count, length, spacing, closed)
     )
     if closed and n < 3:
         raise InputError("count", f"{verb[:-1]}ing a closed curve needs count >= 3, got {n}")
@@ -159,7 +150,9 @@ def sample_rings(
             )
             for i in members
         ]
-        sampled_batch = kernel(port, ksampling.sample_closed_batch, batch, tol, guard, params=True)
+        sampled_batch = InputError.call(
+            port, ksampling.sample_closed_batch, batch, tol, guard, params=True
+        )
         batched.update(zip(members, sampled_batch, strict=True))
     for i, c in enumerate(curves):  # one step per curve; its samples are vectorized
         poly = isinstance(c, NurbsCurve) and c.degree == 1
@@ -185,7 +178,7 @@ def sample_rings(
             )
         elif isinstance(c, NurbsCurve):
             w = np.asarray(c.weights) if c.rational else None
-            ring = kernel(
+            ring = InputError.call(
                 port,
                 ksampling.sample_nurbs,
                 c.control_points,

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from enum import Enum
-from typing import Annotated, Any, NamedTuple
+from typing import Annotated, NamedTuple
 
 import numpy as np
 
@@ -67,14 +67,6 @@ def _polyline(points: np.ndarray, closed: bool) -> NurbsCurve:
     return NurbsCurve.polyline(p, closed=closed)
 
 
-def _kernel(port: str, fn: Any, *args: Any, **kwargs: Any) -> Any:
-    """Call a kernel; its ValueError names the node input it is about."""
-    try:
-        return fn(*args, **kwargs)
-    except ValueError as exc:
-        raise InputError(port, str(exc)) from None
-
-
 @node("curves.bezier", version=1)
 def bezier(points: Points) -> NurbsCurve:
     """A chain of cubic Bezier segments, laid out as Processing's bezierVertex; exact.
@@ -93,7 +85,7 @@ def bezier(points: Points) -> NurbsCurve:
     -------
     ``s: {type: curves.bezier, points: [[0, 0], [1, 2], [3, 2], [4, 0]]}``
     """
-    return NurbsCurve(*_kernel("points", kc.bezier_chain, points.xyz))
+    return NurbsCurve(*InputError.call("points", kc.bezier_chain, points.xyz))
 
 
 @node("curves.catmull_rom", version=1)
@@ -127,7 +119,7 @@ def catmull_rom(
         Open curves: processing (the first and last points only shape the end tangents) or
         clamped (the curve passes through every point).
     """
-    result = _kernel(
+    result = InputError.call(
         "points",
         kc.catmull_rom,
         points.xyz,
@@ -173,7 +165,7 @@ def subdivide(
     """
     p, closed = _control_polygon(curve)
     ctx.guard(kc.subdivided_count(len(p), closed, iterations), "points")
-    out = _kernel("curve", kc.subdivide_polygon, p, closed=closed, iterations=iterations)
+    out = InputError.call("curve", kc.subdivide_polygon, p, closed=closed, iterations=iterations)
     return _polyline(out, closed=closed)
 
 
@@ -247,9 +239,9 @@ def resample(
     closed = curve.closed
     if isinstance(curve, NurbsCurve) and curve.degree == 1:
         p, _ = _control_polygon(curve)
-        length = _kernel("curve", kc.polyline_length, p, closed)
+        length = InputError.call("curve", kc.polyline_length, p, closed)
         n = _o.divisions(length, count, spacing, closed, ctx, "resample")
-        out = _kernel("curve", kc.resample_polyline, p, count=n, closed=closed)
+        out = InputError.call("curve", kc.resample_polyline, p, count=n, closed=closed)
         return _polyline(out, closed=closed)
 
     t = _o.even_parameters(curve, closed, count, spacing, ctx, "resample")
@@ -296,7 +288,7 @@ def offset(
         p, closed = np.asarray(curve.display_points()), curve.closed
         if closed:
             p = p[:-1]
-    out, source = _kernel(
+    out, source = InputError.call(
         "curve",
         kc.bisector_offset,
         p,

@@ -91,7 +91,7 @@ def polygon(
     """
     ctx.guard(sides, "polygon corners")
     port = "sides" if sides < 3 else "radius"
-    corners = _o.kernel(port, kshapes.regular_polygon, sides, radius, center, angle)
+    corners = InputError.call(port, kshapes.regular_polygon, sides, radius, center, angle)
     return NurbsCurve.polyline(corners, closed=True)
 
 
@@ -217,12 +217,12 @@ def _font(font: str, font_file: str | None, ctx: Context) -> ktext.Font:
             return ktext.load_font(data)
         except ValueError as exc:
             raise InputError("font_file", f"{font_file!r}: {exc}") from None
-    path = _o.kernel("font", ktext.bundled_font_path, font)
+    path = InputError.call("font", ktext.bundled_font_path, font)
     try:
         data = path.read_bytes()
     except OSError as exc:
         raise InputError("font", f"cannot read the bundled font {font!r}: {exc}") from None
-    return _o.kernel("font", ktext.load_font, data)
+    return InputError.call("font", ktext.load_font, data)
 
 
 @node("curves.text", version=1)
@@ -274,7 +274,9 @@ def text(
         raise InputError("size", f"size must be positive, got {size}")
     ctx.guard(len(text) * 64, "glyph control points")  # a glyph has tens of points
     f = _font(font, font_file, ctx)
-    degree, pts, offsets, missing = _o.kernel("text", ktext.layout, f, text, size, align.value)
+    degree, pts, offsets, missing = InputError.call(
+        "text", ktext.layout, f, text, size, align.value
+    )
     if missing:
         chars = "".join(missing[:20])
         ctx.warn(

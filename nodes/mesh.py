@@ -155,7 +155,7 @@ def catmull_clark(
     return Mesh.trusted(v, fi, fo, point_data, face_data)  # all quads of valid indices
 
 
-@node("mesh.doo_sabin", version=1)
+@node("mesh.doo_sabin", version=2)
 def doo_sabin(mesh: Mesh, levels: Annotated[int, Range(min=0)] = 1, *, ctx: Context) -> Mesh:
     """Doo-Sabin subdivision: corner cutting that converges to a biquadratic-like surface.
 
@@ -174,13 +174,15 @@ def doo_sabin(mesh: Mesh, levels: Annotated[int, Range(min=0)] = 1, *, ctx: Cont
     """
     he = _halfedges(mesh)
     _guard_counts(ctx, subdivision.doo_sabin_counts(he, levels))
+    # point attributes ride along as extra columns (the same stencils as the points), face
+    # attributes as the face values (v2: the sums in another order, the last bits differ)
     stacked = carry.columns(mesh.vertices, mesh.point_data)
-    faces = carry.columns(np.zeros((mesh.n_faces, 3)), mesh.face_data)
-    v, fi, fo, fv = subdivision.doo_sabin(
-        stacked, mesh.face_indices, mesh.face_offsets, levels, face_values=faces
+    faces = carry.columns(np.zeros((mesh.n_faces, 3)), mesh.face_data) if mesh.face_data else None
+    v, fi, fo, *fv = subdivision.doo_sabin(
+        stacked, mesh.face_indices, mesh.face_offsets, levels, face_values=faces, halfedges=he
     )
     v, point_data = carry.split_columns(v, mesh.point_data)
-    _, face_data = carry.split_columns(fv, mesh.face_data)
+    face_data = carry.split_columns(fv[0], mesh.face_data)[1] if fv else {}
     return Mesh(v, fi, fo, point_data, face_data)
 
 

@@ -224,6 +224,9 @@ def test_resample_polyline_spacing_and_port_errors():
     g.add("none", "curves.resample", curve="@n0")
     with pytest.raises(fg.NodeError, match=r"exactly one of count and spacing"):
         g.evaluate("none")
+    g.add("zero", "curves.resample", curve="@n0", spacing=0.0)  # the kernel's ValueError
+    with pytest.raises(fg.NodeError, match=r"input 'spacing'.*spacing must be a positive"):
+        g.evaluate("zero")
     g.add("tiny", "curves.resample", curve="@n0", spacing=1e-12)
     with pytest.raises(fg.BudgetError, match=r"points, over the budget"):
         g.evaluate("tiny")

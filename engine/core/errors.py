@@ -8,7 +8,9 @@ line, the node and the input.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 
 @dataclass(frozen=True)
@@ -105,6 +107,15 @@ class InputError(ValueError):
     def __init__(self, port: str, message: str):
         self.port = port
         super().__init__(message)
+
+    @classmethod
+    def call(cls, port: str, fn: Callable[..., Any], *args: Any, **kwargs: Any) -> Any:
+        """``fn(*args, **kwargs)``, a kernel's ValueError made an InputError on ``port``:
+        the node input the kernel's complaint is about."""
+        try:
+            return fn(*args, **kwargs)
+        except ValueError as exc:
+            raise cls(port, str(exc)) from None
 
 
 class UsageError(Exception):

@@ -7,16 +7,20 @@ Both schemes come from the same 1978 issue of Computer-Aided Design:
 - D. Doo, M. Sabin, "Behaviour of recursive division surfaces near extraordinary points",
   CAD 10(6), 356-360 -- generalises uniform biquadratic B-splines.
 
-Each level is a handful of gathers and ``np.bincount`` scatter-adds over the half-edges (no
-Python loop per face, edge or vertex). Catmull-Clark builds the half-edge structure once;
-the connectivity of every later level follows in closed form from the previous one.
+Each level's rules are sparse matrices applied to all the vertices' columns at once (x, y,
+z and point attributes), built by gathers over the half-edges (no Python loop per face,
+edge or vertex). Catmull-Clark builds the half-edge structure once; the connectivity of
+every later level follows in closed form from the previous one. Doo-Sabin builds the
+half-edges of each level's output.
 """
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
-from .catmull_clark_levels import Level, index_type
+from .catmull_clark_levels import Level, _csr, index_type
 from .halfedge import HalfEdges, build_halfedges
 
 __all__ = [
@@ -325,26 +329,82 @@ def doo_sabin_weights(k: int) -> np.ndarray:
     return a[(i[None, :] - i[:, None]) % k]
 
 
+def _doo_sabin_points(he: HalfEdges, n: int, kept: np.ndarray) -> tuple[Any, Any]:
+    """The new points of a Doo-Sabin level as two sparse products: ``sums @ v`` gives each
+    face's sums ``S = sum v_j``, ``C = sum cos(t_j) v_j``, ``D = sum sin(t_j) v_j`` over its
+    corners (``t_j = 2 pi j / k``), and ``points @ [v; S; C; D]`` every new point.
+
+    The corner rule ``sum_j a_|i-j| v_j`` with ``a_i = (3 + 2 cos t_i) / (4k)`` (and 1/4
+    more on ``a_0``) is, as ``cos(t_i - t_j) = cos t_i cos t_j + sin t_i sin t_j``,
+    ``v_i / 4 + (3 S + 2 cos t_i C + 2 sin t_i D) / (4k)``: four entries a corner whatever
+    the face's size (the circulant's k would be k^2). The boundary Chaikin points
+    (3/4, 1/4 and 1/4, 3/4 of each boundary edge) and the ``kept`` corners are rows of the
+    same product.
+    """
+    fi, fo, face = he.origin, he.face_offsets, he.face
+    m, n_faces = fi.size, fo.size - 1
+    sizes = he.face_sizes
+    k = sizes[face]
+    b = he.boundary_halfedges
+    nb = b.size
+    itype = index_type(n + 3 * n_faces + 9 * m)  # every index and entry count
+
+    # cos t and sin t of every corner, looked up in one table of every face size present
+    present = np.flatnonzero(np.bincount(sizes))
+    start = np.zeros(present[-1] + 1 if present.size else 1, dtype=np.int64)
+    start[present] = np.cumsum(present) - present
+    of_k = np.repeat(present, present)
+    angle = (np.arange(of_k.size) - start[of_k]) * (2.0 * np.pi) / of_k
+    at = np.arange(m) - fo[face]
+    at += start[k]
+
+    data = np.empty(3 * m)
+    data[:m] = 1.0
+    np.take(np.cos(angle), at, out=data[m : 2 * m])
+    np.take(np.sin(angle), at, out=data[2 * m :])
+    indices = np.empty(3 * m, dtype=itype)
+    indices.reshape(3, m)[:] = fi
+    indptr = np.empty(3 * n_faces + 1, dtype=itype)
+    indptr[: n_faces + 1] = fo
+    np.add(fo[1:], m, out=indptr[n_faces + 1 : 2 * n_faces + 1])
+    np.add(fo[1:], 2 * m, out=indptr[2 * n_faces + 1 :])
+    sums = _csr(data, indices, indptr, (3 * n_faces, n))
+
+    nnz = 4 * m + 4 * nb + kept.size
+    rows = m + 2 * nb + kept.size
+    weight, column = np.empty(nnz), np.empty(nnz, dtype=itype)
+    w, c = weight[: 4 * m].reshape(m, 4), column[: 4 * m].reshape(m, 4)
+    c[:, 0] = fi  # v_i, then S, C and D of its face
+    np.add(face, n, out=c[:, 1])
+    np.add(c[:, 1], n_faces, out=c[:, 2])
+    np.add(c[:, 2], n_faces, out=c[:, 3])
+    w[:, 0] = 0.25
+    inv = 0.5 / k
+    np.multiply(inv, 1.5, out=w[:, 1])
+    np.multiply(data[m : 2 * m], inv, out=w[:, 2])
+    np.multiply(data[2 * m :], inv, out=w[:, 3])
+    # the Chaikin points: (a, b) twice per boundary edge a -> b
+    ends = column[4 * m : 4 * m + 4 * nb].reshape(nb, 2, 2)
+    ends[:, :, 0] = he.origin[b, None]
+    ends[:, :, 1] = he.vertex[b, None]
+    weight[4 * m : 4 * m + 4 * nb].reshape(nb, 4)[:] = [0.75, 0.25, 0.25, 0.75]
+    column[4 * m + 4 * nb :] = kept
+    weight[4 * m + 4 * nb :] = 1.0
+    indptr = np.empty(rows + 1, dtype=itype)
+    indptr[: m + 1] = np.arange(0, 4 * m + 1, 4, dtype=itype)
+    indptr[m : m + 2 * nb + 1] = np.arange(4 * m, 4 * m + 4 * nb + 1, 2, dtype=itype)
+    indptr[m + 2 * nb :] = np.arange(4 * m + 4 * nb, nnz + 1, dtype=itype)
+    points = _csr(weight, column, indptr, (rows, n + 3 * n_faces))
+    return sums, points
+
+
 def _doo_sabin_step(
     v: np.ndarray, he: HalfEdges, fvals: np.ndarray | None = None
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
-    fi, fo = he.origin, he.face_offsets
-    m = fi.size
+    m = he.origin.size
     sizes = he.face_sizes
-
-    # one new point per corner (half-edge), by the weights of its face's size
-    d = v.shape[1]
-    corner = np.empty((m, d))
-    for k in np.unique(sizes):
-        faces = np.flatnonzero(sizes == k)
-        idx = fo[faces][:, None] + np.arange(k)
-        corner[idx] = np.einsum("ij,fjd->fid", doo_sabin_weights(int(k)), v[fi[idx]])
-
-    # boundary edges get two points at 1/4 and 3/4 (Chaikin), boundary corners keep theirs
     b = he.boundary_halfedges
     nb = b.size
-    a_b, z_b = v[he.origin[b]], v[he.vertex[b]]
-    chaikin = np.stack([0.75 * a_b + 0.25 * z_b, 0.25 * a_b + 0.75 * z_b], axis=1).reshape(-1, d)
     c_first = np.full(m, -1, dtype=np.int64)  # new id of the Chaikin point near origin(h)
     c_first[b] = m + 2 * np.arange(nb)
 
@@ -353,7 +413,13 @@ def _doo_sabin_step(
     fan_open = ~fans.closed
     corner_fan = fan_open & (fan_size == 1) & he.is_manifold_vertex[fans.vertex]
     kept = fans.vertex[corner_fan]
-    new_v = np.concatenate([corner, chaikin, v[kept]])
+    # the new points (one per corner, two per boundary edge, the kept corners), all the
+    # vertices' columns (x, y, z and point attributes) in each product
+    sums, points = _doo_sabin_points(he, v.shape[0], kept)
+    x = np.empty((v.shape[0] + sums.shape[0], v.shape[1]))
+    x[: v.shape[0]] = v
+    x[v.shape[0] :] = sums @ v
+    new_v = points @ x
 
     # F-faces: the corner points of each face, in the face's order
     parts = [np.arange(m, dtype=np.int64)]
@@ -394,13 +460,27 @@ def _doo_sabin_step(
     new_f = None
     if fvals is not None:
         # F-faces keep their face's values, E-faces take the mean of the faces on their
-        # edge, V-faces the mean of the faces around their vertex
-        fh = fvals[he.face]
-        fan_sum = np.add.reduceat(fh[fans.halfedges], fans.offsets[:-1], axis=0)
-        fan_mean = fan_sum / np.maximum(fan_size, 1)[:, None]
-        new_f = np.concatenate(
-            [fvals, 0.5 * (fh[h] + fh[t]), fh[b], fan_mean[out_size > 0]], axis=0
+        # edge, V-faces the mean of the faces around their vertex: one sparse product
+        face, n_faces = he.face, sizes.size
+        n_fan = fan_size[out_size > 0]  # the faces around each V-face's vertex
+        n_inner = 2 * h.size
+        rows = np.concatenate(  # each face's own, each edge's two faces, each fan's faces
+            [np.arange(n_faces), np.stack([face[h], face[t]], 1).reshape(-1), face[b]]
+            + [face[fans.halfedges[placed]]]
         )
+        weights = np.concatenate(
+            [np.ones(n_faces), np.full(n_inner, 0.5), np.ones(nb), np.repeat(1.0 / n_fan, n_fan)]
+        )
+        starts = np.concatenate(
+            [
+                np.arange(n_faces),
+                n_faces + np.arange(0, n_inner, 2),
+                n_faces + n_inner + np.arange(nb + 1),
+                n_faces + n_inner + nb + np.cumsum(n_fan),
+            ]
+        )
+        spread = _csr(weights, rows, starts, (all_sizes.size, n_faces))
+        new_f = spread @ fvals
     return new_v, face_indices, face_offsets, new_f
 
 
@@ -410,6 +490,7 @@ def doo_sabin(
     face_offsets: np.ndarray,
     levels: int = 1,
     face_values: np.ndarray | None = None,
+    halfedges: HalfEdges | None = None,
 ) -> tuple[np.ndarray, ...]:
     """Doo-Sabin subdivision of a polygon mesh (Doo & Sabin 1978).
 
@@ -446,6 +527,14 @@ def doo_sabin(
         The mesh, faces counter-clockwise seen from outside.
     levels : int
         Number of subdivision steps (0 returns a copy).
+    halfedges : HalfEdges, optional
+        The half-edges of these faces when the caller has them already (a ``Mesh``'s
+        ``halfedges``): not built a second time.
+
+    Each level is two sparse products over all the vertices' columns (see
+    :func:`_doo_sabin_points`): the corner rule in its cosine form costs four entries a
+    corner whatever the face's size, so a face of thousands of corners costs what as many
+    quads do.
 
     vertices may carry extra columns beyond x, y, z (point attributes): they follow the
     same weights. ``face_values`` (n_faces, c), when given, follow the faces: an F-face keeps
@@ -470,7 +559,7 @@ def doo_sabin(
     """
     v = _as_vertices(vertices)
     levels = _check_levels(levels)
-    he = build_halfedges(face_indices, face_offsets, v.shape[0])
+    he = _halfedges_of(face_indices, face_offsets, v.shape[0], halfedges)
     fv = (
         None if face_values is None else np.asarray(face_values, np.float64).reshape(he.n_faces, -1)
     )
