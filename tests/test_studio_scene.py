@@ -4,6 +4,7 @@ of a step, with its polydata serializer keeping each cell array's legacy export.
 from __future__ import annotations
 
 import shutil
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -22,6 +23,23 @@ def _serializers():
 
     initialize_serializers()  # trame-vtk's own, as its protocol does when it starts
     return registry
+
+
+@contextmanager
+def _tube_scene(tmp_path):
+    """The spiral tube opened in a studio session and shown in a fresh off-screen scene."""
+    from formgraph.studio.scene import StudioScene, make_plotter
+
+    path = tmp_path / "tube.yaml"
+    shutil.copy(TUBE, path)
+    session = StudioSession(path, out_dir=tmp_path / "out")
+    plotter = make_plotter()
+    try:
+        scene = StudioScene(plotter)
+        scene.update(session.open().shown)
+        yield session, plotter, scene
+    finally:
+        plotter.close()
 
 
 def _describe(serializer, data):
@@ -49,18 +67,12 @@ def test_cells_once_describes_polydata_as_trame_vtk_does():
 def test_unchanged_cells_keep_their_array_and_hash(tmp_path):
     from trame_vtk.modules.vtk.serializers import SynchronizationContext
 
-    from formgraph.studio.scene import StudioScene, make_plotter, send_cells_once
+    from formgraph.studio.scene import send_cells_once
 
     registry = _serializers()
     send_cells_once()
     serializer = registry.SERIALIZERS["vtkPolyData"]
-    path = tmp_path / "tube.yaml"
-    shutil.copy(TUBE, path)
-    s = StudioSession(path, out_dir=tmp_path / "out")
-    plotter = make_plotter()
-    try:
-        scene = StudioScene(plotter)
-        scene.update(s.open().shown)
+    with _tube_scene(tmp_path) as (s, _plotter, scene):
         data = scene.parts[("solid", "meshes")].data
         context = SynchronizationContext()
         first = serializer(None, data, "d", context, 1)["properties"]
@@ -77,8 +89,6 @@ def test_unchanged_cells_keep_their_array_and_hash(tmp_path):
         assert third["polys"]["hash"] != first["polys"]["hash"]
         legacy = context.data_array_cache[third["polys"]["hash"]]["array"]
         assert np.array_equal(np.asarray(legacy), data.faces)
-    finally:
-        plotter.close()
 
 
 def test_a_step_sends_only_its_new_arrays(tmp_path):
@@ -87,24 +97,12 @@ def test_a_step_sends_only_its_new_arrays(tmp_path):
     from trame_vtk.modules.vtk.serializers import SynchronizationContext, serialize
     from trame_vtk.modules.vtk.serializers.utils import reference_id
 
-    from formgraph.studio.scene import (
-        SentArrays,
-        StudioScene,
-        make_plotter,
-        send_back_faces,
-        send_cells_once,
-    )
+    from formgraph.studio.scene import SentArrays, send_back_faces, send_cells_once
 
     _serializers()
     send_back_faces()
     send_cells_once()
-    path = tmp_path / "tube.yaml"
-    shutil.copy(TUBE, path)
-    s = StudioSession(path, out_dir=tmp_path / "out")
-    plotter = make_plotter()
-    try:
-        scene = StudioScene(plotter)
-        scene.update(s.open().shown)
+    with _tube_scene(tmp_path) as (s, plotter, scene):
         window = plotter.render_window
         context = SynchronizationContext()
 
@@ -128,8 +126,6 @@ def test_a_step_sends_only_its_new_arrays(tmp_path):
             np.ascontiguousarray(lines.points, dtype=np.float32).tobytes(),
         }
         assert sent.fresh(describe()) == []
-    finally:
-        plotter.close()
 
 
 def test_sent_arrays_forget_the_oldest():
