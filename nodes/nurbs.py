@@ -8,7 +8,7 @@ vectorized); a kernel's ``ValueError`` is reported against the input it is about
 from __future__ import annotations
 
 from enum import Enum
-from typing import Annotated, Any
+from typing import Annotated
 
 import numpy as np
 
@@ -37,16 +37,6 @@ class Parametrization(str, Enum):
     uniform = "uniform"  # equal steps
 
 
-def _call(port: str, fn: Any, *args: Any, **kwargs: Any) -> Any:
-    """Call a kernel; its ValueError names the node input it is about."""
-    try:
-        return fn(*args, **kwargs)
-    except InputError:
-        raise
-    except ValueError as exc:
-        raise InputError(port, str(exc)) from None
-
-
 def _tuple(curve: NurbsCurve) -> CurveTuple:
     w = curve.weights if curve.rational else None
     return (np.asarray(curve.control_points), curve.degree, np.asarray(curve.knots), w)
@@ -73,7 +63,7 @@ def _as_nurbs(curve: Curve, port: str, ctx: Context) -> CurveTuple:
     entries = K.banded_entries(n, 4, 3, closed) + 8 * n
     ctx.guard(entries, f"entries of the interpolation system of input '{port}'")
     pts = np.asarray(curve.sample(n))
-    return _call(port, K.interpolate, pts[:-1] if closed else pts, 3, closed)
+    return InputError.call(port, K.interpolate, pts[:-1] if closed else pts, 3, closed)
 
 
 def _capped_degree(degree: int, count: int, port: str, ctx: Context) -> int:
@@ -141,10 +131,10 @@ def curve(
         p = _capped_degree(degree, len(cp), "degree", ctx)
         ctrl, kn, _ = K.periodic_curve(cp, p)
         ww = None if w is None else np.concatenate([w, w[:p]])
-        return _call("weights", NurbsCurve, ctrl, p, kn, ww)
+        return InputError.call("weights", NurbsCurve, ctrl, p, kn, ww)
     if knots is None:
         p = _capped_degree(degree, len(cp), "degree", ctx)
-        return _call("weights", NurbsCurve, cp, p, K.clamped_uniform_knots(len(cp), p), w)
+        return InputError.call("weights", NurbsCurve, cp, p, K.clamped_uniform_knots(len(cp), p), w)
     kn = np.asarray(knots, dtype=np.float64)
     try:
         K.validate_curve(cp, degree, kn, None)
@@ -158,7 +148,7 @@ def curve(
             else "points"
         )
         raise InputError(port, msg) from None
-    return _call("weights", NurbsCurve, cp, degree, kn, w)
+    return InputError.call("weights", NurbsCurve, cp, degree, kn, w)
 
 
 @node("nurbs.circle", version=1)
@@ -182,7 +172,7 @@ def circle(
     normal : Vec3
         Normal of the circle's plane (non-zero).
     """
-    return _curve(_call("radius", K.circle, radius, center, _nonzero(normal, "normal")))
+    return _curve(InputError.call("radius", K.circle, radius, center, _nonzero(normal, "normal")))
 
 
 @node("nurbs.arc", version=1)
@@ -216,7 +206,9 @@ def arc(
             "end",
             f"an arc must sweep more than 0 and at most 360 degrees, got {start:g} to {end:g}",
         )
-    return _curve(_call("radius", K.arc, radius, start, end, center, _nonzero(normal, "normal")))
+    return _curve(
+        InputError.call("radius", K.arc, radius, start, end, center, _nonzero(normal, "normal"))
+    )
 
 
 def _nonzero(v: np.ndarray, port: str) -> np.ndarray:
@@ -258,7 +250,9 @@ def interpolate(
     # what the banded solve holds at once (kernels.nurbs.banded_entries)
     width = min(degree, max(count - 1, 1)) + 1
     ctx.guard(K.banded_entries(count, width, 3, closed), "entries of the interpolation system")
-    return _curve(_call("points", K.interpolate, pts, degree, closed, parametrization.value))
+    return _curve(
+        InputError.call("points", K.interpolate, pts, degree, closed, parametrization.value)
+    )
 
 
 class Direction(str, Enum):
@@ -348,7 +342,7 @@ def elevate_degree(
     q = curve.degree + times
     # each new control point is a blossom of degree q: q^2 / 2 affine steps (one pass)
     ctx.guard(n_new * (q + 1) ** 2 // 2, "blossom steps (new control points x degree^2 / 2)")
-    return _curve(_call("times", K.elevate_degree, *_tuple(curve), times))
+    return _curve(InputError.call("times", K.elevate_degree, *_tuple(curve), times))
 
 
 # ------------------------------------------------------------------------------ surfaces
@@ -403,7 +397,7 @@ def surface(
     w = None if weights is None else _surface_weights(weights, nu, nv)
     ku = _surface_knots(knots_u, degree_u, nu, "u", ctx)
     kv = _surface_knots(knots_v, degree_v, nv, "v", ctx)
-    return _call("weights", NurbsSurface, net, ku[1], kv[1], ku[0], kv[0], w)
+    return InputError.call("weights", NurbsSurface, net, ku[1], kv[1], ku[0], kv[0], w)
 
 
 def _surface_weights(weights: list, nu: int, nv: int) -> np.ndarray:
@@ -469,7 +463,7 @@ def loft(
     """
     tuples = [_as_nurbs(c, "curves", ctx) for c in curves]
     ctx.guard(sum(len(t[0]) for t in tuples) * len(tuples), "control points")
-    return _surface(_call("curves", K.loft, tuples, degree_v, closed))
+    return _surface(InputError.call("curves", K.loft, tuples, degree_v, closed))
 
 
 @node("nurbs.extrude", version=1)
@@ -484,7 +478,9 @@ def extrude(curve: Curve, direction: Vec3 = (0.0, 0.0, 1.0), *, ctx: Context) ->
     direction : Vec3
         Direction and length of the extrusion.
     """
-    return _surface(_call("direction", K.extrude, _as_nurbs(curve, "curve", ctx), direction))
+    return _surface(
+        InputError.call("direction", K.extrude, _as_nurbs(curve, "curve", ctx), direction)
+    )
 
 
 @node("nurbs.revolve", version=1)
@@ -519,7 +515,7 @@ def revolve(
             "angle", f"angle must be more than 0 and at most 360 degrees, got {angle:g}"
         )
     prof = _as_nurbs(curve, "curve", ctx)
-    return _surface(_call("axis", K.revolve, prof, axis_point, axis, angle))
+    return _surface(InputError.call("axis", K.revolve, prof, axis_point, axis, angle))
 
 
 @node("nurbs.sweep", version=1)
@@ -563,7 +559,7 @@ def sweep(
     if np.any(weak):
         chords = np.gradient(pts, axis=0)
         tangents = np.where(weak[:, None], chords, tangents)
-    return _surface(_call("path", K.sweep, prof, pts, tangents))
+    return _surface(InputError.call("path", K.sweep, prof, pts, tangents))
 
 
 def _auto_stations(path: Curve) -> int:

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import dataclasses
 
+import pytest
+
 import formgraph as fg
 from formgraph.core import registry
 
@@ -42,3 +44,24 @@ def test_registration_is_seen():
     finally:
         del registry._REGISTRY["stub.registry_probe"]
     assert "stub.registry_probe" not in fg.node_types()
+
+
+def test_input_error_call_names_the_port_unless_an_inner_input_did():
+    from formgraph.core.errors import InputError
+
+    def kernel(x):
+        if x < 0:
+            raise ValueError("x must not be negative")
+        if x == 0:
+            raise InputError("inner", "zero is refused by the inner input")
+        return 2 * x
+
+    assert InputError.call("outer", kernel, 2) == 4
+    with pytest.raises(InputError, match="negative") as bad:
+        InputError.call("outer", kernel, -1)
+    assert bad.value.port == "outer"
+    with pytest.raises(InputError, match="zero") as inner:
+        InputError.call("outer", kernel, 0)
+    assert inner.value.port == "inner"  # it named its own input: kept
+    with pytest.raises(TypeError):  # not a complaint about a value: not rewrapped
+        InputError.call("outer", kernel, "a")

@@ -111,9 +111,12 @@ class InputError(ValueError):
     @classmethod
     def call(cls, port: str, fn: Callable[..., Any], *args: Any, **kwargs: Any) -> Any:
         """``fn(*args, **kwargs)``, a kernel's ValueError made an InputError on ``port``:
-        the node input the kernel's complaint is about."""
+        the node input the kernel's complaint is about (an InputError from inside already
+        names its own input and passes unchanged)."""
         try:
             return fn(*args, **kwargs)
+        except InputError:
+            raise
         except ValueError as exc:
             raise cls(port, str(exc)) from None
 
