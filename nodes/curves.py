@@ -210,7 +210,7 @@ def parametric(
     return curve
 
 
-@node("curves.resample", version=1)
+@node("curves.resample", version=2)
 def resample(
     curve: Curve,
     count: Annotated[int | None, Range(min=2)] = None,

@@ -300,7 +300,7 @@ def text(
     return out
 
 
-@node("curves.divide", version=1)
+@node("curves.divide", version=2)
 def divide(
     curve: Curve,
     count: Annotated[int | None, Range(min=2)] = None,
