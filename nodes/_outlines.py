@@ -68,6 +68,12 @@ def divisions(
 ) -> int:
     """How many points divide a curve of ``length``: ``count``, or from ``spacing``; checked
     and charged to the budget. ``verb`` ("divide", "resample") words the errors."""
+    if not math.isfinite(length):
+        raise InputError(
+            "curve",
+            f"cannot {verb} a curve whose length is not finite (got {length}: coordinates "
+            "too large to measure, or not numbers)",
+        )
     if not length > 0.0:
         raise InputError("curve", f"cannot {verb} a curve of zero length")
     n = (

@@ -209,3 +209,18 @@ def test_relax_rest_length_zero_names_the_range(how):
     with pytest.raises(fg.GraphError, match=r"input 'rest_length': must be >= 1e-12, got 0") as e:
         fg.Graph.from_text(text, file="h.yaml").evaluate("r")
     assert "Annotated" not in str(e.value)
+
+
+@pytest.mark.parametrize("node", ["curves.divide", "curves.resample"])
+def test_a_curve_too_large_to_measure_is_refused_on_its_input(tmp_path, node):
+    """A control point at 1e308 is finite, but the curve's length overflows: refused on
+    'curve' before any point is placed (it was a NaN point's complaint from the output)."""
+    (tmp_path / "g.yaml").write_text(
+        HEAD
+        + "  c: {type: nurbs.curve, points: [[0,0,0],[1,0,0],[1,1,0],[1e308,1e308,0]]}\n"
+        + f"  d: {{type: {node}, curve: '@c', count: 1000}}\n"
+    )
+    g = fg.load(tmp_path / "g.yaml")
+    with pytest.raises(fg.NodeError, match=r"input 'curve'.*length is not finite") as info:
+        g.evaluate("d")
+    assert "g.yaml:4: node 'd'" in str(info.value)
