@@ -381,6 +381,39 @@ def _bounds(port: str, bounds: Any) -> np.ndarray:
     return b
 
 
+def _thinnest(field: Field) -> tuple[str, float] | None:
+    """The thinnest wall a field's construction names — a TPMS sheet, a shell, a tube's
+    diameter — in the units it is meshed in (scaled by the transforms above it), with the
+    words for it; None when none does. Walked without recursion: a field is a DAG that
+    graphs of any depth build."""
+    best: tuple[str, float] | None = None
+    stack, seen = [(field, 1.0)], set()
+    while stack:
+        f, scale = stack.pop()
+        if (id(f), scale) in seen:
+            continue
+        seen.add((id(f), scale))
+        own = None
+        if f.op == "tpms":
+            own = (
+                f"the {f.args['kind']} sheet ({f.args['thickness']:g} thick)",
+                f.args["thickness"],
+            )
+        elif f.op == "shell":
+            own = (f"the shell ({f.args['thickness']:g} thick)", f.args["thickness"])
+        elif f.op == "from_curves":
+            own = (
+                f"the tubes round the curves ({2 * f.args['radius']:g} across)",
+                2 * f.args["radius"],
+            )
+        if own is not None and (best is None or own[1] * scale < best[1]):
+            best = (own[0] if scale == 1.0 else f"{own[0]} scaled by {scale:g}", own[1] * scale)
+        if f.op == "transform":
+            scale *= float(np.min(f.args["scale"]))
+        stack.extend((c, scale) for c in f.children)
+    return best
+
+
 def mesh_of(
     field: Field, cell: float | None, bounds: Any, ctx: Context, port: str = "field"
 ) -> Mesh:
@@ -406,6 +439,18 @@ def mesh_of(
         cell = extent / 100 if extent > 0 else 1.0
     elif not cell > 0:
         raise InputError("cell", f"cell must be > 0, got {cell:g}")
+    elif extent > 0 and cell > extent:
+        raise InputError(
+            "cell",
+            f"cell {cell:g} is larger than the box to mesh (its largest side is {extent:g}): "
+            f"nothing of the surface can be resolved; use a cell of {extent / 10:g} or less",
+        )
+    thin = _thinnest(field)
+    if thin is not None and thin[1] < cell:
+        ctx.warn(
+            f"{thin[0]} is thinner than the cell {cell:g}: the mesh cannot resolve it and "
+            f"comes out with holes or not at all; use a cell of {thin[1] / 2:g} or less"
+        )
     # a box n cells wide has at least n^2 surface cells; refuse a hopeless grid up front
     ctx.guard(((extent / cell) + 2) ** 2, "surface cells")
     try:

@@ -106,3 +106,58 @@ def test_remeshing_finer_than_the_budget_fails_before_allocating():
     )
     with pytest.raises(BudgetError, match="vertices"):
         g.evaluate("r")
+
+
+def test_a_cell_larger_than_the_box_is_refused_on_cell():
+    g = graph(
+        s=("field.sphere", {"radius": 5}),
+        m=("field.mesh", {"field": "@s", "cell": 1e300}),
+    )
+    with pytest.raises(fg.NodeError, match=r"input 'cell'.*larger than the box.*side is 10"):
+        g.evaluate("m")
+
+
+@pytest.mark.parametrize(
+    "nodes, what",
+    [
+        (  # a sheet of 1e-301 (it meshed 80k faces of aliasing noise without a word)
+            {"t": ("field.tpms", {"period": 1e-300, "thickness": 1e-301})},
+            "gyroid sheet",
+        ),
+        ({"t": ("field.tpms", {"period": 10, "thickness": 0.1})}, "gyroid sheet"),
+        (
+            {
+                "s": ("field.sphere", {"radius": 4}),
+                "t": ("field.shell", {"field": "@s", "thickness": 0.1}),
+            },
+            "shell",
+        ),
+        (  # a sheet of 1 made 0.1 thick by a transform's scale
+            {
+                "g": ("field.tpms", {"period": 40, "thickness": 1}),
+                "t": ("field.transform", {"field": "@g", "scale": 0.1}),
+            },
+            r"scaled by 0\.1",
+        ),
+    ],
+)
+def test_a_wall_thinner_than_the_cell_is_warned_of(nodes, what):
+    g = graph(
+        **nodes,
+        b=("field.box", {"size": [10, 10, 10]}),
+        i=("field.intersection", {"fields": ["@t", "@b"]}),
+        m=("field.mesh", {"field": "@i", "cell": 0.25}),
+    )
+    with pytest.warns(fg.FormgraphWarning, match=f"{what}.*thinner than the cell 0.25"):
+        g.evaluate("m")
+
+
+def test_a_wall_the_cell_resolves_is_not_warned_of(recwarn):
+    g = graph(
+        t=("field.tpms", {"period": 10, "thickness": 1}),
+        b=("field.box", {"size": [10, 10, 10]}),
+        i=("field.intersection", {"fields": ["@t", "@b"]}),
+        m=("field.mesh", {"field": "@i", "cell": 0.25}),
+    )
+    assert g.evaluate("m").n_faces > 0
+    assert not [w for w in recwarn if "thinner" in str(w.message)]
