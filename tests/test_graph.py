@@ -102,6 +102,15 @@ def test_evaluate_all_evaluates_the_sinks():
     g.add("side", "stub.value", x=7.0, label="side")
     assert g.sinks() == ["a2", "side"]
     assert g.evaluate_all() == {"a2": 12.0, "side": 7.0}
+    # the sinks are kept between runs and follow every change of the graph
+    g.sinks().append("not a node")  # the caller's list is its own
+    assert g.sinks() == ["a2", "side"]
+    g.add("reader", "stub.sum", items=["@side"])
+    assert g.sinks() == ["a2", "reader"]
+    g.set_input("reader", "items", ["@a2"])
+    assert g.sinks() == ["side", "reader"]
+    g.remove("reader")
+    assert g.sinks() == ["a2", "side"]
 
 
 def test_memory_cache_is_bounded_by_bytes():

@@ -187,6 +187,11 @@ class MemoryCache:
             _, (_, s) = self._items.popitem(last=False)
             self.bytes -= s
 
+    def size(self, key: str, value: Any) -> int:
+        """The size ``put`` counted for ``key`` when it holds ``value``; else ``sizeof``."""
+        item = self._items.get(key)
+        return item[1] if item is not None and item[0] is value else sizeof(value)
+
     def __contains__(self, key: str) -> bool:
         return key in self._items
 

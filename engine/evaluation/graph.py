@@ -129,6 +129,7 @@ class Graph(Plans):
         self._replay: dict[tuple[str, ...], Any] = {}  # targets -> last run's keys (run.py)
         self._pure_root: tuple[str, Path] | None = None  # out_dir -> its root, for plans
         self._step_params: tuple[str, dict[str, Any]] | None = None  # compute_step's last
+        self._sinks: list[str] | None = None  # sinks(), kept until the graph changes
         self._checked = False
         # from_text: (the text read, its description and outputs); forgotten on any change
         self._source: tuple[str, str, dict[str, Any]] | None = None
@@ -147,6 +148,7 @@ class Graph(Plans):
         if not value:
             self._replay.clear()
             self._step_params = None
+            self._sinks = None
             self._source = None
 
     # ----------------------------------------------------------------------- building
@@ -461,10 +463,10 @@ class Graph(Plans):
 
     def _output_of(self, name: str) -> tuple[str, str | None]:
         """(node, output) of ``name``: a node, or ``node.output`` as a wire spells it."""
-        from ..language.params import suggest
-
         if name in self._nodes:
             return name, None
+        from ..language.params import suggest
+
         node, _, output = name.rpartition(".")
         if node in self._nodes:
             spec = self.node_types().get(self._nodes[node].type)
@@ -492,8 +494,10 @@ class Graph(Plans):
 
     def sinks(self) -> list[str]:
         """Nodes nothing else reads from (exports, usually), in author order."""
-        used = {up for nd in self._nodes.values() for up in nd.upstream()}
-        return [n for n in self._nodes if n not in used]
+        if self._sinks is None:
+            used = {up for nd in self._nodes.values() for up in nd.upstream()}
+            self._sinks = [n for n in self._nodes if n not in used]
+        return list(self._sinks)
 
     def evaluate_all(self, **params: Any) -> dict[str, Any]:
         """Evaluate every sink (so every export writes its file)."""

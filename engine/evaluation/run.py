@@ -379,9 +379,13 @@ class _Run(LanguageRun, SimulationRun, Replay):
                     hit, value, source = self.lookup(self.keys[n], spec)
                 if hit:
                     self.results[n] = value
-                    self.stats[n] = NodeStat(
-                        "cached", time.perf_counter() - t0, _cache.sizeof(value), source=source
+                    size = (
+                        self.g.memory.size(self.keys[n], value)
+                        if source == "memory" and nd.repeat is None and nd.simulate is None
+                        else _cache.sizeof(value)
                     )
+                    seconds = time.perf_counter() - t0
+                    self.stats[n] = NodeStat("cached", seconds, size, source=source)
                     if nd.repeat is not None:
                         self.stats[n].items = len(self.item_keys[n])
                     elif nd.simulate is not None:
