@@ -679,6 +679,19 @@ def test_save_writes_the_file(page, studio):
     ]
 
 
+def test_save_right_after_an_edit_saves_the_edit(page, studio):
+    """Typed and saved in one go (the same task of the page, before the text's state update
+    can reach the server): the page sends its text with the click, so the edit is saved."""
+    page.click("#editor .view-lines")
+    page.keyboard.press("Control+Home")
+    page.evaluate(
+        "document.execCommand('insertText', false, '# saved at once\\n');"
+        "document.querySelector('#save').click()"
+    )
+    page.wait_for_function("document.querySelector('#status').innerText.includes('saved')")
+    assert studio.graph.read_text().startswith("# saved at once\n")
+
+
 def test_click_a_node_shows_it(page):
     before = _canvas(page)
     page.locator("#graph [data-node='spiral']").click()

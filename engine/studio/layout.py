@@ -228,7 +228,11 @@ def build(page: Any) -> tuple[Any, Any]:
         )
         with v.VAppBar(density="compact", flat=True, border=True):
             v.VAppBarTitle(f"{page.session.path.name}", style="flex: 0 0 auto; font-size: 16px;")
-            v.VBtn("Save", click=page.ctrl.save, variant="tonal", classes="ml-2", id="save")
+            # the editor's text goes with the click: what the page shows is what is saved,
+            # even while the text's own state update is still on its way
+            v.VBtn(
+                "Save", click="trigger('save', [text])", variant="tonal", classes="ml-2", id="save"
+            )
             v.VBtn("Run", click=page.ctrl.run, variant="tonal", classes="ml-2", id="run")
             v.VBtn(
                 "Reload",

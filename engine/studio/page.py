@@ -167,7 +167,7 @@ class Page:
         ctrl.trigger("show_node")(self._show_node)
         ctrl.trigger("colour_by")(self._colour_by)
         ctrl.trigger("show_frame")(self._show_frame)
-        ctrl.add("save")(self._save)
+        ctrl.trigger("save")(self._save)
         ctrl.add("run")(self._run)
         ctrl.add("reload")(lambda: self.worker.submit("disk", self._open_disk))
         ctrl.add("reset_all")(lambda: self.worker.submit("params", self.session.reset_params))
@@ -240,8 +240,10 @@ class Page:
     def _open_disk(self) -> Cooked:
         return self.session.open()  # the file's text
 
-    def _save(self) -> None:
-        text = self.state.text
+    def _save(self, text: Any = None) -> None:
+        """Save the text the page sent with the click (the state's, from an older page)."""
+        if not isinstance(text, str):
+            text = self.state.text
         self.worker.submit("save", self._save_text, text)
 
     def _save_text(self, text: str) -> tuple[str, str, str | None]:
