@@ -67,6 +67,23 @@ def fail_at(x: float, bad: float) -> float:
     return x
 
 
+@node("stub.die_at", version=1)
+def die_at(x: float, bad: float) -> float:
+    """x, or the process ends at once (as an out-of-memory kill ends a worker) when x equals
+    ``bad``.
+
+    Parameters
+    ----------
+    x : float
+        The number.
+    bad : float
+        The value that kills.
+    """
+    if x == bad:
+        os._exit(1)
+    return x
+
+
 class CurveStats(NamedTuple):
     length: float
     closed: bool

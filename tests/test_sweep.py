@@ -161,6 +161,24 @@ def test_a_worker_killed_mid_sweep_is_survived(tmp_path):
     assert [r["sum"] for r in s.rows] == [a + 2.0 for a in range(1, 11)]
 
 
+def test_a_variant_that_kills_its_worker_fails_alone(tmp_path):
+    """Variants go several to a task; when one of them ends its worker's process each time
+    it runs (Dask gives up: KilledWorker), the task's rows are run again one a task, so only
+    that variant fails and the others of its task come back."""
+    import dask
+
+    g = fg.Graph()
+    g.add_param("a", 1.0)
+    g.add("d", "stub.die_at", x="=a", bad=7.0)
+    with dask.config.set({"distributed.scheduler.allowed-failures": 1}):
+        with cluster(2) as c, Client(c) as cl:
+            s = fg.sweep(g, {"a": "1:160:160"}, ["d"], client=cl, cache_dir=None)
+    failed = [r["a"] for r in s.rows if r["status"] != "ok"]
+    assert failed == [7.0]
+    assert "kept dying" in next(r["error"] for r in s.rows if r["status"] != "ok")
+    assert [r["d"] for r in s.rows if r["status"] == "ok"] == [a for a in range(1, 161) if a != 7]
+
+
 def test_an_interrupted_sweep_resumes_with_every_row_once(client, tmp_path):
     log = tmp_path / "calls.log"
     out = tmp_path / "out"

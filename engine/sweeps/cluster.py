@@ -447,6 +447,17 @@ def run(
                         continue
                     if fut.key in results:
                         finished = results[fut.key].rows
+                    elif len(chunks[fut.key]) > 1 and _killed(fut):
+                        # one variant of the task kills its worker (out of memory, a crash
+                        # in compiled code): each of its rows again on its own, so only that
+                        # one fails and the others are not blamed for it
+                        again = c.get(
+                            dsk, _split(dsk, chunks, fut.key), sync=False, optimize_graph=False
+                        )
+                        futures.extend(again)
+                        pending.update(again)
+                        fut.release()
+                        continue
                     else:
                         finished = _chunk_result(fut, chunks[fut.key])
                     fut.release()
@@ -459,6 +470,29 @@ def run(
     totals.computed = sum(1 for _, st in seen.values() if st == "computed")
     totals.cached = sum(1 for _, st in seen.values() if st == "cached")
     return totals
+
+
+def _killed(fut: Any) -> bool:
+    """Whether a task failed because the workers running it kept dying (KilledWorker)."""
+    if fut.status != "error":
+        return False
+    try:
+        return type(fut.exception()).__name__ == "KilledWorker"
+    except Exception:  # lost with its worker: said when its result is asked for
+        return False
+
+
+def _split(dsk: dict[str, Any], chunks: dict[str, list[str]], task_key: str) -> list[str]:
+    """The rows of the row task ``task_key`` as tasks of one row each, put in ``dsk`` and
+    ``chunks`` under their row keys (what a one-row task is keyed by); their keys."""
+    fn, bp_key, job, packed, *_ = dsk[task_key]
+    keys = []
+    for plan in packed.unpack().plans:
+        shared = tuple(dict.fromkeys(k for _, k in plan.shared))
+        dsk[plan.key] = (fn, bp_key, job, Packed.of(RowChunk((plan,), shared)), *shared)
+        chunks[plan.key] = [plan.key]
+        keys.append(plan.key)
+    return keys
 
 
 def _chunk_result(fut: Any, row_keys: list[str]) -> list[tuple[str, RowResult]]:
