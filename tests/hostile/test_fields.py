@@ -161,3 +161,18 @@ def test_a_wall_the_cell_resolves_is_not_warned_of(recwarn):
     )
     assert g.evaluate("m").n_faces > 0
     assert not [w for w in recwarn if "thinner" in str(w.message)]
+
+
+def test_the_mesher_refuses_a_box_too_many_cells_across_to_number():
+    """Called directly (the node's budget stops this long before), a box 4e7 cells across
+    overflowed the block keys and meshed an open, wrong surface; it is refused."""
+    from formgraph.kernels.field import mesher
+
+    def sphere(p):
+        return np.linalg.norm(p, axis=-1) - 1.0
+
+    with pytest.raises(ValueError, match="cells across"):
+        mesher.mesh_field(sphere, np.full(3, -1e6), np.full(3, 1e6), 0.05, 1.0, 10**15)
+    v, t = mesher.mesh_field(sphere, np.full(3, -1.5), np.full(3, 1.5), 0.05, 1.0)
+    edges = np.sort(np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]]), axis=1)
+    assert len(v) and (np.unique(edges, axis=0, return_counts=True)[1] == 2).all()

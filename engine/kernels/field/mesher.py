@@ -290,6 +290,9 @@ class _Vertices:
         return verts
 
 
+MAX_SIDE = 1 << 20  # cells a side at most: (blocks a side)^3 well inside int64
+
+
 def mesh_field(
     f: Fn,
     lo,
@@ -335,6 +338,12 @@ def mesh_field(
     """
     if not (cell > 0 and np.isfinite(cell)):
         raise ValueError(f"cell must be > 0, got {cell:g}")
+    side = float(np.max(np.asarray(hi, float) - np.asarray(lo, float))) / cell
+    if not side <= MAX_SIDE:  # block keys and lattice indices stay exact in int64
+        raise ValueError(
+            f"the box is {side:.3g} cells across, over the {MAX_SIDE:,} a side the mesher "
+            "can number: use a larger cell or a smaller box"
+        )
     empty = np.zeros((0, 3)), np.zeros((0, 3), np.int64)
     lat = Lattice(f, lo, hi, cell, lipschitz, max_cells, grid)
     nk = len(lat.blocks)
