@@ -312,6 +312,81 @@ def test_worker_newest_request_supersedes_the_running_one():
     assert w.superseded == 2
 
 
+def test_worker_idle_can_leave_background_kinds_aside():
+    release = threading.Event()
+    w = Worker(lambda *a: None, lambda *a: None)
+    try:
+        w.submit("drawing", release.wait, 5)
+        time.sleep(0.05)  # running now
+        assert not w.idle() and w.idle(ignore=("drawing",))
+        w.submit("params", lambda: None)  # waiting behind the drawing
+        assert not w.idle(ignore=("drawing",))
+    finally:
+        release.set()
+        w.stop()
+
+
+def test_the_busy_spinner_ends_with_a_step_even_when_a_drawing_is_queued(tube, tmp_path):
+    """Step N settles (its drawing of the graph queued) while step N+1 cooks: when N+1 is
+    applied, only that drawing waits, and the page is not busy (the spinner stayed on for
+    good: nothing after the drawing cleared it; found by review)."""
+    from formgraph.studio.page import Page
+
+    class Timers:  # the page's loop, fired by hand
+        def __init__(self):
+            self.timers = []
+
+        def call_later(self, _delay, fn):
+            timer = threading.Timer(3600, fn)  # never started: only fired below
+            self.timers.append(timer)
+            return timer
+
+        def call_soon_threadsafe(self, fn, *args):
+            fn(*args)
+
+        def fire(self):
+            live, self.timers = [t for t in self.timers if not t.finished.is_set()], []
+            for t in live:
+                t.function()
+
+    s = StudioSession(tube, out_dir=tmp_path / "out")
+    page = Page(s, Guard("t"))
+    try:
+        deadline = time.time() + 60
+        while not (page.worker.idle() and page._early) and time.time() < deadline:
+            time.sleep(0.05)  # the first cook delivered (kept for a loop not yet there)
+        page._early.clear()
+        page.loop = loop = Timers()
+        release = threading.Event()
+        page._apply("params", s.set_params(thickness=0.3), 0.0, (None, None, page._snapshot()))
+
+        def step():  # step N+1, cooking until released
+            release.wait(5)
+            return s.set_params(thickness=0.35)
+
+        applied = page._apply
+
+        def apply(kind, result, *rest):
+            applied(kind, result, *rest)
+            if kind == "params":
+                seen.append(page.state.busy)
+
+        seen: list[bool] = []
+        page._apply = apply
+
+        page.worker.submit("params", step)
+        time.sleep(0.05)
+        loop.fire()  # step N's settle timer fires while N+1 cooks: its drawing queued
+        assert page.worker.waiting("drawing")
+        release.set()  # N+1 done and applied, the drawing still to run
+        deadline = time.time() + 30
+        while not seen and time.time() < deadline:
+            time.sleep(0.02)
+        assert seen == [False]  # step N+1 applied: not busy, its drawing queued or not
+    finally:
+        page.close()
+
+
 def test_superseded_is_not_a_formgraph_error():
     from formgraph.core.errors import FormgraphError
 

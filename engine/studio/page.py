@@ -36,6 +36,9 @@ POLL_SECONDS = 0.5  # how often the graph's files are looked at
 # not need: the graph's drawing with its times, and the whole scene for a page that loads
 # later (the page open now gets each step's changes alone)
 SETTLE_DELAY = 0.3
+# work the page does not wait on (a settled step's drawing of the graph): the busy spinner
+# is for recooks, saves and runs, not for it
+BACKGROUND = ("drawing",)
 _names = itertools.count()
 
 
@@ -342,7 +345,7 @@ class Page:
                         f"{_ms(cooked.seconds)} (nothing recooked)"
                     )
                     s.status_bad = False
-                s.busy = not self.worker.idle()
+                s.busy = not self.worker.idle(ignore=BACKGROUND)
                 s.cook_id = s.cook_id + 1
             self._settle()
             return
@@ -408,7 +411,7 @@ class Page:
                 more = f" (+{len(lines) - 1} more)" if len(lines) > 1 else ""
                 s.status = f"{name}: {lines[0]}{more}{kept}"
                 s.status_bad = True
-            s.busy = not self.worker.idle()
+            s.busy = not self.worker.idle(ignore=BACKGROUND)
             s.cook_id = s.cook_id + 1
             s.timing = {
                 "cook_ms": round(cooked.seconds * 1000, 2),

@@ -68,9 +68,11 @@ class Worker:
         with self._cv:
             return kind in self._pending
 
-    def idle(self) -> bool:
+    def idle(self, ignore: tuple[str, ...] = ()) -> bool:
+        """Whether nothing runs or waits, requests of the kinds in ``ignore`` aside."""
         with self._cv:
-            return self._running is None and not self._pending
+            running = self._running is not None and self._running not in ignore
+            return not running and all(kind in ignore for kind in self._pending)
 
     def stop(self) -> None:
         with self._cv:
