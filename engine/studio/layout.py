@@ -124,10 +124,24 @@ ARRAYS = """
       return Promise.resolve(whole ? this.buffer : this.buffer.slice(this.start, this.end));
     }
   }
+  const asBuffer = (data) => {  // msgpack's bytes (a view) as an ArrayBuffer of their own
+    if (!data || !(data.buffer instanceof ArrayBuffer)) return data;  // text: base64
+    const whole = data.byteOffset === 0 && data.byteLength === data.buffer.byteLength;
+    return whole ? data.buffer
+      : data.buffer.slice(data.byteOffset, data.byteOffset + data.byteLength);
+  };
+  const sent = new Map();  // hash -> ArrayBuffer, until vtk.js asks for it
+  let held = 0;  // their bytes
+  const client = window.trame && window.trame.client;
+  const session = client && client.getConnection && client.getConnection().getSession();
+  if (!session || !client.registerProtocol) return;  // (the arrays are then asked for)
+  // (installed only now that trame's client is known to be the one reading its messages)
   const send = WebSocket.prototype.send;
   WebSocket.prototype.send = function (data) {
-    // (a client that reads ArrayBuffers itself, or has no handler yet: left as it is)
-    if (!this.fgBuffers && this.binaryType === 'blob' && typeof this.onmessage === 'function') {
+    // only trame's own socket (its /ws route; any other on the page is left as it is), and
+    // not one that reads ArrayBuffers itself or has no handler yet
+    if (!this.fgBuffers && this.binaryType === 'blob' && typeof this.onmessage === 'function'
+        && new URL(this.url).pathname.endsWith('/ws')) {
       this.fgBuffers = true;
       const handle = this.onmessage;
       this.binaryType = 'arraybuffer';
@@ -136,25 +150,26 @@ ARRAYS = """
     }
     return send.call(this, data);
   };
-  const asBuffer = (data) => {  // msgpack's bytes (a view) as an ArrayBuffer of their own
-    if (!data || !(data.buffer instanceof ArrayBuffer)) return data;  // text: base64
-    const whole = data.byteOffset === 0 && data.byteLength === data.buffer.byteLength;
-    return whole ? data.buffer
-      : data.buffer.slice(data.byteOffset, data.byteOffset + data.byteLength);
-  };
-  const sent = new Map();  // hash -> ArrayBuffer, until vtk.js asks for it
-  const client = window.trame && window.trame.client;
-  const session = client && client.getConnection && client.getConnection().getSession();
-  if (!session || !client.registerProtocol) return;  // (the arrays are then asked for)
   session.subscribe('%(topic)s', ([arrays]) => {
-    for (const [hash, data] of Object.entries(arrays)) sent.set(hash, asBuffer(data));
-    while (sent.size > 64) sent.delete(sent.keys().next().value);  // (the oldest first)
+    for (const [hash, data] of Object.entries(arrays)) {
+      const buffer = asBuffer(data);
+      if (sent.has(hash)) held -= sent.get(hash).byteLength || 0;
+      sent.set(hash, buffer);
+      held += buffer.byteLength || 0;
+    }
+    // (the oldest first) at most 64 arrays and 256 MiB: those vtk.js never asks for go too
+    while (sent.size > 64 || (held > 256 * 2 ** 20 && sent.size > 1)) {
+      const oldest = sent.keys().next().value;
+      held -= sent.get(oldest).byteLength || 0;
+      sent.delete(oldest);
+    }
   });
   client.registerProtocol('SyncView', (s) => ({  // trame's own, but for getArray
     getArray(hash, binary = true) {
       if (sent.has(hash)) {
         const buffer = sent.get(hash);
         sent.delete(hash);
+        held -= buffer.byteLength || 0;
         return Promise.resolve(buffer);
       }
       return s.call('viewport.geometry.array.get', [hash, binary]).then(asBuffer);
