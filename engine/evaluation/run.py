@@ -379,11 +379,7 @@ class _Run(LanguageRun, SimulationRun, Replay):
                     hit, value, source = self.lookup(self.keys[n], spec)
                 if hit:
                     self.results[n] = value
-                    size = (
-                        self.g.memory.size(self.keys[n], value)
-                        if source == "memory" and nd.repeat is None and nd.simulate is None
-                        else _cache.sizeof(value)
-                    )
+                    size = self.g.memory.size(self.keys.get(n, ""), value)  # or sizeof
                     seconds = time.perf_counter() - t0
                     self.stats[n] = NodeStat("cached", seconds, size, source=source)
                     if nd.repeat is not None:

@@ -364,9 +364,7 @@ class Page:
                 s.status += f"{self.session.out_dir}"
                 s.status_bad = False
                 if svg is not None:
-                    self._to_draw, self._settled_svg = None, None
-                    self._drawings += 1
-                    s.graph_svg = svg
+                    self._show_now(svg)
                 return
             s.problems = _problem_lines(cooked.problems)
             if cooked.new_graph or not cooked.ok or kind in ("text", "disk"):
@@ -390,9 +388,7 @@ class Page:
             elif kind == "params":
                 self._to_draw = cooked  # drawn once the steps settle
             elif svg is not None:
-                self._to_draw, self._settled_svg = None, None
-                self._drawings += 1
-                s.graph_svg = svg
+                self._show_now(svg)
             s.shown = snap["shown_text"]
             if cooked.ok:
                 s.frames_n = cooked.frames
@@ -431,6 +427,13 @@ class Page:
             s.attributes = datasets.attributes
             s.colour_items = ["none", *datasets.attributes]
             s.color_by = datasets.color_by or "none"
+
+    def _show_now(self, svg: str) -> None:
+        """A drawing of the graph shown with this request (in a ``with state`` block): one
+        waiting for the steps to settle is older, and goes."""
+        self._to_draw, self._settled_svg = None, None
+        self._drawings += 1
+        self.state.graph_svg = svg
 
     def _settle(self) -> None:
         """Send what the picture did not need (see SETTLE_DELAY), once steps pause."""

@@ -222,13 +222,25 @@ def build(
         row_plans.append(RowPlan(own, shared, params, row_key))
     chunks: dict[str, list[str]] = {}
     for i in range(0, len(row_plans), chunk):
-        group = tuple(row_plans[i : i + chunk])
-        keys = tuple(dict.fromkeys(k for p in group for _, k in p.shared))
-        task_key = group[0].key if len(group) == 1 else "rows-" + key_of([p.key for p in group])
-        dsk[task_key] = (run_rows, bp_key, job, Packed.of(RowChunk(group, keys)), *keys)
-        chunks[task_key] = [p.key for p in group]
+        _row_task(dsk, chunks, bp_key, job, tuple(row_plans[i : i + chunk]))
     totals.needed = len(users)
     return dsk, rows, chunks, totals
+
+
+def _row_task(
+    dsk: dict[str, Any],
+    chunks: dict[str, list[str]],
+    bp_key: str,
+    job: RowJob,
+    group: tuple[RowPlan, ...],
+) -> str:
+    """Put the row task of ``group`` (its variants' plans) in ``dsk`` and its rows in
+    ``chunks``; its key (a single row's task is keyed by its row key)."""
+    keys = tuple(dict.fromkeys(k for p in group for _, k in p.shared))
+    task_key = group[0].key if len(group) == 1 else "rows-" + key_of([p.key for p in group])
+    dsk[task_key] = (run_rows, bp_key, job, Packed.of(RowChunk(group, keys)), *keys)
+    chunks[task_key] = [p.key for p in group]
+    return task_key
 
 
 @contextlib.contextmanager
@@ -483,16 +495,10 @@ def _killed(fut: Any) -> bool:
 
 
 def _split(dsk: dict[str, Any], chunks: dict[str, list[str]], task_key: str) -> list[str]:
-    """The rows of the row task ``task_key`` as tasks of one row each, put in ``dsk`` and
-    ``chunks`` under their row keys (what a one-row task is keyed by); their keys."""
-    fn, bp_key, job, packed, *_ = dsk[task_key]
-    keys = []
-    for plan in packed.unpack().plans:
-        shared = tuple(dict.fromkeys(k for _, k in plan.shared))
-        dsk[plan.key] = (fn, bp_key, job, Packed.of(RowChunk((plan,), shared)), *shared)
-        chunks[plan.key] = [plan.key]
-        keys.append(plan.key)
-    return keys
+    """The rows of the row task ``task_key`` as tasks of one row each (:func:`_row_task`);
+    their keys."""
+    _, bp_key, job, packed, *_ = dsk[task_key]
+    return [_row_task(dsk, chunks, bp_key, job, (plan,)) for plan in packed.unpack().plans]
 
 
 def _chunk_result(fut: Any, row_keys: list[str]) -> list[tuple[str, RowResult]]:

@@ -79,14 +79,19 @@ _TO_MONOMIAL = np.linalg.inv(np.vander(_GAUSS_X, 8, increasing=True))
 _AT_MINUS_ONE = -((-1.0) ** np.arange(1, 9))
 
 
+def _monomial(at_nodes: np.ndarray) -> np.ndarray:
+    """The coefficients of x^0..x^7 on [-1, 1] of the polynomial through each row's 8
+    Gauss-node speeds, ``(pieces, 8)``."""
+    return at_nodes @ _TO_MONOMIAL.T
+
+
 def _invert_interpolant(
-    at_nodes: np.ndarray, half: np.ndarray, rest: np.ndarray, frac: np.ndarray
+    c: np.ndarray, half: np.ndarray, rest: np.ndarray, frac: np.ndarray
 ) -> np.ndarray:
-    """Where, within its piece (as x in [-1, 1]), the interpolated speed has covered ``rest``
-    of the length: Newton on ``half * P(x) = rest`` for the interpolant's integral P, from
-    the linear guess ``frac``, kept inside the piece. Arrays of the targets only: no sample
-    of the curve is taken."""
-    c = at_nodes @ _TO_MONOMIAL.T  # (m, 8): x^0..x^7
+    """Where, within its piece (as x in [-1, 1]), the interpolated speed (coefficients ``c``
+    of :func:`_monomial`, one row a target) has covered ``rest`` of the length: Newton on
+    ``half * P(x) = rest`` for the interpolant's integral P, from the linear guess ``frac``,
+    kept inside the piece. Arrays of the targets only: no sample of the curve is taken."""
     integral = c / np.arange(1, 9)  # coefficients of x^1..x^8
     base = integral @ _AT_MINUS_ONE
     goal = np.divide(rest, half, out=np.zeros_like(rest), where=half > 0.0)
@@ -106,21 +111,21 @@ def _invert_interpolant(
 def _interpolant_exact(
     speed: Callable[[np.ndarray], np.ndarray],
     edges: np.ndarray,
-    at_nodes: np.ndarray,
     pieces: np.ndarray,
+    c: np.ndarray,
+    scale: np.ndarray,
 ) -> np.ndarray:
     """Per piece of ``pieces``: whether the degree-7 polynomial through its Gauss-node speeds
-    matches the true speed at both ends and at the middle within 1e-12 of its mean speed.
-    The error of an interpolant at the Gauss nodes is f^(8)/8! times the nodes' polynomial,
+    (coefficients ``c`` of :func:`_monomial`, one row a piece) matches the true speed at
+    both ends and at the middle within 1e-12 of ``scale`` (the piece's mean speed). The
+    error of an interpolant at the Gauss nodes is f^(8)/8! times the nodes' polynomial,
     which is largest in magnitude at the ends of the piece; the middle catches a piece whose
     speed changes its character inside (three samples a piece, one call of ``speed``)."""
     lo, hi = edges[pieces], edges[pieces + 1]
     m = len(pieces)
     true = speed(np.concatenate([lo, 0.5 * (lo + hi), hi])).reshape(3, m)
-    c = at_nodes[pieces] @ _TO_MONOMIAL.T
     sign = (-1.0) ** np.arange(8)
     guessed = np.stack([c @ sign, c[:, 0], c.sum(axis=1)])
-    scale = np.abs(at_nodes[pieces]).mean(axis=1)
     return np.all(np.abs(guessed - true) <= 1e-12 * scale, axis=0) & (scale > 0.0)
 
 
@@ -161,14 +166,14 @@ def parameters_at_lengths(
     frac = np.clip(np.divide(rest, piece, out=np.zeros_like(s), where=piece > 0.0), 0.0, 1.0)
     if at_nodes is None:
         t = lo + (hi - lo) * frac
-    else:
-        x = _invert_interpolant(at_nodes[k], 0.5 * (hi - lo), rest, frac)
-        t = lo + 0.5 * (hi - lo) * (x + 1.0)
-    if at_nodes is None:
         active = np.arange(len(s))  # the targets still moving
     else:  # Newton only where the interpolant is not exact to rounding
         pieces, of_target = np.unique(k, return_inverse=True)
-        trusted = _interpolant_exact(speed, edges, at_nodes, pieces)
+        c = _monomial(at_nodes[pieces])
+        x = _invert_interpolant(c[of_target], 0.5 * (hi - lo), rest, frac)
+        t = lo + 0.5 * (hi - lo) * (x + 1.0)
+        scale = np.abs(at_nodes[pieces]).mean(axis=1)
+        trusted = _interpolant_exact(speed, edges, pieces, c, scale)
         active = np.flatnonzero(~trusted[of_target])
     for _ in range(iterations):
         if active.size == 0:
