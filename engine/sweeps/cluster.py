@@ -416,7 +416,7 @@ def run(
     worker_cache: bool = False,
 ) -> Totals:
     """Run ``variants`` (index, params) and call ``on_row`` on the client as each finishes."""
-    from distributed import as_completed
+    from distributed import as_completed, wait
 
     if not variants:  # all done already (a resumed sweep): no cluster needed
         return Totals()
@@ -440,6 +440,14 @@ def run(
         futures = c.get(dsk, list(chunks), sync=False, optimize_graph=False)
         pending = as_completed(futures)
         resubmitted: dict[str, int] = {}
+        suspects: list[str] = []  # one-row tasks killed with others: each again, alone
+
+        def deliver(finished: list[tuple[str, RowResult]]) -> None:
+            for row_key, result in finished:
+                seen.update(result.costs)
+                for index in rows[row_key]:
+                    on_row(index, result)
+
         try:
             for batch in pending.batches():  # one gather per batch: no round trip per task
                 done = [f for f in batch if f.status == "finished"]
@@ -470,13 +478,26 @@ def run(
                         pending.update(again)
                         fut.release()
                         continue
+                    elif _killed(fut):  # it, or a task beside it on the dying worker
+                        suspects.append(fut.key)
+                        fut.release()
+                        continue
                     else:
                         finished = _chunk_result(fut, chunks[fut.key])
                     fut.release()
-                    for row_key, result in finished:
-                        seen.update(result.costs)
-                        for index in rows[row_key]:
-                            on_row(index, result)
+                    deliver(finished)
+            # a worker that dies takes every task it holds with it: run each killed row
+            # alone, one after another, so only the one that kills is blamed
+            for key in suspects:
+                (alone,) = c.get(dsk, [key], sync=False, optimize_graph=False)
+                futures.append(alone)
+                wait([alone])
+                try:
+                    finished = alone.result().rows
+                except Exception:
+                    finished = _chunk_result(alone, chunks[key])
+                alone.release()
+                deliver(finished)
         finally:
             c.cancel(futures)
     totals.computed = sum(1 for _, st in seen.values() if st == "computed")
