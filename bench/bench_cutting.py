@@ -34,7 +34,9 @@ import numpy as np
 
 from formgraph.core.registry import Context
 from formgraph.geometry import NurbsCurve
-from formgraph.nodes import cutting
+from formgraph.nodes.curves import regions as cutting
+from formgraph.nodes.curves import sample as curve_sample
+from formgraph.nodes.curves import text as curve_text
 
 N = 10_000
 PANGRAM = "The quick brown fox jumps over the lazy dog. "
@@ -142,7 +144,8 @@ def run(table) -> None:  # noqa: ANN001 - the harness's Table
 
     line = NurbsCurve.polyline(wiggly(N, 0.0))  # open: the loop without its closing edge
     case = f"divide a {N:,}-vertex polyline into 100,000 points"
-    table.time(case, "formgraph", lambda: cutting.divide(line, count=100_000, ctx=ctx), repeat=3)
+    divide = lambda: curve_sample.divide(line, count=100_000, ctx=ctx)  # noqa: E731
+    table.time(case, "formgraph", divide, repeat=3)
     try:
         import shapely
 
@@ -160,14 +163,14 @@ def run(table) -> None:  # noqa: ANN001 - the harness's Table
     table.time(
         "divide a 100-point cubic NURBS into 10,000 points",
         "formgraph",
-        lambda: cutting.divide(cubic, count=10_000, ctx=ctx),
+        lambda: curve_sample.divide(cubic, count=10_000, ctx=ctx),
         repeat=3,
     )
 
     text = (PANGRAM * 23)[:1000]
     case = "text of 1,000 characters"
-    cutting.text(text, ctx=ctx)  # the font parsed once
-    table.time(case, "formgraph", lambda: cutting.text(text, ctx=ctx), repeat=3)
+    curve_text.text(text, ctx=ctx)  # the font parsed once
+    table.time(case, "formgraph", lambda: curve_text.text(text, ctx=ctx), repeat=3)
     from matplotlib.font_manager import FontProperties
     from matplotlib.textpath import TextPath
 
@@ -178,9 +181,9 @@ def run(table) -> None:  # noqa: ANN001 - the harness's Table
     # numbers formatted in one call (there is no reference writer of the same paths)
     import tempfile
 
-    from formgraph.nodes import export
+    from formgraph.nodes.export import drawing as export
 
-    glyphs = cutting.text(text, ctx=ctx)
+    glyphs = curve_text.text(text, ctx=ctx)
     with tempfile.TemporaryDirectory() as out:
         wctx = Context("bench", Path(out))
         seconds = table.time(
@@ -193,7 +196,7 @@ def run(table) -> None:  # noqa: ANN001 - the harness's Table
         table.rows[-1].note = f"{seconds / len(glyphs) * 1e6:.0f} us a curve"
 
     # the offset of an offset: the nameplate's kerf on its rounded plate
-    from formgraph.nodes import offset as offset_nodes
+    from formgraph.nodes.offset import marching_squares as offset_nodes
 
     def rect(w: float, h: float) -> NurbsCurve:
         x, y = w / 2, h / 2

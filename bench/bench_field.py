@@ -156,7 +156,7 @@ def run(table) -> None:
     from pathlib import Path
 
     from formgraph.core.registry import Context
-    from formgraph.nodes.field import mesh_of
+    from formgraph.nodes.field.mesh import mesh_of
 
     ctx = Context("offset", Path("."), budget=10**9)
     table.time(

@@ -45,7 +45,7 @@ def _placements():
 
 
 def ours(mesh: Mesh, points: Points, rotate: np.ndarray, scale: list[float]) -> Mesh:
-    from formgraph.nodes.geometry import mesh_copy_to_points
+    from formgraph.nodes.mesh.instance import mesh_copy_to_points
 
     ctx = Context("bench", out_dir=None, budget=10**9)  # type: ignore[arg-type]
     return mesh_copy_to_points(mesh, points, scale=scale, rotate=rotate, ctx=ctx)

@@ -65,7 +65,7 @@ def _offset_rows(table, n: int) -> None:  # noqa: ANN001
 
     from formgraph.core.registry import Context
     from formgraph.geometry import NurbsCurve
-    from formgraph.nodes import offset as offset_node
+    from formgraph.nodes.offset import marching_squares as offset_node
 
     pts = wiggly(n)
     curve = NurbsCurve.polyline(np.c_[pts, np.zeros(n)], closed=True)

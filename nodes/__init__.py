@@ -1,6 +1,8 @@
-"""Node families of formgraph: one module per family, each registering its nodes on import.
+"""Node families of formgraph: one package per family prefix, its modules by topic.
 
-Every module in this package is imported here, so a new family needs no list to edit.
+A node's name says where its code is: ``mesh.offset`` is under ``nodes/mesh/``. Every module
+below this package is imported here, so a new family or topic needs no list to edit. Modules
+whose names start with ``_`` hold helpers shared by several nodes and register nothing.
 """
 
 from __future__ import annotations
@@ -8,6 +10,6 @@ from __future__ import annotations
 import importlib
 import pkgutil
 
-for _info in sorted(pkgutil.iter_modules(__path__), key=lambda m: m.name):
-    if not _info.name.startswith("_"):
-        importlib.import_module(f"{__name__}.{_info.name}")
+for _info in sorted(pkgutil.walk_packages(__path__, f"{__name__}."), key=lambda m: m.name):
+    if not _info.name.rsplit(".", 1)[-1].startswith("_"):
+        importlib.import_module(_info.name)

@@ -1,4 +1,4 @@
-"""The region machinery of the cutting nodes (:mod:`formgraph.nodes.cutting`): closed curves
+"""The region machinery of the cutting nodes (:mod:`formgraph.nodes.curves.regions`): closed curves
 sampled into rings, the rings made regions (:mod:`formgraph.kernels.curves.regions`), and a
 region's boundary made curves again — input curves the operation left whole as themselves,
 the arcs it cut of exact curves as arcs (:mod:`formgraph.kernels.curves.arcs`), the rest

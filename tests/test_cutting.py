@@ -1,4 +1,4 @@
-"""The cutting nodes (nodes/cutting.py): rectangles, polygons, region booleans, text.
+"""The cutting nodes (nodes/curves/regions.py): rectangles, polygons, region booleans, text.
 
 References are closed forms (areas of rounded rectangles, circle lenses, polygons), shapely
 on the same polylines, and an even-odd point count of our own on a grid.

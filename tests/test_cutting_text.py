@@ -1,4 +1,4 @@
-"""curves.text (nodes/cutting.py, kernels/curves/text.py): glyph outlines as exact NURBS.
+"""curves.text (nodes/curves/text.py, kernels/curves/text.py): glyph outlines as exact NURBS.
 
 References: fontTools' own pen decomposition of the same glyphs (the implied on-curve
 points), the font's hmtx and legacy kern tables read directly, shapely areas of densely

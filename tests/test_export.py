@@ -266,7 +266,7 @@ def test_curves_in_bezier_form_are_read_off_their_control_points():
     # takes their pieces without knot insertion, the same pieces as A5.6 gives
     import formgraph as fg
     from formgraph.kernels import nurbs as kn
-    from formgraph.nodes.export import _bezier_form
+    from formgraph.nodes.export.drawing import _bezier_form
 
     g = fg.Graph()
     g.add("t", "curves.text", text="gS8")

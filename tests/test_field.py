@@ -1,4 +1,4 @@
-"""Field nodes (nodes/field.py): the Field type, field.*, field.mesh and mesh.offset."""
+"""Field nodes (nodes/field/): the Field type, field.*, field.mesh and mesh.offset."""
 
 from __future__ import annotations
 

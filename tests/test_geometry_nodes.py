@@ -1,4 +1,5 @@
-"""geometry.transform, mesh/curves.copy_to_points and geometry.sample_surface (nodes/geometry.py)
+"""geometry.transform, mesh/curves.copy_to_points and geometry.sample_surface (nodes/geometry/,
+nodes/mesh/instance.py, nodes/curves/instance.py)
 with their kernels (formgraph.kernels.geometry)."""
 
 from __future__ import annotations
@@ -297,8 +298,8 @@ def test_copy_to_points_against_mesh_transform_per_point(n, seed, mirror):
 
     from formgraph.core.registry import Context
     from formgraph.kernels.mesh import meshops
-    from formgraph.nodes.geometry import mesh_copy_to_points
-    from formgraph.nodes.mesh import transform as mesh_transform
+    from formgraph.nodes.mesh.edit import transform as mesh_transform
+    from formgraph.nodes.mesh.instance import mesh_copy_to_points
 
     rng = np.random.default_rng(seed)
     part = _part()

@@ -1,4 +1,4 @@
-"""Mesh processing nodes (nodes/meshproc.py): mesh.smooth, mesh.decimate, mesh.remesh."""
+"""Mesh processing nodes (nodes/mesh/process.py): mesh.smooth, mesh.decimate, mesh.remesh."""
 
 from __future__ import annotations
 

@@ -65,3 +65,16 @@ def test_input_error_call_names_the_port_unless_an_inner_input_did():
     assert inner.value.port == "inner"  # it named its own input: kept
     with pytest.raises(TypeError):  # not a complaint about a value: not rewrapped
         InputError.call("outer", kernel, "a")
+
+
+def test_a_node_name_says_where_its_code_is():
+    """``mesh.offset`` is under nodes/mesh/: one package per family prefix (SPEC layout)."""
+    misplaced = {
+        name: spec.func.__module__
+        for name, spec in fg.node_types().items()
+        if spec.func.__module__.startswith("formgraph.nodes.")
+        and not spec.func.__module__.startswith(f"formgraph.nodes.{spec.family}.")
+    }
+    assert not misplaced
+    families = {spec.family for spec in fg.node_types().values()}
+    assert {"mesh", "curves", "nurbs", "field", "export", "read"} <= families

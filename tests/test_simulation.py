@@ -1,6 +1,7 @@
-"""The nodes made to step (nodes/simulation.py) in graphs: curves.grow lengthens a curve
-and keeps it simple (shapely) and inside its bounds; mesh.relax brings a net to rest with
-its anchors unmoved, symmetric, and inflates a closed mesh; bad inputs are located."""
+"""The nodes made to step (nodes/curves/grow.py, nodes/mesh/relax.py) in graphs: curves.grow
+lengthens a curve and keeps it simple (shapely) and inside its bounds; mesh.relax brings a
+net to rest with its anchors unmoved, symmetric, and inflates a closed mesh;
+bad inputs are located."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Solid nodes (nodes/solids.py), curves.measure, Mesh measures, poles, run --strict."""
+"""Solid nodes (nodes/mesh/), curves.measure, Mesh measures, poles, run --strict."""
 
 from __future__ import annotations
 

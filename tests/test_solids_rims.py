@@ -1,4 +1,4 @@
-"""mesh.solidify's planar rims (nodes/solids.py, kernels/mesh/solidify.py)."""
+"""mesh.solidify's planar rims (nodes/mesh/offset.py, kernels/mesh/solidify.py)."""
 
 from __future__ import annotations
 

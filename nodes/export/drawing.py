@@ -1,10 +1,9 @@
-"""Export: STL, OBJ and PLY meshes; SVG, PDF and DXF drawings.
+"""Export of drawings: SVG, PDF and DXF, exact arcs and splines where the format has them.
 
-Each node builds the file's bytes with a kernel (:mod:`formgraph.kernels.io.exporters`,
-:mod:`~formgraph.kernels.io.drawing`, :mod:`~formgraph.kernels.io.dxf`) and hands them to
-``ctx.write``, which writes atomically inside the output directory, creates sub-folders,
-refuses paths that leave it, and leaves a file alone when it already holds these bytes. Each
-returns the written file's path.
+Each node builds the file's bytes with a kernel (:mod:`formgraph.kernels.io.drawing`,
+:mod:`~formgraph.kernels.io.dxf`) and hands them to ``ctx.write``, which writes atomically
+inside the output directory, creates sub-folders, refuses paths that leave it, and leaves a
+file alone when it already holds these bytes. Each returns the written file's path.
 """
 
 from __future__ import annotations
@@ -21,85 +20,12 @@ from formgraph.kernels import nurbs
 from formgraph.kernels.io import (
     Path2D,
     dxf_bytes,
-    fan_triangles,
-    mesh_report,
-    obj_bytes,
     pdf_bytes,
-    ply_binary,
-    stl_ascii_chunks,
-    stl_binary,
     svg_bytes,
 )
 from formgraph.kernels.io.colors import css_color
 
 _CIRCLE_TOL = 1e-9  # relative: a rational quadratic piece closer than this to a circle is one
-
-
-@node("export.stl", version=1)
-def stl(mesh: Mesh, path: OutputPath, ascii: bool = False, *, ctx: Context) -> str:
-    """Write a mesh as STL (binary, or ASCII), for 3-D printing.
-
-    Polygons are fan-triangulated, each facet's normal comes from its winding. A mesh that is
-    not watertight, not consistently oriented, inside out or has zero-area triangles is
-    still written, with a warning in the node's stats saying what a slicer will find.
-
-    Parameters
-    ----------
-    mesh : Mesh
-        The mesh to write.
-    path : OutputPath
-        File path relative to the output directory, e.g. ``parts/tube.stl``.
-    ascii : bool
-        Write the text layout (``facet normal ... endfacet``) instead of binary.
-    """
-    v, fi, fo = mesh.vertices, mesh.face_indices, mesh.face_offsets
-    ctx.guard(int(np.sum(mesh.face_sizes - 2)), "triangles")
-    for warning in mesh_report(v, fi, fo).warnings():
-        ctx.warn(warning)
-    # ASCII: written a block of facets at a time (the text is five times the binary)
-    data = stl_ascii_chunks(v, fi, fo) if ascii else stl_binary(v, fi, fo)
-    return str(ctx.write(path, data))
-
-
-@node("export.obj", version=1)
-def obj(mesh: Mesh, path: OutputPath, normals: bool = False, *, ctx: Context) -> str:
-    """Write a mesh as Wavefront OBJ: polygons kept as they are, 1-based indices.
-
-    Coordinates are written as the shortest text that reads back to the same double, so
-    the file holds the mesh exactly.
-
-    Parameters
-    ----------
-    mesh : Mesh
-        The mesh to write.
-    path : OutputPath
-        File path relative to the output directory.
-    normals : bool
-        Also write one normal per vertex (``vn``; the area-weighted average of the normals
-        of the faces around it) and reference them from the faces (``f 1//1 2//2 3//3``).
-    """
-    v, fi, fo = mesh.vertices, mesh.face_indices, mesh.face_offsets
-    vn = _vertex_normals(v, fi, fo) if normals else None
-    return str(ctx.write(path, obj_bytes(v, fi, fo, normals=vn)))
-
-
-@node("export.ply", version=1)
-def ply(mesh: Mesh, path: OutputPath, *, ctx: Context) -> str:
-    """Write a mesh as binary little-endian PLY: double coordinates, polygon faces kept.
-
-    Every point and face attribute is written: a ``color`` (3 or 4 components in 0..1) as
-    ``uchar red green blue [alpha]``, which viewers show, a ``normal`` as ``nx ny nz``, any
-    other as ``double`` properties (``name``, or ``name_0, name_1, ...`` for a vector).
-
-    Parameters
-    ----------
-    mesh : Mesh
-        The mesh to write.
-    path : OutputPath
-        File path relative to the output directory.
-    """
-    data = ply_binary(*mesh.arrays, mesh.point_data, mesh.face_data)
-    return str(ctx.write(path, data))
 
 
 @node("export.svg", version=2)
@@ -363,10 +289,6 @@ def _layer_colors(
     return {name: given.get(name, _PALETTE[i % len(_PALETTE)]) for i, name in enumerate(order)}
 
 
-# --------------------------------------------------------------------------------------------
-# adapters
-
-
 def _guard_samples(curves: list[Curve], samples: int, ctx: Context, drawing: bool = True) -> None:
     """Refuse, before sampling, more polyline points than the budget (all curves together).
 
@@ -474,23 +396,3 @@ def _circular_pieces(cp: np.ndarray, knots: np.ndarray, w: np.ndarray) -> np.nda
     if not np.all(circular):
         return None
     return np.concatenate([p[:1, 0], p[:, 1:].reshape(-1, 2)])
-
-
-def _vertex_normals(v: np.ndarray, fi: np.ndarray, fo: np.ndarray) -> np.ndarray:
-    """Area-weighted vertex normals: the sum of the area vectors of the faces around each.
-
-    A face's area vector is the sum of its fan triangles' cross products (Newell's normal,
-    twice the area, exact for planar polygons); it is added to each of the face's vertices.
-    """
-    tris = fan_triangles(fi, fo)
-    a = v[tris[:, 0]]
-    cross = np.cross(v[tris[:, 1]] - a, v[tris[:, 2]] - a)
-    face_of_tri = np.repeat(np.arange(fo.size - 1), np.diff(fo) - 2)
-    area = np.zeros((fo.size - 1, 3))
-    np.add.at(area, face_of_tri, cross)
-    acc = np.zeros_like(v)
-    np.add.at(acc, fi, area[np.repeat(np.arange(fo.size - 1), np.diff(fo))])
-    length = np.linalg.norm(acc, axis=1)
-    out = np.zeros_like(v)
-    np.divide(acc, length[:, None], out=out, where=length[:, None] > 0)
-    return out

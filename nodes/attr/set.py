@@ -1,4 +1,4 @@
-"""Attributes: named per-element data on points and meshes (family ``attr``).
+"""``attr.set``: named per-element data on points and meshes.
 
 ``attr.set`` computes an attribute for every point (or face) at once, from a number, a
 vector, or expressions over the element (``x y z``, ``nx ny nz``, ``i``, ``count``, its other

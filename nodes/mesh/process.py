@@ -1,4 +1,4 @@
-"""Mesh processing (mesh family): smoothing, decimation, isotropic remeshing.
+"""Mesh processing: smoothing, decimation, isotropic remeshing.
 
 Thin adapters over :mod:`formgraph.kernels.mesh.smooth` (sparse Laplacian and Taubin
 smoothing, boundaries held), :mod:`formgraph.kernels.mesh.simplify` (quadric decimation

@@ -1,5 +1,6 @@
 """Robust offsets: outlines at a distance from any curves, through GEOS's buffer or a signed
-distance field and marching squares (`formgraph.kernels.offset.offset_loops` picks)."""
+distance field and marching squares (:func:`formgraph.kernels.offset.offset_loops` picks).
+"""
 
 from __future__ import annotations
 
@@ -19,8 +20,14 @@ from formgraph.kernels.offset import (
 )
 
 _TOLERANCE = 1e-3  # the kernel's accuracy, as a fraction of the input's extent
+
+
 _SAMPLE_SHARE = 0.1  # sampling error allowed, as a share of that (and of the cell)
+
+
 MAX_SMOOTH = 100  # smoothing passes: each costs a pass over every vertex; more change nothing
+
+
 _SMALLEST = 1e-9  # the smallest |distance| and cell, relative to the input's extent
 
 

@@ -1,0 +1,69 @@
+"""``mesh.measure``: volume, area, bounds and the checks a slicer makes
+(:mod:`formgraph.kernels.mesh.measure`).
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from formgraph.core.registry import Context, node
+from formgraph.core.types import Vec3
+from formgraph.geometry import Mesh
+
+
+class MeshMeasures(NamedTuple):
+    area: float
+    volume: float
+    watertight: bool
+    size: Vec3
+    center: Vec3
+    faces: int
+
+
+@node("mesh.measure", version=1)
+def measure(mesh: Mesh, *, ctx: Context) -> MeshMeasures:
+    """Area, volume, watertightness, bounding box and face count of a mesh.
+
+    Outputs: ``area`` (sum of face areas), ``volume`` (enclosed volume by the divergence
+    theorem; 0, with a warning, for a mesh that is not watertight), ``watertight`` (every
+    edge on exactly two faces), ``size`` and ``center`` of the bounding box, ``faces``.
+
+    The volume is signed: a closed mesh whose faces point inward measures negative, with a
+    warning (``mesh.orient`` turns it outward); a closed mesh whose faces disagree across
+    some edges warns that its volume means nothing until it is oriented.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        Any polygon mesh.
+    """
+    watertight = mesh.is_watertight
+    volume = mesh.volume if watertight else 0.0
+    if mesh.n_faces == 0:
+        ctx.warn("mesh has no faces: area and volume 0")
+    elif not watertight:
+        open_edges = int(np.count_nonzero(mesh.edge_table.counts != 2))
+        ctx.warn(f"mesh is not watertight ({open_edges} open or non-manifold edges): volume 0")
+    else:
+        disagree = int(np.count_nonzero(mesh.edge_table.same_way))
+        if disagree:
+            ctx.warn(
+                f"the faces disagree in orientation across {disagree} edges, so the volume "
+                f"({volume:g}) means nothing; mesh.orient makes them agree"
+            )
+        elif volume < 0:
+            ctx.warn(
+                f"the mesh faces inward: its volume is negative ({volume:g}); mesh.orient "
+                "turns it outward"
+            )
+    lo, hi = mesh.bounds
+    return MeshMeasures(
+        area=mesh.area,
+        volume=float(volume),
+        watertight=watertight,
+        size=[float(x) for x in hi - lo],  # type: ignore[arg-type]
+        center=[float(x) for x in (lo + hi) / 2],  # type: ignore[arg-type]
+        faces=mesh.n_faces,
+    )

@@ -1,0 +1,1 @@
+"""The ``points.*`` nodes: point sources (``sources``: list, grid, circle, random)."""

@@ -1,0 +1,1 @@
+"""The ``read.*`` nodes: geometry read from files (``files``), budgeted and located."""

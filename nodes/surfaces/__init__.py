@@ -1,0 +1,1 @@
+"""The ``surfaces.*`` nodes: surfaces through grids of points and expressions (``construct``)."""
