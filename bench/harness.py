@@ -1,24 +1,37 @@
 """Timing harness shared by every benchmark module in bench/.
 
-Each ``bench/bench_*.py`` defines ``run(table: Table) -> None`` and adds rows with
-:meth:`Table.time`. ``python bench/run.py [name ...]`` runs them and prints one table
-in which every reference library's time is shown next to ours, measured in the same run.
+Each ``bench/bench_*.py`` defines ``run(table: Table) -> None`` and adds rows. The row a
+user's claim rests on is :meth:`Table.compare`: ours **through the public API** (a graph
+evaluated as a user calls it, or ``fg.*``), beside **the kernel alone**, against
+**references written the way their own users write them**, timed in interleaved rounds whose
+order turns, reported as medians with their range (min-max) and the ratio of ours to each
+reference per round (its median and range). :meth:`Table.memory` does the same for peak
+memory. ``python bench/run.py [name ...]`` prints the table; ``--markdown`` prints the table
+the documentation shows, from that one run.
+
+The older :meth:`Table.time` / :meth:`Table.time_together` (best-of rows) remain until every
+module has moved to :meth:`Table.compare`.
 """
 
 from __future__ import annotations
 
+import gc
 import os
+import statistics
 import time
+import tracemalloc
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
 # ``BENCH_CLOCK=cpu`` times CPU seconds of this process instead of wall seconds: on a
 # machine shared with other jobs, far steadier (every row here is single-threaded: one
-# BLAS thread; a threaded reference would have its threads' time added up).
+# BLAS thread; a threaded reference would have its threads' time added up). A row that
+# measures parallel work (workers, subprocesses) passes ``clock="wall"`` itself.
 CLOCK = os.environ.get("BENCH_CLOCK", "wall")
 if CLOCK not in ("wall", "cpu"):
     raise SystemExit(f"BENCH_CLOCK must be wall or cpu, got {CLOCK!r}")
-_now = time.process_time if CLOCK == "cpu" else time.perf_counter
+_CLOCKS = {"wall": time.perf_counter, "cpu": time.process_time}
+_now = _CLOCKS[CLOCK]
 
 
 def best_time(
@@ -28,12 +41,8 @@ def best_time(
     min_seconds: float = 0.2,
     number: int | None = None,
 ) -> float:
-    """Best wall time of one call of ``fn`` in seconds.
-
-    Calls ``fn`` once to warm up, then takes the best of ``repeat`` rounds, each of which
-    loops enough calls to last ``min_seconds`` (at least one), so short calls are not
-    dominated by timer resolution.
-    """
+    """Best time of one call of ``fn`` in seconds (warm-up call first; each round loops
+    enough calls to last ``min_seconds``)."""
     t0 = _now()
     fn()
     first = _now() - t0
@@ -51,17 +60,159 @@ def best_time(
 
 
 @dataclass
+class Stat:
+    """Per-round values of one implementation: their median and range."""
+
+    values: list[float]
+
+    @property
+    def median(self) -> float:
+        return statistics.median(self.values)
+
+    @property
+    def low(self) -> float:
+        return min(self.values)
+
+    @property
+    def high(self) -> float:
+        return max(self.values)
+
+
+@dataclass
 class Row:
     case: str
     impl: str
     seconds: float | None
     note: str = ""
+    # set by compare(): the per-round times and, for references, ours / theirs per round
+    stat: Stat | None = None
+    ratio: Stat | None = None
+    unit: str = "s"  # "s" or "bytes" (memory rows)
+    role: str = ""  # "api", "kernel", "reference" (compare rows); "" for older rows
 
 
 @dataclass
 class Table:
     rows: list[Row] = field(default_factory=list)
 
+    # -- the row every claim rests on -------------------------------------------------------
+    def compare(
+        self,
+        case: str,
+        *,
+        api: Callable[[], object],
+        kernel: Callable[[], object] | None = None,
+        references: dict[str, Callable[[], object]] | None = None,
+        rounds: int = 7,
+        min_seconds: float = 0.1,
+        clock: str | None = None,
+        note: str = "",
+        notes: dict[str, str] | None = None,
+    ) -> dict[str, Stat]:
+        """Time ``api`` (ours as a user calls it), ``kernel`` (ours without the graph) and
+        each reference in ``rounds`` interleaved rounds whose order turns by one each round.
+
+        Each implementation is called once to warm up (imports, caches a user would also have
+        warm, JIT compilation); the number of calls per timing is fixed from that call so a
+        timing lasts about ``min_seconds``. A reference that fails to import is noted as not
+        installed, never silently dropped. Returns the per-implementation :class:`Stat`.
+        """
+        now = _CLOCKS[clock] if clock else _now
+        impls: list[tuple[str, str, Callable[[], object]]] = [("formgraph", "api", api)]
+        if kernel is not None:
+            impls.append(("formgraph kernel", "kernel", kernel))
+        missing: dict[str, str] = {}
+        for name, fn in (references or {}).items():
+            impls.append((name, "reference", fn))
+        numbers: dict[str, int] = {}
+        for name, _, fn in list(impls):
+            try:
+                t0 = now()
+                fn()
+                first = now() - t0
+            except ImportError as exc:
+                missing[name] = f"not installed ({exc.name})"
+                impls = [i for i in impls if i[0] != name]
+                continue
+            numbers[name] = max(1, int(min_seconds / max(first, 1e-9)))
+        times: dict[str, list[float]] = {name: [] for name, _, _ in impls}
+        for r in range(rounds):
+            k = r % len(impls)
+            for name, _, fn in impls[k:] + impls[:k]:
+                gc.collect()
+                n = numbers[name]
+                t0 = now()
+                for _ in range(n):
+                    fn()
+                times[name].append((now() - t0) / n)
+        stats = {name: Stat(v) for name, v in times.items()}
+        ours = times["formgraph"]
+        notes = notes or {}
+        for name, role, _ in impls:
+            ratio = None
+            if role == "reference":
+                ratio = Stat([a / b for a, b in zip(ours, times[name], strict=True)])
+            self.rows.append(
+                Row(
+                    case,
+                    name,
+                    stats[name].median,
+                    notes.get(name, note if role == "api" else ""),
+                    stat=stats[name],
+                    ratio=ratio,
+                    role=role,
+                )
+            )
+        for name, why in missing.items():
+            self.rows.append(Row(case, name, None, why, role="reference"))
+        return stats
+
+    def memory(
+        self,
+        case: str,
+        *,
+        api: Callable[[], object],
+        references: dict[str, Callable[[], object]] | None = None,
+        note: str = "",
+    ) -> dict[str, int]:
+        """Peak memory allocated while each call runs (tracemalloc, which numpy reports to),
+        ours through the API against each reference; the result is dropped before the next."""
+        peaks: dict[str, int] = {}
+        impls = [("formgraph", "api", api)] + [
+            (n, "reference", f) for n, f in (references or {}).items()
+        ]
+        for name, _role, fn in impls:
+            gc.collect()
+            tracemalloc.start()
+            try:
+                result = fn()
+                del result
+            except ImportError as exc:
+                tracemalloc.stop()
+                self.rows.append(Row(case, name, None, f"not installed ({exc.name})", unit="bytes"))
+                continue
+            _, peak = tracemalloc.get_traced_memory()
+            tracemalloc.stop()
+            peaks[name] = peak
+        for name, role, _ in impls:
+            if name in peaks:
+                ratio = None
+                if role == "reference" and peaks[name]:
+                    ratio = Stat([peaks["formgraph"] / peaks[name]])
+                self.rows.append(
+                    Row(
+                        case,
+                        name,
+                        float(peaks[name]),
+                        note if role == "api" else "",
+                        ratio=ratio,
+                        unit="bytes",
+                        role=role,
+                    )
+                )
+        return peaks
+
+    # -- older best-of rows (kept until every module uses compare) ---------------------------
     def time(
         self,
         case: str,
@@ -72,7 +223,7 @@ class Table:
         note: str = "",
         number: int | None = None,
     ) -> float | None:
-        """Time ``fn`` and record it; a reference that fails to import or run is noted."""
+        """Time ``fn`` (best of rounds) and record it; a reference that fails is noted."""
         try:
             seconds = best_time(fn, repeat=repeat, number=number)
         except ImportError as exc:
@@ -88,12 +239,7 @@ class Table:
         *,
         rounds: int = 7,
     ) -> None:
-        """Time several implementations of one case in alternating rounds, best of each.
-
-        ``impls`` holds ``(impl, fn, note)``. Every round times each ``fn`` once after the
-        other (:func:`best_time` with one repeat), so a burst of load on a shared machine
-        falls on all of them rather than on whichever ran during it.
-        """
+        """Several implementations of one case in alternating rounds, best of each."""
         best = {impl: float("inf") for impl, _, _ in impls}
         for _ in range(rounds):
             for impl, fn, _ in impls:
@@ -104,23 +250,62 @@ class Table:
     def add(self, case: str, impl: str, seconds: float | None, note: str = "") -> None:
         self.rows.append(Row(case, impl, seconds, note))
 
-    def render(self) -> str:
-        head = "time" if CLOCK == "wall" else "cpu time"
-        lines = [f"{'case':<52} {'impl':<22} {head:>11} {'vs ours':>9}  note", "-" * 110]
+    # -- output ------------------------------------------------------------------------------
+    def _cases(self) -> dict[str, list[Row]]:
         cases: dict[str, list[Row]] = {}
         for row in self.rows:
             cases.setdefault(row.case, []).append(row)
-        for case, rows in cases.items():
+        return cases
+
+    def render(self) -> str:
+        head = "time" if CLOCK == "wall" else "cpu time"
+        lines = [
+            f"{'case':<52} {'impl':<24} {head + ' (median [range])':>30} {'ours/theirs':>22}  note",
+            "-" * 140,
+        ]
+        for case, rows in self._cases().items():
             ours = next((r.seconds for r in rows if r.impl == "formgraph"), None)
             for r in rows:
-                t = "-" if r.seconds is None else _fmt(r.seconds)
-                ratio = (
-                    f"{r.seconds / ours:8.2f}x"
-                    if ours and r.seconds is not None and r.impl != "formgraph"
-                    else ""
+                lines.append(
+                    f"{case:<52} {r.impl:<24} {_value(r):>30} {_ratio(r, ours):>22}  {r.note}"
                 )
-                lines.append(f"{case:<52} {r.impl:<22} {t:>11} {ratio:>9}  {r.note}")
         return "\n".join(lines)
+
+    def markdown(self) -> str:
+        """The table as the documentation shows it: one row per case and implementation."""
+        head = "time" if CLOCK == "wall" else "CPU time"
+        lines = [
+            f"| case | implementation | {head}, median [range] | ours / theirs, median [range] "
+            "| note |",
+            "|---|---|---|---|---|",
+        ]
+        for case, rows in self._cases().items():
+            ours = next((r.seconds for r in rows if r.impl == "formgraph"), None)
+            for i, r in enumerate(rows):
+                label = case if i == 0 else ""
+                lines.append(f"| {label} | {r.impl} | {_value(r)} | {_ratio(r, ours)} | {r.note} |")
+        return "\n".join(lines)
+
+
+def _value(r: Row) -> str:
+    if r.seconds is None:
+        return "-"
+    fmt = _mib if r.unit == "bytes" else _fmt
+    if r.stat is None or len(r.stat.values) < 2:
+        return fmt(r.seconds)
+    return f"{fmt(r.stat.median)} [{fmt(r.stat.low)}-{fmt(r.stat.high)}]"
+
+
+def _ratio(r: Row, ours: float | None) -> str:
+    """Ours divided by theirs: below 1 we are faster (or smaller)."""
+    if r.ratio is not None:
+        s = r.ratio
+        if len(s.values) < 2:
+            return f"{s.median:.2f}"
+        return f"{s.median:.2f} [{s.low:.2f}-{s.high:.2f}]"
+    if r.role or r.impl == "formgraph" or not ours or r.seconds is None:
+        return ""
+    return f"{ours / r.seconds:.2f}"  # older best-of rows: ours / theirs
 
 
 def _fmt(seconds: float) -> str:
@@ -129,3 +314,7 @@ def _fmt(seconds: float) -> str:
     if seconds < 1.0:
         return f"{seconds * 1e3:.2f} ms"
     return f"{seconds:.2f} s"
+
+
+def _mib(n: float) -> str:
+    return f"{n / 2**20:.1f} MiB"

@@ -1,6 +1,8 @@
 """Run the benchmarks: ``python bench/run.py`` (all) or ``python bench/run.py nurbs mesh``.
 
-The "vs ours" column is the reference's time divided by ours: above 1x we are faster.
+The "ours/theirs" column is our time (through the public API) divided by the reference's,
+per interleaved round: its median and range; below 1 we are faster. ``--markdown`` prints the
+table the documentation shows (``python bench/run.py --markdown > docs/speed-table.md``).
 """
 
 from __future__ import annotations
@@ -21,13 +23,15 @@ from harness import Table  # noqa: E402
 
 
 def main(argv: list[str]) -> int:
+    markdown = "--markdown" in argv
+    argv = [a for a in argv if a != "--markdown"]
     names = argv or sorted(p.stem[len("bench_") :] for p in HERE.glob("bench_*.py"))
     table = Table()
     for name in names:
         module = importlib.import_module(f"bench_{name}")
         print(f"running bench_{name} ...", file=sys.stderr, flush=True)
         module.run(table)
-    print(table.render())
+    print(table.markdown() if markdown else table.render())
     return 0
 
 
