@@ -83,7 +83,7 @@ def controls_of(graph: Graph, values: dict[str, Any]) -> list[Control]:
     int), any other number a number field, a bool a toggle, and anything else (a vector, a
     list, a string) a text field holding its YAML.
     """
-    from formgraph.language.params import param_kind
+    from formgraph.language.params import param_kind, param_step
 
     out = []
     current = {**graph.params, **values}
@@ -103,7 +103,7 @@ def controls_of(graph: Graph, values: dict[str, Any]) -> list[Control]:
             out.append(Control(name, "toggle", bool(value), default, doc=p.doc))
         elif isinstance(value, (int, float)) and p.min is not None and p.max is not None:
             lo, hi = float(p.min), float(p.max)
-            step = 1.0 if integer else _nice_step(lo, hi)
+            step = param_step(p) or 1.0
             out.append(Control(name, "slider", value, default, lo, hi, step, doc=p.doc))
         elif isinstance(value, (int, float)):
             step = 1.0 if integer else None
@@ -111,21 +111,6 @@ def controls_of(graph: Graph, values: dict[str, Any]) -> list[Control]:
         else:
             out.append(Control(name, "text", value, default, doc=p.doc))
     return out
-
-
-def _nice_step(lo: float, hi: float) -> float:
-    """About a hundredth of the range, rounded to 1, 2 or 5 times a power of ten."""
-    import math
-
-    span = hi - lo
-    if not span > 0:
-        return 1.0
-    raw = span / 100.0
-    power = 10.0 ** math.floor(math.log10(raw))
-    for m in (1.0, 2.0, 5.0, 10.0):
-        if raw <= m * power:
-            return m * power
-    return 10.0 * power
 
 
 @dataclass
