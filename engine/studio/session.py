@@ -47,6 +47,27 @@ class Control:
     choices: tuple[Any, ...] = ()  # a choice's options: texts, numbers or booleans
     doc: str = ""
 
+    @property
+    def digits(self) -> int | None:
+        """Decimals that show a value on the step's grid (0.05: 2; 1 or 5: 0); None
+        without a step."""
+        import math
+
+        if not self.step or not math.isfinite(self.step):
+            return None
+        return max(0, -math.floor(math.log10(self.step) + 1e-9))
+
+    def snap(self, number: float) -> float:
+        """A slider's ``number`` on its grid (min + k step), rounded to the step's decimals:
+        the browser's float steps add up to 9.399999999999999, the param gets 9.4."""
+        if self.kind != "slider" or not self.step or self.min is None:
+            return number
+        k = round((number - self.min) / self.step)
+        on_grid = self.min + k * self.step
+        if self.max is not None:
+            on_grid = min(max(on_grid, self.min), self.max)
+        return round(on_grid, self.digits or 0)
+
     def as_dict(self) -> dict[str, Any]:
         """The control as the page's state holds it (JSON: an Enum as its value)."""
         return {
@@ -56,6 +77,7 @@ class Control:
             "min": self.min,
             "max": self.max,
             "step": self.step,
+            "digits": self.digits,
             "choices": [plain(c) for c in self.choices],
             "doc": self.doc,
         }
