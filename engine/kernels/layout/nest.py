@@ -6,8 +6,8 @@ as SVGnest does it): each part, at each allowed turn, may go anywhere in its she
 inner-fit rectangle (the translations that keep it on the sheet) outside the no-fit
 polygons of the parts already there (:mod:`.nfp`). The free region is a polygon whose
 corners are the candidate positions; every corner is scored at once (numpy), and the part
-goes to the one that keeps the sheet's used length (its rightmost edge) shortest, then
-the leftmost, then the lowest; to the first sheet with room, else to a new sheet. The free
+goes to the lowest, then leftmost, of those that keep the sheet's used length (its
+rightmost edge) within 1 % of the sheet's width of the shortest; to the first sheet with room, else to a new sheet. The free
 region of each part shape and turn on each sheet is kept and only the no-fit polygons of
 parts placed since are taken from it, so a sheet's work grows with the parts on it, not
 with their square.
@@ -39,6 +39,7 @@ __all__ = ["Nesting", "PartTooLarge", "nest"]
 
 _POPULATION = 10
 _MUTATION = 0.1  # chance that a part swaps places with the next in a child's order
+_SLACK = 0.01  # of the sheet's width: used lengths this close count as equal
 _GROW_MITRE = 2.0  # mitre limit of the growth by half the spacing (>= 1: contains the round)
 
 
@@ -115,6 +116,7 @@ class _Problem:
         diag = float(np.hypot(*(bounds[:, 2:] - bounds[:, :2]).T).max()) + spacing + 2 * tolerance
         self.scale = knfp.grid_scale(max(sheet) + 2 * diag)
         self.sheet = sheet
+        self.tolerance = tolerance
         self.area = shapely.area(np.array(polygons, dtype=object))
         # congruent parts (the same outline up to a translation) share their no-fit polygons
         keys: dict[bytes, int] = {}
@@ -216,12 +218,22 @@ class _Sheet:
         return np.concatenate(paths)
 
 
+def _lowest(right: np.ndarray, xy: np.ndarray, slack: int) -> int:
+    """The candidate to take: of those that keep the used length within ``slack`` of the
+    shortest, the lowest, then the leftmost. A hair further left must not beat a place far
+    lower down (rounded corners that nest into each other would otherwise start a new
+    column at the top of the sheet)."""
+    near = np.flatnonzero(right <= right.min() + slack)
+    return int(near[np.lexsort((xy[near, 0], xy[near, 1]))[0]])
+
+
 def _evaluate(problem: _Problem, order: np.ndarray) -> tuple[float, np.ndarray]:
     """Bottom-left fill of the parts in ``order``: its score (sheets, then the last one's
     used length) and per part (sheet, turn, x, y) on the grid."""
     w = problem.sheet[0] * problem.scale
     sheet_area = problem.sheet[0] * problem.sheet[1]
     sheets: list[_Sheet] = []
+    slack = int(_SLACK * w)
     out = np.zeros((problem.n, 4), dtype=np.int64)
     for i in order.tolist():  # one step per part
         t = int(problem.kind[i])
@@ -232,7 +244,7 @@ def _evaluate(problem: _Problem, order: np.ndarray) -> tuple[float, np.ndarray]:
                 sheets.append(sh)
             elif sh.room < problem.area[i] * (1 - 1e-9):
                 continue
-            best: tuple | None = None
+            bests = []
             for k in range(len(problem.angles)):  # one step per turn
                 cand = sh.positions(problem, t, k)
                 if cand is None:
@@ -240,18 +252,20 @@ def _evaluate(problem: _Problem, order: np.ndarray) -> tuple[float, np.ndarray]:
                 shape = problem.shapes[t][k]
                 assert shape is not None
                 right = np.maximum(cand[:, 0] + shape.right, sh.right)
-                j = np.lexsort((cand[:, 1], cand[:, 0], right))[0]
-                key = (int(right[j]), int(cand[j, 0]), int(cand[j, 1]))
-                if best is None or key < best[0]:
-                    best = (key, k, cand[j])
-            if best is None:
+                j = _lowest(right, cand, slack)
+                bests.append((int(right[j]), int(cand[j, 1]), int(cand[j, 0]), k))
+            if not bests:
                 if s == len(sheets) - 1 and not sh.placed:
                     raise AssertionError("a part that fits an empty sheet found no room")
                 continue
-            (right_edge, _, _), k, v = best
+            rows = np.array(bests, dtype=np.int64)
+            j = _lowest(rows[:, 0], rows[:, 2:0:-1], slack)
+            k, v = int(rows[j, 3]), rows[j, 2:0:-1].copy()
+            shape = problem.shapes[t][k]
+            assert shape is not None
             sh.placed.append((t, k, v))
             sh.room -= problem.area[i]
-            sh.right = right_edge
+            sh.right = max(sh.right, int(v[0]) + shape.right)
             out[i] = (s, k, v[0], v[1])
             placed = True
             break
