@@ -123,11 +123,9 @@ def nest(
         shift = result.offset[i] + (result.sheet[i] * w * (1 + SHEET_GAP), 0.0)
         offset = np.array([shift[0], shift[1], 0.0])
         placed += [transform_one(g, linear, offset) for g in group]
+    corners = np.array([[0, 0, 0], [w, 0, 0], [w, h, 0], [0, h, 0]], dtype=np.float64)
     outlines: list[Curve] = [
-        NurbsCurve.polyline(
-            np.array([[0, 0, 0], [w, 0, 0], [w, h, 0], [0, h, 0]]) + [k * w * (1 + SHEET_GAP), 0, 0],
-            closed=True,
-        )
+        NurbsCurve.polyline(corners + [k * w * (1 + SHEET_GAP), 0, 0], closed=True)
         for k in range(result.sheets)
     ]
     return Nested(placed, result.sheets, result.utilisation, outlines)

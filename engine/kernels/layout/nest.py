@@ -7,10 +7,10 @@ inner-fit rectangle (the translations that keep it on the sheet) outside the no-
 polygons of the parts already there (:mod:`.nfp`). The free region is a polygon whose
 corners are the candidate positions; every corner is scored at once (numpy), and the part
 goes to the lowest, then leftmost, of those that keep the sheet's used length (its
-rightmost edge) within 1 % of the sheet's width of the shortest; to the first sheet with room, else to a new sheet. The free
-region of each part shape and turn on each sheet is kept and only the no-fit polygons of
-parts placed since are taken from it, so a sheet's work grows with the parts on it, not
-with their square.
+rightmost edge) within 1 % of the sheet's width of the shortest; to the first sheet with
+room, else to a new sheet. The free region of each part shape and turn on each sheet is
+kept and only the no-fit polygons of parts placed since are taken from it, so a sheet's
+work grows with the parts on it, not with their square.
 
 The search (SVGnest's, after Burke et al.) is over the order: it starts from the parts by
 decreasing area, and breeds orders by one-cut order crossover and swaps of neighbours,
