@@ -114,7 +114,7 @@ def nest(
             "use a larger sheet, allow turns, or split the part",
         ) from None
     except ValueError as exc:
-        port = "tolerance" if "tolerance" in str(exc) else "sheet"
+        port = "tolerance" if str(exc).startswith("the tolerance") else "sheet"
         raise InputError(port, str(exc)) from None
     placed: list[Curve] = []
     for i, group in enumerate(groups):  # one step per part: its curves moved as a whole

@@ -39,6 +39,7 @@ __all__ = ["Nesting", "PartTooLarge", "nest"]
 
 _POPULATION = 10
 _MUTATION = 0.1  # chance that a part swaps places with the next in a child's order
+_FINEST = 8  # grid steps the tolerance spans at least
 _SLACK = 0.01  # of the sheet's width: used lengths this close count as equal
 _GROW_MITRE = 2.0  # mitre limit of the growth by half the spacing (>= 1: contains the round)
 
@@ -323,12 +324,25 @@ def nest(
         raise ValueError(f"rotations must be 1 or more, got {rotations}")
     if effort < 1:
         raise ValueError(f"effort must be 1 or more evaluations, got {effort}")
-    tol = 1e-4 * math.hypot(w, h) if tolerance is None else float(tolerance)
     polygons = [shapely.Polygon(r[0], list(r[1:])) for r in parts]
     if not polygons:
         z = np.zeros(0)
         return Nesting(np.zeros(0, np.int64), z, np.zeros((0, 2)), 0, 0.0, 0.0, 0)
+    box = shapely.bounds(np.array(polygons, dtype=object))
+    smallest = float(np.min(np.max(box[:, 2:] - box[:, :2], axis=1)))
+    if tolerance is None:  # 1e-4 of the sheet, and never coarse next to the smallest part
+        tol = min(1e-4 * math.hypot(w, h), 1e-3 * smallest)
+    elif not (math.isfinite(tolerance) and tolerance > 0):
+        raise ValueError(f"the tolerance must be positive, got {tolerance}")
+    else:
+        tol = float(tolerance)
     problem = _Problem(polygons, (w, h), spacing, rotations, tol)
+    if tol * problem.scale < _FINEST:
+        raise ValueError(
+            f"the sheet ({w:.6g} x {h:.6g}) is too large for the nesting grid next to the "
+            f"tolerance {tol:.3g} (the parts' smallest is {smallest:.3g}): the grid has 2**29 "
+            "steps; scale the drawing, or give a coarser tolerance"
+        )
     for t, turns in enumerate(problem.shapes):  # a part that fits at no turn is named
         if all(s is None for s in turns):
             i = int(np.flatnonzero(problem.kind == t)[0])
