@@ -143,3 +143,32 @@ def test_a_part_larger_than_the_sheet_is_named():
     assert knest.nest([[tall]], (100, 20), rotations=4).sheets == 1
     with pytest.raises(knest.PartTooLarge):
         knest.nest([[tall]], (100, 20), rotations=1)
+
+
+def _swept_pocket(hole: np.ndarray, moving: np.ndarray) -> shapely.Geometry:
+    """The reference: (H - b0) less the sweep of -B's boundary along H's (Clipper's
+    Minkowski sum of a pattern along a closed path: the union of edge parallelograms)."""
+    import pyclipper
+
+    swept = pyclipper.MinkowskiSum((-moving).tolist(), hole.tolist(), True)
+    pc = pyclipper.Pyclipper()
+    pc.AddPath((hole - moving[0]).tolist(), pyclipper.PT_SUBJECT, True)
+    pc.AddPaths(swept, pyclipper.PT_CLIP, True)
+    return _ours([np.asarray(r) for r in pc.Execute(pyclipper.CT_DIFFERENCE, 1, 1)])
+
+
+@pytest.mark.parametrize(
+    "hole",
+    [
+        [[0, 0], [30, 0], [30, 30], [20, 30], [20, 10], [10, 10], [10, 30], [0, 30]],  # a U
+        [[0, 0], [40, 0], [40, 5], [25, 20], [40, 35], [40, 40], [0, 40]],  # a notch
+    ],
+)
+@pytest.mark.parametrize("part", [[[0, 0], [6, 0], [6, 6], [0, 6]], [[0, 0], [7, 2], [3, 6]]])
+def test_the_pocket_by_convolution_matches_the_swept_one_for_convex_parts(hole, part):
+    hole = np.array(hole, dtype=np.int64) * 1000
+    part = np.array(part, dtype=np.int64) * 1000
+    ours = _ours(nfp.pocket(hole, -part))
+    ref = _swept_pocket(hole, part)
+    assert ref.area > 0
+    assert shapely.symmetric_difference(ours, ref).area < 1e-6 * ref.area + 50

@@ -96,6 +96,7 @@ class _Shape:
     high: np.ndarray
     right: int  # its containment box's right edge, from its reference point
     area: float
+    fits: bool  # whether the sheet holds it at this turn
 
 
 class _Problem:
@@ -130,7 +131,7 @@ class _Problem:
             self.kind[i] = keys.setdefault(key, len(firsts))
             if self.kind[i] == len(firsts):
                 firsts.append(i)
-        self.shapes: list[list[_Shape | None]] = []
+        self.shapes: list[list[_Shape]] = []
         for i in firsts:  # one step per distinct shape
             rel = shapely.transform(polygons[i], lambda xy, c=self.centre[i]: xy - c)
             grown = shapely.buffer(
@@ -147,10 +148,11 @@ class _Problem:
                 turns.append(self._shape(grown, ring, a, tolerance, i, k))
             self.shapes.append(turns)
         self._nfp: dict[tuple[int, int, int, int], tuple[list[np.ndarray], np.ndarray]] = {}
+        self._base: dict[tuple[int, int, int], list[np.ndarray]] = {}
 
     def _shape(
         self, grown: shapely.Polygon, ring: np.ndarray, a: float, tol: float, i: int, k: int
-    ) -> _Shape | None:
+    ) -> _Shape:
         c, s = math.cos(a), math.sin(a)
         rot = np.array([[c, -s], [s, c]])
 
@@ -164,23 +166,38 @@ class _Problem:
         w, h = self.sheet
         low = np.ceil(-lo * self.scale).astype(np.int64)
         high = np.floor((np.array([w, h]) - hi) * self.scale).astype(np.int64)
-        if np.any(low > high):
-            return None
-        return _Shape(outer, holes, low, high, int(math.ceil(hi[0] * self.scale)), self.area[i])
+        right = int(math.ceil(hi[0] * self.scale))
+        return _Shape(outer, holes, low, high, right, self.area[i], bool(np.all(low <= high)))
 
     def nfp(self, a: int, ka: int, b: int, kb: int) -> tuple[list[np.ndarray], np.ndarray]:
         """The no-fit polygon of shape a at turn ka (placed at the origin) and shape b at
-        turn kb, with its box (xmin, ymin, xmax, ymax)."""
+        turn kb, with its box (xmin, ymin, xmax, ymax). Made once per relative turn: the
+        polygon of (a, 0, b, kb - ka) turned by ka (exactly, on the grid, for quarter turns)."""
         key = (a, ka, b, kb)
         got = self._nfp.get(key)
         if got is None:
-            fixed, moving = self.shapes[a][ka], self.shapes[b][kb]
-            assert fixed is not None and moving is not None
-            paths = knfp.no_fit(fixed.outer, fixed.holes, moving.outer)
+            rel = (kb - ka) % len(self.angles)
+            base = self._base.get((a, b, rel))
+            if base is None:
+                fixed, moving = self.shapes[a][0], self.shapes[b][rel]
+                base = knfp.no_fit(fixed.outer, fixed.holes, moving.outer)
+                self._base[(a, b, rel)] = base
+            paths = [_turn(r, self.angles[ka]) for r in base]
             pts = np.concatenate(paths)
             got = (paths, np.r_[pts.min(axis=0), pts.max(axis=0)])
             self._nfp[key] = got
         return got
+
+
+def _turn(ring: np.ndarray, angle: float) -> np.ndarray:
+    """Integer points turned by ``angle`` about the origin: exact for quarter turns."""
+    quarter = angle / (np.pi / 2)
+    if abs(quarter - round(quarter)) < 1e-12:
+        x, y = ring[:, 0], ring[:, 1]
+        k = round(quarter) % 4
+        return [ring, np.c_[-y, x], -ring, np.c_[y, -x]][k]
+    c, s = math.cos(angle), math.sin(angle)
+    return np.round(ring @ np.array([[c, s], [-s, c]])).astype(np.int64)
 
 
 class _Sheet:
@@ -195,7 +212,7 @@ class _Sheet:
     def positions(self, problem: _Problem, t: int, k: int) -> np.ndarray | None:
         """The corners of the free region of shape t at turn k: (c, 2) int64, or None."""
         shape = problem.shapes[t][k]
-        if shape is None:
+        if not shape.fits:
             return None
         paths, done = self.free.get((t, k), (None, 0))
         if paths is None:
@@ -234,7 +251,7 @@ def _evaluate(problem: _Problem, order: np.ndarray) -> tuple[float, np.ndarray]:
     w = problem.sheet[0] * problem.scale
     sheet_area = problem.sheet[0] * problem.sheet[1]
     sheets: list[_Sheet] = []
-    slack = int(_SLACK * w)
+    slack = int(_SLACK * min(w, problem.sheet[1] * problem.scale))
     out = np.zeros((problem.n, 4), dtype=np.int64)
     for i in order.tolist():  # one step per part
         t = int(problem.kind[i])
@@ -251,7 +268,6 @@ def _evaluate(problem: _Problem, order: np.ndarray) -> tuple[float, np.ndarray]:
                 if cand is None:
                     continue
                 shape = problem.shapes[t][k]
-                assert shape is not None
                 right = np.maximum(cand[:, 0] + shape.right, sh.right)
                 j = _lowest(right, cand, slack)
                 bests.append((int(right[j]), int(cand[j, 1]), int(cand[j, 0]), k))
@@ -263,7 +279,6 @@ def _evaluate(problem: _Problem, order: np.ndarray) -> tuple[float, np.ndarray]:
             j = _lowest(rows[:, 0], rows[:, 2:0:-1], slack)
             k, v = int(rows[j, 3]), rows[j, 2:0:-1].copy()
             shape = problem.shapes[t][k]
-            assert shape is not None
             sh.placed.append((t, k, v))
             sh.room -= problem.area[i]
             sh.right = max(sh.right, int(v[0]) + shape.right)
@@ -344,7 +359,7 @@ def nest(
             "steps; scale the drawing, or give a coarser tolerance"
         )
     for t, turns in enumerate(problem.shapes):  # a part that fits at no turn is named
-        if all(s is None for s in turns):
+        if not any(s.fits for s in turns):
             i = int(np.flatnonzero(problem.kind == t)[0])
             lo, hi = shapely.bounds(polygons[i]).reshape(2, 2)
             size = hi - lo + spacing

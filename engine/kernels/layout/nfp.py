@@ -22,11 +22,11 @@ How the sum is made here:
   O(n + m + r m) segments (r reflex vertices), not the n m parallelograms of a union of
   edge sums, and every test is an exact integer cross product. Clipper (Angus Johnson's
   polygon clipper, through pyclipper) takes the cycle's nonzero region.
-- **Holes by erosion.** A hole H of A can hold B where B + t lies inside H: the inner-fit
-  region (H - b0) minus the sweep of B's boundary along H's, (dH) (+) (-dB) (Clipper's
-  Minkowski sum of a pattern along a closed path). Only holes whose box can hold B's box
-  are swept; for the others A is taken filled, and B is always taken filled (a part is
-  never placed around one already placed), which only ever forbids more.
+- **Holes by erosion.** A hole H of A can hold B where B + t lies inside H. For B's convex
+  hull K that set is where the convolution of H (run clockwise) with -K winds negatively
+  (:func:`pocket`); the hull only ever forbids more than B itself would. Only holes whose
+  box can hold B's box are looked at; for the others A is taken filled, and B is always
+  taken filled (a part is never placed around one already placed).
 
 Coordinates are integers (Clipper's, and exact cross products): :func:`grid_scale` chooses
 the scale so every sum and product stays within int64.
@@ -38,8 +38,9 @@ from collections.abc import Sequence
 
 import numpy as np
 import pyclipper
+import shapely
 
-__all__ = ["Paths", "feasible", "grid_scale", "minkowski_outer", "no_fit", "orient_ccw"]
+__all__ = ["Paths", "feasible", "grid_scale", "minkowski_outer", "no_fit", "orient_ccw", "pocket"]
 
 Paths = list  # list of (k, 2) int64 rings, Clipper's orientation: outer CCW, holes CW
 
@@ -184,22 +185,41 @@ def no_fit(outer: np.ndarray, holes: Sequence[np.ndarray], moving: np.ndarray) -
     region = minkowski_outer(outer, neg)
     size = moving.max(axis=0) - moving.min(axis=0)
     pockets: list[np.ndarray] = []
+    hull = None
     for h in holes:  # one step per hole; only those whose box holds the part's box
         if not _fits(size, h):
             continue
-        h = orient_ccw(h)
-        swept = pyclipper.MinkowskiSum(neg.tolist(), h.tolist(), True)
-        pc = pyclipper.Pyclipper()
-        pc.AddPath((h - moving[0]).tolist(), pyclipper.PT_SUBJECT, True)
-        if swept:
-            pc.AddPaths(swept, pyclipper.PT_CLIP, True)
-        pockets += [np.asarray(r) for r in pc.Execute(pyclipper.CT_DIFFERENCE, 1, 1)]
+        if hull is None:
+            hull = _clean(orient_ccw(_hull(neg)))
+        pockets += pocket(h, hull)
     if not pockets:
         return region
     pc = pyclipper.Pyclipper()
     pc.AddPaths(region, pyclipper.PT_SUBJECT, True)
     pc.AddPaths(pockets, pyclipper.PT_CLIP, True)
     return [np.asarray(r, dtype=np.int64) for r in pc.Execute(pyclipper.CT_DIFFERENCE, 1, 1)]
+
+
+def _hull(points: np.ndarray) -> np.ndarray:
+    """The convex hull of integer points, counter-clockwise, on the same grid (its corners
+    are input points; Andrew's monotone chain through shapely's GEOS)."""
+    hull = shapely.convex_hull(shapely.multipoints(points.astype(np.float64)))
+    return np.asarray(shapely.get_coordinates(hull)[:-1], dtype=np.int64)
+
+
+def pocket(hole: np.ndarray, convex: np.ndarray) -> Paths:
+    """Where a convex part (``convex``, the moving part's hull, reflected) fits inside a
+    hole: the translations t with -convex + t inside the hole's region, i.e. the points
+    around which the convolution of the hole run clockwise with ``convex`` winds
+    negatively (Chen and McMains 2005, "Polygon offsetting by computing winding numbers":
+    the offset of a region by a convex shape is where the convolution of its boundary
+    cycles winds positively; the big box around the hole adds one everywhere near it)."""
+    h = _clean(orient_ccw(hole)[::-1])
+    if len(h) < 3:
+        return []
+    pc = pyclipper.Pyclipper()
+    pc.AddPaths(_convolution(h, convex), pyclipper.PT_SUBJECT, True)
+    return [np.asarray(r, dtype=np.int64) for r in pc.Execute(pyclipper.CT_UNION, 3, 3)]
 
 
 def feasible(subject: Paths, clips: Sequence[np.ndarray]) -> Paths:
