@@ -45,16 +45,12 @@ def _parts(count: int, kinds=KINDS) -> list:  # noqa: ANN001
 
 
 def _arrays(curves) -> list[list[np.ndarray]]:  # noqa: ANN001
-    """The parts as ``layout.nest`` reads them (its sampling, the even-odd region's pieces,
-    outer ring first), for the kernel's rows."""
+    """The parts as ``layout.nest`` reads them (the even-odd region's pieces, outer ring
+    first), for the kernel's rows."""
     from formgraph.core.registry import Context
-    from formgraph.kernels.curves.regions import even_odd_region, rings_of
     from formgraph.nodes import _outlines
 
-    tol = _outlines.sampling_tolerance(None, curves)
-    rings, _, _ = _outlines.sample_rings(curves, "curves", tol, Context("bench", Path(".")))
-    coords, offsets, hole = rings_of(even_odd_region(rings))
-    loops = [coords[offsets[i] : offsets[i + 1] - 1] for i in range(len(offsets) - 1)]
+    loops, _, hole = _outlines.region_loops(curves, Context("bench", Path(".")))
     starts = list(np.flatnonzero(~hole)) + [len(loops)]
     return [loops[a:b] for a, b in zip(starts[:-1], starts[1:], strict=True)]
 

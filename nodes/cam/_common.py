@@ -16,7 +16,6 @@ from formgraph.core.registry import Context
 from formgraph.geometry import Curve, NurbsCurve
 from formgraph.kernels.cam import arcs as karcs
 from formgraph.kernels.cam import paths as kpaths
-from formgraph.kernels.curves import regions as kregions
 from formgraph.nodes import _outlines as _o
 from formgraph.nodes.geometry.transform import transform_one
 from formgraph.nodes.offset.marching_squares import _loop_curve
@@ -34,12 +33,7 @@ def region(
         curves = [curves]
     if not curves:
         raise InputError("curves", "give the closed curves of the region to cut, got none")
-    tol = _o.sampling_tolerance(None, curves)
-    rings, sampled, sources = _o.sample_rings(curves, "curves", tol, ctx)
-    shape = _o.make_region(kregions.even_odd_region, rings, "curves")
-    outline = _o.outline_curves(shape, curves, sampled, sources, tol, ctx)
-    coords, offsets, hole = kregions.rings_of(shape)
-    loops = [coords[offsets[i] : offsets[i + 1] - 1] for i in range(len(offsets) - 1)]
+    loops, outline, hole = _o.region_loops(curves, ctx)
     return loops, outline, hole, _ACCURACY * _o.span_of(curves)
 
 

@@ -19,7 +19,6 @@ import shapely
 from formgraph.core.errors import InputError
 from formgraph.core.registry import Context, Range, node
 from formgraph.geometry import Curve, NurbsCurve
-from formgraph.kernels.curves import regions as kregions
 from formgraph.kernels.layout import nest as knest
 from formgraph.nodes import _outlines as _o
 from formgraph.nodes.geometry.transform import transform_one
@@ -93,12 +92,7 @@ def nest(
     w, h = float(sheet[0]), float(sheet[1])
     if not math.isfinite(spacing):
         raise InputError("spacing", f"the spacing must be finite, got {spacing}")
-    tol = _o.sampling_tolerance(None, curves)
-    rings, sampled, sources = _o.sample_rings(curves, "curves", tol, ctx)
-    region = _o.make_region(kregions.even_odd_region, rings, "curves")
-    outline = _o.outline_curves(region, curves, sampled, sources, tol, ctx)
-    coords, offsets, hole = kregions.rings_of(region)
-    loops = [coords[offsets[i] : offsets[i + 1] - 1] for i in range(len(offsets) - 1)]
+    loops, outline, hole = _o.region_loops(curves, ctx)
     starts = np.flatnonzero(~hole)
     bounds = np.r_[starts, len(loops)]
     parts = [loops[a:b] for a, b in zip(bounds[:-1], bounds[1:], strict=True)]

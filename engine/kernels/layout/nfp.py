@@ -192,12 +192,7 @@ def no_fit(outer: np.ndarray, holes: Sequence[np.ndarray], moving: np.ndarray) -
         if hull is None:
             hull = _clean(orient_ccw(_hull(neg)))
         pockets += pocket(h, hull)
-    if not pockets:
-        return region
-    pc = pyclipper.Pyclipper()
-    pc.AddPaths(region, pyclipper.PT_SUBJECT, True)
-    pc.AddPaths(pockets, pyclipper.PT_CLIP, True)
-    return [np.asarray(r, dtype=np.int64) for r in pc.Execute(pyclipper.CT_DIFFERENCE, 1, 1)]
+    return feasible(region, pockets)
 
 
 def _hull(points: np.ndarray) -> np.ndarray:
