@@ -362,7 +362,7 @@ def _expression(field: Field, p: np.ndarray) -> np.ndarray:
 
 
 def _from_mesh(field: Field, p: np.ndarray) -> np.ndarray:
-    from ..kernels.field import meshdist
+    from ..kernels.geometry import meshdist
 
     cache = field._cache
     if "signed" not in cache:
@@ -383,7 +383,7 @@ def _triangles(mesh: Any) -> np.ndarray:
 
 
 def _from_curves(field: Field, p: np.ndarray) -> np.ndarray:
-    from ..kernels.field import meshdist
+    from ..kernels.geometry import meshdist
 
     cache = field._cache
     if "nearest" not in cache:
