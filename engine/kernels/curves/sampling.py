@@ -104,12 +104,13 @@ def piece_jet(coef: np.ndarray, piece: int, t: float) -> tuple[np.ndarray, np.nd
 
 
 def chord_gap(a: np.ndarray, b: np.ndarray, p: np.ndarray) -> np.ndarray:
-    """Distance from each point ``p`` to the chord ``a -> b`` (all (m, 2))."""
+    """Distance from each point ``p`` to the chord ``a -> b`` (all (m, 2) or (m, 3))."""
     ab = b - a
     den = np.einsum("ij,ij->i", ab, ab)
     num = np.einsum("ij,ij->i", p - a, ab)
     s = np.clip(np.divide(num, den, out=np.zeros_like(den), where=den > 0), 0.0, 1.0)
-    return np.hypot(*(p - a - s[:, None] * ab).T)
+    gap = p - a - s[:, None] * ab
+    return np.hypot(*gap.T) if gap.shape[1] == 2 else np.linalg.norm(gap, axis=1)
 
 
 def refine_chords(
@@ -123,9 +124,9 @@ def refine_chords(
 
     Parameters
     ----------
-    evaluate : callable (m,) parameters -> (m, 2) points
+    evaluate : callable (m,) parameters -> (m, 2) or (m, 3) points
     u : (n,) increasing parameters, the last the end of the curve
-    points : (n, 2) the curve at ``u``
+    points : (n, 2) or (n, 3) the curve at ``u``
     tol : float
     guard : callable of the sample count, called before each round grows the sampling
 

@@ -25,6 +25,7 @@ from .bvh import morton_codes
 
 __all__ = [
     "Nearest",
+    "fan_triangles",
     "SignedDistance",
     "WindingNumber",
     "point_segment_distance",
@@ -32,6 +33,20 @@ __all__ = [
 ]
 
 CHUNK = 8192  # winding-number points per batch: bounds the (point, node) pairs held at once
+
+
+def fan_triangles(
+    face_indices: np.ndarray, face_offsets: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """(t, 3) the triangles of polygon faces, each fanned from its first corner (the faces
+    of a closed mesh stay closed), and (t,) the face each triangle comes from."""
+    fo = np.asarray(face_offsets, dtype=np.int64)
+    fi = np.asarray(face_indices, dtype=np.int64)
+    sizes = np.diff(fo)
+    face = np.repeat(np.arange(len(sizes)), sizes - 2)
+    k = np.arange(len(face)) - np.repeat(np.cumsum(sizes - 2) - (sizes - 2), sizes - 2)
+    first = fo[:-1][face]
+    return np.stack([fi[first], fi[first + k + 1], fi[first + k + 2]], axis=1), face
 
 
 def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
