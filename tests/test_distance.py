@@ -171,6 +171,6 @@ def test_transfer_from_points_copies_the_nearest_points_values():
 def test_transfer_names_an_attribute_the_source_lacks_and_lists_what_it_has():
     src = Points([[0, 0, 0]], {"height": [1.0], "color": [[1.0, 0, 0]]})
     with pytest.raises(
-        fg.GraphError, match=r"no point attribute 'heigth' \(its point attributes: color, height\)"
+        fg.NodeError, match=r"no point attribute 'heigth' \(its point attributes: color, height\)"
     ):
         ask("attr.transfer", cloud(3), src, port="source", names=["heigth"])
