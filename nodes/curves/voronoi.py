@@ -97,8 +97,9 @@ def voronoi(
         raise InputError("points", "a cell came out empty: the points are too close together")
     xyz = frozen_array(coords)
     knots = frozen_array(_o.chord_knots(step, offsets))
-    return [  # one curve per cell; its points are a view of the one array
-        NurbsCurve._of_valid(xyz[a:b], 1, knots[a + 2 * i : b + 2 * i + 2])
+    ones = frozen_array(np.ones(len(xyz)))
+    return [  # one curve per cell; its points, knots and weights are views of three arrays
+        NurbsCurve._of_valid(xyz[a:b], 1, knots[a + 2 * i : b + 2 * i + 2], ones[a:b])
         for i, (a, b) in enumerate(zip(offsets[:-1].tolist(), offsets[1:].tolist(), strict=True))
     ]
 
