@@ -28,6 +28,7 @@ __all__ = [
     "even_parameters",
     "make_region",
     "outline_curves",
+    "region_rings",
     "sample_rings",
     "sampling_tolerance",
     "span_of",
@@ -223,6 +224,55 @@ def make_region(make: Any, rings: list[np.ndarray], port: str) -> Any:
         raise InputError(
             port, f"curve {exc.ring} encloses no area (fewer than 3 distinct points)"
         ) from None
+
+
+def region_rings(
+    curves: list[Curve], tolerance: float | None, ctx: Context, port: str = "curves"
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+    """The even-odd region of closed curves in XY, as ``curves.boolean`` reads it, given
+    back as its boundary rings: the solids made from outlines (``mesh.extrude``,
+    ``mesh.revolve``) read their region here and nowhere else.
+
+    Returns
+    -------
+    xy : (N, 2) float
+        Every ring's points, ring after ring, each without its closing point; no point
+        repeats the one before it.
+    offsets : (r + 1,) int
+        Ring i is ``xy[offsets[i]:offsets[i + 1]]``; a polygon's outer ring (counter-
+        clockwise) comes before its holes (clockwise).
+    hole : (r,) bool
+    tol : float
+        The sampling tolerance: ``tolerance``, or 1e-5 of the size of the region.
+
+    Raises
+    ------
+    InputError
+        On ``port``: no curves, an open curve, a curve that encloses nothing, or a region
+        of no area (e.g. a curve given twice: by the even-odd rule the two cancel).
+    """
+    if isinstance(curves, Curve):
+        curves = [curves]
+    if not curves:
+        raise InputError(port, "give closed curves bounding a region, got none")
+    tol = sampling_tolerance(tolerance, curves, port)
+    rings, _, _ = sample_rings(curves, port, tol, ctx)
+    region = make_region(kregions.even_odd_region, rings, port)
+    coords, offsets, hole = kregions.rings_of(region)
+    if len(offsets) < 2:
+        raise InputError(
+            port,
+            f"the {len(curves)} curve(s) bound a region of no area (by the even-odd rule a "
+            "curve given twice, or two that coincide, cancel out)",
+        )
+    # each ring without its closing point: ring i loses its last row
+    r = len(offsets) - 1
+    keep = np.ones(len(coords), dtype=bool)
+    keep[offsets[1:] - 1] = False
+    xy = coords[keep]
+    if tolerance is None:  # (polylines were taken as they are: 1e-5 of the region's size)
+        tol = _TOLERANCE * float(max(np.ptp(xy[:, 0]), np.ptp(xy[:, 1])))
+    return xy, offsets - np.arange(r + 1), hole, tol
 
 
 def _distinct(ring: np.ndarray) -> np.ndarray:
