@@ -28,6 +28,7 @@ from .curve import homogeneous, project
 __all__ = [
     "clamp",
     "decompose_bezier",
+    "decompose_bezier_surface",
     "elevate_degree",
     "insert_knot",
     "insert_knot_surface",
@@ -451,6 +452,39 @@ def decompose_bezier(
     seg, _ = _bezier_pieces(degree, U, homogeneous(control_points, weights))
     cp, w = project(seg, weights is not None)
     return cp, w
+
+
+def decompose_bezier_surface(
+    control_points: np.ndarray,
+    degree_u: int,
+    degree_v: int,
+    knots_u: np.ndarray,
+    knots_v: np.ndarray,
+    weights: np.ndarray | None,
+) -> tuple[np.ndarray, np.ndarray | None]:
+    """Split a surface into its Bezier patches, one per pair of non-empty knot spans.
+
+    A tensor product decomposes one direction at a time: :func:`decompose_bezier`'s
+    blossoms along u with every column of control points carried along (each column a
+    curve in u), then along v on the result (A5.7 done as two passes of A5.6).
+
+    Returns
+    -------
+    patches : (k, p + 1, q + 1, 3) float
+        Patch (i, j) of the spans is ``k = i * (spans in v) + j``.
+    patch_weights : (k, p + 1, q + 1) float, or None for a non-rational surface
+    """
+    validate_surface(control_points, degree_u, degree_v, knots_u, knots_v, weights)
+    p, q = int(degree_u), int(degree_v)
+    pw = homogeneous(control_points, weights)  # (nu, nv, d)
+    nu, nv, d = pw.shape
+    a, _ = _bezier_pieces(p, np.asarray(knots_u, np.float64), pw.reshape(nu, nv * d))
+    su = a.shape[0]  # (su, p + 1, nv * d): every column's u pieces
+    cols = a.reshape(su * (p + 1), nv, d).transpose(1, 0, 2).reshape(nv, -1)
+    b, _ = _bezier_pieces(q, np.asarray(knots_v, np.float64), cols)
+    sv = b.shape[0]  # (sv, q + 1, su * (p + 1) * d)
+    patches = b.reshape(sv, q + 1, su, p + 1, d).transpose(2, 0, 3, 1, 4)
+    return project(patches.reshape(su * sv, p + 1, q + 1, d), weights is not None)
 
 
 def reparametrize(knots: np.ndarray, t0: float, t1: float, degree: int | None = None) -> np.ndarray:
