@@ -24,6 +24,7 @@ __all__ = [
     "bezier_pieces",
     "chord_gap",
     "piece_jet",
+    "points_within",
     "polyline_at_lengths",
     "refine_chords",
     "sample_closed_batch",
@@ -358,3 +359,46 @@ def sample_closed_batch(
 def _breaks(curve: tuple[np.ndarray, int, np.ndarray, np.ndarray | None]) -> np.ndarray:
     cp, p, kn, _ = curve
     return np.unique(np.asarray(kn, dtype=np.float64)[p : len(cp) + 1])
+
+
+def points_within(
+    evaluate: Callable[[np.ndarray], np.ndarray],
+    second: Callable[[np.ndarray], np.ndarray],
+    breaks: np.ndarray,
+    tol: float,
+    guard: Callable[[int], None] | None = None,
+) -> np.ndarray:
+    """(m, 3) points of a curve in space whose chords are all within ``tol`` of it.
+
+    Each span between ``breaks`` (knots, where a NURBS may bend sharply) gets
+    ``ceil(sqrt(1.5 max |C''| / (8 tol)))`` equal parameter steps, ``max |C''|`` looked at on
+    a grid of the span (the interpolation bound of the module docstring, in 3-D).
+
+    Parameters
+    ----------
+    evaluate : callable (m,) params -> (m, 3) points
+    second : callable (m,) params -> (m, 3) second derivatives
+    breaks : (s + 1,) float
+        The spans' ends, increasing.
+    tol : float
+        > 0.
+    guard : callable of the point count, optional
+        Called before the points are made.
+    """
+    if not tol > 0:
+        raise ValueError(f"the sampling tolerance must be positive, got {tol}")
+    b = np.asarray(breaks, dtype=np.float64)
+    spans = len(b) - 1
+    g = np.linspace(0.0, 1.0, _GRID + 1)
+    width = np.diff(b)
+    t = (b[:-1, None] + g[None, :] * width[:, None]).reshape(-1)
+    d2 = np.linalg.norm(np.asarray(second(t)), axis=-1).reshape(spans, _GRID + 1)
+    steps = _steps(d2.max(axis=1) * width**2, tol)  # |C''| in the span's unit parameter
+    total = int(steps.sum()) + 1
+    if guard is not None:
+        guard(total)
+    first = np.concatenate([[0], np.cumsum(steps)[:-1]])
+    span = np.repeat(np.arange(spans), steps)
+    f = (np.arange(total - 1) - first[span]) / steps[span]
+    u = np.append(b[span] + f * width[span], b[-1])
+    return np.asarray(evaluate(u))
