@@ -72,7 +72,9 @@ def extrude(
     from +z, about the z axis; OpenSCAD turns the other way) and scales linearly to
     ``scale`` at the top (after the turn). Exact curves are sampled so that every chord is
     within ``tolerance`` of its curve; with a twist the solid is cut into slices so that
-    each point's helix is followed to the same tolerance (at most 45 degrees a slice).
+    each point's helix is followed to the same tolerance (at most 45 degrees a slice), and
+    with a twist or unequal scales long edges get points along them, so that the sides'
+    triangles stay within the tolerance of the exact twisted surface.
 
     Parameters
     ----------
@@ -115,6 +117,15 @@ def extrude(
             f"triangles would cut across the solid (it would intersect itself); use at least "
             f"{math.ceil(abs(twist) / ke.MAX_TWIST_STEP)} slices, or leave slices unset",
         )
+    # the sides between slices follow the exact twisted (or unequally scaled) solid to
+    # the tolerance: points along the long edges (counted against the budget first)
+    sx_sy = (sx, sy)
+    step = (abs(sx - sy) / 2 + max(1.0, sx, sy) * abs(math.radians(twist))) / slices
+    if step > 0:
+        edges = np.hypot(*(np.roll(xy, -1, axis=0) - xy).T)  # (a ring's last: a bound)
+        added = float(np.sum(np.ceil(step * edges / (4.0 * tol))))
+        ctx.guard((slices + 1) * added, "vertices")
+        xy, offsets = ke.refine_edges(xy, offsets, twist, sx_sy, slices, tol)
     n = len(xy)
     ctx.guard((slices + 1) * n, "vertices")
     ctx.guard(2 * slices * n + 2 * n, "faces")

@@ -32,6 +32,7 @@ __all__ = [
     "MAX_TWIST_STEP",
     "cap_triangles",
     "extrude",
+    "refine_edges",
     "revolve",
     "turn_segments",
     "twist_slices",
@@ -122,6 +123,50 @@ def twist_slices(twist_degrees: float, radius: float, tolerance: float) -> int:
     if 0 < tolerance < radius:
         step = min(step, 2.0 * math.acos(1.0 - tolerance / radius))
     return max(1, math.ceil(turn / step - 1e-9))
+
+
+def refine_edges(
+    xy: np.ndarray,
+    offsets: np.ndarray,
+    twist: float,
+    scale: tuple[float, float],
+    slices: int,
+    tolerance: float,
+) -> tuple[np.ndarray, np.ndarray]:
+    """The rings with points added along their edges, so that the side of a twisted or
+    unequally scaled extrusion stays within ``tolerance`` of the exact solid.
+
+    Between two slices an edge a -> b sweeps a bilinear patch (the edge at the lower
+    level, the same edge turned and scaled at the upper); its two triangles leave that
+    patch by a quarter of the patch's twist ``(M' - M)(b - a)`` across it, M the map of a
+    level. Only the part of ``M' - M`` that does not move points along the edge counts:
+    the turn (``max(sx, sy) * twist / slices`` radians) and the unequal part of the scale
+    (``|sx - sy| / 2 / slices``; an equal scale keeps each side in its plane). An edge is
+    cut into ``ceil(|M' - M| |b - a| / (4 tolerance))`` equal pieces.
+
+    Returns
+    -------
+    xy, offsets
+        The refined rings (the input's points kept, in order).
+    """
+    sx, sy = scale
+    step = (abs(sx - sy) / 2 + max(1.0, sx, sy) * abs(math.radians(twist))) / slices
+    xy = np.asarray(xy, dtype=np.float64)
+    off = np.asarray(offsets, dtype=np.int64)
+    if step == 0.0 or not tolerance > 0:
+        return xy, off
+    nxt = next_corner(off)
+    length = np.hypot(*(xy[nxt] - xy).T)
+    pieces = np.maximum(1, np.ceil(step * length / (4.0 * tolerance) - 1e-9)).astype(np.int64)
+    if np.all(pieces == 1):
+        return xy, off
+    start = np.repeat(np.arange(len(xy)), pieces)
+    f = np.arange(len(start)) - np.repeat(np.cumsum(pieces) - pieces, pieces)
+    f = f / pieces[start]
+    out = xy[start] + f[:, None] * (xy[nxt[start]] - xy[start])
+    out[f == 0] = xy[start[f == 0]]  # the input's points exactly
+    ring_points = np.add.reduceat(pieces, off[:-1])
+    return out, np.concatenate([[0], np.cumsum(ring_points)])
 
 
 def turn_segments(angle_degrees: float, radius: float, tolerance: float) -> int:
