@@ -120,7 +120,7 @@ def bounds(geometry: Geometry | list[Geometry]) -> Bounds:
     Outputs ``min``, ``max`` (its lowest and highest corner), ``size`` and ``center``.
     Points and meshes are bounded by their vertices. NURBS curves and surfaces are bounded
     by the curve or surface itself, not by their control points (which stick out: a
-    circle's by 41 %): each is split into its Bezier pieces and the extremes of each
+    circle turned 45 degrees by 41 %): each is split into its Bezier pieces and the extremes of each
     coordinate found by branch and bound over them (a piece's control points bound it,
     its corners lie on it; the pieces that could still hold an extreme are halved until
     none can), to 1e-10 of the size. Curves and surfaces given by expressions are sampled
