@@ -39,7 +39,8 @@ def minkowski(a: Mesh, b: Mesh, *, ctx: Context) -> Mesh:
     for port, m in (("a", a), ("b", b)):
         if m.n_faces == 0:
             raise InputError(port, "the mesh has no faces: there is no solid to sum")
-    work = km.cost(mesh_arrays(a), mesh_arrays(b))
+    ca, cb = km.is_convex(*mesh_arrays(a)), km.is_convex(*mesh_arrays(b))
+    work = km.cost(mesh_arrays(a), mesh_arrays(b), ca, cb)
     ctx.guard(work, "elements of Minkowski hulls (faces x vertices of the inputs)")
     mans = []
     for port, m in (("a", a), ("b", b)):
@@ -51,7 +52,7 @@ def minkowski(a: Mesh, b: Mesh, *, ctx: Context) -> Mesh:
         kb.check_precision(mans, ("the mesh", "the mesh"))
     except kb.NotSolidError as exc:
         raise InputError("ab"[exc.operand or 0], str(exc)) from None
-    out = Mesh(*kb.from_manifold(km.minkowski(*mans)))
+    out = Mesh(*km.minkowski(mesh_arrays(a), mesh_arrays(b), *mans, ca and cb))
     if out.n_faces == 0:
         ctx.warn("the Minkowski sum is empty (both solids bound no volume)")
     return out

@@ -11,7 +11,10 @@ node can refuse it against the element budget before it starts.
 
 :func:`is_convex` follows manifold3d's own test (its ``IsConvex``): genus 0 (V - E + F = 2
 on the triangles) and no concave edge (across each edge, the turn from one face's normal to
-the other's agrees with the edge's direction).
+the other's agrees with the edge's direction), with faces that meet flat up to rounding
+taken as flat. Two solids it finds convex are summed here, as the hull of the pairwise
+sums of their vertices (manifold3d's own convex path), so the cost counted is the work
+done whatever manifold3d would have decided.
 """
 
 from __future__ import annotations
@@ -24,6 +27,10 @@ from .meshops import triangulate
 __all__ = ["cost", "is_convex", "minkowski"]
 
 MeshArrays = tuple[np.ndarray, np.ndarray, np.ndarray]
+
+#: faces meeting at an angle whose sine is below this are flat there (the two triangles of
+#: a planar quad, whose normals differ by rounding)
+_FLAT = 1e-9
 
 
 def _triangles(v: np.ndarray, fi: np.ndarray, fo: np.ndarray) -> np.ndarray:
@@ -52,9 +59,10 @@ def is_convex(vertices: np.ndarray, face_indices: np.ndarray, face_offsets: np.n
     flat = tri.reshape(-1)
     nxt = np.where(first % 3 == 2, first - 2, first + 1)
     edge = v[flat[nxt]] - v[flat[first]]
-    same = np.all(n[f0] == n[f1], axis=1)
-    turn = np.einsum("ij,ij->i", edge, np.cross(n[f0], n[f1]))
-    return bool(np.all(same | (turn > 0)))
+    bend = np.cross(n[f0], n[f1])  # the sine of the angle between the faces
+    flat = np.einsum("ij,ij->i", bend, bend) <= _FLAT**2
+    turn = np.einsum("ij,ij->i", edge, bend)
+    return bool(np.all(flat | (turn > 0)))
 
 
 def cost(
@@ -78,6 +86,19 @@ def cost(
     return 14 * ta * tb
 
 
-def minkowski(a: object, b: object) -> object:
-    """``a + b`` of two ``manifold3d.Manifold`` solids (the Minkowski sum)."""
-    return a.minkowski_sum(b)  # type: ignore[attr-defined]
+def minkowski(a: MeshArrays, b: MeshArrays, ma: object, mb: object, convex: bool) -> MeshArrays:
+    """The Minkowski sum of two closed outward meshes, as flat arrays (triangles).
+
+    ``convex`` (both are, by :func:`is_convex`): the hull of all ``len(a) x len(b)`` vertex
+    sums (manifold3d's ``hull_points``); otherwise manifold3d's ``minkowski_sum`` of their
+    manifolds ``ma``, ``mb``.
+    """
+    import manifold3d
+
+    from .boolean import from_manifold
+
+    if convex:
+        va, vb = np.asarray(a[0], dtype=np.float64), np.asarray(b[0], dtype=np.float64)
+        sums = (va[:, None, :] + vb[None, :, :]).reshape(-1, 3)
+        return from_manifold(manifold3d.Manifold.hull_points(sums))
+    return from_manifold(ma.minkowski_sum(mb))  # type: ignore[attr-defined]
