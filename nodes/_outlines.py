@@ -42,14 +42,12 @@ _LARGEST = 1e150  # the largest extent whose areas (its square, times vertex cou
 def span_of(curves: list[Curve]) -> float:
     """The largest side of the XY box around the curves (their control points when NURBS:
     the curve lies in their hull)."""
-    box = np.array([np.inf, np.inf, -np.inf, -np.inf])
-    for c in curves:  # one step per curve; a column at a time (numpy's axis=0 min is slow)
-        p = np.asarray(c.control_points) if isinstance(c, NurbsCurve) else c.sample(65)
-        x, y = p[:, 0], p[:, 1]
-        box = np.r_[
-            np.minimum(box[:2], [x.min(), y.min()]), np.maximum(box[2:], [x.max(), y.max()])
-        ]
-    return float((box[2:] - box[:2]).max())
+    pts = [
+        c.control_points if isinstance(c, NurbsCurve) else np.asarray(c.sample(65)) for c in curves
+    ]
+    p = pts[0] if len(pts) == 1 else np.concatenate(pts)
+    x, y = p[:, 0], p[:, 1]  # a column at a time (numpy's axis=0 min is slow)
+    return float(max(x.max() - x.min(), y.max() - y.min()))
 
 
 def closes(c: Curve) -> bool:
@@ -109,11 +107,12 @@ def even_parameters(
 
 
 def sample_rings(
-    curves: list[Curve], port: str, tol: float, ctx: Context
+    curves: list[Curve], port: str, tol: float, ctx: Context, exact: bool = True
 ) -> tuple[list[np.ndarray], list[np.ndarray | None], list[karcs.Source | None]]:
     """Each closed curve sampled to ``tol`` in XY; (for curves that are not polylines) the
     same rings again, to recognize the curves a boolean leaves whole; and (for NURBS of
-    degree >= 2) the curve with its samples' parameters, to rebuild the arcs it cuts."""
+    degree >= 2, with ``exact``) the curve with its samples' parameters, to rebuild the
+    arcs it cuts (a solid made of the region needs neither: ``exact=False``)."""
     rings: list[np.ndarray] = []
     sampled: list[np.ndarray | None] = []
     sources: list[karcs.Source | None] = [None] * len(curves)
@@ -158,7 +157,7 @@ def sample_rings(
             for i in members
         ]
         sampled_batch = InputError.call(
-            port, ksampling.sample_closed_batch, batch, tol, guard, params=True
+            port, ksampling.sample_closed_batch, batch, tol, guard, params=exact, validate=False
         )
         batched.update(zip(members, sampled_batch, strict=True))
     for i, c in enumerate(curves):  # one step per curve; its samples are vectorized
@@ -173,7 +172,9 @@ def sample_rings(
             rings.append(ring)
             sampled.append(None)
             continue
-        if i in batched:
+        if i in batched and not exact:
+            ring = batched[i]
+        elif i in batched:
             ring, t = batched[i]
             x, y = ring[:, 0], ring[:, 1]
             keep = np.r_[True, (x[1:] != x[:-1]) | (y[1:] != y[:-1])]
@@ -256,7 +257,7 @@ def region_rings(
     if not curves:
         raise InputError(port, "give closed curves bounding a region, got none")
     tol = sampling_tolerance(tolerance, curves, port)
-    rings, _, _ = sample_rings(curves, port, tol, ctx)
+    rings, _, _ = sample_rings(curves, port, tol, ctx, exact=False)
     region = make_region(kregions.even_odd_region, rings, port)
     coords, offsets, hole = kregions.rings_of(region)
     if len(offsets) < 2:

@@ -12,7 +12,6 @@ import numpy as np
 from formgraph.core.errors import InputError
 from formgraph.core.registry import Context, node
 from formgraph.geometry import Curve, Mesh, NurbsCurve, frozen_array
-from formgraph.kernels.curves import regions as kregions
 from formgraph.kernels.io.meshdata import fan_triangles
 from formgraph.kernels.mesh import repair
 from formgraph.kernels.mesh import section as ksection
@@ -31,10 +30,10 @@ class Axis(str, Enum):
 _FRAME = {"x": (1, 2, 0), "y": (2, 0, 1), "z": (0, 1, 2)}
 
 
-def _curves(region: object, place) -> list[Curve]:
-    """The region's rings (outer counter-clockwise, holes clockwise) as closed polylines,
+def _curves(rings: tuple[np.ndarray, np.ndarray, np.ndarray, bool], place) -> list[Curve]:
+    """Rings (:func:`~formgraph.kernels.mesh.section.section_rings`) as closed polylines,
     each point placed in 3-D by ``place((m, 2)) -> (m, 3)``; t is arc length."""
-    coords, offsets, _, step = kregions.rings_of(region, steps=True)
+    coords, offsets, step, _ = rings
     if len(offsets) < 2:
         return []
     xyz = frozen_array(place(coords))
@@ -120,8 +119,8 @@ def mesh_slice(
             "is open or not manifold there, and the chains that do not close were left out "
             "(mesh.weld and mesh.cap make it a closed solid)"
         )
-    region, filled = ksection.region_of_loops(xy, offsets)
-    if filled:
+    rings = ksection.section_rings(xy, offsets)
+    if rings[3]:
         ctx.warn(
             "the section's loops overlap or cross (parts of the mesh overlap or its faces "
             "intersect): they were united by their winding numbers"
@@ -133,7 +132,7 @@ def mesh_slice(
         out[:, u], out[:, w], out[:, along] = p[:, 0], p[:, 1], h
         return out
 
-    curves = _curves(region, place)
+    curves = _curves(rings, place)
     if not curves:
         ctx.warn(f"the plane {axis.value} = {height:g} leaves no area in its section")
     return curves
@@ -170,12 +169,12 @@ def project(mesh: Mesh, *, ctx: Context) -> list[Curve]:
     if len(offsets) < 2:
         ctx.warn("every face is seen edge-on from above: the shadow has no area")
         return []
-    region, _ = ksection.region_of_loops(xy, offsets, fill=True)
+    rings = ksection.section_rings(xy, offsets, fill=True)
 
     def place(p: np.ndarray) -> np.ndarray:
         return np.column_stack([p, np.zeros(len(p))])
 
-    curves = _curves(region, place)
+    curves = _curves(rings, place)
     if not curves:
         ctx.warn("the shadow has no area")
     return curves

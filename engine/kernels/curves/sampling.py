@@ -13,6 +13,7 @@ once (vectorized over pieces and samples).
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable
 
@@ -36,12 +37,14 @@ _SAFETY = 1.5  # on the sampled maximum of |C''|
 _ROUNDS = 40  # midpoint refinement rounds (each halves the worst chord)
 
 
+@functools.lru_cache(maxsize=16)
 def _power_matrix(p: int) -> np.ndarray:
     """M with Bernstein B_{i,p}(t) = sum_j M[i, j] t**j."""
     m = np.zeros((p + 1, p + 1))
     for i in range(p + 1):  # degree + 1 rows: a tiny constant matrix
         for j in range(i, p + 1):
             m[i, j] = math.comb(p, i) * math.comb(p - i, j - i) * (-1) ** (j - i)
+    m.flags.writeable = False  # (kept: one per degree)
     return m
 
 
@@ -58,13 +61,18 @@ def _steps(curv: np.ndarray, tol: float) -> np.ndarray:
 
 
 def bezier_pieces(
-    control_points: np.ndarray, degree: int, knots: np.ndarray, weights: np.ndarray | None
+    control_points: np.ndarray,
+    degree: int,
+    knots: np.ndarray,
+    weights: np.ndarray | None,
+    validate: bool = True,
 ) -> np.ndarray:
     """Homogeneous power-form coefficients of each Bezier piece in XY: (k, p + 1, 3).
 
     Row j of piece k holds the t**j coefficients of (w x, w y, w) on t in [0, 1].
+    ``validate=False`` for a curve checked when it was made.
     """
-    seg, sw = decompose_bezier(control_points, degree, knots, weights)
+    seg, sw = decompose_bezier(control_points, degree, knots, weights, validate)
     w = np.ones(seg.shape[:2]) if sw is None else sw
     hom = np.concatenate([seg[:, :, :2] * w[:, :, None], w[:, :, None]], axis=2)
     return np.einsum("ij,kic->kjc", _power_matrix(degree), hom)
@@ -281,8 +289,10 @@ def sample_closed_batch(
     tol: float,
     guard: Callable[[int], None] | None = None,
     params: bool = False,
+    validate: bool = True,
 ) -> list[np.ndarray] | list[tuple[np.ndarray, np.ndarray]]:
-    """:func:`sample_nurbs` of many closed curves of one degree (>= 2) at once.
+    """:func:`sample_nurbs` of many closed curves of one degree (>= 2) at once
+    (``validate=False`` for curves checked when they were made).
 
     Every curve's Bezier pieces go into one array, so the curvature bound, the sampling and
     each round of midpoint refinement are one vectorized pass over all of them (a line of
@@ -302,7 +312,10 @@ def sample_closed_batch(
     degrees = {int(c[1]) for c in curves}
     if len(degrees) != 1 or min(degrees) < 2:
         raise ValueError(f"a batch is of one degree >= 2, got degrees {sorted(degrees)}")
-    coef = [bezier_pieces(np.asarray(cp, dtype=np.float64), p, kn, w) for cp, p, kn, w in curves]
+    coef = [
+        bezier_pieces(np.asarray(cp, dtype=np.float64), p, kn, w, validate)
+        for cp, p, kn, w in curves
+    ]
     k = np.array([c.shape[0] for c in coef])
     coef_all = np.concatenate(coef)
     first_piece = np.concatenate([[0], np.cumsum(k)[:-1]])

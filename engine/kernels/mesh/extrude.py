@@ -26,7 +26,7 @@ import math
 
 import numpy as np
 
-from .measure import is_closed_oriented, next_corner
+from .measure import next_corner
 
 __all__ = [
     "MAX_TWIST_STEP",
@@ -90,9 +90,14 @@ def _ring_area(pts: np.ndarray, ends: np.ndarray) -> float:
 
 
 def _tiles(pts: np.ndarray, ends: np.ndarray, tri: np.ndarray) -> bool:
-    """Whether earcut's triangles (turned counter-clockwise in place) tile the polygon."""
+    """Whether earcut's triangles (turned counter-clockwise in place) tile the polygon:
+    the count of a tiling, none turned over, their areas adding up to the polygon's, no
+    edge run twice the same way, and the edges that have no partner run the other way
+    are exactly the rings' edges (so the caps close on the sides, with no point of one
+    ring on an edge of another)."""
     holes = len(ends) - 1
-    if len(tri) != len(pts) + 2 * holes - 2:
+    n = len(pts)
+    if len(tri) != n + 2 * holes - 2:
         return False
     area = _signed_areas(pts, tri)
     if area.sum() < 0:  # earcut's own winding: made the region's
@@ -100,7 +105,19 @@ def _tiles(pts: np.ndarray, ends: np.ndarray, tri: np.ndarray) -> bool:
         area = -area
     total = _ring_area(pts, ends)
     scale = float(np.abs(area).sum())
-    return bool(area.min(initial=0.0) >= -1e-12 * scale and abs(area.sum() - total) <= 1e-9 * scale)
+    if area.min(initial=0.0) < -1e-12 * scale or abs(area.sum() - total) > 1e-9 * scale:
+        return False
+    a, b = tri.reshape(-1), tri[:, [1, 2, 0]].reshape(-1)
+    key = np.sort(a * n + b)
+    if np.any(key[1:] == key[:-1]):
+        return False
+    off = np.concatenate([[0], ends.astype(np.int64)])
+    ring = np.arange(n) * n + next_corner(off)  # increasing: sorted queries
+    rev = np.sort(b * n + a)  # (sorted queries: searchsorted walks the keys once)
+    at = np.minimum(np.searchsorted(key, rev), len(key) - 1)
+    alone = np.count_nonzero(key[at] != rev)  # tri edges with no partner
+    at = np.minimum(np.searchsorted(key, ring), len(key) - 1)
+    return alone == n and bool(np.all(key[at] == ring))
 
 
 def _manifold_triangles(pts: np.ndarray, ends: np.ndarray) -> np.ndarray:
@@ -179,20 +196,6 @@ def turn_segments(angle_degrees: float, radius: float, tolerance: float) -> int:
         step = min(step, 2.0 * math.acos(1.0 - tolerance / radius))
     least = 3 if angle_degrees >= 360.0 else 1
     return max(least, math.ceil(turn / step - 1e-9))
-
-
-def _closed_or_retriangulated(
-    build, xy: np.ndarray, offsets: np.ndarray, caps: np.ndarray, n_vertices: int
-) -> MeshArrays:
-    """``build(caps)``'s mesh, checked closed and oriented; if a cap from earcut left it
-    open (rings touching where a point of one lies on an edge of another), built again with
-    manifold3d's triangulation of every polygon."""
-    v, fi, fo = build(caps)
-    if is_closed_oriented(fi, fo, n_vertices):
-        return v, fi, fo
-    ends = np.asarray(offsets[1:], dtype=np.int64)
-    tri = _manifold_triangles(np.ascontiguousarray(xy, dtype=np.float64), ends)
-    return build(tri)
 
 
 def extrude(
@@ -279,7 +282,6 @@ def extrude(
         sides.append((quads.reshape(-1), 3))
     if cone:
         sides.append((np.stack([a[-1], b[-1], d[-1]], axis=-1).reshape(-1), 3))
-    n_vertices = len(v)
 
     def build(tri: np.ndarray) -> MeshArrays:
         parts = list(sides)
@@ -288,9 +290,7 @@ def extrude(
             parts.append(((tri + slices * n).reshape(-1), 3))  # top, facing +z
         return v, *_faces(parts)
 
-    if caps is None:
-        caps = cap_triangles(xy, off, hole)
-    return _closed_or_retriangulated(build, xy, off, caps, n_vertices)
+    return build(cap_triangles(xy, off, hole) if caps is None else caps)
 
 
 def revolve(
@@ -374,9 +374,7 @@ def revolve(
 
     if whole:
         return build(np.zeros((0, 3), np.int64))
-    if caps is None:
-        caps = cap_triangles(rz, off, hole)
-    return _closed_or_retriangulated(build, rz, off, caps, len(v))
+    return build(cap_triangles(rz, off, hole) if caps is None else caps)
 
 
 def _faces(parts: list[tuple[np.ndarray, int]]) -> tuple[np.ndarray, np.ndarray]:

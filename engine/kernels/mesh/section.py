@@ -40,6 +40,7 @@ __all__ = [
     "cycles",
     "nonzero_fill",
     "region_of_loops",
+    "section_rings",
     "shadow_loops",
     "slice_loops",
 ]
@@ -66,23 +67,24 @@ def cycles(succ: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         return np.zeros(0, np.int64), np.zeros(1, np.int64)
     # the smallest element of each cycle, by pointer jumping on (min so far, jump): once a
     # round changes nothing, no later round would (each window's minimum is settled)
-    low = np.minimum(np.arange(n), succ)
-    jump = succ.copy()
+    idx = np.arange(n)
+    low = np.minimum(idx, succ)
+    jump = succ
     while True:
-        nxt_low = np.minimum(low, low[jump])
-        if np.array_equal(nxt_low, low):
+        nxt_low = np.minimum(low, low.take(jump))
+        if not (nxt_low < low).any():
             break
-        low, jump = nxt_low, jump[jump]
+        low, jump = nxt_low, jump.take(jump)
     # cut each cycle before its smallest element and rank the paths (distance to the end)
-    head = low == np.arange(n)
-    last = head[succ]  # i is followed by its cycle's head: the end of the path
-    nxt = np.where(last, np.arange(n), succ)
+    head = low == idx
+    last = head.take(succ)  # i is followed by its cycle's head: the end of the path
+    nxt = np.where(last, idx, succ)
     dist = (~last).astype(np.int64)
     while True:
-        further = nxt[nxt]
-        if np.array_equal(further, nxt):
+        further = nxt.take(nxt)
+        if not (further != nxt).any():
             break
-        dist += dist[nxt]
+        dist += dist.take(nxt)
         nxt = further
     # dist counts steps to the end; within a cycle of length L, position = L - 1 - dist
     cycle = low
@@ -172,41 +174,80 @@ def slice_loops(
         above = z > h
         na = above[tri].sum(axis=1)
         cut = np.flatnonzero((na > 0) & (na < 3))
-    t = tri[cut]
-    if len(t) == 0:
+    k = len(cut)
+    if k == 0:
         return np.zeros((0, 2)), np.zeros(1, np.int64), 0
-    above = z[t] > h  # (k, 3)
-    # the edge i -> i + 1 of each triangle goes up (below -> above) or down
-    a, b = t, np.roll(t, -1, axis=1)
-    ua, ub = above, np.roll(above, -1, axis=1)
-    up = ~ua & ub
-    down = ua & ~ub
+    t = tri[cut]
+    flat = t.reshape(-1)
+    above = z[flat] > h  # (indexing, not take: take would copy a strided column whole)
+    code = above[0::3] + 2 * above[1::3] + 4 * above[2::3]  # which corners are above
+    base = 3 * np.arange(k)
+    # edge i runs from corner i to corner i + 1: the one going up ends the segment, the
+    # one going down starts it
+    up = base + _UP.take(code)
+    down = base + _DOWN.take(code)
+    ua, ub = flat.take(up), flat.take(_next_in_triangle(up))
+    da, db = flat.take(down), flat.take(_next_in_triangle(down))
     n = len(v)
-    key = np.minimum(a, b) * n + np.maximum(a, b)
-    end_key = key[up]  # one per triangle (exactly one edge goes up, one down)
-    start_key = key[down]
-    # successor: the segment starting on the edge this one ends on
-    sorder, skeys = sort_keys(start_key, n * n) if n < 3_037_000_499 else _argsorted(start_key)
-    at = np.searchsorted(skeys, end_key)
-    at = np.minimum(at, len(skeys) - 1)
-    found = skeys[at] == end_key
-    succ = sorder[at]
-    open_chains = int(np.count_nonzero(~found))
+    end_key = np.minimum(ua, ub) * n + np.maximum(ua, ub)
+    lo, hi = np.minimum(da, db), np.maximum(da, db)
+    start_key = lo * n + hi
+    succ, found = _match(start_key, end_key)
+    open_chains = int(k - np.count_nonzero(found))
     if open_chains:  # drop the segments of chains that do not close
         succ, keep_seg = _closed_only(succ, found)
-        start_key = start_key[keep_seg]
-        if len(start_key) == 0:
+        lo, hi = lo[keep_seg], hi[keep_seg]
+        if len(lo) == 0:
             return np.zeros((0, 2)), np.zeros(1, np.int64), open_chains
-    else:
-        keep_seg = None
     order, offsets = cycles(succ)
     # the point on each segment's start edge, from its lower vertex to its higher
-    k = start_key[order]
-    lo, hi = k // n, k % n
-    zl, zh = z[lo], z[hi]
-    s = (h - zl) / (zh - zl)
-    xy = v[lo, :2] + s[:, None] * (v[hi, :2] - v[lo, :2])
+    lo, hi = lo.take(order), hi.take(order)
+    zl = z[lo]
+    s = (h - zl) / (z[hi] - zl)
+    pl, ph = v[lo, :2], v[hi, :2]
+    xy = pl + s[:, None] * (ph - pl)
     return _without_repeats(xy, offsets) + (open_chains,)
+
+
+def _crossings() -> tuple[np.ndarray, np.ndarray]:
+    """For each pattern of corners above the plane (bit i: corner i), the edge that goes
+    up through it and the one that goes down (0 where the plane does not cut)."""
+    up, down = np.zeros(8, np.int64), np.zeros(8, np.int64)
+    for code in range(1, 7):  # the six patterns with corners on both sides
+        ab = [(code >> i) & 1 for i in range(3)]
+        up[code] = next(i for i in range(3) if not ab[i] and ab[(i + 1) % 3])
+        down[code] = next(i for i in range(3) if ab[i] and not ab[(i + 1) % 3])
+    return up, down
+
+
+_UP, _DOWN = _crossings()
+
+
+def _next_in_triangle(pos: np.ndarray) -> np.ndarray:
+    """The flat position of the next corner of a triangle's corner (its last: its first)."""
+    return pos + 1 - 3 * (pos % 3 == 2)
+
+
+def _match(start: np.ndarray, end: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Segment s is followed by one whose start key is s's end key; of equal keys (an edge
+    on more than two faces) the j-th end meets the j-th start. Returns the successor of
+    every segment and whether it has one."""
+    k = len(start)
+    so = np.argsort(start, kind="stable")
+    eo = np.argsort(end, kind="stable")
+    ss, se = start.take(so), end.take(eo)
+    succ = np.empty(k, dtype=np.int64)
+    if np.array_equal(ss, se):  # a closed mesh: every end meets a start
+        succ[eo] = so
+        return succ, np.ones(k, dtype=bool)
+    rank = np.arange(k) - np.searchsorted(se, se, side="left")
+    target = np.searchsorted(ss, se, side="left") + rank
+    ok = target < k
+    ok[ok] = ss[target[ok]] == se[ok]
+    found = np.zeros(k, dtype=bool)
+    found[eo[ok]] = True
+    succ[eo] = np.where(ok, so.take(np.minimum(target, k - 1)), 0)
+    return succ, found
 
 
 def _argsorted(key: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -359,3 +400,39 @@ def region_of_loops(xy: np.ndarray, offsets: np.ndarray, fill: bool = False) -> 
         return region, False
     filled = nonzero_fill(xy, offsets)
     return kregions.even_odd_region(filled), True
+
+
+def section_rings(
+    xy: np.ndarray, offsets: np.ndarray, fill: bool = False
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, bool]:
+    """The loops as the rings of a valid region (:func:`region_of_loops`), each closed by
+    its first point, outer ones counter-clockwise and holes clockwise.
+
+    One loop that winds once around the centre of its box, every edge turning the same way
+    about it, is simple (:func:`~formgraph.kernels.curves.regions._star_shaped`: a section
+    of a convex part, the usual case) and is its own region: it is taken as it is, turned
+    counter-clockwise, without GEOS.
+
+    Returns
+    -------
+    coords : (N, 2) float
+    offsets : (r + 1,) int64
+    step : (N - 1,) float
+        The length of each step (at a ring's end, the jump to the next ring's start).
+    filled : bool
+        See :func:`region_of_loops`.
+    """
+    if len(offsets) == 2 and not fill and len(xy) >= 3:
+        ring = np.concatenate([xy, xy[:1]])
+        x, y = ring[:, 0], ring[:, 1]
+        box = np.array([x.min(), y.min(), x.max(), y.max()])
+        if kregions._star_shaped(ring, box):
+            twice = np.dot(x[:-1] - x[0], y[1:] - y[0]) - np.dot(x[1:] - x[0], y[:-1] - y[0])
+            if twice < 0:
+                ring = ring[::-1].copy()
+            d = np.diff(ring, axis=0)
+            step = np.sqrt(np.einsum("ij,ij->i", d, d))
+            return ring, np.array([0, len(ring)], dtype=np.int64), step, False
+    region, filled = region_of_loops(xy, offsets, fill)
+    coords, off, _, step = kregions.rings_of(region, steps=True)
+    return coords, off, step, filled

@@ -433,21 +433,27 @@ def _bezier_pieces(p: int, U: np.ndarray, pw: np.ndarray) -> tuple[np.ndarray, n
 
 
 def decompose_bezier(
-    control_points: np.ndarray, degree: int, knots: np.ndarray, weights: np.ndarray | None
+    control_points: np.ndarray,
+    degree: int,
+    knots: np.ndarray,
+    weights: np.ndarray | None,
+    validate: bool = True,
 ) -> tuple[np.ndarray, np.ndarray | None]:
     """Split the curve into its Bezier pieces, one per non-empty knot span (A5.6).
 
     Bezier point k of the piece on ``[a, b]`` is the blossom of that piece at
     ``(a, .., a, b, .., b)`` (p - k times a, k times b): the result of inserting every
     knot up to multiplicity p, computed for all pieces at once. Works for unclamped
-    curves too (only the domain's pieces).
+    curves too (only the domain's pieces). ``validate=False`` skips the check of the
+    arrays, for callers that hand over a curve checked when it was made (a NurbsCurve's).
 
     Returns
     -------
     segments : (k, p + 1, 3) float
     segment_weights : (k, p + 1) float, or None for a non-rational curve
     """
-    validate_curve(control_points, degree, knots, weights)
+    if validate:
+        validate_curve(control_points, degree, knots, weights)
     U = np.asarray(knots, dtype=np.float64)
     seg, _ = _bezier_pieces(degree, U, homogeneous(control_points, weights))
     cp, w = project(seg, weights is not None)
