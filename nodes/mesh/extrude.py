@@ -130,7 +130,8 @@ def extrude(
     ctx.guard((slices + 1) * n, "vertices")
     ctx.guard(2 * slices * n + 2 * n, "faces")
     bottom = -height / 2 if center else 0.0
-    return Mesh(*ke.extrude(xy, offsets, hole, height, twist, (sx, sy), slices, bottom))
+    # (Mesh.trusted: the kernel's faces index its vertices by construction)
+    return Mesh.trusted(*ke.extrude(xy, offsets, hole, height, twist, (sx, sy), slices, bottom))
 
 
 @node("mesh.revolve", version=1)
@@ -193,4 +194,4 @@ def revolve(
     n = len(xy)
     ctx.guard((segments + 1) * n, "vertices")
     ctx.guard(segments * n + 2 * n, "faces")
-    return Mesh(*ke.revolve(xy, offsets, hole, angle, segments))
+    return Mesh.trusted(*ke.revolve(xy, offsets, hole, angle, segments))

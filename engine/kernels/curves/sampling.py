@@ -19,7 +19,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ..nurbs import decompose_bezier
+from ..nurbs import decompose_bezier, decompose_bezier_batch, validate_curve
 
 __all__ = [
     "bezier_pieces",
@@ -72,9 +72,11 @@ def bezier_pieces(
     Row j of piece k holds the t**j coefficients of (w x, w y, w) on t in [0, 1].
     ``validate=False`` for a curve checked when it was made.
     """
-    seg, sw = decompose_bezier(control_points, degree, knots, weights, validate)
-    w = np.ones(seg.shape[:2]) if sw is None else sw
-    hom = np.concatenate([seg[:, :, :2] * w[:, :, None], w[:, :, None]], axis=2)
+    seg, _ = decompose_bezier(control_points, degree, knots, weights, validate, projected=False)
+    if weights is None:  # (w x, w y, w) with w = 1
+        hom = np.concatenate([seg[:, :, :2], np.ones(seg.shape[:2] + (1,))], axis=2)
+    else:
+        hom = seg[:, :, [0, 1, 3]]
     return np.einsum("ij,kic->kjc", _power_matrix(degree), hom)
 
 
@@ -312,12 +314,12 @@ def sample_closed_batch(
     degrees = {int(c[1]) for c in curves}
     if len(degrees) != 1 or min(degrees) < 2:
         raise ValueError(f"a batch is of one degree >= 2, got degrees {sorted(degrees)}")
-    coef = [
-        bezier_pieces(np.asarray(cp, dtype=np.float64), p, kn, w, validate)
-        for cp, p, kn, w in curves
-    ]
-    k = np.array([c.shape[0] for c in coef])
-    coef_all = np.concatenate(coef)
+    if validate:
+        for cp, p, kn, w in curves:
+            validate_curve(np.asarray(cp, dtype=np.float64), p, kn, w)
+    # every curve's Bezier pieces in one pass of the blossoms, then (w x, w y, w) in power form
+    seg, k = decompose_bezier_batch(curves)
+    coef_all = np.einsum("ij,kic->kjc", _power_matrix(int(curves[0][1])), seg[:, :, [0, 1, 3]])
     first_piece = np.concatenate([[0], np.cumsum(k)[:-1]])
     base = first_piece + np.arange(len(k))  # the gap of 1 before each next curve
     # the curvature bound per piece, then equal steps

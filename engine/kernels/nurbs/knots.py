@@ -28,6 +28,7 @@ from .curve import homogeneous, project
 __all__ = [
     "clamp",
     "decompose_bezier",
+    "decompose_bezier_batch",
     "decompose_bezier_surface",
     "elevate_degree",
     "insert_knot",
@@ -438,6 +439,7 @@ def decompose_bezier(
     knots: np.ndarray,
     weights: np.ndarray | None,
     validate: bool = True,
+    projected: bool = True,
 ) -> tuple[np.ndarray, np.ndarray | None]:
     """Split the curve into its Bezier pieces, one per non-empty knot span (A5.6).
 
@@ -445,7 +447,9 @@ def decompose_bezier(
     ``(a, .., a, b, .., b)`` (p - k times a, k times b): the result of inserting every
     knot up to multiplicity p, computed for all pieces at once. Works for unclamped
     curves too (only the domain's pieces). ``validate=False`` skips the check of the
-    arrays, for callers that hand over a curve checked when it was made (a NurbsCurve's).
+    arrays, for callers that hand over a curve checked when it was made (a NurbsCurve's);
+    ``projected=False`` gives the pieces in homogeneous coordinates ``(w x, w y, w z, w)``
+    (a rational curve's; a non-rational one's are its points) and None.
 
     Returns
     -------
@@ -456,8 +460,64 @@ def decompose_bezier(
         validate_curve(control_points, degree, knots, weights)
     U = np.asarray(knots, dtype=np.float64)
     seg, _ = _bezier_pieces(degree, U, homogeneous(control_points, weights))
+    if not projected:
+        return seg, None
     cp, w = project(seg, weights is not None)
     return cp, w
+
+
+def decompose_bezier_batch(curves: Sequence[Curve]) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`decompose_bezier` of many curves of one degree at once, in homogeneous
+    coordinates ``(w x, w y, w z, w)`` (w = 1 for a non-rational curve).
+
+    The blossoms of a span use only the knots and control points around it, so the curves'
+    knot vectors are laid end to end as they are (not shifted: each piece comes out bit for
+    bit as it would alone) and each curve's control points padded with ``p + 1`` rows, so
+    that control point j of every curve sits at the index its knots do; one pass of the
+    blossoms then makes every piece of every curve. The curves are not checked (callers
+    hand over curves checked when they were made).
+
+    Returns
+    -------
+    pieces : (k, p + 1, 4) float
+        The pieces of every curve, curve after curve.
+    counts : (c,) int64
+        How many pieces each curve has.
+    """
+    if not curves:
+        return np.zeros((0, 1, 4)), np.zeros(0, np.int64)
+    p = int(curves[0][1])
+    pws, knots, spans = [], [], []
+    at = 0
+    for cp, degree, kn, w in curves:  # one step per curve: its arrays are laid end to end
+        if int(degree) != p:
+            raise ValueError(f"a batch is of one degree, got {degree} and {p}")
+        cp = np.asarray(cp, dtype=np.float64)
+        n = len(cp)
+        hom = homogeneous(cp, np.ones(n) if w is None else w)
+        pws += [hom, np.zeros((p + 1, 4))]
+        U = np.asarray(kn, dtype=np.float64)
+        knots.append(U)
+        local = np.arange(p, n)
+        spans.append(local[U[local + 1] > U[local]] + at)
+        at += n + p + 1
+    U = np.concatenate(knots)
+    pw = np.concatenate(pws)
+    mu = np.concatenate(spans)
+    a, b = U[mu], U[mu + 1]
+    kk = np.arange(p + 1)
+    # argument j of Bezier point k is b when j < k, else a
+    args = np.where(
+        np.arange(p)[None, None, :] < kk[None, :, None], b[:, None, None], a[:, None, None]
+    )
+    rows = np.repeat(mu, p + 1)
+    alpha = blossom_basis(p, U, rows, args.reshape(-1, p))
+    idx = rows[:, None] - p + kk
+    seg = np.einsum("ir,ird->id", alpha, pw[idx]).reshape(len(mu), p + 1, 4)
+    counts = np.array([len(x) for x in spans], dtype=np.int64)
+    plain = np.repeat([c[3] is None for c in curves], counts)
+    seg[plain, :, 3] = 1.0  # a non-rational curve's weights stay exactly 1 (not a sum)
+    return seg, counts
 
 
 def decompose_bezier_surface(
