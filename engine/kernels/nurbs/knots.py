@@ -420,6 +420,11 @@ def _bezier_pieces(p: int, U: np.ndarray, pw: np.ndarray) -> tuple[np.ndarray, n
     first, last = domain_spans(p, U)
     spans = np.arange(first, last + 1)
     spans = spans[U[spans + 1] > U[spans]]
+    return _pieces_at(p, U, pw, spans), spans
+
+
+def _pieces_at(p: int, U: np.ndarray, pw: np.ndarray, spans: np.ndarray) -> np.ndarray:
+    """The Bezier control points (S, p + 1, d) of the pieces on knot spans ``spans``."""
     a, b = U[spans], U[spans + 1]
     kk = np.arange(p + 1)
     # argument j of Bezier point k is b when j < k, else a
@@ -429,8 +434,7 @@ def _bezier_pieces(p: int, U: np.ndarray, pw: np.ndarray) -> tuple[np.ndarray, n
     mu = np.repeat(spans, p + 1)
     alpha = blossom_basis(p, U, mu, args.reshape(-1, p))
     idx = mu[:, None] - p + kk
-    seg = np.einsum("ir,ird->id", alpha, pw[idx]).reshape(len(spans), p + 1, -1)
-    return seg, spans
+    return np.einsum("ir,ird->id", alpha, pw[idx]).reshape(len(spans), p + 1, -1)
 
 
 def decompose_bezier(
@@ -501,19 +505,7 @@ def decompose_bezier_batch(curves: Sequence[Curve]) -> tuple[np.ndarray, np.ndar
         local = np.arange(p, n)
         spans.append(local[U[local + 1] > U[local]] + at)
         at += n + p + 1
-    U = np.concatenate(knots)
-    pw = np.concatenate(pws)
-    mu = np.concatenate(spans)
-    a, b = U[mu], U[mu + 1]
-    kk = np.arange(p + 1)
-    # argument j of Bezier point k is b when j < k, else a
-    args = np.where(
-        np.arange(p)[None, None, :] < kk[None, :, None], b[:, None, None], a[:, None, None]
-    )
-    rows = np.repeat(mu, p + 1)
-    alpha = blossom_basis(p, U, rows, args.reshape(-1, p))
-    idx = rows[:, None] - p + kk
-    seg = np.einsum("ir,ird->id", alpha, pw[idx]).reshape(len(mu), p + 1, 4)
+    seg = _pieces_at(p, np.concatenate(knots), np.concatenate(pws), np.concatenate(spans))
     counts = np.array([len(x) for x in spans], dtype=np.int64)
     plain = np.repeat([c[3] is None for c in curves], counts)
     seg[plain, :, 3] = 1.0  # a non-rational curve's weights stay exactly 1 (not a sum)
