@@ -84,9 +84,9 @@ def test_3mf_units_scale_on_reading(tmp_path):
     g, out = _run(
         tmp_path, TWO + "  x: {type: export.3mf, meshes: ['@box'], path: p.3mf, units: inch}\n", "x"
     )
-    from formgraph.kernels.io.threemf import read_3mf
+    from formgraph.kernels.io.threemf_read import read_3mf
 
-    ((_, v, _, _),) = read_3mf(Path(out).read_bytes())
+    v = read_3mf(Path(out).read_bytes()).vertices
     np.testing.assert_allclose(v, g.evaluate("box").vertices * 25.4)
 
 

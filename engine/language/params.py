@@ -164,7 +164,7 @@ def file_value(name: str, declared: Any, text: str) -> Any:
         raise GraphError(f"--set {name}: {exc}") from None
     try:
         if base is Mesh and not many:
-            v, fi, fo, attributes = readers.mesh_data(text, data)
+            v, fi, fo, attributes = readers.mesh_data(text, data, DEFAULT_BUDGET)
             return Mesh(v, fi, fo, point_data=attributes or None)
         if base is Points and not many:
             ext = readers.extension(text, readers.POINT_FORMATS)

@@ -75,7 +75,7 @@ def mesh(path: InputPath, weld: bool = False, *, ctx: Context) -> Mesh:
     ``part: {type: read.mesh, path: scan.stl, weld: true}``
     """
     _, data = ctx.read(path)
-    v, fi, fo, attributes = parsed(path, "a mesh", readers.mesh_data, path, data)
+    v, fi, fo, attributes = parsed(path, "a mesh", readers.mesh_data, path, data, ctx.budget)
     ctx.guard(len(fo) - 1, "faces")
     if weld:
         if attributes:
