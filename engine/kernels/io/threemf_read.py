@@ -669,12 +669,12 @@ def _build(parts: dict[str, _Part], root: str, max_elements: int) -> Read3MF:
             size[key] = (*(sum(size[c][k] for c in o.children) for k in range(2)),
                          1 + sum(size[c][2] for c in o.children))  # fmt: skip
     totals = [sum(size[k][j] for k in keys) for j in range(3)]
-    for count, what in zip(totals, ("vertices", "triangles", "object placements"), strict=True):
-        if count > max_elements:
-            raise ValueError(
-                f"the build places {count:,} {what} ({len(keys):,} items, components inside "
-                f"components), over the budget of {max_elements:,}: refused before expanding"
-            )
+    if max(totals) > max_elements:
+        raise ValueError(
+            f"the build places {totals[1]:,} triangles and {totals[0]:,} vertices in "
+            f"{totals[2]:,} object placements (from {len(keys):,} build items through their "
+            f"components), over the budget of {max_elements:,}: refused before expanding"
+        )
     nv, nt = totals[0], totals[1]
     # each placement of an object: its transform and where its vertices and triangles go
     starts_v = np.concatenate([[0], np.cumsum([size[k][0] for k in keys])[:-1]]).astype(np.int64)

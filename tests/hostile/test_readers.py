@@ -1,0 +1,350 @@
+"""Hostile files for the readers (#33): a few kilobytes that hung a parser, decompressed
+giants, fan-outs of instances, lying headers. Each parse runs in a forked child under a
+time limit and a memory limit, so a regression fails the test instead of hanging (or
+swapping) the suite; on the fixed code each is well under a second or two."""
+
+from __future__ import annotations
+
+import io
+import multiprocessing
+import resource
+import struct
+import zipfile
+
+import numpy as np
+import pytest
+
+from formgraph.kernels.io.threemf import write_3mf
+from formgraph.kernels.io.threemf_read import read_3mf
+
+CORE = "http://schemas.microsoft.com/3dmanufacturing/core/2015/02"
+PROD = "http://schemas.microsoft.com/3dmanufacturing/production/2015/06"
+
+
+def bounded(fn, *args, seconds: float = 20, memory: int = 2 << 30, **kwargs):
+    """``fn(*args, **kwargs)`` in a forked child with ``seconds`` to finish and ``memory``
+    bytes more address space than the parent has: ``('ok', result)`` or ``('error', type
+    name, message)``. A child still running at the limit is killed and the test fails."""
+    ctx = multiprocessing.get_context("fork")
+    receive, send = ctx.Pipe(duplex=False)
+
+    def child() -> None:
+        with open("/proc/self/status") as fh:
+            size = next(int(x.split()[1]) * 1024 for x in fh if x.startswith("VmSize"))
+        resource.setrlimit(resource.RLIMIT_AS, (size + memory, size + memory))
+        try:
+            out = ("ok", fn(*args, **kwargs))
+        except BaseException as exc:  # noqa: BLE001  (what it raised is the answer)
+            out = ("error", type(exc).__name__, str(exc))
+        send.send(out)
+
+    proc = ctx.Process(target=child, daemon=True)
+    proc.start()
+    try:
+        if not receive.poll(seconds):
+            pytest.fail(f"{getattr(fn, '__name__', fn)} still running after {seconds} s")
+        return receive.recv()
+    finally:
+        proc.kill()
+        proc.join()
+
+
+def refused(fn, *args, match: str, **kwargs) -> str:
+    """Assert ``fn`` raised a ValueError whose message matches ``match`` (in bounds)."""
+    got = bounded(fn, *args, **kwargs)
+    assert got[0] == "error" and got[1] == "ValueError", got[:3]
+    import re
+
+    assert re.search(match, got[2]), got[2]
+    return got[2]
+
+
+def package(model: bytes | str, extra: dict | None = None) -> bytes:
+    """A 3MF zip holding ``model`` as its root part (and ``extra`` parts)."""
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w", zipfile.ZIP_DEFLATED) as z:
+        z.writestr("3D/3dmodel.model", model)
+        for name, data in (extra or {}).items():
+            z.writestr(name, data)
+    return buf.getvalue()
+
+
+def model(resources: str, build: str, head: str = "") -> str:
+    return (
+        f'<?xml version="1.0" encoding="UTF-8"?>\n<model unit="millimeter" xmlns="{CORE}" '
+        f'xmlns:p="{PROD}"{head}><resources>{resources}</resources><build>{build}</build>'
+        "</model>"
+    )
+
+
+TRIANGLE = (
+    '<object id="1" type="model"><mesh><vertices><vertex x="0" y="0" z="0"/>'
+    '<vertex x="1" y="0" z="0"/><vertex x="0" y="1" z="0"/></vertices>'
+    '<triangles><triangle v1="0" v2="1" v3="2"/></triangles></mesh></object>'
+)
+
+
+# ------------------------------------------------------------------------- 3MF: item 1
+
+
+@pytest.mark.parametrize("tag", ['<object id="1">', "<m:colorgroup>", "<vertices>"])
+def test_a_3mf_of_150000_unclosed_tags_is_refused_at_once(tag):
+    """4.8 KB of zip: the regular expressions took past 60 s; expat reads it once."""
+    data = package(f'<model xmlns="{CORE}" xmlns:m="x"><resources>' + tag * 150_000)
+    assert len(data) < 10_000
+    refused(read_3mf, data, match="not well-formed XML|where the 3MF core does not put", seconds=10)
+
+
+def test_a_namespaced_attribute_is_not_the_core_one():
+    """``p:x`` is the production namespace's x, not the vertex's: the old attribute pattern
+    took it for ``x`` and shifted the vertices."""
+    body = TRIANGLE.replace('<vertex x="1"', '<vertex p:x="7" x="1"').replace(
+        '<vertex x="0" y="1"', '<vertex x="0" p:y="9" y="1"'
+    )
+    got = read_3mf(package(model(body, '<item objectid="1"/>')))
+    np.testing.assert_array_equal(got.vertices, [[0, 0, 0], [1, 0, 0], [0, 1, 0]])
+    np.testing.assert_array_equal(got.triangles, [[0, 1, 2]])
+
+
+def test_elements_of_other_namespaces_are_passed_over_with_their_content():
+    body = TRIANGLE.replace(
+        "<vertices>", '<vertices><q:vertex xmlns:q="urn:other" x="5" y="5" z="5"/>'
+    ).replace(
+        "</mesh>", '<b:beams xmlns:b="urn:beams"><vertex x="9" y="9" z="9"/></b:beams></mesh>'
+    )
+    got = read_3mf(package(model(body, '<item objectid="1"/>')))
+    assert len(got.vertices) == 3 and got.vertices.max() == 1
+
+
+def test_a_core_element_out_of_place_is_named():
+    body = TRIANGLE.replace("<vertices>", '<vertices><triangle v1="0" v2="1" v3="2"/>')
+    refused(
+        read_3mf, package(model(body, '<item objectid="1"/>')), match="<triangle> inside <vertices>"
+    )
+
+
+def test_a_required_extension_we_do_not_read_is_refused():
+    slice_ns = "http://schemas.microsoft.com/3dmanufacturing/slice/2015/07"
+    head = f' xmlns:s="{slice_ns}" requiredextensions="s p"'
+    refused(read_3mf, package(model(TRIANGLE, '<item objectid="1"/>', head)), match="slice/2015/07")
+
+
+def test_an_index_that_is_not_whole_is_refused():
+    body = TRIANGLE.replace('v3="2"', 'v3="1.5"')
+    refused(read_3mf, package(model(body, '<item objectid="1"/>')), match="'1.5' is not a whole")
+
+
+# ------------------------------------------------------------------------- 3MF: item 3
+
+
+def _fan_out(fan: int, levels: int) -> bytes:
+    """Object 1 a triangle; object k + 1 holds ``fan`` copies of object k, ``levels`` deep."""
+    objs = [TRIANGLE]
+    for k in range(1, levels + 1):
+        comps = "".join(
+            f'<component objectid="{k}" transform="1 0 0 0 1 0 0 0 1 {j} 0 0"/>' for j in range(fan)
+        )
+        objs.append(f'<object id="{k + 1}"><components>{comps}</components></object>')
+    return package(model("".join(objs), f'<item objectid="{levels + 1}"/>'))
+
+
+def test_ten_components_ten_levels_deep_are_counted_not_expanded():
+    data = _fan_out(10, 10)
+    assert len(data) < 2000
+    message = refused(read_3mf, data, match="over the budget", seconds=10)
+    assert "10,000,000,000 triangles" in message and "refused before expanding" in message
+
+
+def test_a_million_placements_are_one_copy_per_object():
+    """10 x 6 levels: a million placed triangles, in budget, made by one vectorized copy
+    (the old reader took 36 s and 619 MB for a million instances)."""
+    status, got = bounded(read_3mf, _fan_out(10, 6), seconds=20)
+    assert status == "ok"
+    assert got.triangles.shape == (1_000_000, 3) and got.vertices.shape == (3_000_000, 3)
+    # placement k's triangle is the first one moved by the sum of its digits along x
+    k = np.arange(1_000_000)
+    shift = sum((k // 10**d) % 10 for d in range(6))
+    first = got.vertices[got.triangles[:, 0]]
+    np.testing.assert_array_equal(first[:, 0], shift)
+
+
+def test_a_budget_bounds_placements_of_empty_objects_too():
+    """Objects of empty components make no triangle, yet each placement is work."""
+    objs = ['<object id="1"><components></components></object>']
+    for k in range(1, 9):
+        comps = f'<component objectid="{k}"/>' * 10
+        objs.append(f'<object id="{k + 1}"><components>{comps}</components></object>')
+    data = package(model("".join(objs), '<item objectid="9"/>'))
+    refused(read_3mf, data, match="object placements", seconds=10, max_elements=1_000_000)
+
+
+def test_a_cycle_of_components_is_refused():
+    objs = (
+        '<object id="1"><components><component objectid="2"/></components></object>'
+        '<object id="2"><components><component objectid="1"/></components></object>'
+    )
+    refused(read_3mf, package(model(objs, '<item objectid="1"/>')), match="a cycle")
+
+
+def test_200000_build_items_are_read_in_bulk():
+    """Items are collected and converted a block at a time (2M took 69 s and 1.56 GB)."""
+    items = '<item objectid="1" transform="1 0 0 0 1 0 0 0 1 0 0 2"/>' * 200_000
+    status, got = bounded(read_3mf, package(model(TRIANGLE, items)), seconds=20)
+    assert status == "ok" and got.items == 200_000 and len(got.triangles) == 200_000
+    assert np.all(got.vertices[:, 2] == 2)
+
+
+def test_a_build_over_the_budget_is_refused_before_it_is_placed():
+    refused(
+        read_3mf,
+        package(model(TRIANGLE, '<item objectid="1"/>' * 1000)),
+        match="places 1,000 triangles and 3,000 vertices in 1,000 object placements .* over "
+        "the budget of 999",
+        max_elements=999,
+    )
+
+
+# ------------------------------------------------------------------------- 3MF: item 4
+
+
+def _lying(model_bytes: bytes, claimed: int) -> bytes:
+    """A zip whose model member's headers claim ``claimed`` bytes uncompressed."""
+    data = bytearray(package(model_bytes))
+    for sig, at in ((b"PK\x03\x04", 22), (b"PK\x01\x02", 24)):  # local, central headers
+        k = data.find(sig)
+        struct.pack_into("<I", data, k + at, claimed)
+    return bytes(data)
+
+
+def test_a_model_of_spaces_stops_at_the_cap_as_it_unpacks():
+    """The 1.79 MB file of 1.85 GB of spaces ran 173 s at 5.3 GB: it is now counted as it
+    unpacks and refused at the cap (1 GiB by default; 4 MiB here)."""
+    data = package(b"<model" + b" " * (16 << 20) + b"/>")
+    refused(read_3mf, data, match="claim 16,777,224 bytes .* zip bomb", max_bytes=4 << 20)
+    message = refused(read_3mf, _lying(b"<model" + b" " * (16 << 20) + b"/>", 100), match=".")
+    assert "unpacks to more than" in message or "Bad CRC" in message or "cannot unpack" in message
+    refused(
+        read_3mf,
+        _lying(b"<model" + b" " * (16 << 20) + b"/>", 100),
+        match="unpacks to more than 4,194,304 bytes|cannot unpack",
+        max_bytes=4 << 20,
+    )
+
+
+def test_the_default_cap_is_the_input_cap():
+    from formgraph.core.safety import MAX_INPUT_BYTES
+    from formgraph.kernels.io import threemf_read
+
+    assert threemf_read.MAX_MODEL_BYTES == MAX_INPUT_BYTES
+
+
+def test_a_3mf_dtd_and_a_billion_laughs_are_refused():
+    laughs = (
+        '<?xml version="1.0"?><!DOCTYPE model [<!ENTITY a "aaaaaaaaaa">'
+        + "".join(
+            f'<!ENTITY {n} "{("&" + p + ";") * 10}">'
+            for p, n in zip("abcdefg", "bcdefgh", strict=True)
+        )
+        + f']><model xmlns="{CORE}"><metadata name="x">&h;</metadata></model>'
+    )
+    refused(read_3mf, package(laughs), match="declares a DTD or an entity")
+
+
+# ------------------------------------------------------------------ 3MF: what it reads
+
+
+def test_production_parts_are_read_through_p_path():
+    """Bambu Studio's layout: the root model's object is components naming objects in
+    other model parts; their own units apply."""
+    part = (
+        f'<?xml version="1.0"?><model unit="centimeter" xmlns="{CORE}"><resources>'
+        f"{TRIANGLE}</resources><build/></model>"
+    )
+    comp = (
+        '<object id="5"><components><component p:path="/3D/Objects/part.model" '
+        'objectid="1" transform="1 0 0 0 1 0 0 0 1 0 0 1"/></components></object>'
+    )
+    data = package(model(comp, '<item objectid="5"/>'), {"3D/Objects/part.model": part})
+    got = read_3mf(data)
+    # the part's vertices in cm (x10), the root's translation in mm
+    np.testing.assert_allclose(got.vertices, [[0, 0, 1], [10, 0, 1], [0, 10, 1]])
+
+
+def test_a_p_path_inside_a_non_root_part_is_refused():
+    part = (
+        f'<model xmlns="{CORE}" xmlns:p="{PROD}"><resources>{TRIANGLE}<object id="2">'
+        '<components><component p:path="/3D/x.model" objectid="1"/></components></object>'
+        "</resources></model>"
+    )
+    comp = (
+        '<object id="5"><components><component p:path="/3D/o.model" objectid="2"/>'
+        "</components></object>"
+    )
+    data = package(model(comp, '<item objectid="5"/>'), {"3D/o.model": part})
+    refused(read_3mf, data, match="Production extension forbids")
+
+
+def test_vertex_colours_round_trip_through_our_writer():
+    rng = np.random.default_rng(3)
+    v = rng.random((30, 3))
+    t = rng.permutation(30).reshape(10, 3)  # every vertex on a triangle
+    c = np.round(rng.random((30, 4)) * 255) / 255
+    got = read_3mf(write_3mf([(v, t), (v + 1, t)], vertex_colors=[c, c]))
+    np.testing.assert_array_equal(got.vertices, np.concatenate([v, v + 1]))
+    np.testing.assert_allclose(got.colors, np.concatenate([c, c]))
+
+
+def test_base_material_colours_are_read():
+    got = read_3mf(write_3mf([(np.eye(3), [[0, 1, 2]])], colors=[(1, 0, 0, 1)]))
+    np.testing.assert_allclose(got.colors, [[1, 0, 0, 1]] * 3)
+
+
+# ------------------------------------------------------- the same attacks through read.mesh
+
+
+def _read_mesh(folder, name: str, data: bytes, budget: int | None = None):
+    import formgraph as fg
+
+    (folder / name).write_bytes(data)
+    text = f"formgraph: 1\nnodes:\n  m: {{type: read.mesh, path: {name}}}\n"
+    (folder / "g.yaml").write_text(text)
+    g = fg.load(folder / "g.yaml", **({"budget": budget} if budget else {}))
+    m = g.evaluate("m")
+    return np.asarray(m.vertices), np.asarray(m.face_indices)
+
+
+def test_read_mesh_refuses_unclosed_tags_at_once(tmp_path):
+    data = package(f'<model xmlns="{CORE}"><resources>' + '<object id="1">' * 150_000)
+    got = bounded(_read_mesh, tmp_path, "u.3mf", data, seconds=10)
+    assert got[0] == "error" and got[1] == "NodeError", got
+    assert (
+        "'u.3mf': cannot read it as a mesh" in got[2]
+        and "where the 3MF core does not put one" in got[2]
+    )
+
+
+def test_read_mesh_does_not_shift_vertices_by_a_namespaced_attribute(tmp_path):
+    body = TRIANGLE.replace('<vertex x="1"', '<vertex p:x="7" x="1"')
+    status, (v, f) = bounded(
+        _read_mesh, tmp_path, "p.3mf", package(model(body, '<item objectid="1"/>'))
+    )
+    assert status == "ok"
+    np.testing.assert_array_equal(v, [[0, 0, 0], [1, 0, 0], [0, 1, 0]])
+
+
+def test_read_mesh_counts_a_fan_out_before_expanding(tmp_path):
+    got = bounded(_read_mesh, tmp_path, "f.3mf", _fan_out(10, 10), seconds=10)
+    assert got[0] == "error" and "10,000,000,000 triangles" in got[2], got
+
+
+def test_read_mesh_does_not_take_a_foreign_vertex_for_a_core_one(tmp_path):
+    """The old element pattern took any prefix's ``vertex``: the extra one shifted every
+    index after it without a word."""
+    body = TRIANGLE.replace(
+        "<vertices>", '<vertices><q:vertex xmlns:q="urn:other" x="5" y="5" z="5"/>'
+    )
+    status, (v, f) = bounded(
+        _read_mesh, tmp_path, "q.3mf", package(model(body, '<item objectid="1"/>'))
+    )
+    assert status == "ok"
+    np.testing.assert_array_equal(v, [[0, 0, 0], [1, 0, 0], [0, 1, 0]])
