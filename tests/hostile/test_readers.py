@@ -348,3 +348,71 @@ def test_read_mesh_does_not_take_a_foreign_vertex_for_a_core_one(tmp_path):
     )
     assert status == "ok"
     np.testing.assert_array_equal(v, [[0, 0, 0], [1, 0, 0], [0, 1, 0]])
+
+
+# ------------------------------------------------------------------- SVG: items 2, 9, 11, 13
+
+SVG = '<svg xmlns="http://www.w3.org/2000/svg"'
+
+
+def _read_curves(folder, name: str, data: bytes):
+    import formgraph as fg
+
+    (folder / name).write_bytes(data)
+    text = f"formgraph: 1\nnodes:\n  c: {{type: read.curves, path: {name}}}\n"
+    (folder / "g.yaml").write_text(text)
+    return [np.asarray(c.control_points) for c in fg.load(folder / "g.yaml").evaluate("c")]
+
+
+def curves_refused(folder, data: bytes, match: str, name: str = "a.svg") -> str:
+    got = bounded(_read_curves, folder, name, data, seconds=10)
+    assert got[0] == "error" and got[1] == "NodeError", got[:2]
+    import re
+
+    assert re.search(match, got[2]), got[2]
+    assert not re.search(r"\b[A-Z]\w*(Error|Exception)\b", got[2].replace("NodeError", "")), got[2]
+    return got[2]
+
+
+@pytest.mark.parametrize(
+    "data",
+    [SVG.encode() + b">" + b"<" * 200_000, b"<svg" * 16_000],
+    ids=["lt-without-gt", "root-without-gt"],
+)
+def test_an_svg_of_unclosed_tags_is_refused_at_once(tmp_path, data):
+    """58 KiB of '<' took 20 s in the depth scan (a regular expression per '<')."""
+    curves_refused(tmp_path, data, "not well formed")
+
+
+@pytest.mark.parametrize("width", ["nanmm", "infmm", "0mm", "1e400mm", "-5mm"])
+def test_an_svg_whose_width_draws_nothing_is_refused(tmp_path, width):
+    data = f'{SVG} width="{width}" height="10mm"><path d="M0 0 L5 5"/></svg>'.encode()
+    curves_refused(tmp_path, data, "width .*(finite|positive)")
+
+
+@pytest.mark.parametrize(
+    "transform, match",
+    [
+        ("skewX(90)", "2.16e\\+16 mm after its transforms"),
+        ("scale(1e308)", "not a finite number after its transforms"),
+        ("scale(0)", "flattens it"),
+        ("rotate(1e400)", "the transform attribute holds '1e400'"),
+    ],
+)
+def test_an_svg_transform_that_overflows_or_flattens_is_refused(tmp_path, transform, match):
+    data = f'{SVG}><path id="p" d="M0 1 L5 5" transform="{transform}"/></svg>'.encode()
+    curves_refused(tmp_path, data, match)
+
+
+@pytest.mark.parametrize(
+    "d, match",
+    [
+        ("M 0 0 Q", "the path data 'M 0 0 Q' is not valid SVG syntax"),
+        ("M0 0 A 1e-320 1e-320 0 0 0 1 1", "holds a number too small or too large"),
+    ],
+)
+def test_an_svg_path_svgelements_fails_on_is_named_in_words(tmp_path, d, match):
+    """Once "(ValueError: )" and "(ZeroDivisionError: float division by zero)"."""
+    data = f'{SVG}>\n<g>\n<path d="{d}"/></g></svg>'.encode()
+    message = curves_refused(tmp_path, data, match)
+    assert "line 3" in message
