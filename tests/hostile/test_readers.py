@@ -416,3 +416,81 @@ def test_an_svg_path_svgelements_fails_on_is_named_in_words(tmp_path, d, match):
     data = f'{SVG}>\n<g>\n<path d="{d}"/></g></svg>'.encode()
     message = curves_refused(tmp_path, data, match)
     assert "line 3" in message
+
+
+# ------------------------------------------------------------------------ DXF: items 5, 9
+
+
+def _fan_dxf(levels: int, fan: int = 10) -> bytes:
+    ezdxf = pytest.importorskip("ezdxf")
+    doc = ezdxf.new()
+    doc.blocks.new("L0").add_line((0, 0), (1, 0))
+    for k in range(1, levels + 1):
+        block = doc.blocks.new(f"L{k}")
+        for j in range(fan):
+            block.add_blockref(f"L{k - 1}", (j, 0))
+    doc.modelspace().add_blockref(f"L{levels}", (0, 0))
+    out = io.StringIO()
+    doc.write(out)
+    return out.getvalue().encode()
+
+
+def test_an_11_level_block_fan_out_is_counted_before_expanding(tmp_path):
+    """Refused only after 59 s before, saying "a MINSERT of 1 copies"."""
+    message = curves_refused(
+        tmp_path,
+        _fan_dxf(11),
+        r"the drawing's blocks expand to 211,111,111,111 entities, over the budget of "
+        r"1,000,000: INSERT \w+ of block 'L11' alone makes 211,111,111,110 \(blocks inside "
+        r"blocks\); refused before expanding",
+        name="fan.dxf",
+    )
+    assert "MINSERT" not in message
+
+
+def test_a_block_inserting_itself_is_refused():
+    ezdxf = pytest.importorskip("ezdxf")
+    from formgraph.kernels.io.dxf_read import _counted
+
+    doc = ezdxf.new()
+    a, b = doc.blocks.new("A"), doc.blocks.new("B")
+    a.add_blockref("B", (0, 0))
+    b.add_blockref("A", (0, 0))
+    doc.modelspace().add_blockref("A", (0, 0))
+    with pytest.raises(ValueError, match="block '[AB]' inserts itself"):
+        _counted(doc, 1000)
+
+
+def _degenerate_dxf() -> bytes:
+    ezdxf = pytest.importorskip("ezdxf")
+    doc = ezdxf.new()
+    msp = doc.modelspace()
+    msp.add_arc((0, 0), 0, 0, 90, dxfattribs={"handle": "A1"})
+    msp.add_arc((0, 0), -5, 0, 90, dxfattribs={"handle": "A2"})
+    msp.add_circle((0, 0), 0, dxfattribs={"handle": "C1"})
+    msp.add_ellipse((0, 0), major_axis=(7, 0, 0), ratio=0.5, dxfattribs={"handle": "E1"})
+    msp.add_line((0, 0), (1, 1))
+    out = io.StringIO()
+    doc.write(out)
+    text = out.getvalue()
+    at = text.index("AcDbEllipse")  # a zero major axis, which ezdxf will not write itself
+    text = text[:at] + text[at : at + 200].replace(" 11\n7.0", " 11\n0.0", 1) + text[at + 200 :]
+    return text.encode()
+
+
+def test_degenerate_dxf_entities_are_warned_about_with_their_handles(tmp_path):
+    import formgraph as fg
+
+    (tmp_path / "d.dxf").write_bytes(_degenerate_dxf())
+    (tmp_path / "g.yaml").write_text(
+        "formgraph: 1\nnodes:\n  c: {type: read.curves, path: d.dxf}\n"
+    )
+    g = fg.load(tmp_path / "g.yaml")
+    with pytest.warns(fg.FormgraphWarning) as caught:
+        curves = g.evaluate("c")
+    assert len(curves) == 1  # the line
+    text = " ".join(str(w.message) for w in caught)
+    assert "ARC that draws nothing (a radius of 0; handle A1)" in text
+    assert "ARC that draws nothing (a radius of -5; handle A2)" in text
+    assert "CIRCLE that draws nothing (a radius of 0; handle C1)" in text
+    assert "ELLIPSE(#E1) with invalid major axis" in text
