@@ -31,6 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..geometry import MAX_COORDINATE
 from .chains import Chain, CurveArrays, arc_pieces, bezier_piece, line_piece
 
 __all__ = ["MAX_DEPTH", "MAX_ELEMENTS", "MAX_NUMBERS", "SvgCurve", "read_svg"]
@@ -219,9 +220,6 @@ def read_svg(data: bytes, max_elements: int = MAX_ELEMENTS) -> tuple[list[SvgCur
             _in_range(cp, name)
             out.append(SvgCurve((cp, p, k, w), layer))
     return out, passed
-
-
-MAX_COORDINATE = 1e15  # mm: past it a double no longer holds a tenth of a millimetre
 
 
 def _in_range(cp: np.ndarray, name: str) -> None:
