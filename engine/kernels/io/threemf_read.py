@@ -289,7 +289,10 @@ class _Part:
         """The (part, object id) pairs this part's components and items name."""
         out = [c for o in self.objects.values() if isinstance(o, _Components) for c in o.children]
         for ids, _, paths in self.items:
-            out += [(p or self.name, int(i)) for i, p in zip(ids, paths, strict=True)]
+            if any(paths):
+                out += [(p or self.name, int(i)) for i, p in zip(ids, paths, strict=True)]
+            else:  # the common case: every item in this part, a few distinct objects
+                out += [(self.name, int(i)) for i in np.unique(ids)]
         return out
 
     # -- elements -----------------------------------------------------------------------------
@@ -521,31 +524,36 @@ class _Part:
         return f"{self.name!r}, object {oid}" if oid is not None else repr(self.name)
 
     def _flush_items(self) -> None:
+        """The collected items as arrays: object ids, (k, 4, 3) transforms, part paths."""
         rows = self.item_rows.copy()
         self.item_rows.clear()
         if not rows:
             return
-        dicts = [_attrs(r) for r in rows]
-        ids = np.array([_int_attr(d, "objectid", self.name, "an <item>") for d in dicts])
+        ids, extra = _values(rows, ("objectid",), ("transform", _P_PATH), self.name, "item")
+        ids = self._numbers(ids, len(rows), "an item's objectid", 1, whole=True).ravel()
+        if ids.size and ids.min() < 0:
+            raise ValueError(f"{self.name!r}: an item's objectid is negative")
         transforms = np.empty((len(rows), 4, 3))
-        given = [k for k, d in enumerate(dicts) if d.get("transform") is not None]
         transforms[:] = _IDENTITY
-        if given:
-            text = " ".join(dicts[k]["transform"] for k in given)
-            try:
-                m = parse_floats(np.frombuffer(text.encode(), np.uint8), 12 * len(given))
-            except ValueError:
-                for k in given:  # name the one that is wrong
-                    _transform(dicts[k]["transform"], self.name, self.unit)
-                raise
-            m = m.reshape(-1, 4, 3)
-            if not np.isfinite(m).all():
-                raise ValueError(f"{self.name!r}: an item's transform is not finite numbers")
-            m[:, 3] *= self.unit
-            transforms[given] = m
-        paths = [_part_name(d[_P_PATH]) if d.get(_P_PATH) else None for d in dicts]
-        if any(paths) and not self.is_root:
-            raise ValueError(f"{self.name!r}: a build item outside the root model part")
+        paths: list = [None] * len(rows)
+        if extra is not None:
+            given = [k for k in range(len(rows)) if extra[2 * k]]
+            if given:
+                text = " ".join(extra[2 * k] for k in given)
+                try:
+                    m = parse_floats(np.frombuffer(text.encode(), np.uint8), 12 * len(given))
+                except ValueError:
+                    for k in given:  # name the one that is wrong
+                        _transform(extra[2 * k], self.name, self.unit)
+                    raise
+                m = m.reshape(-1, 4, 3)
+                if not np.isfinite(m).all():
+                    raise ValueError(f"{self.name!r}: an item's transform is not finite numbers")
+                m[:, 3] *= self.unit
+                transforms[given] = m
+            paths = [_part_name(p) if p else None for p in extra[1::2]]
+            if any(paths) and not self.is_root:
+                raise ValueError(f"{self.name!r}: a build item outside the root model part")
         self.items.append((ids, transforms, paths))
 
 
@@ -611,9 +619,20 @@ def _values(rows: list, names: tuple, optional: tuple | None, part: str, tag: st
     keys = flat[0::2]
     if len(flat) == 2 * w * n and keys == list(names) * n:
         return flat[1::2], None
-    if optional and len(flat) == 2 * (w + len(optional)) * n and keys == list(names + optional) * n:
-        table = np.array(flat[1::2], dtype=object).reshape(n, -1)
-        return table[:, :w].ravel().tolist(), table[:, w:].ravel().tolist()
+    layout = rows[0][0::2] if rows else []
+    if len(flat) == len(layout) * 2 * n and keys == layout * n and set(names) <= set(layout):
+        # every row has the same attributes in the same order (what a writer makes: p:UUID,
+        # properties, ...): columns picked by position in one array operation
+        table = np.array(flat[1::2], dtype=object).reshape(n, len(layout))
+        values = table[:, [layout.index(k) for k in names]].ravel().tolist()
+        if not optional or not set(optional) & set(layout):
+            return values, None
+        cols = [layout.index(k) if k in layout else None for k in optional]
+        extra = np.full((n, len(optional)), "", dtype=object)
+        for j, c in enumerate(cols):
+            if c is not None:
+                extra[:, j] = table[:, c]
+        return values, extra.ravel().tolist()
     values: list[str] = []
     extra: list[str] = []
     for row in rows:
@@ -652,14 +671,22 @@ def _build(parts: dict[str, _Part], root: str, max_elements: int) -> Read3MF:
     top = parts[root]
     ids = np.concatenate([i for i, _, _ in top.items]) if top.items else np.zeros(0, np.int64)
     transforms = np.concatenate([m for _, m, _ in top.items]) if top.items else np.zeros((0, 4, 3))
-    paths = [p or root for _, _, ps in top.items for p in ps]
-    keys = list(zip(paths, ids.tolist(), strict=True))
-    for key in set(keys):
+    # the items' objects as codes into the few distinct (part, id) pairs: every step below
+    # is an array operation over the items, however many millions
+    if any(p for _, _, ps in top.items for p in ps):  # Production items naming other parts
+        names = [p or root for _, _, ps in top.items for p in ps]
+        _, part_code = np.unique(np.array(names, dtype=object), return_inverse=True)
+        pair = part_code.astype(np.int64) * (int(ids.max(initial=0)) + 1) + ids
+    else:
+        names, pair = None, ids
+    _, first, item_code = np.unique(pair, return_index=True, return_inverse=True)
+    keys = [(names[k] if names else root, int(ids[k])) for k in first]
+    for key in keys:
         if key not in objects:
             raise ValueError(f"a build item names object {key[1]} ({key[0]!r}), which is not there")
     order = _topological(objects, set(keys))
-    # what one placement of each object makes: vertices, triangles, meshes (Python ints: a
-    # fan-out multiplies past int64 long before it is refused)
+    # what one placement of each object makes: vertices, triangles, placements (Python
+    # ints: a fan-out multiplies past int64 long before it is refused)
     size: dict = {}
     for key in reversed(order):
         o = objects[key]
@@ -668,23 +695,24 @@ def _build(parts: dict[str, _Part], root: str, max_elements: int) -> Read3MF:
         else:  # every placement counts, an object of components too: each costs work
             size[key] = (*(sum(size[c][k] for c in o.children) for k in range(2)),
                          1 + sum(size[c][2] for c in o.children))  # fmt: skip
-    totals = [sum(size[k][j] for k in keys) for j in range(3)]
+    counts = np.bincount(item_code, minlength=len(keys))
+    totals = [sum(int(n) * size[k][j] for k, n in zip(keys, counts, strict=True)) for j in range(3)]
     if max(totals) > max_elements:
         raise ValueError(
             f"the build places {totals[1]:,} triangles and {totals[0]:,} vertices in "
-            f"{totals[2]:,} object placements (from {len(keys):,} build items through their "
-            f"components), over the budget of {max_elements:,}: refused before expanding"
+            f"{totals[2]:,} object placements (from {len(item_code):,} build items through "
+            f"their components), over the budget of {max_elements:,}: refused before expanding"
         )
     nv, nt = totals[0], totals[1]
     # each placement of an object: its transform and where its vertices and triangles go
-    starts_v = np.concatenate([[0], np.cumsum([size[k][0] for k in keys])[:-1]]).astype(np.int64)
-    starts_t = np.concatenate([[0], np.cumsum([size[k][1] for k in keys])[:-1]]).astype(np.int64)
+    per_v = np.array([size[k][0] for k in keys], np.int64)[item_code]
+    per_t = np.array([size[k][1] for k in keys], np.int64)[item_code]
+    starts_v, starts_t = np.cumsum(per_v) - per_v, np.cumsum(per_t) - per_t
+    grouped = np.argsort(item_code, kind="stable")
+    bounds = np.concatenate([[0], np.cumsum(counts)])
     placed: dict = {}
-    inverse = {}
-    for k, key in enumerate(keys):
-        inverse.setdefault(key, []).append(k)
-    for key, where in inverse.items():
-        w = np.array(where)
+    for u, key in enumerate(keys):
+        w = grouped[bounds[u] : bounds[u + 1]]
         placed[key] = [(transforms[w], starts_v[w], starts_t[w])]
     out_v = np.empty((nv, 3))
     out_t = np.empty((nt, 3), np.int64)
@@ -708,7 +736,7 @@ def _build(parts: dict[str, _Part], root: str, max_elements: int) -> Read3MF:
             if size[child][0] or size[child][1]:  # nothing to place in an empty one
                 placed.setdefault(child, []).append((full, sv + dv, st + dt))
             dv, dt = dv + size[child][0], dt + size[child][1]
-    return Read3MF(out_v, out_t, colors.result(), len(keys))
+    return Read3MF(out_v, out_t, colors.result(), len(item_code))
 
 
 def _topological(objects: dict, roots: set) -> list:
