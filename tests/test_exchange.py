@@ -4,6 +4,7 @@ reader (lib3mf, trimesh and pygltflib, OpenCASCADE, rhino3dm) and by our own rea
 from __future__ import annotations
 
 import io
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -394,3 +395,45 @@ def test_step_rational_curve_stays_a_circle_in_opencascade(tmp_path):
     for t in np.linspace(c.knots[0], c.knots[-1], 17):
         p = curve.Value(float(t))
         np.testing.assert_allclose([p.X(), p.Y(), p.Z()], c.evaluate([t])[0], atol=1e-12)
+
+
+def test_3mf_writes_a_base_material_only_for_a_mesh_without_vertex_colours(tmp_path):
+    """#33 item 19: the ``colors`` entry of a vertex-coloured mesh was written as a base
+    material nothing referenced."""
+    lib3mf = pytest.importorskip("lib3mf")
+    g, out = _run(
+        tmp_path,
+        COLOURED + "  box: {type: mesh.box, size: [1, 1, 1]}\n"
+        "  x: {type: export.3mf, meshes: ['@paint', '@box'], path: c.3mf,"
+        " colors: [red, '#0080ff']}\n",
+        "x",
+    )
+    with zipfile.ZipFile(out) as z:
+        text = z.read("3D/3dmodel.model").decode()
+    assert text.count("<base ") == 1 and 'displaycolor="#0080FFFF"' in text
+    model = lib3mf.get_wrapper().CreateModel()
+    reader = model.QueryReader("3mf")
+    reader.SetStrictModeActive(True)
+    reader.ReadFromFile(out)
+    assert reader.GetWarningCount() == 0
+    objects = model.GetMeshObjects()
+    props = []
+    while objects.MoveNext():
+        props.append(objects.GetCurrentMeshObject().GetObjectLevelProperty())
+    bases = model.GetBaseMaterialGroups()
+    assert bases.MoveNext()
+    base = bases.GetCurrentBaseMaterialGroup()
+    assert base.GetCount() == 1 and props[1][:2] == (
+        base.GetResourceID(),
+        base.GetAllPropertyIDs()[0],
+    )
+    colour = base.GetDisplayColor(base.GetAllPropertyIDs()[0])
+    assert (colour.Red, colour.Green, colour.Blue) == (0, 128, 255)
+    with zipfile.ZipFile(
+        _run(
+            tmp_path,
+            COLOURED + "  y: {type: export.3mf, meshes: ['@paint'], path: d.3mf, colors: [red]}\n",
+            "y",
+        )[1]
+    ) as z:
+        assert "basematerials" not in z.read("3D/3dmodel.model").decode()

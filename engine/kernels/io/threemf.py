@@ -93,13 +93,17 @@ def write_3mf(
         "<resources>\n"
     ]
     next_id = 1
-    if colors is not None:
+    # a base material only for a mesh its object points at: one with vertex colours uses
+    # its colour group instead (an unreferenced material is what strict consumers flag)
+    plain = [k for k in range(n) if vertex_colors[k] is None] if colors is not None else []
+    if plain:
         bases = "".join(
-            f'<base name={quoteattr(names[k])} displaycolor="{_hex(c)}"/>\n'
-            for k, c in enumerate(colors)
+            f'<base name={quoteattr(names[k])} displaycolor="{_hex(colors[k])}"/>\n'
+            for k in plain
         )
         parts.append(f'<basematerials id="1">\n{bases}</basematerials>\n')
         next_id = 2
+    base_index = {k: j for j, k in enumerate(plain)}
     chunks: list[bytes] = ["".join(parts).encode()]
     object_ids = []
     for k, (v, tris) in enumerate(meshes):
@@ -115,8 +119,8 @@ def write_3mf(
             chunks.append(b"</m:colorgroup>\n")
         if group is not None:
             pid = f' pid="{group}" pindex="0"'
-        elif colors is not None:
-            pid = f' pid="1" pindex="{k}"'
+        elif k in base_index:
+            pid = f' pid="1" pindex="{base_index[k]}"'
         else:
             pid = ""
         object_ids.append(next_id)
