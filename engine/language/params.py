@@ -184,7 +184,7 @@ def file_value(name: str, declared: Any, text: str) -> Any:
             return curves[0]
     except (ValueError, IndexError, KeyError, TypeError, OverflowError, RecursionError,
             struct.error, zlib.error) as exc:  # fmt: skip
-        raise GraphError(f"--set {name}: cannot read {text!r}: {exc}") from None
+        raise GraphError(f"--set {name}: cannot read {text!r}: {readers.in_words(exc)}") from None
     raise GraphError(
         f"--set {name}: a {declared.name} param is not read from a file (Mesh, Points, Curve "
         f"and list[Curve] are)"

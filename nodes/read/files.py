@@ -42,7 +42,9 @@ def parsed(path: str, what: str, fn, *args):
     except RecursionError:
         raise InputError("path", f"{path!r}: nested too deeply to read as {what}") from None
     except PARSE_ERRORS as exc:
-        raise InputError("path", f"{path!r}: cannot read it as {what}: {exc}") from None
+        raise InputError(
+            "path", f"{path!r}: cannot read it as {what}: {readers.in_words(exc)}"
+        ) from None
 
 
 @node("read.mesh", version=2)

@@ -621,3 +621,31 @@ def test_text_of_size_1e308_is_refused(tmp_path):
     )
     with pytest.raises(fg.NodeError, match=r"input 'size'.*beyond 1e\+15 mm"):
         g.evaluate("t")
+
+
+# ------------------------------------------------------------------ item 13: in words
+
+
+@pytest.mark.parametrize(
+    "exc, words",
+    [
+        (ValueError(), "it is malformed (the reader gave no reason)"),
+        (KeyError("accessors"), "a field it needs is missing (accessors)"),
+        (IndexError(), "it ends before the data it announces (truncated?)"),
+        (struct.error("unpack requires a buffer of 4 bytes"), "shorter than its format says"),
+        (ValueError("'use' references expand"), "'use' references expand"),
+    ],
+)
+def test_a_reader_error_is_said_in_words(exc, words):
+    from formgraph.kernels.io.readers import in_words
+
+    said = in_words(exc)
+    assert words in said and "Error" not in said
+
+
+def test_a_dxf_ezdxf_cannot_read_is_said_without_an_exception_name(tmp_path):
+    data = b"0\nSECTION\n2\nENTITIES\n0\nCIRCLE\n10\n0\n20\n0\n40\nabc\n0\nENDSEC\n0\nEOF\n"
+    message = curves_refused(
+        tmp_path, data, "not a DXF drawing ezdxf can read: Invalid tag", "j.dxf"
+    )
+    assert "cannot read it as a drawing" in message

@@ -56,7 +56,8 @@ def read_dxf(data: bytes, max_entities: int = MAX_ENTITIES) -> tuple[list[DxfCur
     try:
         doc, auditor = recover.read(io.BytesIO(data))
     except (ezdxf.DXFError, ValueError, TypeError, IndexError, KeyError, UnicodeError) as exc:
-        raise ValueError(f"not a DXF drawing ({type(exc).__name__}: {str(exc)[:100]})") from None
+        reason = str(exc).strip()[:100] or "it stops without saying why"
+        raise ValueError(f"not a DXF drawing ezdxf can read: {reason}") from None
     scale = UNITS_MM.get(int(doc.header.get("$INSUNITS", 0) or 0), 1.0)
     out: list[DxfCurve] = []
     skipped: Counter = Counter()

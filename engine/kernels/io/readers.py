@@ -7,6 +7,8 @@ building geometry values from them is the caller's job.
 
 from __future__ import annotations
 
+import struct
+import zlib
 from pathlib import PurePath
 
 import numpy as np
@@ -25,6 +27,7 @@ __all__ = [
     "MESH_FORMATS",
     "POINT_FORMATS",
     "extension",
+    "in_words",
     "mesh_arrays",
     "mesh_data",
     "vertex_attributes",
@@ -117,3 +120,24 @@ def vertex_attributes(name: str, data: bytes) -> dict[str, np.ndarray]:
     """The per-vertex attributes a point file carries (a PLY's extra vertex properties);
     none for the text formats."""
     return point_data(data) if extension(name, POINT_FORMATS) == ".ply" else {}
+
+
+_WHY = {  # what an exception a parser did not raise on purpose means of the file
+    KeyError: "a field it needs is missing",
+    IndexError: "it ends before the data it announces (truncated?)",
+    TypeError: "a value has the wrong type for its field",
+    OverflowError: "a number is too large",
+    struct.error: "a binary field is shorter than its format says (truncated?)",
+    zlib.error: "a compressed block is corrupt",
+}
+
+
+def in_words(exc: BaseException) -> str:
+    """A reader's error as a sentence about the file: its own message when it raised one on
+    purpose (a ValueError with a reason), else what that kind of failure means, with the
+    detail, never a bare exception name (#33 item 13)."""
+    message = str(exc.args[0] if isinstance(exc, KeyError) and exc.args else exc).strip()
+    if type(exc) is ValueError or (isinstance(exc, ValueError) and message):
+        return message or "it is malformed (the reader gave no reason)"
+    why = next((w for kind, w in _WHY.items() if isinstance(exc, kind)), "it is malformed")
+    return f"{why} ({message[:100]})" if message else why
