@@ -708,12 +708,17 @@ def _build(parts: dict[str, _Part], root: str, max_elements: int) -> Read3MF:
     per_v = np.array([size[k][0] for k in keys], np.int64)[item_code]
     per_t = np.array([size[k][1] for k in keys], np.int64)[item_code]
     starts_v, starts_t = np.cumsum(per_v) - per_v, np.cumsum(per_t) - per_t
-    grouped = np.argsort(item_code, kind="stable")
-    bounds = np.concatenate([[0], np.cumsum(counts)])
     placed: dict = {}
-    for u, key in enumerate(keys):
-        w = grouped[bounds[u] : bounds[u + 1]]
-        placed[key] = [(transforms[w], starts_v[w], starts_t[w])]
+    if len(keys) == 1:  # every item places the same object: no gathered copies
+        placed[keys[0]] = [(transforms, starts_v, starts_t)]
+    else:
+        grouped = np.argsort(item_code, kind="stable")
+        bounds = np.concatenate([[0], np.cumsum(counts)])
+        for u, key in enumerate(keys):
+            w = grouped[bounds[u] : bounds[u + 1]]
+            placed[key] = [(transforms[w], starts_v[w], starts_t[w])]
+    del transforms, starts_v, starts_t, per_v, per_t
+    top.items = []  # the items' arrays live on in the placements only
     out_v = np.empty((nv, 3))
     out_t = np.empty((nt, 3), np.int64)
     colors = _Colors(parts, nv)
@@ -721,9 +726,11 @@ def _build(parts: dict[str, _Part], root: str, max_elements: int) -> Read3MF:
         batches = placed.pop(key, [])
         if not batches:
             continue
-        m = np.concatenate([b[0] for b in batches])
-        sv = np.concatenate([b[1] for b in batches])
-        st = np.concatenate([b[2] for b in batches])
+        if len(batches) == 1:
+            m, sv, st = batches[0]
+        else:
+            m, sv, st = (np.concatenate([b[j] for b in batches]) for j in range(3))
+        del batches
         o = objects[key]
         if isinstance(o, _Mesh):
             _place(o, m, sv, st, out_v, out_t)
@@ -780,15 +787,29 @@ def _children(objects: dict, key) -> list:
 
 def _place(o: _Mesh, m: np.ndarray, sv: np.ndarray, st: np.ndarray, out_v, out_t) -> None:
     """Every placement of one mesh, in one vectorized pass: (k, n, 3) copies written where
-    each placement's vertices and triangles go."""
-    n, t = len(o.vertices), len(o.triangles)
+    each placement's vertices and triangles go (straight into the output when the
+    placements follow one another there, as the items of one object do)."""
+    n, t, k = len(o.vertices), len(o.triangles), len(m)
     if n:
-        copies = np.einsum("nj,kji->kni", o.vertices, m[:, :3]) + m[:, None, 3]
-        out_v[(sv[:, None] + np.arange(n)).ravel()] = copies.reshape(-1, 3)
+        if _consecutive(sv, n):
+            view = out_v[sv[0] : sv[0] + k * n].reshape(k, n, 3)
+            np.einsum("nj,kji->kni", o.vertices, m[:, :3], out=view)
+            view += m[:, None, 3]
+        else:
+            copies = np.einsum("nj,kji->kni", o.vertices, m[:, :3]) + m[:, None, 3]
+            out_v[(sv[:, None] + np.arange(n)).ravel()] = copies.reshape(-1, 3)
     if t:
-        out_t[(st[:, None] + np.arange(t)).ravel()] = (
-            o.triangles[None] + sv[:, None, None]
-        ).reshape(-1, 3)
+        if _consecutive(st, t):
+            view = out_t[st[0] : st[0] + k * t].reshape(k, t, 3)
+            np.add(o.triangles[None], sv[:, None, None], out=view)
+        else:
+            copies = (o.triangles[None] + sv[:, None, None]).reshape(-1, 3)
+            out_t[(st[:, None] + np.arange(t)).ravel()] = copies
+
+
+def _consecutive(starts: np.ndarray, size: int) -> bool:
+    """Whether placement i starts ``size`` after placement i - 1, for every i."""
+    return bool(starts.size) and bool(np.all(np.diff(starts) == size))
 
 
 class _Colors:
