@@ -98,8 +98,7 @@ def write_3mf(
     plain = [k for k in range(n) if vertex_colors[k] is None] if colors is not None else []
     if plain:
         bases = "".join(
-            f'<base name={quoteattr(names[k])} displaycolor="{_hex(colors[k])}"/>\n'
-            for k in plain
+            f'<base name={quoteattr(names[k])} displaycolor="{_hex(colors[k])}"/>\n' for k in plain
         )
         parts.append(f'<basematerials id="1">\n{bases}</basematerials>\n')
         next_id = 2
