@@ -319,16 +319,22 @@ def test_glb_carries_a_color_attribute_as_color_0(tmp_path):
     np.testing.assert_allclose(back.point_data["color"], want, atol=1e-7)
 
 
+def _strict_lib3mf(lib3mf, path):
+    """The file read by lib3mf in strict mode, which must raise no warning."""
+    model = lib3mf.get_wrapper().CreateModel()
+    reader = model.QueryReader("3mf")
+    reader.SetStrictModeActive(True)
+    reader.ReadFromFile(path)
+    assert reader.GetWarningCount() == 0
+    return model
+
+
 def test_3mf_carries_a_color_attribute_as_a_colour_group(tmp_path):
     lib3mf = pytest.importorskip("lib3mf")
     g, out = _run(
         tmp_path, COLOURED + "  x: {type: export.3mf, meshes: ['@paint'], path: c.3mf}\n", "x"
     )
-    model = lib3mf.get_wrapper().CreateModel()
-    reader = model.QueryReader("3mf")
-    reader.SetStrictModeActive(True)
-    reader.ReadFromFile(out)
-    assert reader.GetWarningCount() == 0
+    model = _strict_lib3mf(lib3mf, out)
     groups = model.GetColorGroups()
     assert groups.MoveNext()
     group = groups.GetCurrentColorGroup()
@@ -411,11 +417,7 @@ def test_3mf_writes_a_base_material_only_for_a_mesh_without_vertex_colours(tmp_p
     with zipfile.ZipFile(out) as z:
         text = z.read("3D/3dmodel.model").decode()
     assert text.count("<base ") == 1 and 'displaycolor="#0080FFFF"' in text
-    model = lib3mf.get_wrapper().CreateModel()
-    reader = model.QueryReader("3mf")
-    reader.SetStrictModeActive(True)
-    reader.ReadFromFile(out)
-    assert reader.GetWarningCount() == 0
+    model = _strict_lib3mf(lib3mf, out)
     objects = model.GetMeshObjects()
     props = []
     while objects.MoveNext():
