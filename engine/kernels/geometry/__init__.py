@@ -19,4 +19,9 @@ from __future__ import annotations
 
 from . import affine, instancing
 
-__all__ = ["affine", "instancing"]
+__all__ = ["MAX_COORDINATE", "affine", "instancing"]
+
+# millimetres: past 1e15 a double no longer holds a tenth of a millimetre (its spacing there
+# is 0.125), so a coordinate beyond it is an error of the input (a skew of 90 degrees, a
+# text of size 1e308), refused by what reads or makes it rather than passed on to overflow
+MAX_COORDINATE = 1e15
