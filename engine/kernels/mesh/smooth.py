@@ -8,10 +8,13 @@ surface design", SIGGRAPH 1995) is a low-pass filter whose gain at the lowest fr
 ``(1 - lambda k)(1 - mu k)`` for small ``k``, is slightly above 1: it does not shrink, but
 it grows a closed surface a little each step (a clean icosphere of 2,562 vertices by
 0.25 % in 10 steps and 2.5 % in 100, as trimesh's ``filter_taubin`` does). With
-``keep_volume`` each closed part is then scaled about its centroid back to the volume it
-started with after every step (Desbrun, Meyer, Schroeder & Barr, "Implicit fairing of
-irregular meshes using diffusion and curvature flow", SIGGRAPH 1999, section 2.4: a
-uniform scale by ``(V0 / V)^(1/3)``), which changes no shape, only its size.
+``keep_volume`` each closed part is scaled about its vertex mean back to the volume it
+started with (Desbrun, Meyer, Schroeder & Barr, "Implicit fairing of irregular meshes using
+diffusion and curvature flow", SIGGRAPH 1999, section 2.4: a uniform scale by
+``(V0 / V)^(1/3)``), which changes no shape, only its size. Desbrun et al. scale after
+every step; once at the end is the same: a pass is linear with rows summing to 1 on a
+closed part (no vertex held), so it commutes with a uniform scale about any point, and the
+scales of all steps compose into one.
 Vertices on a boundary edge (or a non-manifold one) are held where they are, so an open
 sheet keeps its outline and a closed mesh stays closed (no vertex or face is added or
 removed: the connectivity is the input's).
@@ -21,10 +24,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..io.meshdata import fan_triangles
-from .measure import next_corner, union_find
+from .measure import next_corner, signed_volume
 
-__all__ = ["held_vertices", "smooth", "umbrella", "VolumeKeeper"]
+__all__ = ["held_vertices", "part_volumes", "smooth", "umbrella"]
 
 
 def _halfedges(face_indices: np.ndarray, face_offsets: np.ndarray):
@@ -83,9 +85,10 @@ def smooth(
         Step sizes: ``0 < lamb < 1``; Taubin's ``mu < -lamb`` (pass band
         ``1 / lamb + 1 / mu``: 0.5 and -0.53 give about 0.11).
     keep_volume : bool
-        After every step, scale each closed part (no boundary or non-manifold edge, a
-        volume not 0) about its centroid back to its starting volume
-        (:class:`VolumeKeeper`); open parts are left as the filter makes them.
+        Scale each closed part (joined by edges; no vertex on a boundary or non-manifold
+        edge; a volume not 0) about its vertex mean back to its starting volume, once at
+        the end (the same as after every step, see above); open parts, and a part whose
+        volume the filter took to 0 or turned inside out, are left as the filter makes them.
     """
     v = np.array(vertices, dtype=np.float64)
     if method not in ("taubin", "laplacian"):
@@ -96,73 +99,67 @@ def smooth(
     held = held_vertices(uses)
     free = None if not held.any() else (~held).astype(np.float64)[:, None]
     steps = (lamb, mu) if method == "taubin" else (lamb,)
-    keeper = VolumeKeeper(v, face_indices, face_offsets, held) if keep_volume else None
+    if keep_volume:
+        from scipy.sparse.csgraph import connected_components
+
+        n_parts, part = connected_components(uses, directed=False)
+        faces = (np.asarray(face_indices, np.int64), np.asarray(face_offsets, np.int64))
+        volume0, _ = part_volumes(v, faces, part, n_parts)
     for _ in range(iterations):
         for s in steps:
             step = w @ v
             step -= v
             step *= s if free is None else s * free
             v += step
-        if keeper is not None:
-            keeper.restore(v)
+    if keep_volume:
+        _restore_volumes(v, volume0, faces, part, n_parts, held)
     return v
 
 
-class VolumeKeeper:
-    """Scales the closed parts of a mesh back to the volumes they had when it was made.
+def _restore_volumes(
+    v: np.ndarray,
+    volume0: np.ndarray,
+    faces: tuple[np.ndarray, np.ndarray],
+    part: np.ndarray,
+    n_parts: int,
+    held: np.ndarray,
+) -> None:
+    """Scale each closed part of ``v`` (n, 3), in place, about its vertex mean back to
+    ``volume0``; open parts (a held vertex), parts of no volume (within 1e-12 of the
+    mesh's size cubed) and parts turned inside out keep their vertices bit for bit."""
+    volume, mean = part_volumes(v, faces, part, n_parts)
+    open_part = np.zeros(n_parts, dtype=bool)
+    open_part[part[held]] = True
+    size = float(np.ptp(v, axis=0).max())
+    ratio = np.divide(volume0, volume, out=np.zeros_like(volume), where=volume != 0)
+    kept = ~open_part & (np.abs(volume0) > 1e-12 * size**3) & (ratio > 0)
+    at = np.flatnonzero(kept[part])
+    c = mean[part[at]]
+    v[at] = c + (v[at] - c) * np.cbrt(ratio)[part[at], None]
 
-    A part is a set of faces joined through shared vertices; it is closed when none of its
-    vertices is held (on an edge not shared by exactly two faces) and its volume is not 0.
-    :meth:`restore` scales each closed part about its volume centroid (the centroid of the
-    solid, from the signed tetrahedra of its fan triangles) by ``(V0 / V)^(1/3)``, all
-    parts at once; the connectivity is fixed, so the fans and parts are found once.
+
+def part_volumes(
+    v: np.ndarray, faces: tuple[np.ndarray, np.ndarray], part: np.ndarray, n_parts: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """Each part's signed volume (n_parts,) and vertex mean (n_parts, 3).
+
+    Parameters
+    ----------
+    v : (n, 3) float
+        Vertices.
+    faces : (face_indices, face_offsets)
+        The polygons, each within one part.
+    part : (n,) int
+        Each vertex's part, 0 .. n_parts - 1.
+
+    The volume is the divergence theorem's sum of signed cones
+    (:func:`~formgraph.kernels.mesh.measure.signed_volume`) from the part's vertex mean, a
+    point among its vertices, so the terms stay well conditioned far from the origin; it is
+    the volume enclosed where the part is closed and outward.
     """
-
-    def __init__(
-        self, vertices: np.ndarray, face_indices: np.ndarray, face_offsets: np.ndarray, held
-    ):
-        fi = np.asarray(face_indices, dtype=np.int64)
-        fo = np.asarray(face_offsets, dtype=np.int64)
-        n = len(vertices)
-        root, _ = union_find(n, fi, fi[next_corner(fo)])
-        used = np.zeros(n, dtype=bool)
-        used[fi] = True
-        parts, self.part = np.unique(root, return_inverse=True)
-        self.n_parts = parts.size
-        self.tris = fan_triangles(fi, fo)
-        self.tri_part = self.part[self.tris[:, 0]]
-        open_part = np.zeros(self.n_parts, dtype=bool)
-        open_part[self.part[np.asarray(held, dtype=bool) | ~used]] = True
-        self.volume0, _ = self._measure(np.asarray(vertices, dtype=np.float64))
-        size = float(np.ptp(np.asarray(vertices, dtype=np.float64)[used], axis=0).max())
-        self.closed = ~open_part & (np.abs(self.volume0) > 1e-12 * size**3)
-
-    def _measure(self, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Each part's signed volume (parts,) and volume centroid (parts, 3)."""
-        count = np.bincount(self.part, minlength=self.n_parts)
-        # a point inside each part's box, so the tetrahedra are well conditioned
-        origin = _sums(self.part, v, self.n_parts) / np.maximum(count, 1)[:, None]
-        o = origin[self.tri_part]
-        a, b, c = (v[self.tris[:, k]] - o for k in range(3))
-        six = np.einsum("ij,ij->i", a, np.cross(b, c))  # 6 x the tetrahedron's volume
-        volume = np.bincount(self.tri_part, six, self.n_parts) / 6.0
-        # sum of volume x (tetrahedron's centroid - origin)
-        moment = _sums(self.tri_part, six[:, None] * (a + b + c), self.n_parts) / 24.0
-        centre = origin + np.divide(
-            moment, volume[:, None], out=np.zeros_like(moment), where=volume[:, None] != 0
-        )
-        return volume, centre
-
-    def restore(self, v: np.ndarray) -> None:
-        """Scale the closed parts of ``v`` (n, 3), in place, back to their first volumes."""
-        volume, centre = self._measure(v)
-        ratio = np.divide(self.volume0, volume, out=np.ones_like(volume), where=volume != 0)
-        kept = self.closed & (ratio > 0)
-        at = np.flatnonzero(kept[self.part])  # the other parts' vertices stay bit for bit
-        c = centre[self.part[at]]
-        v[at] = c + (v[at] - c) * np.cbrt(ratio)[self.part[at], None]
-
-
-def _sums(index: np.ndarray, values: np.ndarray, n: int) -> np.ndarray:
-    """(n, 3) sums of the rows of ``values`` (m, 3) by ``index`` (m,)."""
-    return np.stack([np.bincount(index, values[:, k], n) for k in range(3)], 1)
+    fi, fo = faces
+    count = np.maximum(np.bincount(part, minlength=n_parts), 1)
+    mean = np.stack([np.bincount(part, v[:, k], n_parts) for k in range(3)], 1) / count[:, None]
+    face_part = part.take(fi.take(fo[:-1]))
+    cones = signed_volume(v, fi, fo, origin=mean[face_part])
+    return np.bincount(face_part, cones, n_parts), mean
