@@ -716,6 +716,16 @@ def test_values_are_shown_to_the_step(page):
     page.wait_for_function("document.querySelector('#controls').innerText.includes('radius = 2.0')")
 
 
+def _open_until_drawn(page, url: str) -> None:
+    """Load the studio in ``page`` and wait until its first run is shown and drawn."""
+    page.set_default_timeout(WAIT_MS)
+    page.goto(url)
+    page.wait_for_function("document.querySelector('#status')?.innerText.includes('cached')")
+    end = time.monotonic() + 20
+    while _shows_model(_canvas(page)) < 0.02 and time.monotonic() < end:
+        time.sleep(0.2)
+
+
 def test_the_page_loads_without_a_console_error_or_a_failed_request(page, studio):
     """Nothing on the console but information, no request refused or failed: the client's
     first POST to paraview/ (a launcher it asks for the websocket's address) was answered
@@ -742,12 +752,7 @@ def test_the_page_loads_without_a_console_error_or_a_failed_request(page, studio
                 else None
             ),
         )
-        other.set_default_timeout(WAIT_MS)
-        other.goto(studio.url)
-        other.wait_for_function("document.querySelector('#status')?.innerText.includes('cached')")
-        end = time.monotonic() + 20
-        while _shows_model(_canvas(other)) < 0.02 and time.monotonic() < end:
-            time.sleep(0.2)
+        _open_until_drawn(other, studio.url)
         other.wait_for_timeout(2000)  # what loads after the picture (the editor) too
     finally:
         context.close()
@@ -791,12 +796,7 @@ def test_a_page_loaded_after_steps_shows_them(page, studio):
     context = page.context.browser.new_context(viewport=page.viewport_size)
     try:
         other = context.new_page()  # a second tab, or the page reloaded
-        other.set_default_timeout(WAIT_MS)
-        other.goto(studio.url)
-        other.wait_for_function("document.querySelector('#status')?.innerText.includes('cached')")
-        end = time.monotonic() + 20
-        while _shows_model(_canvas(other)) < 0.02 and time.monotonic() < end:
-            time.sleep(0.2)
+        _open_until_drawn(other, studio.url)
         # the same tube (the cameras may differ: the first page was framed again as the
         # tube grew), told by its proportions: each turn makes it taller, not wider
         assert _aspect(_canvas(other)) == pytest.approx(_aspect(_canvas(page)), rel=0.12)
