@@ -68,9 +68,9 @@ POT = [[1.2, 0, 3], [0.8, 0, 2], [1.5, 0, 1], [1, 0, 0]]  # the README's pot
 
 
 def triangles(m: fg.Mesh) -> np.ndarray:
-    from formgraph.geometry.field import _triangles
+    from formgraph.kernels.io.meshdata import fan_triangles
 
-    return _triangles(m)
+    return fan_triangles(m.face_indices, m.face_offsets)
 
 
 def check_shell(surface: fg.Mesh, shell: fg.Mesh, bottom: float, top: float) -> None:

@@ -9,6 +9,7 @@ import numpy as np
 
 from formgraph.geometry import Field
 from formgraph.kernels.field import planar
+from formgraph.kernels.io.meshdata import fan_triangles
 
 _AXES = np.vstack([np.eye(3), -np.eye(3)])
 
@@ -61,10 +62,9 @@ def _own_planes(f: Field) -> np.ndarray:
         z, h = a["center"][2], a["height"] / 2
         return np.array([[0, 0, 1, z + h], [0, 0, -1, -(z - h)]], dtype=np.float64)
     if f.op == "from_mesh":
-        from formgraph.geometry.field import _triangles
-
         mesh = a["mesh"]
-        n, c = planar.coplanar_faces(np.asarray(mesh.vertices)[_triangles(mesh)])
+        tri = fan_triangles(mesh.face_indices, mesh.face_offsets)
+        n, c = planar.coplanar_faces(np.asarray(mesh.vertices)[tri])
         return np.column_stack([n, c])
     return np.zeros((0, 4))
 
