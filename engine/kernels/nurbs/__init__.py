@@ -53,6 +53,8 @@ from .fit import fit_columns, interpolate, interpolation_parameters
 from .knots import (
     clamp,
     decompose_bezier,
+    decompose_bezier_batch,
+    decompose_bezier_surface,
     elevate_degree,
     insert_knot,
     insert_knot_surface,
@@ -83,6 +85,8 @@ __all__ = [
     "curve_derivatives",
     "curve_evaluate",
     "decompose_bezier",
+    "decompose_bezier_batch",
+    "decompose_bezier_surface",
     "domain_spans",
     "elevate_degree",
     "evaluate_homogeneous",
