@@ -152,15 +152,17 @@ class Solid(Geometry):
         lo, hi = self.bounds
         return float(np.linalg.norm(hi - lo)) * 1e-3 or 1e-3
 
-    def mesh(self, tolerance: float | None = None, angle: float = 0.3) -> Any:
-        """The closed, outward triangle mesh within ``tolerance`` of the surfaces (the
-        ``brep.mesh`` node's kernel), as a :class:`~.mesh.Mesh`."""
+    def mesh(self, tolerance: float | None = None, angle: float = 0.35, guard: Any = None) -> Any:
+        """The closed, outward triangle mesh within ``tolerance`` of the surfaces, no two
+        neighbours on a curved face turning by more than ``angle`` radians (the ``brep.mesh``
+        node's kernel, and what the viewer draws), as a :class:`~.mesh.Mesh`; ``guard`` is
+        called with the triangle count before they are gathered."""
         from ..kernels.brep import tessellate
         from .mesh import Mesh
 
         tol = self.default_tolerance() if tolerance is None else float(tolerance)
-        v, t = tessellate.tessellate(self.shape, tol, angle)
-        return Mesh(v, t.reshape(-1), np.arange(0, 3 * len(t) + 1, 3))
+        v, t = tessellate.tessellate(self.shape, tol, angle, guard)
+        return Mesh.trusted(v, t.reshape(-1), np.arange(0, 3 * len(t) + 1, 3, dtype=np.int64))
 
     @functools.cached_property
     def _display(self) -> Any:

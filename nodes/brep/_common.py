@@ -140,12 +140,10 @@ def select(value: Any, table: Any, port: str, what: str, ctx: Context) -> list[i
                 f"{what}: x y z (the centre), {size}, kind, i, count; the kinds: {kinds}",
             )
     try:
-        chosen = value.evaluate(env, n, what)
+        chosen = value.mask(env, n, what)
     except ValueError as exc:
         raise InputError(port, str(exc)) from None
-    if chosen.ndim != 1:
-        raise InputError(port, f"'{value.text}' must give one true or false per {what[:-1]}")
-    picked = np.flatnonzero((chosen != 0) & usable).tolist()
+    picked = np.flatnonzero(chosen & usable).tolist()
     if not picked:
         lo, hi = table.centre.min(0), table.centre.max(0)
         span = ", ".join(

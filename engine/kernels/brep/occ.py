@@ -160,8 +160,7 @@ def bounds(shape: TopoDS_Shape) -> np.ndarray:
     BRepBndLib.AddOptimal_s(shape, box, False, False)
     if box.IsVoid():
         return np.zeros((2, 3))
-    x0, y0, z0, x1, y1, z1 = box.Get()
-    return np.array([[x0, y0, z0], [x1, y1, z1]])
+    return np.stack([point(box.CornerMin()), point(box.CornerMax())])
 
 
 def point(p: Any) -> np.ndarray:

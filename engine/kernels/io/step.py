@@ -13,7 +13,10 @@ What goes in (ISO 10303-42 resources, as CAD programs exchange them):
   ``GEOMETRIC_CURVE_SET``;
 - each closed mesh a ``MANIFOLD_SOLID_BREP`` of a ``CLOSED_SHELL``, an open one an
   ``OPEN_SHELL`` of the surface model, each polygon a planar face bounded by a
-  ``POLY_LOOP`` (a faceted solid).
+  ``POLY_LOOP`` (a faceted solid);
+- exact solids come as the entities of another STEP file (OpenCASCADE's, written by
+  :mod:`formgraph.kernels.brep.stepwrite`: manifold solid B-reps with their own products,
+  names and colours), appended with their entity numbers moved past ours (``attach``).
 
 All hang off one product, in millimetres. Numbers are written as their shortest round-trip
 decimals, in bulk (:mod:`formgraph.kernels.io.numfmt`), so the file holds the geometry to the
@@ -21,6 +24,8 @@ last bit; control points and mesh vertices are ``CARTESIAN_POINT`` rows built as
 """
 
 from __future__ import annotations
+
+import re
 
 import numpy as np
 
@@ -336,6 +341,7 @@ def write_step(
     surfaces: list[Surface] = (),  # type: ignore[assignment]
     meshes: list[tuple[np.ndarray, np.ndarray, np.ndarray, bool]] = (),  # type: ignore[assignment]
     name: str = "formgraph",
+    attach: bytes = b"",
 ) -> bytes:
     """A STEP AP214 file (ISO 10303-21) of exact curves and surfaces and faceted meshes.
 
@@ -348,6 +354,8 @@ def write_step(
         A closed mesh becomes a faceted solid (closed shell), an open one an open shell.
     name : str
         The product's name.
+    attach : bytes
+        Another STEP file whose entities (its own products) join this one's.
 
     Returns
     -------
@@ -405,4 +413,21 @@ def write_step(
         f"FILE_NAME('{safe}.stp','1970-01-01T00:00:00',(''),(''),'formgraph','formgraph','');\n"
         "FILE_SCHEMA(('AUTOMOTIVE_DESIGN { 1 0 10303 214 1 1 1 1 }'));\nENDSEC;\nDATA;\n"
     ).encode()
-    return header + f.data() + b"ENDSEC;\nEND-ISO-10303-21;\n"
+    return header + f.data() + _renumbered(attach, f.next - 1) + b"ENDSEC;\nEND-ISO-10303-21;\n"
+
+
+_TOKEN = re.compile(rb"'(?:[^']|'')*'|#(\d+)")
+
+
+def _renumbered(data: bytes, offset: int) -> bytes:
+    """The entities of the DATA section of STEP file ``data``, every ``#n`` (outside
+    strings) made ``#(n + offset)``."""
+    if not data:
+        return b""
+    start = data.index(b"DATA;") + len(b"DATA;")
+    end = data.rindex(b"ENDSEC;")
+
+    def moved(m: re.Match[bytes]) -> bytes:
+        return m.group(0) if m.group(1) is None else b"#%d" % (int(m.group(1)) + offset)
+
+    return _TOKEN.sub(moved, data[start:end]).lstrip(b"\n")
