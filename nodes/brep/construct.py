@@ -45,7 +45,7 @@ def extrude(
     curves: list[Curve],
     height: float,
     center: bool = False,
-    tolerance: Annotated[float, Range(min=0)] | None = None,
+    tolerance: Annotated[float | None, Range(min=0)] = None,
     *,
     ctx: Context,
 ) -> Solid:
@@ -87,7 +87,7 @@ def extrude(
 def revolve(
     curves: list[Curve],
     angle: Annotated[float, Range(min=0, max=360)] = 360.0,
-    tolerance: Annotated[float, Range(min=0)] | None = None,
+    tolerance: Annotated[float | None, Range(min=0)] = None,
     *,
     ctx: Context,
 ) -> Solid:
@@ -185,7 +185,7 @@ def loft(curves: list[Curve], ruled: bool = False) -> Solid:
 @node("brep.from_surfaces", version=1, requires=requires)
 def from_surfaces(
     surfaces: list[Surface],
-    tolerance: Annotated[float, Range(min=0)] | None = None,
+    tolerance: Annotated[float | None, Range(min=0)] = None,
 ) -> Solid:
     """The solid that NURBS surfaces enclose, sewn together along their shared boundaries.
 

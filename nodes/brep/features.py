@@ -30,9 +30,11 @@ def _edges(s: Solid, edges: Any, ctx: Context) -> tuple[Any, list[int]]:
     adj = Adjacency(s.shape)
     keep, smooth = usable_edges(adj, chosen)
     if smooth and edges is not None and edges is not True:
+        one = len(smooth) == 1
         ctx.warn(
-            f"edges {numbers(smooth)} join their faces smoothly (or bound one face only): "
-            "no corner there, left as they are"
+            f"{'edge' if one else 'edges'} {numbers(smooth)} {'joins its' if one else 'join their'}"
+            " faces smoothly (or bounds one face only): no corner there, left as "
+            f"{'it is' if one else 'they are'}"
         )
     return adj, keep
 

@@ -19,7 +19,7 @@ from ._common import call, requires
 @node("brep.mesh", version=1, requires=requires)
 def mesh(
     solid: Solid,
-    tolerance: Annotated[float, Range(min=0)] | None = None,
+    tolerance: Annotated[float | None, Range(min=0)] = None,
     angle: Annotated[float, Range(min=0, max=90)] = 20.0,
     *,
     ctx: Context,

@@ -131,17 +131,23 @@ def compound(shapes: list[TopoDS_Shape]) -> TopoDS_Shape:
     return c
 
 
+# The relative error the adaptive integration is run to: OCC's default fixed-order Gauss
+# rule is off by 2e-4 on a disc bounded by a rational circle; the adaptive one is not.
+EPS = 1e-10
+
+
 def volume(shape: TopoDS_Shape) -> float:
-    """The enclosed volume (Gauss integration over the faces, exact to rounding for
-    planes, quadrics and splines alike)."""
+    """The enclosed volume: the divergence theorem over the faces, each integrated by
+    adaptive Gauss-Kronrod in its parameters to :data:`EPS` (relative)."""
     p = GProp_GProps()
-    BRepGProp.VolumeProperties_s(shape, p)
+    BRepGProp.VolumeProperties_s(shape, p, EPS)
     return float(p.Mass())
 
 
 def area(shape: TopoDS_Shape) -> float:
+    """The area of the faces, integrated as :func:`volume` is."""
     p = GProp_GProps()
-    BRepGProp.SurfaceProperties_s(shape, p)
+    BRepGProp.SurfaceProperties_s(shape, p, EPS)
     return float(p.Mass())
 
 
