@@ -21,7 +21,8 @@ from OCP.BRepOffset import BRepOffset_Error, BRepOffset_Mode
 from OCP.BRepOffsetAPI import BRepOffsetAPI_MakeOffsetShape, BRepOffsetAPI_MakeThickSolid
 from OCP.ChFiDS import ChFiDS_ErrorStatus
 from OCP.collections import List_TopoDS_Shape
-from OCP.GeomAbs import GeomAbs_JoinType, GeomAbs_SurfaceType
+from OCP.GeomAbs import GeomAbs_JoinType, GeomAbs_Shape, GeomAbs_SurfaceType
+from OCP.ShapeUpgrade import ShapeUpgrade_ShapeDivideContinuity
 from OCP.TopoDS import TopoDS
 
 from . import BrepError, occ
@@ -197,15 +198,33 @@ def _too_thin_rounds(adj: Adjacency, thickness: float) -> list[tuple[int, float]
     return out
 
 
+def smooth_faces(shape: object, faces: list[object]) -> tuple[object, list[object]]:
+    """``shape`` with every face cut where its surface is only C0 (a rational circle's
+    double knots: the same surface, in C1 pieces, which OCC's offset needs), and the
+    pieces that ``faces`` became (``ShapeUpgrade_ShapeDivideContinuity``)."""
+    divide = ShapeUpgrade_ShapeDivideContinuity(shape)
+    divide.SetBoundaryCriterion(GeomAbs_Shape.GeomAbs_C1)
+    divide.SetPCurveCriterion(GeomAbs_Shape.GeomAbs_C1)
+    divide.SetSurfaceCriterion(GeomAbs_Shape.GeomAbs_C1)
+    if not divide.Perform():
+        return shape, faces
+    context = divide.GetContext()
+    pieces = [p for f in faces for p in occ.explore(context.Apply(f), "face")]
+    return divide.Result(), pieces
+
+
 def shell(shape: object, thickness: float, faces: list[int], adj: Adjacency) -> object:
     """``shape`` hollowed to walls of ``thickness`` (> 0: inward, the outside kept; < 0:
-    outward), ``faces`` removed to open it (none: a closed hollow, a sealed cavity)."""
+    outward), ``faces`` removed to open it (none: a closed hollow, a sealed cavity).
+    Faces that are only C0 inside are first cut into C1 pieces (:func:`smooth_faces`)."""
     offset = -float(thickness)
     try:
+        original = shape
+        shape, removed = smooth_faces(shape, [adj.faces[f] for f in faces])
         if faces:
             closing = List_TopoDS_Shape()
-            for f in faces:
-                closing.Append(adj.faces[f])
+            for f in removed:
+                closing.Append(f)
             maker = BRepOffsetAPI_MakeThickSolid()
             maker.MakeThickSolidByJoin(
                 shape, closing, offset, 1e-6, BRepOffset_Mode.BRepOffset_Skin, False, False,
@@ -231,7 +250,7 @@ def shell(shape: object, thickness: float, faces: list[int], adj: Adjacency) -> 
                 if inner:
                     for s in inner:
                         BRepLib.OrientClosedSolid_s(s)
-                    outer, core = (shape, inner[0]) if offset < 0 else (inner[0], shape)
+                    outer, core = (original, inner[0]) if offset < 0 else (inner[0], original)
                     out = _result(BRepAlgoAPI_Cut(outer, core).Shape())
     except occ.FAILURES:
         error, out = BRepOffset_Error.BRepOffset_UnknownError, None
