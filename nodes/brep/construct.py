@@ -73,8 +73,8 @@ def extrude(
     """
     from formgraph.kernels.brep import build
 
-    if height == 0:
-        raise InputError("height", "an extrusion of height 0 has no volume")
+    if height == 0 or not np.isfinite(height):
+        raise InputError("height", f"must be finite and not 0 (no volume), got {height:g}")
     parts = regions(curves, "curves", tolerance, ctx)
     wires = _wires(parts, "curves")
     h = abs(float(height))  # made upwards from its bottom, z0

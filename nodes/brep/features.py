@@ -87,8 +87,8 @@ def fillet(
     from formgraph.kernels.brep import features
 
     _single(solid, "solid")
-    if not radius > 0:
-        raise InputError("radius", f"must be > 0, got {radius:g}")
+    if not (radius > 0 and np.isfinite(radius)):
+        raise InputError("radius", f"must be finite and > 0, got {radius:g}")
     adj, keep = _edges(solid, edges, ctx)
     if not keep:
         return solid
@@ -125,8 +125,8 @@ def chamfer(
     from formgraph.kernels.brep import features
 
     _single(solid, "solid")
-    if not distance > 0:
-        raise InputError("distance", f"must be > 0, got {distance:g}")
+    if not (distance > 0 and np.isfinite(distance)):
+        raise InputError("distance", f"must be finite and > 0, got {distance:g}")
     adj, keep = _edges(solid, edges, ctx)
     if not keep:
         return solid

@@ -14,6 +14,13 @@ from formgraph.geometry import Solid
 from ._common import call, requires, solid
 
 
+def _finite(value: Vec3, port: str) -> np.ndarray:
+    c = np.asarray(value, dtype=np.float64)
+    if not np.all(np.isfinite(c)):
+        raise InputError(port, f"must be finite, got {c.tolist()}")
+    return c
+
+
 @node("brep.box", version=1, requires=requires)
 def box(size: float | Vec3 = (1.0, 1.0, 1.0), center: Vec3 = (0.0, 0.0, 0.0)) -> Solid:
     """An axis-aligned box: six planar faces, twelve straight edges.
@@ -32,9 +39,9 @@ def box(size: float | Vec3 = (1.0, 1.0, 1.0), center: Vec3 = (0.0, 0.0, 0.0)) ->
     from formgraph.kernels.brep import build
 
     s = np.broadcast_to(np.asarray(size, dtype=np.float64), (3,))
-    if not np.all(s > 0):
-        raise InputError("size", f"every side must be > 0, got {s.tolist()}")
-    c = np.asarray(center, dtype=np.float64)
+    if not np.all((s > 0) & np.isfinite(s)):
+        raise InputError("size", f"every side must be finite and > 0, got {s.tolist()}")
+    c = _finite(center, "center")
     return solid(call("size", build.box, s, c), "box", size=s, center=c)
 
 
@@ -62,8 +69,8 @@ def cylinder(
     from formgraph.kernels.brep import build
 
     for port, v in (("radius", radius), ("height", height)):
-        if not v > 0:
-            raise InputError(port, f"must be > 0, got {v:g}")
-    c = np.asarray(center, dtype=np.float64)
+        if not (v > 0 and np.isfinite(v)):
+            raise InputError(port, f"must be finite and > 0, got {v:g}")
+    c = _finite(center, "center")
     shape = call("radius", build.cylinder, float(radius), float(height), c)
     return solid(shape, "cylinder", radius=radius, height=height, center=c)
