@@ -53,6 +53,20 @@ def _single(s: Solid, port: str) -> None:
         raise InputError(port, "the solid is empty (a boolean that left nothing?)")
 
 
+def _edge_feature(op: str, s: Solid, port: str, size: float, edges: Any, ctx: Context) -> Solid:
+    """The fillet or chamfer (``op``) of ``size`` on the selected edges of ``s``."""
+    from formgraph.kernels.brep import features
+
+    _single(s, "solid")
+    if not (size > 0 and np.isfinite(size)):
+        raise InputError(port, f"must be finite and > 0, got {size:g}")
+    adj, keep = _edges(s, edges, ctx)
+    if not keep:
+        return s
+    shape = call("edges", getattr(features, op), s.shape, float(size), keep, adj)
+    return _solid(shape, op, solid=s, **{port: float(size)}, edges=keep)
+
+
 @node("brep.fillet", version=1, requires=requires)
 def fillet(
     solid: Solid,
@@ -84,16 +98,7 @@ def fillet(
     -------
     ``rounded: {type: brep.fillet, solid: "@block", radius: 2, edges: "=z > 9"}``
     """
-    from formgraph.kernels.brep import features
-
-    _single(solid, "solid")
-    if not (radius > 0 and np.isfinite(radius)):
-        raise InputError("radius", f"must be finite and > 0, got {radius:g}")
-    adj, keep = _edges(solid, edges, ctx)
-    if not keep:
-        return solid
-    shape = call("edges", features.fillet, solid.shape, float(radius), keep, adj)
-    return _solid(shape, "fillet", solid=solid, radius=float(radius), edges=keep)
+    return _edge_feature("fillet", solid, "radius", radius, edges, ctx)
 
 
 @node("brep.chamfer", version=1, requires=requires)
@@ -122,16 +127,7 @@ def chamfer(
     -------
     ``cut: {type: brep.chamfer, solid: "@block", distance: 1, edges: "=kind == line"}``
     """
-    from formgraph.kernels.brep import features
-
-    _single(solid, "solid")
-    if not (distance > 0 and np.isfinite(distance)):
-        raise InputError("distance", f"must be finite and > 0, got {distance:g}")
-    adj, keep = _edges(solid, edges, ctx)
-    if not keep:
-        return solid
-    shape = call("edges", features.chamfer, solid.shape, float(distance), keep, adj)
-    return _solid(shape, "chamfer", solid=solid, distance=float(distance), edges=keep)
+    return _edge_feature("chamfer", solid, "distance", distance, edges, ctx)
 
 
 @node("brep.shell", version=1, requires=requires)

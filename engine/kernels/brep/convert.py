@@ -32,7 +32,7 @@ from OCP.GC import GC_MakeArcOfCircle
 from OCP.Geom import Geom_BSplineCurve, Geom_BSplineSurface
 from OCP.gp import gp_Ax2, gp_Circ, gp_Dir, gp_Pln, gp_Pnt
 
-from ..nurbs import clamp, curve_evaluate, homogeneous, is_clamped, project, respace
+from ..nurbs import clamp, clamp_surface, curve_evaluate, homogeneous, project, respace
 from . import BrepError, occ
 
 __all__ = [
@@ -104,25 +104,6 @@ def bspline_curve(
         raise BrepError(f"OpenCASCADE refuses a curve of degree {p} on {len(cp)} points") from None
 
 
-def _clamp_surface(
-    cp: np.ndarray, du: int, dv: int, ku: np.ndarray, kv: np.ndarray, w: np.ndarray | None
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
-    pw = homogeneous(np.asarray(cp, float), w)
-    for axis, (d, k) in enumerate(((du, ku), (dv, kv))):
-        if is_clamped(d, k):
-            continue
-        n = len(k) - d - 1
-        a, b = k[d], k[n]
-        tau = np.concatenate([[a] * (d + 1), k[(k > a) & (k < b)], [b] * (d + 1)])
-        pw = np.moveaxis(respace(d, k, np.moveaxis(pw, axis, 0), tau), 0, axis)
-        if axis == 0:
-            ku = tau
-        else:
-            kv = tau
-    cp2, w2 = project(pw, w is not None)
-    return cp2, np.asarray(ku, float), np.asarray(kv, float), w2
-
-
 def bspline_surface(
     control_points: np.ndarray,
     degree_u: int,
@@ -132,7 +113,7 @@ def bspline_surface(
     weights: np.ndarray | None,
 ) -> Geom_BSplineSurface:
     """The OCC surface of a NURBS surface, exactly (u along the first axis)."""
-    cp, ku, kv, w = _clamp_surface(control_points, degree_u, degree_v, knots_u, knots_v, weights)
+    cp, ku, kv, w = clamp_surface(control_points, degree_u, degree_v, knots_u, knots_v, weights)
     nu, nv = cp.shape[:2]
     poles = Array2_gp_Pnt(1, nu, 1, nv)
     rows = cp.tolist()

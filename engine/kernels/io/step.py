@@ -29,7 +29,7 @@ import re
 
 import numpy as np
 
-from ..nurbs import homogeneous, is_clamped, project, respace
+from ..nurbs import clamp, clamp_surface, is_clamped
 from .numfmt import float_words, format_int, join_rows, squeeze
 
 __all__ = ["write_step"]
@@ -127,32 +127,12 @@ def _knot_lists(knots: np.ndarray) -> tuple[str, str]:
 
 def _clamp_surface(s: Surface) -> Surface:
     cp, du, dv, ku, kv, w = s
-    pw = homogeneous(cp, w)
-    for axis, (d, k) in enumerate(((du, ku), (dv, kv))):
-        if is_clamped(d, k):
-            continue
-        n = len(k) - d - 1
-        a, b = k[d], k[n]
-        tau = np.concatenate([[a] * (d + 1), k[(k > a) & (k < b)], [b] * (d + 1)])
-        moved = np.moveaxis(pw, axis, 0)
-        pw = np.moveaxis(respace(d, k, moved, tau), 0, axis)
-        if axis == 0:
-            ku = tau
-        else:
-            kv = tau
-    cp2, w2 = project(pw, w is not None)
-    return cp2, du, dv, ku, kv, w2
+    cp2, ku2, kv2, w2 = clamp_surface(cp, du, dv, ku, kv, w)
+    return cp2, du, dv, ku2, kv2, w2
 
 
 def _clamp_curve(c: Curve) -> Curve:
-    cp, p, k, w = c
-    if is_clamped(p, k):
-        return c
-    n = len(k) - p - 1
-    a, b = k[p], k[n]
-    tau = np.concatenate([[a] * (p + 1), k[(k > a) & (k < b)], [b] * (p + 1)])
-    cp2, w2 = project(respace(p, k, homogeneous(cp, w), tau), w is not None)
-    return cp2, p, tau, w2
+    return c if is_clamped(c[1], c[2]) else clamp(*c)
 
 
 def _curve_entity(f: _File, c: Curve, closed: bool = False) -> int:

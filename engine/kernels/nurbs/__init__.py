@@ -52,6 +52,7 @@ from .curve import (
 from .fit import fit_columns, interpolate, interpolation_parameters
 from .knots import (
     clamp,
+    clamp_surface,
     decompose_bezier,
     decompose_bezier_batch,
     decompose_bezier_surface,
@@ -81,6 +82,7 @@ __all__ = [
     "blossom_basis",
     "circle",
     "clamp",
+    "clamp_surface",
     "clamped_uniform_knots",
     "curve_derivatives",
     "curve_evaluate",
