@@ -27,6 +27,7 @@ __all__ = [
     "divisions",
     "even_parameters",
     "make_region",
+    "region_loops",
     "outline_curves",
     "region_rings",
     "sample_rings",
@@ -225,6 +226,23 @@ def make_region(make: Any, rings: list[np.ndarray], port: str) -> Any:
         raise InputError(
             port, f"curve {exc.ring} encloses no area (fewer than 3 distinct points)"
         ) from None
+
+
+def region_loops(
+    curves: list[Curve], ctx: Context
+) -> tuple[list[np.ndarray], list[Curve], np.ndarray]:
+    """The even-odd region of closed curves (port ``curves``) for the nodes that work on its
+    pieces (``layout.nest``, ``cam.*``): its rings in XY (closing point left out), its
+    outlines as curves (exact where the input was; outer counter-clockwise, holes
+    clockwise) in the same order, and which of them are holes (each piece is an outer
+    ring and the holes after it)."""
+    tol = sampling_tolerance(None, curves)
+    rings, sampled, sources = sample_rings(curves, "curves", tol, ctx)
+    shape = make_region(kregions.even_odd_region, rings, "curves")
+    outline = outline_curves(shape, curves, sampled, sources, tol, ctx)
+    coords, offsets, hole = kregions.rings_of(shape)
+    loops = [coords[offsets[i] : offsets[i + 1] - 1] for i in range(len(offsets) - 1)]
+    return loops, outline, hole
 
 
 def region_rings(
