@@ -30,10 +30,16 @@ def requires() -> str | None:
 def call(port: str, fn: Callable[..., Any], *args: Any, **kwargs: Any) -> Any:
     """``fn(*args)``, a :class:`~formgraph.kernels.brep.BrepError` made an error on the
     input it names (else on ``port``)."""
+    from formgraph.kernels.brep import occ
+
     try:
         return fn(*args, **kwargs)
     except kbrep.BrepError as exc:
         raise InputError(exc.port or port, str(exc)) from None
+    except occ.FAILURES:  # a failure no kernel foresaw: said as ours, not as OCC's text
+        raise InputError(
+            port, "OpenCASCADE could not compute this from the input (a degenerate shape?)"
+        ) from None
 
 
 def solid(shape: Any, op: str, **args: Any) -> Solid:

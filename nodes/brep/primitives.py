@@ -13,6 +13,10 @@ from formgraph.geometry import Solid
 
 from ._common import call, requires, solid
 
+# OpenCASCADE's Precision::Confusion: points closer than this are one point
+PRECISION = 1e-7
+TOO_SMALL = "OpenCASCADE's precision (points closer are the same point)"
+
 
 def _finite(value: Vec3, port: str) -> np.ndarray:
     c = np.asarray(value, dtype=np.float64)
@@ -41,6 +45,8 @@ def box(size: float | Vec3 = (1.0, 1.0, 1.0), center: Vec3 = (0.0, 0.0, 0.0)) ->
     s = np.broadcast_to(np.asarray(size, dtype=np.float64), (3,))
     if not np.all((s > 0) & np.isfinite(s)):
         raise InputError("size", f"every side must be finite and > 0, got {s.tolist()}")
+    if np.any(s < PRECISION):
+        raise InputError("size", f"every side must be at least {PRECISION:g}, {TOO_SMALL}")
     c = _finite(center, "center")
     return solid(call("size", build.box, s, c), "box", size=s, center=c)
 
@@ -71,6 +77,8 @@ def cylinder(
     for port, v in (("radius", radius), ("height", height)):
         if not (v > 0 and np.isfinite(v)):
             raise InputError(port, f"must be finite and > 0, got {v:g}")
+        if v < PRECISION:
+            raise InputError(port, f"must be at least {PRECISION:g}, {TOO_SMALL}")
     c = _finite(center, "center")
     shape = call("radius", build.cylinder, float(radius), float(height), c)
     return solid(shape, "cylinder", radius=radius, height=height, center=c)

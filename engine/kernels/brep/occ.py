@@ -48,9 +48,30 @@ __all__ = [
     "volume",
 ]
 
-# What OCC's calls raise, as pybind11 maps them: its own failures and the C++ exceptions
-# that escape an algorithm (e.g. a bad_alloc becomes MemoryError, left alone).
-FAILURES: tuple[type[BaseException], ...] = (Standard_Failure, RuntimeError)
+
+def _failures() -> tuple[type[BaseException], ...]:
+    """Every exception class OCP binds (``Standard_DomainError``, ``StdFail_NotDone``,
+    ``gp_VectorWithNullMagnitude``, ...: about a hundred, each a direct subclass of
+    Exception, not of ``Standard_Failure`` as in C++), and RuntimeError for the C++
+    exceptions pybind11 maps to it (a bad_alloc becomes MemoryError, left alone)."""
+    import OCP.OCP as bound
+
+    found: set[type[BaseException]] = {Standard_Failure, RuntimeError}
+    for module in vars(bound).values():  # one pass over the bound modules, a few ms
+        if type(module).__name__ != "module":
+            continue
+        for value in vars(module).values():
+            if (
+                isinstance(value, type)
+                and issubclass(value, Exception)
+                and value.__module__.startswith("OCP")
+            ):
+                found.add(value)
+    return tuple(sorted(found, key=lambda c: c.__name__))
+
+
+# What OCC's calls raise, as pybind11 maps them.
+FAILURES: tuple[type[BaseException], ...] = _failures()
 
 KINDS = {
     "vertex": TopAbs_VERTEX,

@@ -52,7 +52,6 @@ from .curve import (
 from .fit import fit_columns, interpolate, interpolation_parameters
 from .knots import (
     clamp,
-    clamp_surface,
     decompose_bezier,
     decompose_bezier_batch,
     decompose_bezier_surface,
@@ -67,6 +66,7 @@ from .knots import (
 )
 from .surface import (
     basis_matrix,
+    clamp_surface,
     surface_derivatives,
     surface_evaluate,
     surface_evaluate_grid,

@@ -119,37 +119,6 @@ def clamp(
     return cp, p, tau, w
 
 
-def clamp_surface(
-    control_points: np.ndarray,
-    degree_u: int,
-    degree_v: int,
-    knots_u: np.ndarray,
-    knots_v: np.ndarray,
-    weights: np.ndarray | None,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
-    """The same surface on knot vectors clamped in u and v (:func:`clamp` along each axis
-    that is not).
-
-    Returns
-    -------
-    (control_points (nu, nv, 3), knots_u, knots_v, weights (nu, nv) or None)
-    """
-    pw = homogeneous(np.asarray(control_points, dtype=np.float64), weights)
-    ku = np.asarray(knots_u, dtype=np.float64)
-    kv = np.asarray(knots_v, dtype=np.float64)
-    out = [ku, kv]
-    for axis, d in enumerate((degree_u, degree_v)):
-        k = out[axis]
-        if is_clamped(d, k):
-            continue
-        a, b = k[d], k[len(k) - d - 1]
-        tau = np.concatenate([[a] * (d + 1), k[(k > a) & (k < b)], [b] * (d + 1)])
-        pw = np.moveaxis(respace(d, k, np.moveaxis(pw, axis, 0), tau), 0, axis)
-        out[axis] = tau
-    cp, w = project(pw, weights is not None)
-    return cp, out[0], out[1], w
-
-
 def _copy(w: np.ndarray | None) -> np.ndarray | None:
     return None if w is None else np.array(w, dtype=np.float64)
 
