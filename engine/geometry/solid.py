@@ -127,7 +127,18 @@ class Solid(Geometry):
 
     @property
     def nbytes(self) -> int:
-        return len(self.brep) + 256
+        """The binary B-rep's size once made; before, an estimate from the faces and edges
+        (260 bytes each in OCC's format for a filleted box; counted as 512, OCC's own
+        structures in memory being larger), so the memory cache's accounting does not
+        serialise every solid it holds."""
+        if self._bytes is not None:
+            return len(self._bytes) + 256
+        from ..kernels.brep import occ
+
+        return (
+            512 * (len(occ.index_map(self.shape, "face")) + len(occ.index_map(self.shape, "edge")))
+            + 256
+        )
 
     def __repr__(self) -> str:
         return f"Solid({self.key[:12]})"

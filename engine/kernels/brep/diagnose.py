@@ -62,6 +62,7 @@ class Adjacency:
                 ids = sorted({find(f) - 1 for f in found})
             self._faces_of.append(ids)
         self._edges_of: list[list[int]] | None = None
+        self._surfaces: dict[int, BRepAdaptor_Surface] = {}
 
     def faces_of(self, edge: int) -> list[int]:
         """The distinct faces edge ``edge`` bounds (one for a seam or an open edge)."""
@@ -86,13 +87,19 @@ class Adjacency:
             return False
         return bool(np.dot(n0, n1) > 1.0 - 1e-9)
 
+    def _surface(self, face: int) -> BRepAdaptor_Surface:
+        """The face's surface adaptor, made once per face (a face has several edges)."""
+        if face not in self._surfaces:
+            self._surfaces[face] = BRepAdaptor_Surface(self.faces[face])
+        return self._surfaces[face]
+
     def _normal_at_middle(self, edge: int, face: int) -> np.ndarray | None:
         e, f = self.edges[edge], self.faces[face]
         try:
             c2d = BRepAdaptor_Curve2d(e, f)
             t = 0.5 * (c2d.FirstParameter() + c2d.LastParameter())
             uv = c2d.Value(t)
-            props = BRepLProp_SLProps(BRepAdaptor_Surface(f), uv.X(), uv.Y(), 1, 1e-9)
+            props = BRepLProp_SLProps(self._surface(face), uv.X(), uv.Y(), 1, 1e-9)
             if not props.IsNormalDefined():
                 return None
             n = occ.point(props.Normal())
