@@ -19,6 +19,7 @@ from formgraph.geometry import (
     NurbsCurve,
     NurbsSurface,
     Points,
+    Solid,
     Surface,
 )
 from formgraph.kernels import nurbs
@@ -68,6 +69,8 @@ def _box_of(g: Geometry) -> np.ndarray | None:
             (129, 129),
         )
         return np.stack([lo, hi])
+    elif isinstance(g, Solid):  # from its surfaces (OCC's optimal box)
+        return None if g.is_empty else np.array(g.bounds)
     elif isinstance(g, Field):
         raise InputError(
             "geometry",

@@ -66,6 +66,7 @@ from .knots import (
 )
 from .surface import (
     basis_matrix,
+    clamp_surface,
     surface_derivatives,
     surface_evaluate,
     surface_evaluate_grid,
@@ -81,6 +82,7 @@ __all__ = [
     "blossom_basis",
     "circle",
     "clamp",
+    "clamp_surface",
     "clamped_uniform_knots",
     "curve_derivatives",
     "curve_evaluate",
