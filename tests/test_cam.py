@@ -46,12 +46,16 @@ def test_profile_runs_a_tool_radius_from_the_outline(side, sign):
         d = shapely.distance(shapely.points(p[:, :2]), region.boundary)
         inside = shapely.contains_xy(region, p[:, 0], p[:, 1])
         assert np.all(inside == (sign < 0))
-        # round corners are chords of the arc, within the tolerance (1e-4 of the size: 0.008)
-        assert d.min() >= 3 - 0.008
-        assert np.median(d) == pytest.approx(3, abs=1e-3)
-    # the circle's and the rounded rectangle's paths are exact arcs
+        # every path is exact: at the tool's radius up to the outline's own sampling
+        assert d.min() >= 3 - 1e-4
+        assert np.median(d) == pytest.approx(3, abs=1e-4)
+    # the circle's, the rounded rectangle's and the star's paths are exact: the star (a
+    # polygon, a hole) grows with arcs of the tool's radius about its corners when the
+    # region shrinks, and shrinks to a pentagon of five sharp corners when it grows
     exact = [c for c in paths if c.degree == 2 and c.rational]
-    assert len(exact) == 2 * 3
+    assert len(exact) == (3 if sign < 0 else 2) * 3
+    pentagons = [c for c in paths if c.degree == 1 and len(c.control_points) == 6]
+    assert len(pentagons) == (0 if sign < 0 else 3)
 
 
 def test_profile_cuts_holes_before_the_outer_loop_and_on_stays_on_the_curves():

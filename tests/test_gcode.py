@@ -115,3 +115,35 @@ def test_bad_feeds_and_heights_are_located_errors(tmp_path, kwargs, message):
     with pytest.raises(fg.FormgraphError, match=message):
         _part(tmp_path, **kwargs)
     assert not (tmp_path / "part.nc").exists()
+
+
+@pytest.mark.parametrize(("side", "radius"), [("outside", 3.0), ("inside", None)])
+def test_a_sharp_rectangle_profile_has_its_round_corners_as_arcs(tmp_path, side, radius):
+    g = fg.Graph(out_dir=tmp_path)
+    g.add("plate", "curves.rectangle", size=[40, 30])
+    g.add(
+        "ell",
+        "curves.polyline",
+        points=[[0, 0, 0], [40, 0, 0], [40, 10, 0], [10, 10, 0], [10, 30, 0], [0, 30, 0]],
+        closed=True,
+    )
+    g.add("p", "cam.profile", curves=["@plate" if radius else "@ell"], tool_diameter=6, side=side)
+    g.add("nc", "export.gcode", paths="@p", path="p.nc")
+    text = open(g.evaluate("nc")).read()
+    moves, _ = _run(text)
+    arcs = [m for m in moves if "Arc" in m[0]]
+    lines = [m for m in moves if m[0] == "GCodeLinearMove" and m[1][2] == m[2][2]]
+    centres = np.array([a[:2] + [p["I"], p["J"]] for _, a, _, p in arcs])
+    if radius:  # outside a rectangle: four quarter arcs about its corners, four sides
+        assert len(arcs) == 4 and len(lines) == 4
+        assert all(m[0] == "GCodeArcMoveCCW" for m in arcs)  # the outer loop runs CCW
+        corners = {(-20.0, -15.0), (20.0, -15.0), (20.0, 15.0), (-20.0, 15.0)}
+        assert {tuple(np.round(c, 4)) for c in centres} == corners
+    else:  # inside an L: one arc, about its inside corner, radius 3
+        assert len(arcs) == 1 and len(lines) == 6
+        assert centres[0] == pytest.approx([10, 10], abs=1e-4)
+        radius = 3.0
+    for _, a, b, _ in arcs:  # both ends on the circle of the tool's radius
+        c = centres[[m[1] is a for m in arcs].index(True)]
+        assert np.linalg.norm(a[:2] - c) == pytest.approx(radius, abs=1e-4)
+        assert np.linalg.norm(b[:2] - c) == pytest.approx(radius, abs=1e-4)

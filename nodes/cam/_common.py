@@ -61,19 +61,17 @@ def accuracy(tolerance: float | None, default: float) -> float:
 def exact_loops(
     loops: Sequence[np.ndarray], outline: Sequence[Curve], distance: float, tol: float
 ) -> list[Curve]:
-    """The loops as curves at z = 0: an outline that is a chain of arcs and straight pieces
-    and whose exact offset by ``distance`` (:func:`formgraph.kernels.cam.arcs.offset_chain`)
-    is one of the loops (within the accuracy, by GEOS's Hausdorff distance) replaces it,
-    so circles stay circles; the others stay polylines."""
+    """The loops as curves at z = 0: an outline that is a polygon or a chain of arcs and
+    straight pieces and whose exact offset by ``distance`` (:func:`_exact_offset`) is one
+    of the loops (within the accuracy, by GEOS's Hausdorff distance) replaces it, so
+    circles stay circles and corners rounded by the offset are arcs; the others stay
+    polylines."""
     exact: list[tuple[NurbsCurve, shapely.Geometry]] = []
     for c in outline:  # one step per outline: its offset, if it has an exact one
-        if not (isinstance(c, NurbsCurve) and c.degree == 2 and c.rational):
+        curve = _exact_offset(c, distance)
+        if curve is None:
             continue
-        cp = karcs.offset_chain(c.control_points, c.knots, c.weights, distance)
-        if cp is None:
-            continue
-        curve = NurbsCurve(cp, 2, c.knots, c.weights)
-        pieces = (len(cp) - 1) // 2  # 64 samples a piece: within 1e-4 of an arc's radius
+        pieces = (len(curve.control_points) - 1) // 2  # 64 samples a piece: 1e-4 of a radius
         fine = np.asarray(curve.sample(64 * pieces + 1))[:-1, :2]
         exact.append((curve, shapely.LinearRing(fine)))
     out: list[Curve] = []
@@ -89,6 +87,30 @@ def exact_loops(
         else:
             out.append(exact.pop(twin)[0])
     return out
+
+
+def _exact_offset(c: Curve, distance: float) -> NurbsCurve | None:
+    """The exact offset of an outline that is a polygon or a chain of arcs and straight
+    pieces: the same knots where its pieces meet tangentially
+    (:func:`~formgraph.kernels.cam.arcs.offset_chain`), else with round joins at its
+    corners (:func:`~formgraph.kernels.cam.arcs.offset_loop`); None for any other curve."""
+    if not isinstance(c, NurbsCurve) or distance == 0:
+        return None
+    if c.degree == 1:
+        cp, knots, w = karcs.polygon_chain(np.asarray(c.control_points)[:-1])
+    elif c.degree == 2 and c.rational:
+        cp, knots, w = np.asarray(c.control_points), np.asarray(c.knots), np.asarray(c.weights)
+        moved = karcs.offset_chain(cp, knots, w, distance)
+        if moved is not None:
+            return NurbsCurve(moved, 2, knots, w)
+    else:
+        return None
+    got = karcs.offset_loop(cp, knots, w, distance)
+    if got is None:
+        return None
+    if np.all(got[2] == 1):  # no arc anywhere: a polygon, its corners cut sharp
+        return _loop_curve(got[0][0:-1:2, :2])
+    return NurbsCurve(got[0], 2, got[1], got[2])
 
 
 def at_depths(curves: Sequence[Curve], zs: np.ndarray, ctx: Context) -> list[Curve]:

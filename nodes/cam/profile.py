@@ -39,9 +39,10 @@ def profile(
     The curves are one region by the even-odd rule (as ``curves.boolean`` reads them). Its
     offset by the tool's radius (outward for ``outside``, inward for ``inside``) is the
     offset kernel's (GEOS's buffer, as ``offset.marching_squares``); an outline that is a
-    chain of circular arcs and straight pieces (a circle, a rounded rectangle) gets its
-    exact offset instead, a NURBS of the same kind, so ``export.gcode`` writes its arcs
-    as G2/G3. ``on`` runs on the outlines themselves (exact as they are).
+    polygon or a chain of circular arcs and straight pieces (a circle, a rounded or sharp
+    rectangle) gets its exact offset instead, a NURBS of the same kind whose corners are
+    arcs of the tool's radius where the offset rounds them, so ``export.gcode`` writes
+    its arcs as G2/G3. ``on`` runs on the outlines themselves (exact as they are).
 
     The paths are closed 3-D curves at z = -step_down, -2 step_down, ... down to -depth
     (one pass at -depth without ``step_down``): holes first, then outer loops (the part
