@@ -108,7 +108,7 @@ def test_linuxcnc_interprets_the_program_without_an_error(tmp_path):
     [
         ({"feed": 0}, r"feed.*must be positive"),
         ({"plunge": -5}, r"plunge.*must be positive"),
-        ({"safe_z": -10}, r"safe_z.*not below the safe height"),
+        ({"safe_z": -10}, r"safe_z.*safe height must be above the work \(z > 0"),
     ],
 )
 def test_bad_feeds_and_heights_are_located_errors(tmp_path, kwargs, message):

@@ -92,6 +92,11 @@ def nest(
     w, h = float(sheet[0]), float(sheet[1])
     if not math.isfinite(spacing):
         raise InputError("spacing", f"the spacing must be finite, got {spacing}")
+    if spacing > math.hypot(w, h):
+        ctx.warn(
+            f"the spacing {spacing:g} is more than the sheet's diagonal "
+            f"({math.hypot(w, h):.6g}): every part gets a sheet of its own"
+        )
     loops, outline, hole = _o.region_loops(curves, ctx)
     starts = np.flatnonzero(~hole)
     bounds = np.r_[starts, len(loops)]
