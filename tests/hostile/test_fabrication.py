@@ -202,3 +202,16 @@ def test_a_path_above_the_work_is_a_warning_and_no_paths_too(tmp_path):
         warnings.simplefilter("always")
         g.evaluate("none")
     assert "no paths to cut" in " ".join(str(w.message) for w in caught)
+
+
+def test_nest_refuses_marks_on_no_part_and_takes_none():
+    g = _graph()
+    g.add("far", "curves.text", text="X", size=5, position=[500, 0, 0])
+    g.add("n", "layout.nest", curves=["@disc"], marks=["@far"], sheet=[100, 100])
+    with pytest.raises(
+        fg.FormgraphError, match=r"input 'marks'.*mark 0 \(from \(5\d\d.*on no part"
+    ):
+        g.evaluate("n")
+    g = _graph()  # no marks: an empty list back
+    g.add("n", "layout.nest", curves=["@disc"], marks=[], sheet=[100, 100])
+    assert g.evaluate("n.marks") == []
