@@ -63,23 +63,19 @@ def exact_loops(
 ) -> list[Curve]:
     """The loops as curves at z = 0: an outline that is a polygon or a chain of arcs and
     straight pieces and whose exact offset by ``distance`` (:func:`_exact_offset`) is one
-    of the loops (within the accuracy, by GEOS's Hausdorff distance) replaces it, so
-    circles stay circles and corners rounded by the offset are arcs; the others stay
-    polylines."""
-    exact: list[tuple[NurbsCurve, shapely.Geometry]] = []
+    of the loops (every point of each within 4 ``tol`` of the other, by GEOS's prepared
+    distance tests) replaces it, so circles stay circles and corners rounded by the
+    offset are arcs; the others stay polylines."""
+    exact: list[tuple[NurbsCurve, np.ndarray]] = []
     for c in outline:  # one step per outline: its offset, if it has an exact one
         curve = _exact_offset(c, distance)
-        if curve is None:
-            continue
-        pieces = (len(curve.control_points) - 1) // 2  # 64 samples a piece: 1e-4 of a radius
-        fine = np.asarray(curve.sample(64 * pieces + 1))[:-1, :2]
-        exact.append((curve, shapely.LinearRing(fine)))
+        if curve is not None:
+            exact.append((curve, _chords(curve, tol)))
     out: list[Curve] = []
     for lp in loops:  # one step per loop: its exact twin, if any
-        ring = shapely.LinearRing(lp)
         twin = None
-        for j, (_, sampled) in enumerate(exact):
-            if shapely.hausdorff_distance(ring, sampled, densify=0.25) <= 4 * tol:
+        for j, (_, fine) in enumerate(exact):
+            if _same_loop(lp, fine, 4 * tol):
                 twin = j
                 break
         if twin is None:
@@ -87,6 +83,45 @@ def exact_loops(
         else:
             out.append(exact.pop(twin)[0])
     return out
+
+
+def _chords(curve: NurbsCurve, tol: float) -> np.ndarray:
+    """Points along a chain of arcs and straight pieces in Bezier form, closing point left
+    out: a straight piece's ends, an arc's chords within ``tol`` of it (a sweep of 2 h in
+    steps of 2 acos(1 - tol / R), twice over for the parametrization's unevenness)."""
+    cp = np.asarray(curve.control_points)[:, :2]
+    if curve.degree == 1:  # a polygon (an offset with no arc): its corners
+        return cp[:-1]
+    w = np.asarray(curve.weights) if curve.rational else np.ones(len(cp))
+    p0, p2 = cp[0:-1:2], cp[2::2]
+    wm = w[1::2] / np.sqrt(w[0:-1:2] * w[2::2])
+    half = np.arccos(np.clip(wm, -1.0, 1.0))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        radius = np.hypot(*(p2 - p0).T) / (2 * np.sin(half))
+        step = 2 * np.arccos(np.clip(1 - tol / radius, -1.0, 1.0))
+        n = np.where(half > 1e-12, np.ceil(4 * half / step), 1)
+    n = np.clip(np.nan_to_num(n, nan=1.0), 1, 256).astype(np.int64)
+    spans = np.unique(np.asarray(curve.knots))
+    piece = np.repeat(np.arange(len(n)), n)
+    frac = (np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n)) / np.repeat(n, n)
+    t = spans[piece] + (spans[piece + 1] - spans[piece]) * frac
+    return np.asarray(curve.evaluate(t))[:, :2]
+
+
+def _same_loop(loop: np.ndarray, fine: np.ndarray, within: float) -> bool:
+    """Whether two closed point loops lie within ``within`` of each other both ways: the
+    bounds first, then every vertex and chord middle of each against the other (GEOS's
+    prepared distance test, indexed: n log m, not the n m of a discrete Hausdorff)."""
+    lo, hi = loop.min(axis=0), loop.max(axis=0)
+    if np.abs(lo - fine.min(axis=0)).max() > within or np.abs(hi - fine.max(axis=0)).max() > within:
+        return False
+    for a, b in ((loop, fine), (fine, loop)):  # each way: a's points near b's ring
+        ring = shapely.LinearRing(b)
+        shapely.prepare(ring)
+        mid = 0.5 * (a + np.roll(a, -1, axis=0))
+        if not shapely.dwithin(ring, shapely.points(np.r_[a, mid]), within).all():
+            return False
+    return True
 
 
 def _exact_offset(c: Curve, distance: float) -> NurbsCurve | None:
