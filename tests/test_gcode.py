@@ -147,3 +147,39 @@ def test_a_sharp_rectangle_profile_has_its_round_corners_as_arcs(tmp_path, side,
         c = centres[[m[1] is a for m in arcs].index(True)]
         assert np.linalg.norm(a[:2] - c) == pytest.approx(radius, abs=1e-4)
         assert np.linalg.norm(b[:2] - c) == pytest.approx(radius, abs=1e-4)
+
+
+def test_holding_tabs_lift_only_the_passes_below_their_top(tmp_path):
+    g = fg.Graph(out_dir=tmp_path)
+    g.add("plate", "curves.rectangle", size=[60, 40])
+    g.add(
+        "p",
+        "cam.profile",
+        curves=["@plate"],
+        tool_diameter=6,
+        depth=6,
+        step_down=2,
+        tabs=4,
+        tab_width=5,
+        tab_height=1.5,
+    )
+    g.add("nc", "export.gcode", paths="@p", path="tabs.nc")
+    moves, _ = _run(open(g.evaluate("nc")).read())
+    cuts = [m for m in moves if m[0] != "GCodeRapidMove" and not np.allclose(m[1], m[2])]
+    assert min(m[2][2] for m in cuts) == -6  # never below the depth
+    # the passes at -2 and -4 are above the tabs' top (-4.5): whole, exact arcs
+    assert sum("Arc" in m[0] for m in cuts) == 2 * 4
+    last = [m for m in cuts if m[1][2] in (-6, -4.5) and m[2][2] in (-6, -4.5)]
+    flat = [m for m in last if m[1][2] == m[2][2]]
+    ups = [m for m in last if m[2][2] > m[1][2]]
+    downs = [m for m in last if m[2][2] < m[1][2]]
+    # four tabs: straight up and straight down, in place
+    assert len(ups) == len(downs) == 4
+    assert all(np.allclose(m[1][:2], m[2][:2]) for m in ups + downs)
+    length = {z: sum(np.linalg.norm(m[2][:2] - m[1][:2]) for m in flat if m[1][2] == z)
+              for z in (-6, -4.5)}  # fmt: skip
+    # over each tab for its width plus the tool's diameter; the whole loop as long as the
+    # offset rectangle (chords of its corner arcs within the tolerance)
+    assert length[-4.5] == pytest.approx(4 * (5 + 6), abs=1e-6)
+    perimeter = 2 * (60 + 40) + 2 * np.pi * 3
+    assert length[-6] + length[-4.5] == pytest.approx(perimeter, abs=1e-2)

@@ -193,3 +193,18 @@ def test_a_notch_the_offset_closes_keeps_the_offset_kernels_polylines():
     ref = shapely.buffer(shapely.Polygon(notch), 3.0, quad_segs=64).exterior
     ours = shapely.LinearRing(np.asarray(path.control_points)[:-1, :2])
     assert shapely.hausdorff_distance(ours, ref) < 0.01
+
+
+def test_tabs_lift_a_pass_straight_up_over_and_down_at_even_spacing():
+    square = np.array([[0, 0], [10, 0], [10, 10], [0, 10], [0, 0]], dtype=float)
+    spans = paths.tab_spans(40.0, 2, 4.0)
+    assert spans.tolist() == [[8, 12], [28, 32]]  # centred at 10 and 30
+    got = paths.over_tabs(square, spans, -5.0, -3.0)
+    expected = [
+        [0, 0, -5], [8, 0, -5], [8, 0, -3], [10, 0, -3], [10, 2, -3], [10, 2, -5],
+        [10, 10, -5], [2, 10, -5], [2, 10, -3], [0, 10, -3], [0, 8, -3], [0, 8, -5],
+        [0, 0, -5],
+    ]  # fmt: skip
+    assert got.tolist() == expected
+    with pytest.raises(ValueError, match="3 tabs of 14 .* do not fit on a loop of length 40"):
+        paths.tab_spans(40.0, 3, 14.0)

@@ -16,6 +16,7 @@ from formgraph.core.registry import Context
 from formgraph.geometry import Curve, NurbsCurve
 from formgraph.kernels.cam import arcs as karcs
 from formgraph.kernels.cam import paths as kpaths
+from formgraph.kernels.curves import sampling as ksampling
 from formgraph.nodes import _outlines as _o
 from formgraph.nodes.geometry.transform import transform_one
 from formgraph.nodes.offset.marching_squares import _loop_curve
@@ -146,6 +147,22 @@ def _exact_offset(c: Curve, distance: float) -> NurbsCurve | None:
     if np.all(got[2] == 1):  # no arc anywhere: a polygon, its corners cut sharp
         return _loop_curve(got[0][0:-1:2, :2])
     return NurbsCurve(got[0], 2, got[1], got[2])
+
+
+def polyline_points(c: Curve, tol: float, ctx: Context) -> np.ndarray:
+    """A closed loop's points in XY within ``tol`` of it, the first repeated at the end
+    (a polygon's own corners; any other NURBS by the drawing sampler)."""
+    if isinstance(c, NurbsCurve):
+        cp = np.asarray(c.control_points)
+        if c.degree == 1:
+            return cp[:, :2]
+        w = np.asarray(c.weights) if c.rational else None
+        pts = ksampling.sample_nurbs(
+            cp, c.degree, c.knots, w, tol, closed=True, guard=lambda n: ctx.guard(n, "points")
+        )
+        return np.r_[pts, pts[:1]][:, :2]
+    pts = np.asarray(c.sample(max(65, getattr(c, "samples", 256) + 1)))[:, :2]
+    return pts
 
 
 def at_depths(curves: Sequence[Curve], zs: np.ndarray, ctx: Context) -> list[Curve]:

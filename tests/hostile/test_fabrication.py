@@ -215,3 +215,21 @@ def test_nest_refuses_marks_on_no_part_and_takes_none():
     g = _graph()  # no marks: an empty list back
     g.add("n", "layout.nest", curves=["@disc"], marks=[], sheet=[100, 100])
     assert g.evaluate("n.marks") == []
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"tabs": 1000}, r"input 'tabs'.*1000 tabs of .* do not fit on a loop of length"),
+        ({"tabs": 10**9}, r"tabs"),
+        ({"tabs": 2, "tab_height": 1}, r"tab_height.*below the depth \(1\)"),
+        ({"tabs": 2, "tab_height": 0}, r"tab_height"),
+        ({"tabs": 2, "tab_width": math.nan}, r"tab_width"),
+        ({"tabs": -1}, r"tabs"),
+    ],
+)
+def test_profile_refuses_tabs_that_cannot_be(kwargs, message):
+    g = _graph()
+    g.add("p", "cam.profile", curves=["@disc"], tool_diameter=2, **kwargs)
+    with pytest.raises(fg.FormgraphError, match=message):
+        g.evaluate("p")
