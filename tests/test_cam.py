@@ -126,3 +126,18 @@ def test_bad_tools_and_depths_are_located_errors(kwargs, message):
     g.add("p", "cam.profile", curves=["@plate"], **kwargs)
     with pytest.raises(fg.FormgraphError, match=message):
         g.evaluate("p")
+
+
+def test_tabs_hold_the_part_and_leave_the_holes_exact():
+    g = _graph()
+    g.add(
+        "p", "cam.profile", curves=["@plate", "@hole"], tool_diameter=6, depth=6, step_down=2,
+        tabs=3, tab_height=1,
+    )  # fmt: skip
+    paths = g.evaluate("p")
+    hole, plate = paths[:3], paths[3:]  # holes first, each loop through its depths
+    assert all(c.degree == 2 and c.rational for c in hole)
+    assert all(c.degree == 2 and c.rational for c in plate[:2])  # -2, -4: above -5
+    z = np.asarray(plate[2].control_points)[:, 2]
+    assert set(np.round(z, 9)) == {-6.0, -5.0}  # the last pass, lifted to the tabs' top
+    assert np.sum(np.diff(z) > 0) == 3  # three tabs, each climbed once

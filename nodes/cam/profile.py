@@ -59,11 +59,12 @@ def profile(
 
     Holding tabs (``tabs`` > 0): bridges of material ``tab_width`` wide (along the
     outline) and ``tab_height`` high, left at the bottom of the cut so the part stays in
-    the stock until it is cut free by hand. Each loop gets ``tabs`` of them evenly spaced
-    along it; every pass that goes below the tabs' top (z = -depth + tab_height) is lifted
-    over them: straight up, along at the tabs' top for the tab's width plus the tool's
-    diameter, straight down. A lifted pass is a 3-D polyline within ``tolerance`` of the
-    path (G1 moves); the passes above the tabs stay exact.
+    the stock until it is cut free by hand. Each outer loop (what frees a part; the slugs
+    of holes are not held) gets ``tabs`` of them evenly spaced along it; every pass below
+    the tabs' top (z = -depth + tab_height) is lifted over them: straight up, along at
+    the tabs' top for the tab's width plus the tool's diameter, straight down. A lifted
+    pass is a 3-D polyline within ``tolerance`` of the path (G1 moves); the passes above
+    the tabs stay exact.
 
     Parameters
     ----------
@@ -81,7 +82,7 @@ def profile(
         Accuracy of the offset (the chords of its round corners). Default: 1e-4 of the
         drawing's size.
     tabs : int
-        Holding tabs on each loop (0: none).
+        Holding tabs on each outer loop (0: none).
     tab_width : float
         Width of a tab along the outline. Default: the tool's diameter.
     tab_height : float
@@ -119,11 +120,13 @@ def profile(
     loops_in_order = [flat[i] for i in order]
     if not tabs:
         return _c.at_depths(loops_in_order, zs, ctx)
-    return _tabbed(loops_in_order, zs, tabs, tab_width, tab_height, depth, 2 * r, tol, ctx)
+    outer = [not holes[i] for i in order]
+    return _tabbed(loops_in_order, outer, zs, tabs, tab_width, tab_height, depth, 2 * r, tol, ctx)
 
 
 def _tabbed(
     loops: list[Curve],
+    outer: list[bool],
     zs: np.ndarray,
     count: int,
     width: float | None,
@@ -133,8 +136,8 @@ def _tabbed(
     tol: float,
     ctx: Context,
 ) -> list[Curve]:
-    """Each loop through all its depths, the passes below the tabs' top lifted over them
-    (:func:`formgraph.kernels.cam.paths.over_tabs`)."""
+    """Each loop through all its depths, an outer loop's passes below the tabs' top lifted
+    over them (:func:`formgraph.kernels.cam.paths.over_tabs`)."""
     width = diameter if width is None else width
     height = depth / 3 if height is None else height
     if not (math.isfinite(width) and width > 0):
@@ -149,7 +152,7 @@ def _tabbed(
     for i, loop in enumerate(loops):  # one step per loop: its passes, the low ones lifted
         flat = _c.at_depths([loop], zs, ctx)
         low = zs < top
-        if not low.any():
+        if not (low.any() and outer[i]):
             out += flat
             continue
         pts = _c.polyline_points(loop, tol, ctx)
