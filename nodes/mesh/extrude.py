@@ -46,6 +46,31 @@ def _scale(scale: float | list[float]) -> tuple[float, float]:
     return sx, sy
 
 
+def _warn_touching(xy: np.ndarray, ctx: Context, skip: np.ndarray | None = None) -> None:
+    """Warn where the region's rings pass through one point (a bow-tie's crossing, a hole
+    touching its outline): the solid is made with a vertex of its own for each ring there,
+    so each part closes by itself, but the parts meet along an edge (a circle when
+    revolved) that four faces share, which a slicer reading the file merges and reports
+    as two parts, not manifold. ``skip`` marks points that are allowed to repeat (on the
+    axis of a revolution, where they make one pole)."""
+    pts = xy if skip is None else xy[~skip]
+    if len(pts) < 2:
+        return
+    order = np.lexsort((pts[:, 1], pts[:, 0]))
+    p = pts[order]
+    same = (p[1:, 0] == p[:-1, 0]) & (p[1:, 1] == p[:-1, 1])
+    if same.any():
+        starts = same & np.r_[True, ~same[:-1]]  # the first repeat of each point
+        x, y = (float(c) for c in p[1:][starts][0])
+        ctx.warn(
+            f"curves: the region's outlines touch at {int(starts.sum())} point(s) (first at "
+            f"({x:g}, {y:g})): the solid's parts meet there along an edge shared by four "
+            "faces, so it is not watertight once its vertices are merged (a slicer sees "
+            "separate parts joined by a non-manifold edge); move the outlines apart or make "
+            "them overlap (curves.boolean union) for one solid"
+        )
+
+
 def _o_fmt(sx: float, sy: float) -> str:
     return f"{sx:g}" if sx == sy else f"[{sx:g}, {sy:g}]"
 
@@ -106,6 +131,7 @@ def extrude(
     twist = _finite("twist", twist)
     sx, sy = _scale(scale)
     xy, offsets, hole, tol = _o.region_rings(curves, tolerance, ctx)
+    _warn_touching(xy, ctx)
     reach = float(np.sqrt((xy * xy).sum(axis=1).max())) * max(1.0, sx, sy)
     if slices is None:
         slices = ke.twist_slices(twist, reach, tol)
@@ -186,6 +212,7 @@ def revolve(
             "region at x >= 0 (one that crosses the axis would sweep through itself); move "
             "it to x >= 0 or cut it at the axis with curves.boolean",
         )
+    _warn_touching(xy, ctx, skip=xy[:, 0] == 0.0)
     reach = float(xy[:, 0].max())
     if segments is None:
         segments = ke.turn_segments(angle, reach, tol)

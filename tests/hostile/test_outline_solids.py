@@ -6,6 +6,9 @@ Each case ends as a located sentence (file, line, node, input), a warning, or a 
 from __future__ import annotations
 
 import math
+import re
+import shutil
+import subprocess
 import time
 
 import numpy as np
@@ -291,3 +294,82 @@ def test_a_spline_with_huge_coordinates_still_gets_a_finite_box():
     out = g.evaluate("b")
     assert all(math.isfinite(x) for x in out.max)
     assert out.max[1] == pytest.approx(0.5e150, rel=1e-9)
+
+
+# ------------------------------------------------------------- the audit of issue 34
+
+BOW_TIE = "{type: curves.polyline, points: [[0, 0], [10, 10], [10, 0], [0, 10]], closed: true}"
+
+
+def _triangles(m: fg.Mesh) -> tuple[np.ndarray, np.ndarray]:
+    from formgraph.kernels.mesh.meshops import triangulate
+
+    v, fi, _ = triangulate(m.vertices, m.face_indices, m.face_offsets)
+    return v, fi.reshape(-1, 3)
+
+
+def test_a_bow_tie_is_two_parts_touching_along_an_edge_as_slicers_count_them(tmp_path):
+    """Two prisms sharing one vertical edge (four faces on it once welded): two parts, not
+    watertight, split into two closed solids of 25 each; trimesh and admesh agree."""
+    import trimesh
+    from tools import admesh
+
+    g = _graph(
+        f"  c: {BOW_TIE}\n"
+        "  e: {type: mesh.extrude, curves: ['@c'], height: 1}\n"
+        "  m: {type: mesh.measure, mesh: '@e'}\n"
+        "  s: {type: mesh.split, mesh: '@e'}\n"
+    )
+    with pytest.warns(fg.FormgraphWarning, match=r"node 'e'.*touch at 1 point.*\(5, 5\)"):
+        e = g.evaluate("e")
+    with pytest.warns(fg.FormgraphWarning, match=r"node 'm'.*1 edge\(s\) lie on more than two"):
+        m = g.evaluate("m")
+    assert (m.parts, m.watertight, m.volume) == (2, False, pytest.approx(50))
+    parts = g.evaluate("s")
+    assert [p.is_watertight for p in parts] == [True, True]
+    assert [p.volume for p in parts] == pytest.approx([25, 25])
+    ref = trimesh.Trimesh(*_triangles(e))  # welded, as trimesh loads it
+    assert not ref.is_watertight
+    assert len(ref.split(only_watertight=False)) == 2
+    path = tmp_path / "bow.stl"
+    ref.export(path)
+    if shutil.which("admesh"):
+        assert admesh(path)["Number of parts"] == 2
+    if shutil.which("prusa-slicer"):
+        info = subprocess.run(
+            ["prusa-slicer", "--info", str(path)], capture_output=True, text=True, timeout=120
+        ).stdout
+        assert re.search(r"number_of_parts\s*=\s*2", info)
+
+
+def test_a_fin_on_a_box_is_its_own_open_part_and_the_box_stays_closed():
+    """An edge on three faces joins none of them: the box (two of them) stays one closed
+    part, the fin (one) is an open part, as trimesh splits it."""
+    import trimesh
+
+    box = trimesh.creation.box()
+    v = np.vstack([box.vertices, [[0.5, 0.5, 1.5]]])
+    edge = next(e for e in box.edges_unique if np.ptp(box.vertices[e][:, 0]) == 1.0)
+    fin = [[edge[0], edge[1], len(v) - 1]]
+    mesh = fg.Mesh(v, np.vstack([box.faces, fin]))
+    g = fg.Graph()
+    g.add("m", "mesh.measure", mesh=mesh)
+    g.add("s", "mesh.split", mesh=mesh)
+    with pytest.warns(fg.FormgraphWarning, match="not watertight"):
+        m = g.evaluate("m")
+    assert (m.parts, m.watertight) == (2, False)
+    parts = g.evaluate("s")
+    assert [(p.n_faces, p.is_watertight) for p in parts] == [(12, True), (1, False)]
+    ref = trimesh.Trimesh(v, np.vstack([box.faces, fin])).split(only_watertight=False)
+    assert sorted(len(r.faces) for r in ref) == [1, 12]
+
+
+def test_a_revolved_region_touching_itself_off_the_axis_warns():
+    g = _graph(
+        "  a: {type: curves.rectangle, size: [1, 1], center: [1.5, 0.5, 0]}\n"
+        "  b: {type: curves.rectangle, size: [1, 1], center: [2.5, 1.5, 0]}\n"
+        "  r: {type: mesh.revolve, curves: ['@a', '@b'], segments: 16}\n"
+        "  s: {type: mesh.split, mesh: '@r'}\n"
+    )
+    with pytest.warns(fg.FormgraphWarning, match=r"node 'r'.*touch at 1 point.*\(2, 1\)"):
+        assert [p.is_watertight for p in g.evaluate("s")] == [True, True]
