@@ -373,3 +373,100 @@ def test_a_revolved_region_touching_itself_off_the_axis_warns():
     )
     with pytest.warns(fg.FormgraphWarning, match=r"node 'r'.*touch at 1 point.*\(2, 1\)"):
         assert [p.is_watertight for p in g.evaluate("s")] == [True, True]
+
+
+def test_the_shadow_of_an_upright_plane_is_nothing_and_a_warning():
+    g = fg.Graph()
+    g.add("p", "mesh.plane", size=[1, 1])
+    g.add("r", "geometry.transform", geometry="@p", rotate=[90, 0, 0])  # cos 90 != 0
+    g.add("s", "mesh.project", mesh="@r")
+    with pytest.warns(fg.FormgraphWarning, match=r"node 's'.*shadow has no area.*edge-on"):
+        assert g.evaluate("s") == []
+
+
+@pytest.mark.parametrize("turn", [[90, 0, 0], [45, 0, 0], [0, 0, 30], [30, 0, 45]])
+def test_the_shadow_of_a_turned_box_has_no_repeated_or_collinear_points(turn):
+    """Its outline is the convex hull of its corners' shadows (scipy): exactly the hull's
+    points, each once, none on the line through its neighbours."""
+    from scipy.spatial import ConvexHull
+
+    g = fg.Graph()
+    g.add("b", "mesh.box")
+    g.add("r", "geometry.transform", geometry="@b", rotate=turn)
+    g.add("s", "mesh.project", mesh="@r")
+    (loop,) = g.evaluate("s")
+    pts = loop.control_points[:-1, :2]
+    corners = g.evaluate("r").vertices[:, :2]
+    hull = corners[ConvexHull(corners).vertices]
+    assert len(pts) == len(hull)
+    assert np.abs(pts[:, None] - hull[None]).max(axis=2).min(axis=1).max() < 1e-12
+
+
+def test_a_drilled_block_sliced_beside_its_hole_is_a_rectangle_of_four_corners():
+    """The section along x beside the hole cuts the top and bottom faces across the
+    triangles fanned from the hole: 4 corners, exactly at the block's, not hundreds of
+    collinear points; through the hole the sampled circle's points stay (each off its
+    neighbours' chord by the polygon's sagitta, far above 1e-9)."""
+    import shapely
+
+    g = _graph(
+        "  blk: {type: mesh.box, size: [40, 20, 10]}\n"
+        "  cyl: {type: mesh.cylinder, radius: 4, height: 30, segments: 200}\n"
+        "  d: {type: mesh.boolean, a: '@blk', b: '@cyl', operation: difference}\n"
+        "  x: {type: mesh.slice, mesh: '@d', axis: x, height: 10}\n"
+        "  z: {type: mesh.slice, mesh: '@d', height: 0}\n"
+    )
+    (rect,) = g.evaluate("x")
+    corners = {tuple(p) for p in rect.control_points[:-1, 1:].tolist()}
+    assert corners == {(-10.0, -5.0), (10.0, -5.0), (10.0, 5.0), (-10.0, 5.0)}
+    outer, hole = g.evaluate("z")
+    assert len(outer.control_points) == 5 and len(hole.control_points) == 201
+    area = shapely.Polygon(outer.control_points[:, :2], [hole.control_points[:, :2]]).area
+    assert area == pytest.approx(800 - 100 * 4**2 * math.sin(2 * math.pi / 200), rel=1e-12)
+
+
+def test_dropping_collinear_points_keeps_arcs_and_corners_exactly():
+    """Douglas-Peucker within a tolerance: a fine arc keeps a point wherever dropping it
+    would move the loop by more than the tolerance; every kept point is an input point;
+    a loop of no width goes."""
+    from formgraph.kernels.mesh.section import drop_collinear
+
+    t = np.linspace(0, 2 * np.pi, 20001)[:-1]
+    circle = np.c_[np.cos(t), np.sin(t)]
+    flat = np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 1e-12], [1.0, 0.0]])
+    square = np.array([[0, 0], [0.5, 0], [1, 0], [1, 1 - 1e-17], [1, 1], [0, 1], [0, 0.5]])
+    xy = np.r_[flat, circle, square].astype(float)
+    out, off = drop_collinear(xy, np.array([0, 4, 20004, 20011]), 1e-6)
+    assert np.diff(off).tolist()[1] == 4
+    assert out[off[1] :].tolist() == [[0, 0], [1, 0], [1, 1 - 1e-17], [0, 1]]
+    arc = out[: off[1]]
+    assert set(map(tuple, arc.tolist())) <= set(map(tuple, circle.tolist()))
+    # every dropped point within the tolerance of the chord between the kept ones
+    k = np.flatnonzero((circle[:, None] == arc[None]).all(axis=2).any(axis=1))
+    for a, b in zip(k, np.r_[k[1:], k[0] + len(circle)], strict=True):
+        mid = circle[np.arange(a + 1, b) % len(circle)]
+        p, q = circle[a], circle[b % len(circle)]
+        w, u = mid - p, q - p
+        d = np.abs(u[0] * w[:, 1] - u[1] * w[:, 0]) / np.hypot(*u)
+        assert d.max(initial=0) <= 1e-6
+    # chords of sagitta 1e-6 on r = 1 span 2 acos(1 - 1e-6) each: at least 2222 of them;
+    # splitting chords in two where they fail keeps fewer than twice that
+    least = math.ceil(2 * math.pi / (2 * math.acos(1 - 1e-6)))
+    assert least <= len(arc) < 2 * least
+
+
+def test_a_plane_through_the_top_face_says_it_touches_it():
+    g = _graph(
+        "  b: {type: mesh.box, size: [1, 1, 1]}\n"
+        "  s: {type: mesh.slice, mesh: '@b', height: 0.5}\n"
+        "  t: {type: geometry.transform, geometry: '@b', rotate: [45, 0, 0]}\n"
+    )
+    g.add("e", "mesh.slice", mesh="@t", height=float(g.evaluate("t").vertices[:, 2].max()))
+    with pytest.warns(
+        fg.FormgraphWarning,
+        match=r"z = 0.5 touches the mesh only at its top "
+        r"\(a face lying in it\).*no section.*z = 0.499999",
+    ):
+        assert g.evaluate("s") == []
+    with pytest.warns(fg.FormgraphWarning, match=r"touches the mesh only at its top \(an edge\)"):
+        assert g.evaluate("e") == []

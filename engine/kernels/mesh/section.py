@@ -20,6 +20,9 @@ Both come out as the loops of a planar region, found by chaining oriented segmen
   through manifold3d's ``CrossSection``).
 - :func:`cycles`: the cycles of a successor permutation, each in order, by pointer jumping
   (Wyllie's list ranking, vectorized: log2 of the longest cycle rounds of gathers).
+- :func:`drop_collinear`: points of a loop within a tolerance of the chord between the
+  points kept around them left out (the section of a planar face cut where a mesh's
+  triangles fan across it, a corner repeated up to rounding), the points kept exactly;
 - :func:`region_of_loops`: loops to a valid region: by the even-odd rule of GEOS when that
   agrees with their winding numbers (their signed areas add up to the region's area, as
   they do for the section of a solid that does not intersect itself), else by Clipper2's
@@ -38,6 +41,7 @@ from .keys import sort_keys
 __all__ = [
     "SliceIndex",
     "cycles",
+    "drop_collinear",
     "nonzero_fill",
     "region_of_loops",
     "section_rings",
@@ -295,6 +299,121 @@ def _without_repeats(xy: np.ndarray, offsets: np.ndarray) -> tuple[np.ndarray, n
     return xy, np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
 
 
+#: points within this fraction of the loops' size of the chord around them are dropped: far
+#: below any sampling tolerance (1e-5 of the size by default), far above double rounding
+COLLINEAR = 1e-9
+
+
+def drop_collinear(
+    xy: np.ndarray, offsets: np.ndarray, tol: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """The loops without the points that lie within ``tol`` of the chord joining the kept
+    points before and after them (cyclically), and without loops left with fewer than 3.
+
+    Douglas & Peucker's test (1973, "Algorithms for the reduction of the number of points
+    required to represent a digitized line"), every point at once: first each point is
+    tested against the chord of its two neighbours; then every point so dropped is tested
+    again against the chord between the kept points around its run, and where one is
+    further than ``tol`` the farthest of its run is kept (the chord split there), until no
+    dropped point is (each round only keeps more, so it ends; a run of drift needs a
+    second round, rarely a third). The distance is to the
+    chord as a segment, so a point where the loop turns back (a spike) is kept. Kept points
+    are the input's, bit for bit: corners stay exact.
+
+    Parameters
+    ----------
+    xy : (m, 2) float
+        Loop points, loop after loop, each without its closing point.
+    offsets : (c + 1,) int
+    tol : float
+        >= 0.
+
+    Returns
+    -------
+    xy, offsets
+    """
+    m = len(xy)
+    if m == 0:
+        return xy, offsets
+    offsets = np.asarray(offsets, dtype=np.int64)
+    sizes = np.diff(offsets)
+    loop = np.repeat(np.arange(len(sizes)), sizes)
+    start, end = offsets[:-1], offsets[1:]
+    idx = np.arange(m)
+    prev = idx - 1
+    prev[start] = end - 1
+    nxt = idx + 1
+    nxt[end - 1] = start
+    keep = _chord_distance(xy, prev, nxt) > tol
+    # a loop with no point kept (a fine arc: every point near its neighbours' chord, or a
+    # loop of no width) starts from its first point and the point farthest from it
+    none = np.bincount(loop[keep], minlength=len(sizes)) == 0
+    if none.any():
+        seed = np.flatnonzero(none[loop])
+        far = np.hypot(*(xy[seed] - xy[start[loop[seed]]]).T)
+        order = np.lexsort((far, loop[seed]))
+        last = np.r_[loop[seed][order][1:] != loop[seed][order][:-1], True]
+        keep[start[none]] = True
+        keep[seed[order[last]]] = True
+    while True:
+        b, a = _kept_around(keep, loop, start, end)
+        dropped = np.flatnonzero(~keep & (a >= 0))
+        dist = _chord_distance(xy, b[dropped], a[dropped], dropped)
+        far = dist > tol
+        if not far.any():
+            break
+        # of each run of dropped points (the same kept point before them) the farthest
+        # from its chord is kept, as Douglas-Peucker splits a chord at its farthest point
+        run, dist = b[dropped][far], dist[far]
+        order = np.lexsort((dist, run))
+        last = np.r_[run[order][1:] != run[order][:-1], True]
+        keep[dropped[far][order[last]]] = True
+    kept = np.bincount(loop[keep], minlength=len(sizes))
+    keep &= (kept >= 3)[loop]
+    if keep.all():
+        return xy, offsets
+    sizes = np.bincount(loop[keep], minlength=len(sizes))
+    sizes = sizes[sizes > 0]
+    return xy[keep], np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+
+
+def _kept_around(
+    keep: np.ndarray, loop: np.ndarray, start: np.ndarray, end: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """For every point, the kept point before it and the one after it in its loop
+    (cyclically); -1 for both in a loop with no point kept."""
+    m = len(keep)
+    idx = np.arange(m)
+    low = np.where(keep, idx, -1)
+    high = np.where(keep, idx, m)
+    before = np.r_[-1, np.maximum.accumulate(low)[:-1]]
+    after = np.r_[np.minimum.accumulate(high[::-1])[::-1][1:], m]
+    last = np.maximum.reduceat(low, start)  # each loop's last kept point (-1: none)
+    first = np.minimum.reduceat(high, start)
+    wrap = before < start[loop]
+    before[wrap] = last[loop[wrap]]
+    wrap = after >= end[loop]
+    after[wrap] = first[loop[wrap]]
+    none = last[loop] < 0
+    before[none] = after[none] = -1
+    return before, after
+
+
+def _chord_distance(
+    xy: np.ndarray, a: np.ndarray, b: np.ndarray, p: np.ndarray | None = None
+) -> np.ndarray:
+    """Distance from each point p (default: every point) to the segment from point a to
+    point b."""
+    pa, pb = xy[a], xy[b]
+    q = xy if p is None else xy[p]
+    d = pb - pa
+    w = q - pa
+    dd = np.einsum("ij,ij->i", d, d)
+    t = np.clip(np.einsum("ij,ij->i", w, d) / np.where(dd > 0, dd, 1.0), 0.0, 1.0)
+    r = w - t[:, None] * d
+    return np.sqrt(np.einsum("ij,ij->i", r, r))
+
+
 def shadow_loops(v: np.ndarray, tri: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The boundary of the up-and-down counted projection of the triangles, as loops.
 
@@ -432,7 +551,33 @@ def section_rings(
                 ring = ring[::-1].copy()
             d = np.diff(ring, axis=0)
             step = np.sqrt(np.einsum("ij,ij->i", d, d))
-            return ring, np.array([0, len(ring)], dtype=np.int64), step, False
+            return (*_simplified(ring, np.array([0, len(ring)], dtype=np.int64), step), False)
     region, filled = region_of_loops(xy, offsets, fill)
     coords, off, _, step = kregions.rings_of(region, steps=True)
-    return coords, off, step, filled
+    return (*_simplified(coords, off, step), filled)
+
+
+def _simplified(
+    coords: np.ndarray, offsets: np.ndarray, step: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Closed rings (each ending on its first point) without their collinear points
+    (:func:`drop_collinear` within :data:`COLLINEAR` of their size), their steps again."""
+    r = len(offsets) - 1
+    if r == 0:
+        return coords, offsets, step
+    keep = np.ones(len(coords), dtype=bool)
+    keep[offsets[1:] - 1] = False
+    loops, lo = coords[keep], offsets - np.arange(r + 1)
+    size = float(max(np.ptp(loops[:, 0]), np.ptp(loops[:, 1])))
+    loops2, lo2 = drop_collinear(loops, lo, COLLINEAR * size)
+    if len(loops2) == len(loops):
+        return coords, offsets, step
+    r2 = len(lo2) - 1
+    if r2 == 0:
+        return np.zeros((0, 2)), np.zeros(1, np.int64), np.zeros(0)
+    at = np.arange(len(loops2)) + np.repeat(np.arange(r2), np.diff(lo2))
+    out = np.empty((len(loops2) + r2, 2))
+    out[at] = loops2
+    out[lo2[1:] + np.arange(1, r2 + 1) - 1] = loops2[lo2[:-1]]  # each ring closed again
+    d = np.diff(out, axis=0)
+    return out, lo2 + np.arange(r2 + 1), np.sqrt(np.einsum("ij,ij->i", d, d))
