@@ -470,3 +470,73 @@ def test_a_plane_through_the_top_face_says_it_touches_it():
         assert g.evaluate("s") == []
     with pytest.warns(fg.FormgraphWarning, match=r"touches the mesh only at its top \(an edge\)"):
         assert g.evaluate("e") == []
+
+
+@pytest.mark.parametrize(
+    "curve",
+    [
+        "{type: nurbs.circle, radius: 2, normal: [0, 1, 0]}",
+        "{type: curves.polyline, points: [[0, 0, 0], [1, 0, 0], [1, 0, 1], [0, 0, 1]], "
+        "closed: true}",
+    ],
+)
+def test_an_outline_standing_across_the_xy_plane_is_said_to_be_so(curve):
+    g = _graph(f"  c: {curve}\n  e: {{type: mesh.extrude, curves: ['@c'], height: 1}}\n")
+    with pytest.raises(
+        fg.NodeError, match=r"h.yaml:4: node 'e', input 'curves'.*curve\(s\) 0 are not in the XY"
+    ):
+        g.evaluate("e")
+
+
+def test_a_square_turned_upright_by_rounding_is_no_sliver():
+    g = _graph(
+        "  s: {type: curves.rectangle, size: [2, 2]}\n"
+        "  t: {type: geometry.transform, geometry: '@s', rotate: [90, 0, 0]}\n"
+        "  e: {type: mesh.extrude, curves: ['@t'], height: 1}\n"
+    )
+    with pytest.raises(fg.NodeError, match="node 'e', input 'curves'.*not in the XY plane"):
+        g.evaluate("e")
+
+
+@pytest.mark.parametrize(("center", "span"), [(False, (5, 7)), (True, (4, 6))])
+def test_an_outline_at_z_5_is_extruded_from_its_own_plane(center, span):
+    g = fg.Graph()
+    g.add("c", "nurbs.circle", radius=1, center=[0, 0, 5])
+    g.add("e", "mesh.extrude", curves=["@c"], height=2, center=center)
+    m = g.evaluate("e")
+    assert g.stats["e"].warnings == []
+    assert m.bounds[:, 2].tolist() == list(span)
+    assert m.volume == pytest.approx(2 * math.pi, rel=1e-4)
+
+
+def test_outlines_at_two_heights_warn_and_rise_from_zero():
+    g = fg.Graph()
+    g.add("a", "curves.rectangle", size=[4, 4], center=[0, 0, 5])
+    g.add("b", "curves.rectangle", size=[1, 1], center=[0, 0, 2])
+    g.add("e", "mesh.extrude", curves=["@a", "@b"], height=1)
+    with pytest.warns(fg.FormgraphWarning, match=r"different heights \(z from 2 to 5\)"):
+        m = g.evaluate("e")
+    assert m.bounds[:, 2].tolist() == [0, 1] and m.volume == pytest.approx(15)
+
+
+def test_a_profile_off_the_xy_plane_warns_when_revolved():
+    g = fg.Graph()
+    g.add("a", "curves.rectangle", size=[1, 1], center=[2, 0, 5])
+    g.add("r", "mesh.revolve", curves=["@a"], segments=8)
+    with pytest.warns(fg.FormgraphWarning, match=r"node 'r'.*plane z = 5, not z = 0"):
+        g.evaluate("r")
+
+
+def test_a_tolerance_the_size_of_the_curve_warns_that_it_turns_a_circle_into_a_square():
+    g = fg.Graph()
+    g.add("c", "nurbs.circle", radius=5)
+    g.add("e", "mesh.extrude", curves=["@c"], height=2, tolerance=100)
+    g.add("fine", "mesh.extrude", curves=["@c"], height=2, tolerance=0.01)
+    with pytest.warns(
+        fg.FormgraphWarning,
+        match=r"node 'e'.*tolerance 100 is more than 1/50 of the size of curve 0 \(10\).*"
+        r"polygon of 4 points",
+    ):
+        assert g.evaluate("e").volume == pytest.approx(100)  # the inscribed square
+    assert g.evaluate("fine").volume == pytest.approx(50 * math.pi, rel=3e-3)
+    assert g.stats["fine"].warnings == []
