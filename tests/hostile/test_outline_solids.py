@@ -540,3 +540,19 @@ def test_a_tolerance_the_size_of_the_curve_warns_that_it_turns_a_circle_into_a_s
         assert g.evaluate("e").volume == pytest.approx(100)  # the inscribed square
     assert g.evaluate("fine").volume == pytest.approx(50 * math.pi, rel=3e-3)
     assert g.stats["fine"].warnings == []
+
+
+def test_the_pen_holders_label_faces_the_gallerys_camera():
+    """The gallery looks from (+1, +1, +1): the label stands on the +y face (y = depth / 2),
+    its letters standing out along +y, and reading left to right seen from +y (the text's
+    +x goes to -x; geometry.transform keeps the vertex order, so vertices correspond)."""
+    from pathlib import Path
+
+    g = fg.load(Path(__file__).parents[2] / "graphs" / "pen_holder.yaml")
+    flat, upright = g.evaluate("letters"), g.evaluate("upright")
+    depth = 60.0  # the graph's default
+    assert upright.bounds[0][1] == pytest.approx(depth / 2 - 0.4)
+    x, z = flat.vertices[:, 0], flat.vertices[:, 2]
+    moved = upright.vertices
+    assert moved[np.argmax(x), 0] == pytest.approx(moved[:, 0].min())  # end of text: left
+    assert moved[np.argmax(z), 1] == pytest.approx(moved[:, 1].max())  # relief: outward
