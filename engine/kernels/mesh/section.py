@@ -345,6 +345,8 @@ def drop_collinear(
     nxt = idx + 1
     nxt[end - 1] = start
     keep = _chord_distance(xy, prev, nxt) > tol
+    if keep.all() and sizes.min() >= 3:  # the usual section (a curved part's): nothing to drop
+        return xy, offsets
     # a loop with no point kept (a fine arc: every point near its neighbours' chord, or a
     # loop of no width) starts from its first point and the point farthest from it
     none = np.bincount(loop[keep], minlength=len(sizes)) == 0
@@ -404,14 +406,14 @@ def _chord_distance(
 ) -> np.ndarray:
     """Distance from each point p (default: every point) to the segment from point a to
     point b."""
-    pa, pb = xy[a], xy[b]
-    q = xy if p is None else xy[p]
-    d = pb - pa
-    w = q - pa
-    dd = np.einsum("ij,ij->i", d, d)
-    t = np.clip(np.einsum("ij,ij->i", w, d) / np.where(dd > 0, dd, 1.0), 0.0, 1.0)
-    r = w - t[:, None] * d
-    return np.sqrt(np.einsum("ij,ij->i", r, r))
+    x, y = xy[:, 0], xy[:, 1]  # by coordinate: one gather per column, no (n, 2) temporaries
+    ax, ay = x[a], y[a]
+    dx, dy = x[b] - ax, y[b] - ay
+    wx, wy = (x - ax, y - ay) if p is None else (x[p] - ax, y[p] - ay)
+    dd = dx * dx + dy * dy
+    t = np.clip((wx * dx + wy * dy) / np.where(dd > 0, dd, 1.0), 0.0, 1.0)
+    rx, ry = wx - t * dx, wy - t * dy
+    return np.sqrt(rx * rx + ry * ry)
 
 
 def shadow_loops(v: np.ndarray, tri: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -568,7 +570,7 @@ def _simplified(
     keep = np.ones(len(coords), dtype=bool)
     keep[offsets[1:] - 1] = False
     loops, lo = coords[keep], offsets - np.arange(r + 1)
-    size = float(max(np.ptp(loops[:, 0]), np.ptp(loops[:, 1])))
+    size = float((loops.max(axis=0) - loops.min(axis=0)).max())  # (np.ptp is slower)
     loops2, lo2 = drop_collinear(loops, lo, COLLINEAR * size)
     if len(loops2) == len(loops):
         return coords, offsets, step
