@@ -556,3 +556,22 @@ def test_the_pen_holders_label_faces_the_gallerys_camera():
     moved = upright.vertices
     assert moved[np.argmax(x), 0] == pytest.approx(moved[:, 0].min())  # end of text: left
     assert moved[np.argmax(z), 1] == pytest.approx(moved[:, 1].max())  # relief: outward
+
+
+def test_closed_rings_lose_a_collinear_first_point_and_rings_of_no_width():
+    """The rings a section gives, each closed on its first point: a square starting halfway
+    along an edge is closed again on its first corner, a ring of no width goes, the steps
+    are the new rings' edge lengths (and the jump from one ring to the next)."""
+    from formgraph.kernels.mesh.section import _simplified
+
+    square = [[0.5, 0], [1, 0], [1, 1], [0, 1], [0, 0], [0.5, 0]]
+    flat = [[2, 0], [3, 0], [4, 0], [2, 0]]
+    tri = [[5, 0], [6, 0], [5, 1], [5, 0]]
+    coords = np.array(square + flat + tri, dtype=float)
+    out, off, step = _simplified(coords, np.array([0, 6, 10, 14]))
+    assert off.tolist() == [0, 5, 9]
+    assert out.tolist() == [[1, 0], [1, 1], [0, 1], [0, 0], [1, 0]] + tri
+    assert step == pytest.approx(np.hypot(*np.diff(out, axis=0).T))
+    same = np.array([[0, 0], [1, 0], [0, 1], [0, 0]], dtype=float)
+    kept = _simplified(same, np.array([0, 4]))
+    assert kept[0] is same and kept[2].tolist() == [1, 2**0.5, 1]

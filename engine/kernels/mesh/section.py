@@ -41,6 +41,7 @@ from .keys import sort_keys
 __all__ = [
     "SliceIndex",
     "cycles",
+    "collinear_mask",
     "drop_collinear",
     "nonzero_fill",
     "region_of_loops",
@@ -332,10 +333,21 @@ def drop_collinear(
     -------
     xy, offsets
     """
+    offsets = np.asarray(offsets, dtype=np.int64)
+    keep = collinear_mask(xy, offsets, tol)
+    if keep is None:
+        return xy, offsets
+    sizes = np.bincount(np.repeat(np.arange(len(offsets) - 1), np.diff(offsets))[keep])
+    sizes = sizes[sizes > 0]
+    return xy[keep], np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+
+
+def collinear_mask(xy: np.ndarray, offsets: np.ndarray, tol: float) -> np.ndarray | None:
+    """The points :func:`drop_collinear` keeps, as a (m,) bool mask, or None where it
+    keeps every point (the usual section of a curved part: nothing to copy)."""
     m = len(xy)
     if m == 0:
-        return xy, offsets
-    offsets = np.asarray(offsets, dtype=np.int64)
+        return None
     sizes = np.diff(offsets)
     loop = np.repeat(np.arange(len(sizes)), sizes)
     start, end = offsets[:-1], offsets[1:]
@@ -346,7 +358,7 @@ def drop_collinear(
     nxt[end - 1] = start
     keep = _chord_distance(xy, prev, nxt) > tol
     if keep.all() and sizes.min() >= 3:  # the usual section (a curved part's): nothing to drop
-        return xy, offsets
+        return None
     # a loop with no point kept (a fine arc: every point near its neighbours' chord, or a
     # loop of no width) starts from its first point and the point farthest from it
     none = np.bincount(loop[keep], minlength=len(sizes)) == 0
@@ -357,7 +369,11 @@ def drop_collinear(
         last = np.r_[loop[seed][order][1:] != loop[seed][order][:-1], True]
         keep[start[none]] = True
         keep[seed[order[last]]] = True
-    while True:
+    # a dropped point between two kept ones was tested against the very chord it would
+    # leave: only runs of dropped points need the rounds below (a quad's diagonal cut
+    # between its sides' cuts, every other point of a section, does not)
+    in_runs = (~keep & (~keep[prev] | ~keep[nxt])).any()
+    while in_runs:
         b, a = _kept_around(keep, loop, start, end)
         dropped = np.flatnonzero(~keep & (a >= 0))
         dist = _chord_distance(xy, b[dropped], a[dropped], dropped)
@@ -372,11 +388,7 @@ def drop_collinear(
         keep[dropped[far][order[last]]] = True
     kept = np.bincount(loop[keep], minlength=len(sizes))
     keep &= (kept >= 3)[loop]
-    if keep.all():
-        return xy, offsets
-    sizes = np.bincount(loop[keep], minlength=len(sizes))
-    sizes = sizes[sizes > 0]
-    return xy[keep], np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+    return None if keep.all() else keep
 
 
 def _kept_around(
@@ -551,35 +563,36 @@ def section_rings(
             twice = np.dot(x[:-1] - x[0], y[1:] - y[0]) - np.dot(x[1:] - x[0], y[:-1] - y[0])
             if twice < 0:
                 ring = ring[::-1].copy()
-            d = np.diff(ring, axis=0)
-            step = np.sqrt(np.einsum("ij,ij->i", d, d))
-            return (*_simplified(ring, np.array([0, len(ring)], dtype=np.int64), step), False)
+            return (*_simplified(ring, np.array([0, len(ring)], dtype=np.int64)), False)
     region, filled = region_of_loops(xy, offsets, fill)
     coords, off, _, step = kregions.rings_of(region, steps=True)
     return (*_simplified(coords, off, step), filled)
 
 
 def _simplified(
-    coords: np.ndarray, offsets: np.ndarray, step: np.ndarray
+    coords: np.ndarray, offsets: np.ndarray, step: np.ndarray | None = None
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Closed rings (each ending on its first point) without their collinear points
-    (:func:`drop_collinear` within :data:`COLLINEAR` of their size), their steps again."""
+    (:func:`collinear_mask` within :data:`COLLINEAR` of their size), and their steps
+    (``step`` when given and nothing is dropped)."""
     r = len(offsets) - 1
-    if r == 0:
-        return coords, offsets, step
-    keep = np.ones(len(coords), dtype=bool)
-    keep[offsets[1:] - 1] = False
-    loops, lo = coords[keep], offsets - np.arange(r + 1)
-    size = float((loops.max(axis=0) - loops.min(axis=0)).max())  # (np.ptp is slower)
-    loops2, lo2 = drop_collinear(loops, lo, COLLINEAR * size)
-    if len(loops2) == len(loops):
-        return coords, offsets, step
-    r2 = len(lo2) - 1
-    if r2 == 0:
-        return np.zeros((0, 2)), np.zeros(1, np.int64), np.zeros(0)
-    at = np.arange(len(loops2)) + np.repeat(np.arange(r2), np.diff(lo2))
-    out = np.empty((len(loops2) + r2, 2))
-    out[at] = loops2
-    out[lo2[1:] + np.arange(1, r2 + 1) - 1] = loops2[lo2[:-1]]  # each ring closed again
-    d = np.diff(out, axis=0)
-    return out, lo2 + np.arange(r2 + 1), np.sqrt(np.einsum("ij,ij->i", d, d))
+    if r > 0:
+        closing = offsets[1:] - 1
+        body = np.ones(len(coords), dtype=bool)
+        body[closing] = False
+        loops = coords[body]
+        size = float((loops.max(axis=0) - loops.min(axis=0)).max())  # (np.ptp is slower)
+        mask = collinear_mask(loops, offsets - np.arange(r + 1), COLLINEAR * size)
+        if mask is not None:
+            body[body] = mask  # the kept points of the rings' bodies
+            kept = np.add.reduceat(body, offsets[:-1], dtype=np.int64)  # per ring: 0 or >= 3
+            ring = np.flatnonzero(kept)
+            body[closing[ring]] = True  # a kept ring's closing point, moved below
+            coords = coords[body]
+            offsets = np.concatenate([[0], np.cumsum(kept[ring] + 1)]).astype(np.int64)
+            coords[offsets[1:] - 1] = coords[offsets[:-1]]  # closed on its (new) first point
+            step = None
+    if step is None:
+        d = np.diff(coords, axis=0)
+        step = np.sqrt(np.einsum("ij,ij->i", d, d))
+    return coords, offsets, step
