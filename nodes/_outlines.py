@@ -29,14 +29,17 @@ __all__ = [
     "make_region",
     "region_loops",
     "outline_curves",
+    "plane_height",
     "region_rings",
     "sample_rings",
     "sampling_tolerance",
     "span_of",
+    "z_ranges",
 ]
 
 _TOLERANCE = 1e-5  # default sampling tolerance of region booleans, relative to the extent
 _FEW = 64  # up to this many outlines, their knots are made a ring at a time
+_COARSE = 1 / 50  # a tolerance past this fraction of a curve's size is warned about
 _LARGEST = 1e150  # the largest extent whose areas (its square, times vertex counts) are finite
 
 
@@ -118,6 +121,7 @@ def sample_rings(
     sampled: list[np.ndarray | None] = []
     sources: list[karcs.Source | None] = [None] * len(curves)
     total = 0
+    coarse: list[tuple[int, float, int]] = []  # curves the tolerance leaves coarse
 
     def guard(n: int) -> None:
         ctx.guard(total + n, "curve samples")
@@ -125,7 +129,6 @@ def sample_rings(
     # NURBS of degree >= 2 are sampled together, a batch per degree (one vectorized pass)
     batched: dict[int, np.ndarray] = {}
     by_degree: dict[int, list[int]] = {}
-    tilted: list[int] = []
     for i, c in enumerate(curves):
         if not closes(c):
             raise InputError(
@@ -135,12 +138,7 @@ def sample_rings(
             )
         if isinstance(c, NurbsCurve) and c.degree >= 2:
             by_degree.setdefault(c.degree, []).append(i)
-        z = np.asarray(c.control_points)[:, 2] if isinstance(c, NurbsCurve) else c.sample(65)[:, 2]
-        if not np.count_nonzero(z):  # on z = 0, the usual case: one pass, not two
-            continue
-        lo, hi = float(z.min()), float(z.max())
-        if hi - lo > 1e-9 * max(1.0, -lo, hi):
-            tilted.append(i)
+    tilted = _tilted(z_ranges(curves))
     if tilted:
         shown = ", ".join(str(i) for i in tilted[:10]) + (", ..." if len(tilted) > 10 else "")
         ctx.warn(
@@ -213,7 +211,46 @@ def sample_rings(
         total += len(ring)
         rings.append(ring)
         sampled.append(ring)
+        size = float(max(np.ptp(ring[:, 0]), np.ptp(ring[:, 1])))
+        if tol > _COARSE * size:
+            coarse.append((i, size, len(ring)))
+    if coarse:
+        i, size, n = coarse[0]
+        more = f" (and {len(coarse) - 1} more)" if len(coarse) > 1 else ""
+        ctx.warn(
+            f"tolerance {tol:g} is more than 1/{1 / _COARSE:g} of the size of curve {i} "
+            f"({size:g}){more}: sampled within it, that curve becomes a polygon of {n} "
+            "points, and the region's shape and area change with it; give a tolerance well "
+            "below the curves' size (the default is 1e-5 of the region's)"
+        )
     return rings, sampled, sources
+
+
+def z_ranges(curves: list[Curve]) -> np.ndarray:
+    """(n, 2) float: the lowest and highest z of each curve (of its control points for a
+    NURBS, whose curve lies in their hull, so a curve whose control points share one z
+    lies exactly at that z; of 65 samples otherwise)."""
+    out = np.zeros((len(curves), 2))
+    for i, c in enumerate(curves):  # one step per curve: a min and a max of its points
+        z = np.asarray(c.control_points)[:, 2] if isinstance(c, NurbsCurve) else c.sample(65)[:, 2]
+        if np.count_nonzero(z):  # on z = 0, the usual case: nothing to record
+            out[i] = float(z.min()), float(z.max())
+    return out
+
+
+def _tilted(z: np.ndarray) -> list[int]:
+    """The curves whose z varies (beyond rounding): not parallel to the XY plane."""
+    lo, hi = z[:, 0], z[:, 1]
+    scale = np.maximum(1.0, np.maximum(-lo, hi))
+    return np.flatnonzero(hi - lo > 1e-9 * scale).tolist()
+
+
+def plane_height(curves: list[Curve]) -> float | None:
+    """The z of the plane parallel to XY that every curve lies in (0 for the usual curves
+    in the XY plane), or None when they are tilted or at different heights."""
+    z = z_ranges(curves)
+    lo, hi = float(z[:, 0].min()), float(z[:, 1].max())
+    return 0.5 * (lo + hi) if hi - lo <= 1e-9 * max(1.0, -lo, hi) else None
 
 
 def make_region(make: Any, rings: list[np.ndarray], port: str) -> Any:
@@ -275,15 +312,29 @@ def region_rings(
     if not curves:
         raise InputError(port, "give closed curves bounding a region, got none")
     tol = sampling_tolerance(tolerance, curves, port)
-    rings, _, _ = sample_rings(curves, port, tol, ctx, exact=False)
-    region = make_region(kregions.even_odd_region, rings, port)
-    coords, offsets, hole = kregions.rings_of(region)
-    if len(offsets) < 2:
+    try:
+        rings, _, _ = sample_rings(curves, port, tol, ctx, exact=False)
+        region = make_region(kregions.even_odd_region, rings, port)
+        coords, offsets, hole = kregions.rings_of(region)
+        # (a sliver of rounding width, e.g. a square turned upright, counts as no area)
+        box = np.ptp(coords, axis=0) if len(coords) else np.zeros(2)
+        if len(offsets) < 2 or region.area <= 1e-12 * float(box.max()) ** 2:
+            raise InputError(
+                port,
+                f"the {len(curves)} curve(s) bound a region of no area (by the even-odd rule "
+                "a curve given twice, or two that coincide, cancel out)",
+            )
+    except InputError as exc:
+        standing = _tilted(z_ranges(curves))
+        if exc.port != port or not standing or "no area" not in str(exc):
+            raise
+        shown = ", ".join(str(i) for i in standing[:10]) + (", ..." if len(standing) > 10 else "")
         raise InputError(
             port,
-            f"the {len(curves)} curve(s) bound a region of no area (by the even-odd rule a "
-            "curve given twice, or two that coincide, cancel out)",
-        )
+            f"curve(s) {shown} are not in the XY plane (they stand across it, e.g. a circle "
+            "in the XZ plane): seen from above they enclose no area, and the region is read "
+            "in XY; turn them into the XY plane (geometry.transform rotate) first",
+        ) from None
     # each ring without its closing point: ring i loses its last row
     r = len(offsets) - 1
     keep = np.ones(len(coords), dtype=bool)

@@ -46,6 +46,49 @@ def _scale(scale: float | list[float]) -> tuple[float, float]:
     return sx, sy
 
 
+def _base(curves: list[Curve], ctx: Context) -> float:
+    """Where an extrusion starts: the plane the curves lie in (an outline drawn at z = 5
+    rises from z = 5), or z = 0 with a warning when they are at different heights (tilted
+    curves are warned about where the region is read)."""
+    z = _o.plane_height([curves] if isinstance(curves, Curve) else curves)
+    if z is not None:
+        return z
+    ranges = _o.z_ranges([curves] if isinstance(curves, Curve) else curves)
+    flat = ranges[:, 1] - ranges[:, 0] <= 1e-9 * np.maximum(1.0, np.abs(ranges).max(axis=1))
+    if flat.all():
+        ctx.warn(
+            f"curves: the outlines lie at different heights (z from {ranges[:, 0].min():g} "
+            f"to {ranges[:, 1].max():g}): their projections onto XY bound the region, "
+            "extruded from z = 0; move them into one plane to extrude from it"
+        )
+    return 0.0
+
+
+def _warn_touching(xy: np.ndarray, ctx: Context, skip: np.ndarray | None = None) -> None:
+    """Warn where the region's rings pass through one point (a bow-tie's crossing, a hole
+    touching its outline): the solid is made with a vertex of its own for each ring there,
+    so each part closes by itself, but the parts meet along an edge (a circle when
+    revolved) that four faces share, which a slicer reading the file merges and reports
+    as two parts, not manifold. ``skip`` marks points that are allowed to repeat (on the
+    axis of a revolution, where they make one pole)."""
+    pts = xy if skip is None else xy[~skip]
+    if len(pts) < 2:
+        return
+    order = np.lexsort((pts[:, 1], pts[:, 0]))
+    p = pts[order]
+    same = (p[1:, 0] == p[:-1, 0]) & (p[1:, 1] == p[:-1, 1])
+    if same.any():
+        starts = same & np.r_[True, ~same[:-1]]  # the first repeat of each point
+        x, y = (float(c) for c in p[1:][starts][0])
+        ctx.warn(
+            f"curves: the region's outlines touch at {int(starts.sum())} point(s) (first at "
+            f"({x:g}, {y:g})): the solid's parts meet there along an edge shared by four "
+            "faces, so it is not watertight once its vertices are merged (a slicer sees "
+            "separate parts joined by a non-manifold edge); move the outlines apart or make "
+            "them overlap (curves.boolean union) for one solid"
+        )
+
+
 def _o_fmt(sx: float, sy: float) -> str:
     return f"{sx:g}" if sx == sy else f"[{sx:g}, {sy:g}]"
 
@@ -62,24 +105,29 @@ def extrude(
     *,
     ctx: Context,
 ) -> Mesh:
-    """The region of closed curves in the XY plane extruded along +z into a closed solid.
+    """The region of closed curves in the XY plane (or one parallel to it) extruded along +z
+    into a closed solid.
 
     OpenSCAD's ``linear_extrude``, Grasshopper's Extrude with caps. The curves are read as
-    one region by the even-odd rule, holes included, as ``curves.boolean`` reads them (z
-    is dropped); the solid is closed, outward and consistently wound: its caps are the
-    region triangulated on the ring points (no point added), its sides one quad per ring
-    edge. While it rises the region turns by ``twist`` degrees (counter-clockwise seen
-    from +z, about the z axis; OpenSCAD turns the other way) and scales linearly to
-    ``scale`` at the top (after the turn). Exact curves are sampled so that every chord is
-    within ``tolerance`` of its curve; with a twist the solid is cut into slices so that
-    each point's helix is followed to the same tolerance (at most 45 degrees a slice), and
-    with a twist or unequal scales long edges get points along them, so that the sides'
-    triangles stay within the tolerance of the exact twisted surface.
+    one region by the even-odd rule, holes included, as ``curves.boolean`` reads them; the
+    solid rises from the plane they lie in (curves drawn at z = 5 give a solid from z = 5
+    to 5 + height; tilted curves, or curves at different heights, are read as their
+    projection onto XY and extruded from z = 0, with a warning). It is closed, outward
+    and consistently wound: its caps are the region triangulated on the ring points (no
+    point added), its sides one quad per ring edge. While it rises the region turns by
+    ``twist`` degrees (counter-clockwise seen from +z, about the z axis; OpenSCAD turns
+    the other way) and scales linearly to ``scale`` at the top (after the turn). Exact
+    curves are sampled so that every chord is within ``tolerance`` of its curve; with a
+    twist the solid is cut into slices so that each point's helix is followed to the same
+    tolerance (at most 45 degrees a slice), and with a twist or unequal scales long edges
+    get points along them, so that the sides' triangles stay within the tolerance of the
+    exact twisted surface.
 
     Parameters
     ----------
     curves : list[Curve]
-        Closed curves in the XY plane bounding the region (nested ones are holes).
+        Closed curves in the XY plane, or in one plane parallel to it, bounding the
+        region (nested ones are holes).
     height : float
         The height of the solid, > 0.
     twist : float
@@ -87,10 +135,13 @@ def extrude(
     scale : float | list[float]
         The top's scale, one number or [sx, sy]; 0 ends the solid in a point (a cone).
     center : bool
-        Put the solid from -height/2 to height/2 instead of from 0 to height.
+        Centre the solid on the curves' plane (from -height/2 to height/2 for curves at
+        z = 0) instead of rising from it.
     tolerance : float
         Largest distance between a curve and its chords (and between a twisted point's
-        helix and the side's edges). Default: 1e-5 of the size of the region.
+        helix and the side's edges). Default: 1e-5 of the size of the region. One past
+        1/50 of a curve's size is warned about (a circle sampled within its radius is a
+        square).
     slices : int
         Levels from bottom to top; default: one without a twist, else as the tolerance
         asks. More than 45 degrees of twist a slice is refused (the sides would cut across
@@ -106,6 +157,7 @@ def extrude(
     twist = _finite("twist", twist)
     sx, sy = _scale(scale)
     xy, offsets, hole, tol = _o.region_rings(curves, tolerance, ctx)
+    _warn_touching(xy, ctx)
     reach = float(np.sqrt((xy * xy).sum(axis=1).max())) * max(1.0, sx, sy)
     if slices is None:
         slices = ke.twist_slices(twist, reach, tol)
@@ -129,7 +181,7 @@ def extrude(
     n = len(xy)
     ctx.guard((slices + 1) * n, "vertices")
     ctx.guard(2 * slices * n + 2 * n, "faces")
-    bottom = -height / 2 if center else 0.0
+    bottom = _base(curves, ctx) - (height / 2 if center else 0.0)
     # (Mesh.trusted: the kernel's faces index its vertices by construction)
     return Mesh.trusted(*ke.extrude(xy, offsets, hole, height, twist, (sx, sy), slices, bottom))
 
@@ -173,6 +225,12 @@ def revolve(
     if not 0 < angle <= 360:
         raise InputError("angle", f"angle must be in (0, 360] degrees, got {angle:g}")
     xy, offsets, hole, tol = _o.region_rings(curves, tolerance, ctx)
+    level = _o.plane_height([curves] if isinstance(curves, Curve) else curves)
+    if level:
+        ctx.warn(
+            f"curves: the profile lies in the plane z = {level:g}, not z = 0: it is read in "
+            "XY (z dropped), turned up into the XZ plane and revolved as if drawn at z = 0"
+        )
     size = float(max(np.ptp(xy[:, 0]), np.ptp(xy[:, 1]), np.abs(xy).max()))
     near = np.abs(xy[:, 0]) <= 1e-9 * size  # on the axis, up to rounding: made exactly so
     if near.any():
@@ -186,6 +244,7 @@ def revolve(
             "region at x >= 0 (one that crosses the axis would sweep through itself); move "
             "it to x >= 0 or cut it at the axis with curves.boolean",
         )
+    _warn_touching(xy, ctx, skip=xy[:, 0] == 0.0)
     reach = float(xy[:, 0].max())
     if segments is None:
         segments = ke.turn_segments(angle, reach, tol)

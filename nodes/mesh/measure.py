@@ -30,12 +30,15 @@ def measure(mesh: Mesh, *, ctx: Context) -> MeshMeasures:
     """Area, volume, watertightness, bounding box, face count, parts and cavities of a mesh.
 
     Outputs: ``area`` (sum of face areas), ``volume`` (enclosed volume by the divergence
-    theorem; 0, with a warning, for a mesh that is not watertight), ``watertight`` (every
-    edge on exactly two faces), ``size`` and ``center`` of the bounding box, ``faces``,
-    ``parts`` (connected parts: faces joined through shared edges once coincident vertices
-    are merged, as ``mesh.split`` finds them) and ``cavities`` (closed parts inside an odd
-    number of other closed parts: sealed voids, which a slicer prints as inner shells;
-    found by the parity of a ray's crossings of the other parts).
+    theorem; 0, with a warning, for a mesh whose faces do not close), ``watertight`` (every
+    edge on exactly two faces, also once coincident vertices are merged as a slicer reading
+    an STL merges them: two solids touching along an edge are not watertight, their
+    shared edge is on four faces), ``size`` and ``center`` of the bounding box, ``faces``,
+    ``parts`` (connected parts: faces joined through edges shared by exactly two faces once
+    coincident vertices are merged, as ``mesh.split`` finds them and a slicer counts them)
+    and ``cavities`` (closed parts inside an odd number of other closed parts: sealed
+    voids, which a slicer prints as inner shells; found by the parity of a ray's crossings
+    of the other parts).
 
     The volume is signed: a closed mesh whose faces point inward measures negative, with a
     warning (``mesh.orient`` turns it outward); a closed mesh whose faces disagree across
@@ -46,13 +49,24 @@ def measure(mesh: Mesh, *, ctx: Context) -> MeshMeasures:
     mesh : Mesh
         Any polygon mesh.
     """
-    watertight = mesh.is_watertight
-    volume = mesh.volume if watertight else 0.0
+    parts = kparts.face_parts(*mesh.arrays)
+    closed_indexed = mesh.is_watertight
+    # watertight as a slicer sees the file: coincident vertices merged, every edge on two
+    # faces (solids touching along an edge share it among four: not manifold)
+    watertight = closed_indexed and parts.watertight
+    volume = mesh.volume if closed_indexed else 0.0
     if mesh.n_faces == 0:
         ctx.warn("mesh has no faces: area and volume 0")
-    elif not watertight:
+    elif not closed_indexed:
         open_edges = int(np.count_nonzero(mesh.edge_table.counts != 2))
         ctx.warn(f"mesh is not watertight ({open_edges} open or non-manifold edges): volume 0")
+    elif not watertight:
+        ctx.warn(
+            f"mesh is not watertight once coincident vertices are merged (as a slicer "
+            f"reads it): {parts.shared_edges} edge(s) lie on more than two "
+            f"faces (parts touching along an edge); its volume {volume:g} is the sum of its "
+            f"{parts.count} parts'"
+        )
     else:
         disagree = int(np.count_nonzero(mesh.edge_table.same_way))
         if disagree:
@@ -66,7 +80,6 @@ def measure(mesh: Mesh, *, ctx: Context) -> MeshMeasures:
                 "turns it outward"
             )
     lo, hi = mesh.bounds
-    parts = kparts.face_parts(*mesh.arrays)
     closed = np.flatnonzero(parts.closed)
     cavities = 0
     if len(closed) > 1:

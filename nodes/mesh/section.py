@@ -61,6 +61,29 @@ def _frame(mesh: Mesh, u: int, w: int, along: int) -> tuple[np.ndarray, float, f
     return frame, float(frame[:, 2].min()), float(frame[:, 2].max()), [0]
 
 
+def _missed(z: np.ndarray, tri: np.ndarray, axis: str, h: float, lo: float, hi: float) -> str:
+    """Why the plane ``axis = h`` gives no section: it misses the mesh, or it touches its
+    top (a face, an edge or a point in the plane, which the half-open rule leaves out)."""
+    if h != hi:
+        return (
+            f"the plane {axis} = {h:g} misses the mesh (it spans {axis} from {lo:g} to "
+            f"{hi:g}): no section"
+        )
+    on = (z == h)[tri].sum(axis=1)  # corners of each triangle in the plane
+    if (on == 3).any():
+        what = "a face lying in it"
+    elif (on == 2).any():
+        what = "an edge"
+    else:
+        what = "a point"
+    return (
+        f"the plane {axis} = {h:g} touches the mesh only at its top ({what}), where "
+        f"nothing is cut: no section (a section is taken where the plane has mesh on both "
+        f"sides; a plane just below, e.g. {axis} = {h - 1e-6 * max(hi - lo, 1e-300):.10g}, "
+        "gives the top's outline)"
+    )
+
+
 @node("mesh.slice", version=1)
 def mesh_slice(
     mesh: Mesh, height: float = 0.0, axis: Axis = Axis.z, *, ctx: Context
@@ -74,7 +97,11 @@ def mesh_slice(
     manifold3d's ``slice``), the cuts are chained across shared edges, and the loops are
     closed polylines in the plane: outer loops counter-clockwise and holes clockwise seen
     from +axis (for x the plane's (y, z), for y its (z, x)). The points are where the
-    mesh's edges cross the plane, computed once per edge. Loops of parts that overlap or
+    mesh's edges cross the plane, computed once per edge; points within 1e-9 of the
+    section's size of the straight line through their neighbours (a planar face cut
+    across the triangles fanned over it, a corner repeated by rounding) are left out, the
+    others kept exactly as computed. A plane that misses the mesh or only touches its top
+    gives an empty list and a warning that says which. Loops of parts that overlap or
     cross are united by their winding numbers (the section of the union). ``repeat:`` over
     heights makes a stack of layers.
 
@@ -100,10 +127,7 @@ def mesh_slice(
     tri = _triangles(mesh)
     frame, lo, hi, seen = mesh.derived(f"slice frame {along}", lambda: _frame(mesh, u, w, along))
     if not lo <= height < hi:
-        ctx.warn(
-            f"the plane {axis.value} = {height:g} misses the mesh (it spans {axis.value} "
-            f"from {lo:g} to {hi:g}; a plane at its top cuts nothing): no section"
-        )
+        ctx.warn(_missed(frame[:, 2], tri, Axis(axis).value, float(height), lo, hi))
         return []
     # a mesh sliced more than once (a stack, a slider) gets an index of its triangles by z
     seen[0] += 1
@@ -149,7 +173,10 @@ def project(mesh: Mesh, *, ctx: Context) -> list[Curve]:
     boundary, coincident vertices merged first) is a set of loops whose winding number
     counts the faces over each point; their nonzero fill (Clipper2's sweep, in
     manifold3d, scaled by a power of two so its 1e-8 grid is below double rounding) is the
-    shadow. Outer loops counter-clockwise, holes clockwise seen from +z.
+    shadow. Outer loops counter-clockwise, holes clockwise seen from +z, without points
+    on the straight line through their neighbours (within 1e-9 of the shadow's size). A
+    mesh whose shadow has no area (every face edge-on from above) gives an empty list and
+    a warning.
 
     Parameters
     ----------
@@ -167,7 +194,10 @@ def project(mesh: Mesh, *, ctx: Context) -> list[Curve]:
     tri = fan_triangles(merged[mesh.face_indices], mesh.face_offsets)
     xy, offsets = ksection.shadow_loops(mesh.vertices[first], tri)
     if len(offsets) < 2:
-        ctx.warn("every face is seen edge-on from above: the shadow has no area")
+        ctx.warn(
+            "the shadow has no area: every face is seen edge-on from above (a flat mesh "
+            "standing upright): no outline"
+        )
         return []
     rings = ksection.section_rings(xy, offsets, fill=True)
 
@@ -176,5 +206,8 @@ def project(mesh: Mesh, *, ctx: Context) -> list[Curve]:
 
     curves = _curves(rings, place)
     if not curves:
-        ctx.warn("the shadow has no area")
+        ctx.warn(
+            "the shadow has no area: every face is seen edge-on from above, up to rounding "
+            "(a flat mesh standing upright, e.g. a plane turned 90 degrees): no outline"
+        )
     return curves

@@ -6,6 +6,9 @@ Each case ends as a located sentence (file, line, node, input), a warning, or a 
 from __future__ import annotations
 
 import math
+import re
+import shutil
+import subprocess
 import time
 
 import numpy as np
@@ -291,3 +294,284 @@ def test_a_spline_with_huge_coordinates_still_gets_a_finite_box():
     out = g.evaluate("b")
     assert all(math.isfinite(x) for x in out.max)
     assert out.max[1] == pytest.approx(0.5e150, rel=1e-9)
+
+
+# ------------------------------------------------------------- the audit of issue 34
+
+BOW_TIE = "{type: curves.polyline, points: [[0, 0], [10, 10], [10, 0], [0, 10]], closed: true}"
+
+
+def _triangles(m: fg.Mesh) -> tuple[np.ndarray, np.ndarray]:
+    from formgraph.kernels.mesh.meshops import triangulate
+
+    v, fi, _ = triangulate(m.vertices, m.face_indices, m.face_offsets)
+    return v, fi.reshape(-1, 3)
+
+
+def test_a_bow_tie_is_two_parts_touching_along_an_edge_as_slicers_count_them(tmp_path):
+    """Two prisms sharing one vertical edge (four faces on it once welded): two parts, not
+    watertight, split into two closed solids of 25 each; trimesh and admesh agree."""
+    import trimesh
+    from tools import admesh
+
+    g = _graph(
+        f"  c: {BOW_TIE}\n"
+        "  e: {type: mesh.extrude, curves: ['@c'], height: 1}\n"
+        "  m: {type: mesh.measure, mesh: '@e'}\n"
+        "  s: {type: mesh.split, mesh: '@e'}\n"
+    )
+    with pytest.warns(fg.FormgraphWarning, match=r"node 'e'.*touch at 1 point.*\(5, 5\)"):
+        e = g.evaluate("e")
+    with pytest.warns(fg.FormgraphWarning, match=r"node 'm'.*1 edge\(s\) lie on more than two"):
+        m = g.evaluate("m")
+    assert (m.parts, m.watertight, m.volume) == (2, False, pytest.approx(50))
+    parts = g.evaluate("s")
+    assert [p.is_watertight for p in parts] == [True, True]
+    assert [p.volume for p in parts] == pytest.approx([25, 25])
+    ref = trimesh.Trimesh(*_triangles(e))  # welded, as trimesh loads it
+    assert not ref.is_watertight
+    assert len(ref.split(only_watertight=False)) == 2
+    path = tmp_path / "bow.stl"
+    ref.export(path)
+    if shutil.which("admesh"):
+        assert admesh(path)["Number of parts"] == 2
+    if shutil.which("prusa-slicer"):
+        info = subprocess.run(
+            ["prusa-slicer", "--info", str(path)], capture_output=True, text=True, timeout=120
+        ).stdout
+        assert re.search(r"number_of_parts\s*=\s*2", info)
+
+
+def test_a_fin_on_a_box_is_its_own_open_part_and_the_box_stays_closed():
+    """An edge on three faces joins none of them: the box (two of them) stays one closed
+    part, the fin (one) is an open part, as trimesh splits it."""
+    import trimesh
+
+    box = trimesh.creation.box()
+    v = np.vstack([box.vertices, [[0.5, 0.5, 1.5]]])
+    edge = next(e for e in box.edges_unique if np.ptp(box.vertices[e][:, 0]) == 1.0)
+    fin = [[edge[0], edge[1], len(v) - 1]]
+    mesh = fg.Mesh(v, np.vstack([box.faces, fin]))
+    g = fg.Graph()
+    g.add("m", "mesh.measure", mesh=mesh)
+    g.add("s", "mesh.split", mesh=mesh)
+    with pytest.warns(fg.FormgraphWarning, match="not watertight"):
+        m = g.evaluate("m")
+    assert (m.parts, m.watertight) == (2, False)
+    parts = g.evaluate("s")
+    assert [(p.n_faces, p.is_watertight) for p in parts] == [(12, True), (1, False)]
+    ref = trimesh.Trimesh(v, np.vstack([box.faces, fin])).split(only_watertight=False)
+    assert sorted(len(r.faces) for r in ref) == [1, 12]
+
+
+def test_a_revolved_region_touching_itself_off_the_axis_warns():
+    g = _graph(
+        "  a: {type: curves.rectangle, size: [1, 1], center: [1.5, 0.5, 0]}\n"
+        "  b: {type: curves.rectangle, size: [1, 1], center: [2.5, 1.5, 0]}\n"
+        "  r: {type: mesh.revolve, curves: ['@a', '@b'], segments: 16}\n"
+        "  s: {type: mesh.split, mesh: '@r'}\n"
+    )
+    with pytest.warns(fg.FormgraphWarning, match=r"node 'r'.*touch at 1 point.*\(2, 1\)"):
+        assert [p.is_watertight for p in g.evaluate("s")] == [True, True]
+
+
+def test_the_shadow_of_an_upright_plane_is_nothing_and_a_warning():
+    g = fg.Graph()
+    g.add("p", "mesh.plane", size=[1, 1])
+    g.add("r", "geometry.transform", geometry="@p", rotate=[90, 0, 0])  # cos 90 != 0
+    g.add("s", "mesh.project", mesh="@r")
+    with pytest.warns(fg.FormgraphWarning, match=r"node 's'.*shadow has no area.*edge-on"):
+        assert g.evaluate("s") == []
+
+
+@pytest.mark.parametrize("turn", [[90, 0, 0], [45, 0, 0], [0, 0, 30], [30, 0, 45]])
+def test_the_shadow_of_a_turned_box_has_no_repeated_or_collinear_points(turn):
+    """Its outline is the convex hull of its corners' shadows (scipy): exactly the hull's
+    points, each once, none on the line through its neighbours."""
+    from scipy.spatial import ConvexHull
+
+    g = fg.Graph()
+    g.add("b", "mesh.box")
+    g.add("r", "geometry.transform", geometry="@b", rotate=turn)
+    g.add("s", "mesh.project", mesh="@r")
+    (loop,) = g.evaluate("s")
+    pts = loop.control_points[:-1, :2]
+    corners = g.evaluate("r").vertices[:, :2]
+    hull = corners[ConvexHull(corners).vertices]
+    assert len(pts) == len(hull)
+    assert np.abs(pts[:, None] - hull[None]).max(axis=2).min(axis=1).max() < 1e-12
+
+
+def test_a_drilled_block_sliced_beside_its_hole_is_a_rectangle_of_four_corners():
+    """The section along x beside the hole cuts the top and bottom faces across the
+    triangles fanned from the hole: 4 corners, exactly at the block's, not hundreds of
+    collinear points; through the hole the sampled circle's points stay (each off its
+    neighbours' chord by the polygon's sagitta, far above 1e-9)."""
+    import shapely
+
+    g = _graph(
+        "  blk: {type: mesh.box, size: [40, 20, 10]}\n"
+        "  cyl: {type: mesh.cylinder, radius: 4, height: 30, segments: 200}\n"
+        "  d: {type: mesh.boolean, a: '@blk', b: '@cyl', operation: difference}\n"
+        "  x: {type: mesh.slice, mesh: '@d', axis: x, height: 10}\n"
+        "  z: {type: mesh.slice, mesh: '@d', height: 0}\n"
+    )
+    (rect,) = g.evaluate("x")
+    corners = {tuple(p) for p in rect.control_points[:-1, 1:].tolist()}
+    assert corners == {(-10.0, -5.0), (10.0, -5.0), (10.0, 5.0), (-10.0, 5.0)}
+    outer, hole = g.evaluate("z")
+    assert len(outer.control_points) == 5 and len(hole.control_points) == 201
+    area = shapely.Polygon(outer.control_points[:, :2], [hole.control_points[:, :2]]).area
+    assert area == pytest.approx(800 - 100 * 4**2 * math.sin(2 * math.pi / 200), rel=1e-12)
+
+
+def test_dropping_collinear_points_keeps_arcs_and_corners_exactly():
+    """Douglas-Peucker within a tolerance: a fine arc keeps a point wherever dropping it
+    would move the loop by more than the tolerance; every kept point is an input point;
+    a loop of no width goes."""
+    from formgraph.kernels.mesh.section import drop_collinear
+
+    t = np.linspace(0, 2 * np.pi, 20001)[:-1]
+    circle = np.c_[np.cos(t), np.sin(t)]
+    flat = np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 1e-12], [1.0, 0.0]])
+    square = np.array([[0, 0], [0.5, 0], [1, 0], [1, 1 - 1e-17], [1, 1], [0, 1], [0, 0.5]])
+    xy = np.r_[flat, circle, square].astype(float)
+    out, off = drop_collinear(xy, np.array([0, 4, 20004, 20011]), 1e-6)
+    assert np.diff(off).tolist()[1] == 4
+    assert out[off[1] :].tolist() == [[0, 0], [1, 0], [1, 1 - 1e-17], [0, 1]]
+    arc = out[: off[1]]
+    assert set(map(tuple, arc.tolist())) <= set(map(tuple, circle.tolist()))
+    # every dropped point within the tolerance of the chord between the kept ones
+    k = np.flatnonzero((circle[:, None] == arc[None]).all(axis=2).any(axis=1))
+    for a, b in zip(k, np.r_[k[1:], k[0] + len(circle)], strict=True):
+        mid = circle[np.arange(a + 1, b) % len(circle)]
+        p, q = circle[a], circle[b % len(circle)]
+        w, u = mid - p, q - p
+        d = np.abs(u[0] * w[:, 1] - u[1] * w[:, 0]) / np.hypot(*u)
+        assert d.max(initial=0) <= 1e-6
+    # chords of sagitta 1e-6 on r = 1 span 2 acos(1 - 1e-6) each: at least 2222 of them;
+    # splitting chords in two where they fail keeps fewer than twice that
+    least = math.ceil(2 * math.pi / (2 * math.acos(1 - 1e-6)))
+    assert least <= len(arc) < 2 * least
+
+
+def test_a_plane_through_the_top_face_says_it_touches_it():
+    g = _graph(
+        "  b: {type: mesh.box, size: [1, 1, 1]}\n"
+        "  s: {type: mesh.slice, mesh: '@b', height: 0.5}\n"
+        "  t: {type: geometry.transform, geometry: '@b', rotate: [45, 0, 0]}\n"
+    )
+    g.add("e", "mesh.slice", mesh="@t", height=float(g.evaluate("t").vertices[:, 2].max()))
+    with pytest.warns(
+        fg.FormgraphWarning,
+        match=r"z = 0.5 touches the mesh only at its top "
+        r"\(a face lying in it\).*no section.*z = 0.499999",
+    ):
+        assert g.evaluate("s") == []
+    with pytest.warns(fg.FormgraphWarning, match=r"touches the mesh only at its top \(an edge\)"):
+        assert g.evaluate("e") == []
+
+
+@pytest.mark.parametrize(
+    "curve",
+    [
+        "{type: nurbs.circle, radius: 2, normal: [0, 1, 0]}",
+        "{type: curves.polyline, points: [[0, 0, 0], [1, 0, 0], [1, 0, 1], [0, 0, 1]], "
+        "closed: true}",
+    ],
+)
+def test_an_outline_standing_across_the_xy_plane_is_said_to_be_so(curve):
+    g = _graph(f"  c: {curve}\n  e: {{type: mesh.extrude, curves: ['@c'], height: 1}}\n")
+    with pytest.raises(
+        fg.NodeError, match=r"h.yaml:4: node 'e', input 'curves'.*curve\(s\) 0 are not in the XY"
+    ):
+        g.evaluate("e")
+
+
+def test_a_square_turned_upright_by_rounding_is_no_sliver():
+    g = _graph(
+        "  s: {type: curves.rectangle, size: [2, 2]}\n"
+        "  t: {type: geometry.transform, geometry: '@s', rotate: [90, 0, 0]}\n"
+        "  e: {type: mesh.extrude, curves: ['@t'], height: 1}\n"
+    )
+    with pytest.raises(fg.NodeError, match="node 'e', input 'curves'.*not in the XY plane"):
+        g.evaluate("e")
+
+
+@pytest.mark.parametrize(("center", "span"), [(False, (5, 7)), (True, (4, 6))])
+def test_an_outline_at_z_5_is_extruded_from_its_own_plane(center, span):
+    g = fg.Graph()
+    g.add("c", "nurbs.circle", radius=1, center=[0, 0, 5])
+    g.add("e", "mesh.extrude", curves=["@c"], height=2, center=center)
+    m = g.evaluate("e")
+    assert g.stats["e"].warnings == []
+    assert m.bounds[:, 2].tolist() == list(span)
+    assert m.volume == pytest.approx(2 * math.pi, rel=1e-4)
+
+
+def test_outlines_at_two_heights_warn_and_rise_from_zero():
+    g = fg.Graph()
+    g.add("a", "curves.rectangle", size=[4, 4], center=[0, 0, 5])
+    g.add("b", "curves.rectangle", size=[1, 1], center=[0, 0, 2])
+    g.add("e", "mesh.extrude", curves=["@a", "@b"], height=1)
+    with pytest.warns(fg.FormgraphWarning, match=r"different heights \(z from 2 to 5\)"):
+        m = g.evaluate("e")
+    assert m.bounds[:, 2].tolist() == [0, 1] and m.volume == pytest.approx(15)
+
+
+def test_a_profile_off_the_xy_plane_warns_when_revolved():
+    g = fg.Graph()
+    g.add("a", "curves.rectangle", size=[1, 1], center=[2, 0, 5])
+    g.add("r", "mesh.revolve", curves=["@a"], segments=8)
+    with pytest.warns(fg.FormgraphWarning, match=r"node 'r'.*plane z = 5, not z = 0"):
+        g.evaluate("r")
+
+
+def test_a_tolerance_the_size_of_the_curve_warns_that_it_turns_a_circle_into_a_square():
+    g = fg.Graph()
+    g.add("c", "nurbs.circle", radius=5)
+    g.add("e", "mesh.extrude", curves=["@c"], height=2, tolerance=100)
+    g.add("fine", "mesh.extrude", curves=["@c"], height=2, tolerance=0.01)
+    with pytest.warns(
+        fg.FormgraphWarning,
+        match=r"node 'e'.*tolerance 100 is more than 1/50 of the size of curve 0 \(10\).*"
+        r"polygon of 4 points",
+    ):
+        assert g.evaluate("e").volume == pytest.approx(100)  # the inscribed square
+    assert g.evaluate("fine").volume == pytest.approx(50 * math.pi, rel=3e-3)
+    assert g.stats["fine"].warnings == []
+
+
+def test_the_pen_holders_label_faces_the_gallerys_camera():
+    """The gallery looks from (+1, +1, +1): the label stands on the +y face (y = depth / 2),
+    its letters standing out along +y, and reading left to right seen from +y (the text's
+    +x goes to -x; geometry.transform keeps the vertex order, so vertices correspond)."""
+    from pathlib import Path
+
+    g = fg.load(Path(__file__).parents[2] / "graphs" / "pen_holder.yaml")
+    flat, upright = g.evaluate("letters"), g.evaluate("upright")
+    depth = 60.0  # the graph's default
+    assert upright.bounds[0][1] == pytest.approx(depth / 2 - 0.4)
+    x, z = flat.vertices[:, 0], flat.vertices[:, 2]
+    moved = upright.vertices
+    assert moved[np.argmax(x), 0] == pytest.approx(moved[:, 0].min())  # end of text: left
+    assert moved[np.argmax(z), 1] == pytest.approx(moved[:, 1].max())  # relief: outward
+
+
+def test_closed_rings_lose_a_collinear_first_point_and_rings_of_no_width():
+    """The rings a section gives, each closed on its first point: a square starting halfway
+    along an edge is closed again on its first corner, a ring of no width goes, the steps
+    are the new rings' edge lengths (and the jump from one ring to the next)."""
+    from formgraph.kernels.mesh.section import _simplified
+
+    square = [[0.5, 0], [1, 0], [1, 1], [0, 1], [0, 0], [0.5, 0]]
+    flat = [[2, 0], [3, 0], [4, 0], [2, 0]]
+    tri = [[5, 0], [6, 0], [5, 1], [5, 0]]
+    coords = np.array(square + flat + tri, dtype=float)
+    out, off, step = _simplified(coords, np.array([0, 6, 10, 14]))
+    assert off.tolist() == [0, 5, 9]
+    assert out.tolist() == [[1, 0], [1, 1], [0, 1], [0, 0], [1, 0]] + tri
+    assert step == pytest.approx(np.hypot(*np.diff(out, axis=0).T))
+    same = np.array([[0, 0], [1, 0], [0, 1], [0, 0]], dtype=float)
+    kept = _simplified(same, np.array([0, 4]))
+    assert kept[0] is same and kept[2].tolist() == [1, 2**0.5, 1]

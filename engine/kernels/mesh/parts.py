@@ -2,11 +2,14 @@
 
 A part is a set of faces joined through shared edges once coincident vertices are merged
 (so a triangle soup, every triangle with its own three vertices as STL holds it, falls into
-the same parts as its welded mesh; two parts touching at one point stay two).
+the same parts as its welded mesh; two parts touching at one point stay two). Only an edge
+on exactly two faces joins them, as a slicer counts parts (admesh pairs the faces of an
+edge; trimesh's ``split`` joins across manifold edges only): two solids that touch along
+an edge (a bow-tie extruded, its edge on four faces) are two parts, each closed.
 
 - :func:`face_parts`: the part of every face: coincident vertices merged by one sort of a
-  hash of their coordinates (:func:`~.repair.exact_duplicates`), the faces on each edge
-  joined (:func:`~.measure.edge_table`), components of that graph by scipy's
+  hash of their coordinates (:func:`~.repair.exact_duplicates`), the two faces on each
+  manifold edge joined (:func:`~.measure.edge_table`), components of that graph by scipy's
   ``connected_components`` (a linear-time traversal in C);
 - :func:`split`: each part as its own compact mesh, every array of all parts made in one
   pass (the parts' faces and vertices gathered part after part, each part a slice);
@@ -43,7 +46,7 @@ class Parts:
         The part of each face: 0 is the first in order.
     count : int
     closed : (count,) bool
-        Every edge of the part lies on exactly two of its faces (watertight).
+        Every edge of the part lies on exactly two of its faces (watertight by itself).
     volume : (count,) float
         Signed volume of each part (meaningful for closed ones; negative: facing inward).
     area : (count,) float
@@ -52,6 +55,11 @@ class Parts:
         The merged vertex of every vertex (coincident vertices share one).
     first : (n_merged,) int64
         The first vertex of each merged vertex.
+    open_edges : int
+        Edges (of the merged mesh) on one face: boundary.
+    shared_edges : int
+        Edges (of the merged mesh) on more than two faces: non-manifold (parts that touch
+        along an edge, fins); a slicer reading the mesh as STL sees them.
     """
 
     part: np.ndarray
@@ -61,6 +69,14 @@ class Parts:
     area: np.ndarray
     merged: np.ndarray
     first: np.ndarray
+    open_edges: int = 0
+    shared_edges: int = 0
+
+    @property
+    def watertight(self) -> bool:
+        """Every edge of the merged mesh on exactly two faces (no boundary, no edge shared
+        by more than two faces): what a slicer reading the mesh as STL calls manifold."""
+        return self.count > 0 and self.open_edges == 0 and self.shared_edges == 0
 
 
 def face_parts(vertices: np.ndarray, face_indices: np.ndarray, face_offsets: np.ndarray) -> Parts:
@@ -93,23 +109,44 @@ def face_parts(vertices: np.ndarray, face_indices: np.ndarray, face_offsets: np.
     face_of_corner = np.repeat(np.arange(n_faces), np.diff(fo))
     faces = face_of_corner[table.order]  # faces run edge by edge
     run_end = np.cumsum(table.counts)
-    same_edge = np.ones(len(faces) - 1, dtype=bool) if len(faces) > 1 else np.zeros(0, bool)
-    same_edge[run_end[:-1] - 1] = False  # the last corner of a run and the next edge's first
+    # the faces of a manifold edge are joined; an edge on one face or on more than two
+    # joins nothing (parts that touch along an edge stay apart, as in a slicer)
+    same_edge = np.zeros(max(len(faces) - 1, 0), dtype=bool)
+    pair = table.counts == 2
+    same_edge[run_end[pair] - 2] = True  # the first corner of a two-face run and the second
     a, b = faces[:-1][same_edge], faces[1:][same_edge]
     graph = coo_matrix((np.ones(len(a), dtype=np.int8), (a, b)), shape=(n_faces, n_faces))
     count, label = connected_components(graph.tocsr(), directed=False)
     label = label.astype(np.int64)
-    # a part is open where one of its edges is not on exactly two faces
-    open_corner = np.repeat(table.counts != 2, table.counts)
+    # a part is open where one of its edges is on one face only of the part: an edge on
+    # one face, or an edge on more than two where the part holds other than two of them
     open_part = np.zeros(count, dtype=bool)
-    open_part[label[faces[open_corner]]] = True
+    alone = np.repeat(table.counts == 1, table.counts)
+    open_part[label[faces[alone]]] = True
+    many = table.counts > 2
+    if many.any():
+        corner = np.repeat(many, table.counts)
+        edge = np.repeat(np.arange(len(table.counts)), table.counts)[corner]
+        key = edge * count + label[faces[corner]]
+        keys, held = np.unique(key, return_counts=True)
+        open_part[(keys % count)[held != 2]] = True
     volume, area = _sizes(v, fi, fo, label, count)
     # closed first by size, then open by area; ties by the order the parts first appear
     size = np.where(open_part, area, np.abs(volume))
     rank = np.lexsort((np.arange(count), -size, open_part))
     new = np.empty(count, dtype=np.int64)
     new[rank] = np.arange(count)
-    return Parts(new[label], int(count), ~open_part[rank], volume[rank], area[rank], merged, first)
+    return Parts(
+        new[label],
+        int(count),
+        ~open_part[rank],
+        volume[rank],
+        area[rank],
+        merged,
+        first,
+        int(np.count_nonzero(table.counts == 1)),
+        int(np.count_nonzero(many)),
+    )
 
 
 def _sizes(

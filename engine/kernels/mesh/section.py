@@ -20,6 +20,9 @@ Both come out as the loops of a planar region, found by chaining oriented segmen
   through manifold3d's ``CrossSection``).
 - :func:`cycles`: the cycles of a successor permutation, each in order, by pointer jumping
   (Wyllie's list ranking, vectorized: log2 of the longest cycle rounds of gathers).
+- :func:`drop_collinear`: points of a loop within a tolerance of the chord between the
+  points kept around them left out (the section of a planar face cut where a mesh's
+  triangles fan across it, a corner repeated up to rounding), the points kept exactly;
 - :func:`region_of_loops`: loops to a valid region: by the even-odd rule of GEOS when that
   agrees with their winding numbers (their signed areas add up to the region's area, as
   they do for the section of a solid that does not intersect itself), else by Clipper2's
@@ -38,6 +41,8 @@ from .keys import sort_keys
 __all__ = [
     "SliceIndex",
     "cycles",
+    "collinear_mask",
+    "drop_collinear",
     "nonzero_fill",
     "region_of_loops",
     "section_rings",
@@ -295,6 +300,134 @@ def _without_repeats(xy: np.ndarray, offsets: np.ndarray) -> tuple[np.ndarray, n
     return xy, np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
 
 
+#: points within this fraction of the loops' size of the chord around them are dropped: far
+#: below any sampling tolerance (1e-5 of the size by default), far above double rounding
+COLLINEAR = 1e-9
+
+
+def drop_collinear(
+    xy: np.ndarray, offsets: np.ndarray, tol: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """The loops without the points that lie within ``tol`` of the chord joining the kept
+    points before and after them (cyclically), and without loops left with fewer than 3.
+
+    Douglas & Peucker's test (1973, "Algorithms for the reduction of the number of points
+    required to represent a digitized line"), every point at once: first each point is
+    tested against the chord of its two neighbours; then every point so dropped is tested
+    again against the chord between the kept points around its run, and where one is
+    further than ``tol`` the farthest of its run is kept (the chord split there), until no
+    dropped point is (each round only keeps more, so it ends; a run of drift needs a
+    second round, rarely a third). The distance is to the
+    chord as a segment, so a point where the loop turns back (a spike) is kept. Kept points
+    are the input's, bit for bit: corners stay exact.
+
+    Parameters
+    ----------
+    xy : (m, 2) float
+        Loop points, loop after loop, each without its closing point.
+    offsets : (c + 1,) int
+    tol : float
+        >= 0.
+
+    Returns
+    -------
+    xy, offsets
+    """
+    offsets = np.asarray(offsets, dtype=np.int64)
+    keep = collinear_mask(xy, offsets, tol)
+    if keep is None:
+        return xy, offsets
+    sizes = np.bincount(np.repeat(np.arange(len(offsets) - 1), np.diff(offsets))[keep])
+    sizes = sizes[sizes > 0]
+    return xy[keep], np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+
+
+def collinear_mask(xy: np.ndarray, offsets: np.ndarray, tol: float) -> np.ndarray | None:
+    """The points :func:`drop_collinear` keeps, as a (m,) bool mask, or None where it
+    keeps every point (the usual section of a curved part: nothing to copy)."""
+    m = len(xy)
+    if m == 0:
+        return None
+    sizes = np.diff(offsets)
+    loop = np.repeat(np.arange(len(sizes)), sizes)
+    start, end = offsets[:-1], offsets[1:]
+    idx = np.arange(m)
+    prev = idx - 1
+    prev[start] = end - 1
+    nxt = idx + 1
+    nxt[end - 1] = start
+    keep = _chord_distance(xy, prev, nxt) > tol
+    if keep.all() and sizes.min() >= 3:  # the usual section (a curved part's): nothing to drop
+        return None
+    # a loop with no point kept (a fine arc: every point near its neighbours' chord, or a
+    # loop of no width) starts from its first point and the point farthest from it
+    none = np.bincount(loop[keep], minlength=len(sizes)) == 0
+    if none.any():
+        seed = np.flatnonzero(none[loop])
+        far = np.hypot(*(xy[seed] - xy[start[loop[seed]]]).T)
+        order = np.lexsort((far, loop[seed]))
+        last = np.r_[loop[seed][order][1:] != loop[seed][order][:-1], True]
+        keep[start[none]] = True
+        keep[seed[order[last]]] = True
+    # a dropped point between two kept ones was tested against the very chord it would
+    # leave: only runs of dropped points need the rounds below (a quad's diagonal cut
+    # between its sides' cuts, every other point of a section, does not)
+    in_runs = (~keep & (~keep[prev] | ~keep[nxt])).any()
+    while in_runs:
+        b, a = _kept_around(keep, loop, start, end)
+        dropped = np.flatnonzero(~keep & (a >= 0))
+        dist = _chord_distance(xy, b[dropped], a[dropped], dropped)
+        far = dist > tol
+        if not far.any():
+            break
+        # of each run of dropped points (the same kept point before them) the farthest
+        # from its chord is kept, as Douglas-Peucker splits a chord at its farthest point
+        run, dist = b[dropped][far], dist[far]
+        order = np.lexsort((dist, run))
+        last = np.r_[run[order][1:] != run[order][:-1], True]
+        keep[dropped[far][order[last]]] = True
+    kept = np.bincount(loop[keep], minlength=len(sizes))
+    keep &= (kept >= 3)[loop]
+    return None if keep.all() else keep
+
+
+def _kept_around(
+    keep: np.ndarray, loop: np.ndarray, start: np.ndarray, end: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """For every point, the kept point before it and the one after it in its loop
+    (cyclically); -1 for both in a loop with no point kept."""
+    m = len(keep)
+    idx = np.arange(m)
+    low = np.where(keep, idx, -1)
+    high = np.where(keep, idx, m)
+    before = np.r_[-1, np.maximum.accumulate(low)[:-1]]
+    after = np.r_[np.minimum.accumulate(high[::-1])[::-1][1:], m]
+    last = np.maximum.reduceat(low, start)  # each loop's last kept point (-1: none)
+    first = np.minimum.reduceat(high, start)
+    wrap = before < start[loop]
+    before[wrap] = last[loop[wrap]]
+    wrap = after >= end[loop]
+    after[wrap] = first[loop[wrap]]
+    none = last[loop] < 0
+    before[none] = after[none] = -1
+    return before, after
+
+
+def _chord_distance(
+    xy: np.ndarray, a: np.ndarray, b: np.ndarray, p: np.ndarray | None = None
+) -> np.ndarray:
+    """Distance from each point p (default: every point) to the segment from point a to
+    point b."""
+    x, y = xy[:, 0], xy[:, 1]  # by coordinate: one gather per column, no (n, 2) temporaries
+    ax, ay = x[a], y[a]
+    dx, dy = x[b] - ax, y[b] - ay
+    wx, wy = (x - ax, y - ay) if p is None else (x[p] - ax, y[p] - ay)
+    dd = dx * dx + dy * dy
+    t = np.clip((wx * dx + wy * dy) / np.where(dd > 0, dd, 1.0), 0.0, 1.0)
+    rx, ry = wx - t * dx, wy - t * dy
+    return np.sqrt(rx * rx + ry * ry)
+
+
 def shadow_loops(v: np.ndarray, tri: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The boundary of the up-and-down counted projection of the triangles, as loops.
 
@@ -430,9 +563,36 @@ def section_rings(
             twice = np.dot(x[:-1] - x[0], y[1:] - y[0]) - np.dot(x[1:] - x[0], y[:-1] - y[0])
             if twice < 0:
                 ring = ring[::-1].copy()
-            d = np.diff(ring, axis=0)
-            step = np.sqrt(np.einsum("ij,ij->i", d, d))
-            return ring, np.array([0, len(ring)], dtype=np.int64), step, False
+            return (*_simplified(ring, np.array([0, len(ring)], dtype=np.int64)), False)
     region, filled = region_of_loops(xy, offsets, fill)
     coords, off, _, step = kregions.rings_of(region, steps=True)
-    return coords, off, step, filled
+    return (*_simplified(coords, off, step), filled)
+
+
+def _simplified(
+    coords: np.ndarray, offsets: np.ndarray, step: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Closed rings (each ending on its first point) without their collinear points
+    (:func:`collinear_mask` within :data:`COLLINEAR` of their size), and their steps
+    (``step`` when given and nothing is dropped)."""
+    r = len(offsets) - 1
+    if r > 0:
+        closing = offsets[1:] - 1
+        body = np.ones(len(coords), dtype=bool)
+        body[closing] = False
+        loops = coords[body]
+        size = float((loops.max(axis=0) - loops.min(axis=0)).max())  # (np.ptp is slower)
+        mask = collinear_mask(loops, offsets - np.arange(r + 1), COLLINEAR * size)
+        if mask is not None:
+            body[body] = mask  # the kept points of the rings' bodies
+            kept = np.add.reduceat(body, offsets[:-1], dtype=np.int64)  # per ring: 0 or >= 3
+            ring = np.flatnonzero(kept)
+            body[closing[ring]] = True  # a kept ring's closing point, moved below
+            coords = coords[body]
+            offsets = np.concatenate([[0], np.cumsum(kept[ring] + 1)]).astype(np.int64)
+            coords[offsets[1:] - 1] = coords[offsets[:-1]]  # closed on its (new) first point
+            step = None
+    if step is None:
+        d = np.diff(coords, axis=0)
+        step = np.sqrt(np.einsum("ij,ij->i", d, d))
+    return coords, offsets, step
