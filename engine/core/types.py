@@ -250,7 +250,12 @@ class PortType:
                 return None
             raise TypeMismatch(f"expected {self.name}, got nothing (null)")
         errors = []
-        for k in self.kinds:
+        kinds = self.kinds
+        if isinstance(value, (list, tuple)) and not value and len(kinds) > 1:
+            # An empty list where a list is one of the choices is that list (no curves), not
+            # an empty point set: what ``Points([])`` would also take.
+            kinds = tuple(sorted(kinds, key=lambda k: not k.is_list))
+        for k in kinds:
             try:
                 out = _coerce_kind(k, value)
             except TypeMismatch as exc:

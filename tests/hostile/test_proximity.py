@@ -54,6 +54,27 @@ def test_filtering_everything_away_gives_an_empty_value_not_an_error():
     assert out.n_faces == 0 and out.n_vertices == 0
 
 
+TEXT = "  c: {type: curves.text, text: 'Hi', size: 10}\n"
+
+
+@pytest.mark.parametrize("keep", ["'=area < 0'", "false"])
+def test_filtering_all_curves_away_gives_an_empty_list_of_curves_and_says_so(keep, tmp_path):
+    text = TEXT + f"  f: {{type: geometry.filter, geometry: '@c', keep: {keep}}}\n"
+    text += "  s: {type: export.svg, curves: '@f', path: out.svg}\n"
+    g = _graph(text, out_dir=tmp_path)
+    with pytest.warns(fg.FormgraphWarning, match=r"node 'f': keep is false for all 3 curves"):
+        assert g.evaluate("f") == []
+    # the next node sees no curves (not an empty point set of the wrong type)
+    with pytest.raises(fg.NodeError, match="node 's'.*needs at least one path, got none"):
+        g.evaluate("s")
+
+
+def test_a_filter_on_an_empty_list_of_curves_reads_the_curve_names():
+    text = "  c: {type: curves.text, text: ' ', size: 10}\n"
+    text += "  f: {type: geometry.filter, geometry: '@c', keep: '=length > 0'}\n"
+    assert _graph(text).evaluate("f") == []
+
+
 # ------------------------------------------------------------------------- attr.distance
 
 
