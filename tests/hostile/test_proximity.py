@@ -184,6 +184,38 @@ def test_curvature_of_degenerate_triangles_is_finite():
     assert np.all(np.isfinite(out.point_data["gaussian_curvature"]))
 
 
+CIRCLE = (
+    "  p: {type: points.list, points: [[0, 0, 0], [2, 0, 0], [0, 3, 0], [0.5, 0.5, 0]]}\n"
+    "  c: {type: nurbs.circle, radius: 1}\n"
+)
+
+
+@pytest.mark.parametrize("tol", ["1e-12", "1e-300"])
+def test_a_tolerance_below_double_precision_is_refused_before_sampling(tol):
+    text = CIRCLE + f"  d: {{type: attr.distance, geometry: '@p', to: '@c', tolerance: {tol}}}\n"
+    with pytest.raises(
+        fg.NodeError,
+        match=rf"h.yaml:5: node 'd', input 'tolerance'.*a tolerance of {tol} is below what "
+        r"double precision resolves on curves 2 across: use 2e-11 or more",
+    ):
+        _graph(text).evaluate("d")
+
+
+def test_curve_samples_a_tolerance_asks_for_are_counted_before_sampling():
+    text = CIRCLE + "  d: {type: attr.distance, geometry: '@p', to: '@c', tolerance: 1e-8}\n"
+    # a circle sampled within 1e-8 needs about 2 pi / sqrt(8e-8) = 22,214 chords
+    with pytest.raises(
+        fg.BudgetError,
+        match=r"h.yaml:5: node 'd': a tolerance of 1e-08 asks for about 22,\d{3} curve "
+        r"samples, over the budget of 10,000: use a tolerance of ([\d.]+e-07) or more",
+    ) as err:
+        _graph(text, budget=10_000).evaluate("d")
+    enough = err.value.args[0].split("use a tolerance of ")[1].split()[0]
+    out = _graph(text.replace("1e-8", enough), budget=10_000).evaluate("d")
+    # the tolerance it names does fit, and the distances are within it of the exact ones
+    assert np.allclose(out.point_data["distance"], [1, 1, 2, 1 - np.sqrt(0.5)], atol=float(enough))
+
+
 # ------------------------------------------------------------------------- voronoi
 
 
