@@ -234,6 +234,56 @@ def test_voronoi_of_too_few_or_coincident_points_is_located(points, message):
         _graph(text).evaluate("v")
 
 
+@pytest.mark.parametrize(
+    ("points", "message"),
+    [
+        (
+            "[[0, 0], [1e-13, 0], [1, 1]]",
+            r"points 0 and 1 are only 1e-13 apart, under 1e-09 of the diagram's extent 1.1",
+        ),
+        (
+            "[[0, 0], [1e300, 0], [0, 1e300]]",
+            r"point 1 at \(1e\+300, 0\) lies past 1e\+15 from the origin \(2 points do\)",
+        ),
+        (
+            "[[0, 0], [1e-300, 0], [0, 1e-300]]",
+            r"the points and their region span only 1.1e-300: a Voronoi diagram needs 1e-100",
+        ),
+    ],
+)
+def test_voronoi_of_points_past_double_arithmetic_is_refused_in_words(points, message):
+    text = f"  p: {{type: points.list, points: {points}}}\n"
+    text += "  v: {type: curves.voronoi, points: '@p'}\n"
+    with pytest.raises(fg.NodeError, match=rf"h.yaml:4: node 'v', input 'points'.*: {message}"):
+        _graph(text).evaluate("v")
+
+
+def test_voronoi_of_points_just_apart_enough_still_tiles_the_box():
+    text = "  p: {type: points.list, points: [[0, 0], [2e-9, 0], [1, 1]]}\n"
+    text += "  v: {type: curves.voronoi, points: '@p'}\n"
+    cells = _graph(text).evaluate("v")
+    assert len(cells) == 3
+
+
+def test_a_failure_of_geos_is_a_located_sentence(monkeypatch):
+    import shapely
+
+    from formgraph.kernels.curves import voronoi as kvoronoi
+
+    def fails(*_):
+        raise shapely.errors.GEOSException("TopologyException: side location conflict at 0 0")
+
+    monkeypatch.setattr(kvoronoi, "cells", fails)
+    text = "  p: {type: points.list, points: [[0, 0], [1, 0], [1, 1]]}\n"
+    text += "  v: {type: curves.voronoi, points: '@p'}\n"
+    with pytest.raises(
+        fg.NodeError,
+        match=r"h.yaml:4: node 'v', input 'points'.*GEOS could not build the diagram of these "
+        r"points \(side location conflict\): they are too near together or too far apart",
+    ):
+        _graph(text).evaluate("v")
+
+
 def test_voronoi_of_collinear_points_still_tiles_the_box():
     text = "  p: {type: points.list, points: [[0, 0], [1, 0], [2, 0], [3, 0]]}\n"
     text += "  v: {type: curves.voronoi, points: '@p'}\n"

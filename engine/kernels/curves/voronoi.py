@@ -18,7 +18,15 @@ from __future__ import annotations
 import numpy as np
 import shapely
 
-__all__ = ["cells", "coincident", "triangles"]
+__all__ = ["NEAREST", "SMALLEST", "cells", "coincident", "closest_pair", "triangles"]
+
+# Two points nearer than this fraction of the diagram's extent are refused: GEOS's
+# incremental Delaunay triangulation loses the side of a point at about 1e-13 of it
+# ("side location conflict"), and such a cell would be a sliver no cutter follows anyway.
+NEAREST = 1e-9
+# The smallest extent of a diagram: the circumcentres GEOS computes square coordinate
+# differences, which underflow below about 1e-150.
+SMALLEST = 1e-100
 
 
 def coincident(xy: np.ndarray) -> tuple[int, int] | None:
@@ -32,6 +40,18 @@ def coincident(xy: np.ndarray) -> tuple[int, int] | None:
     pairs = np.sort(np.stack([order[same], order[same + 1]], axis=1), axis=1)
     i, j = pairs[np.lexsort((pairs[:, 1], pairs[:, 0]))[0]]
     return int(i), int(j)
+
+
+def closest_pair(xy: np.ndarray) -> tuple[int, int, float]:
+    """The two nearest points (i < j) of ``xy`` (n, 2), n >= 2, and their distance: a k-d
+    tree's nearest neighbour of every point (scipy's cKDTree), O(n log n)."""
+    from scipy.spatial import cKDTree
+
+    p = np.asarray(xy, dtype=np.float64)
+    d, k = cKDTree(p).query(p, k=2)
+    i = int(np.argmin(d[:, 1]))
+    j = int(k[i, 1])
+    return min(i, j), max(i, j), float(d[i, 1])
 
 
 def cells(xy: np.ndarray, region: shapely.Geometry) -> tuple[np.ndarray, np.ndarray]:
