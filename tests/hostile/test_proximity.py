@@ -150,6 +150,7 @@ def test_a_spacing_too_small_is_over_the_budget_before_anything_is_drawn():
         ("count: 1000000000000", "", "over the budget"),
         ("spacing: 0", "spacing", "spacing must be > 0"),
         ("count: 5, spacing: 1", "count", "not both"),
+        ("count: 5, seed: -3", "seed", "must be >= 0, got -3"),
     ],
 )
 def test_scatter_counts_and_spacings_that_cannot_be(inputs, port, message):
@@ -157,6 +158,30 @@ def test_scatter_counts_and_spacings_that_cannot_be(inputs, port, message):
     where = f", input '{port}'" if port else ""
     with pytest.raises(fg.FormgraphError, match=rf"h.yaml:4: node 's'{where}.*{message}"):
         _graph(text).evaluate("s")
+
+
+def test_scatter_on_a_surface_past_the_largest_coordinate_is_refused_in_words():
+    text = "  box: {type: mesh.box, size: [1e200, 1e200, 1e200]}\n"
+    text += "  s: {type: points.scatter, geometry: '@box', spacing: 1e190}\n"
+    with pytest.raises(
+        fg.NodeError,
+        match=r"h.yaml:4: node 's', input 'geometry'.*reaches a coordinate of 5e\+199, past "
+        r"1e\+15",
+    ):
+        _graph(text).evaluate("s")
+
+
+def test_a_spacing_past_the_surface_takes_one_point_without_overflow():
+    text = "  box: {type: mesh.box, size: [1, 1, 1]}\n"
+    text += "  s: {type: points.scatter, geometry: '@box', spacing: 1e190}\n"
+    out = _graph(text).evaluate("s")
+    assert len(out) == 1 and np.all(np.abs(out.xyz) <= 0.5)
+
+
+def test_a_negative_seed_of_random_points_names_the_input_and_the_rule():
+    text = "  r: {type: points.random, count: 3, seed: -3}\n"
+    with pytest.raises(fg.GraphError, match=r"h.yaml:3: node 'r', input 'seed': must be >= 0"):
+        _graph(text).evaluate("r")
 
 
 def test_scatter_on_a_mesh_without_area_is_a_located_error():
