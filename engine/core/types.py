@@ -355,6 +355,8 @@ def _coerce_kind(k: Kind, value: Any) -> Any:
         if isinstance(value, (list, tuple)):
             if k.base is Vec3:
                 return _vec_list(value)
+            if _is_geometry(k.base) and all(isinstance(v, k.base) for v in value):
+                return value  # a node's list of geometry, already of the class: as it is
             items = [_coerce_kind(Kind(k.base), v) for v in value]
             return Entries(items, value.entries) if isinstance(value, Entries) else items
         if k.base is Vec3 and isinstance(value, np.ndarray) and value.ndim == 2:

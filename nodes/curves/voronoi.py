@@ -14,6 +14,10 @@ from formgraph.kernels.curves import voronoi as kvoronoi
 from formgraph.kernels.geometry import MAX_COORDINATE
 from formgraph.nodes import _outlines as _o
 
+# What a cell counts against the element budget: each is an object of its own (a GEOS
+# polygon, then a NurbsCurve of three arrays), about 28 us of CPU, the time of some 200
+# elements of a vectorized array job; so 300,000 points (8 s) are over the default budget.
+CELL_COST = 200
 MARGIN = 0.05  # the default region: the points' box, each side moved out by 5 % of its size
 
 
@@ -120,7 +124,7 @@ def voronoi(
     ``cells: {type: curves.voronoi, points: "@seeds", region: "@panel"}``
     """
     xy = _sites(points, 2, "a Voronoi diagram")
-    ctx.guard(8 * len(xy), "cell corners")
+    ctx.guard(CELL_COST * len(xy), f"elements' worth of cells ({CELL_COST} a cell)")
     area = _region(region, xy, ctx)
     outside = ~shapely.intersects_xy(area, xy[:, 0], xy[:, 1])
     if outside.any():

@@ -324,6 +324,18 @@ def test_voronoi_with_an_open_region_curve_is_refused():
         _graph(text).evaluate("v")
 
 
+def test_a_300000_point_voronoi_is_over_the_default_budget_before_it_is_built():
+    """It ran 37 s: every cell is a curve object of its own, counted as 200 elements."""
+    text = "  p: {type: points.random, count: 300000, seed: 1}\n"
+    text += "  v: {type: curves.voronoi, points: '@p'}\n"
+    with pytest.raises(
+        fg.BudgetError,
+        match=r"h.yaml:4: node 'v': would make 60,000,000 elements' worth of cells \(200 a "
+        r"cell\), over the budget of 50,000,000",
+    ):
+        _graph(text).evaluate("v")
+
+
 def test_huge_voronoi_and_delaunay_counts_are_over_a_small_budget():
     text = "  p: {type: points.random, count: 100000, seed: 1}\n"
     text += (

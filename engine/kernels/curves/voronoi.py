@@ -71,16 +71,26 @@ def cells(xy: np.ndarray, region: shapely.Geometry) -> tuple[np.ndarray, np.ndar
     sites = shapely.multipoints(p)
     diagram = shapely.voronoi_polygons(sites, extend_to=region, ordered=True)
     raw = shapely.get_parts(diagram)
-    clipped = shapely.intersection(raw, region)
+    clipped = raw.copy()
+    # Only the cells that reach out of the region are cut: for a rectangle (the default
+    # region) a cell whose box lies inside it is inside it, and the diagram's cells reach
+    # the region's box only at its rim, so most cells skip the intersection
+    box = np.asarray(shapely.bounds(region), dtype=np.float64)
+    rectangle = shapely.area(region) == shapely.area(shapely.envelope(region))
+    if rectangle:
+        b = shapely.bounds(raw)
+        cut = (b[:, 0] < box[0]) | (b[:, 1] < box[1]) | (b[:, 2] > box[2]) | (b[:, 3] > box[3])
+    else:
+        cut = np.ones(len(raw), dtype=bool)
+    clipped[cut] = shapely.intersection(raw[cut], region)
     odd = (shapely.get_type_id(clipped) != 3) | (shapely.get_num_interior_rings(clipped) > 0)
     split = np.zeros(len(p), dtype=bool)
-    pts = shapely.points(p)
     for i in np.flatnonzero(odd).tolist():  # one step per odd cell: rare
         # a collection (a polygon with a stray line or point where it touches the region's
         # outline at a corner), pieces, or a hole: the polygon round the point, unholed
         parts = shapely.get_parts(clipped[i])
         parts = parts[(shapely.get_type_id(parts) == 3) & (shapely.area(parts) > 0)]
-        hold = shapely.intersects(parts, pts[i])
+        hold = shapely.intersects(parts, shapely.points(p[i]))
         piece = parts[np.argmax(hold)] if hold.any() else parts[np.argmax(shapely.area(parts))]
         split[i] = len(parts) > 1 or shapely.get_num_interior_rings(piece) > 0
         clipped[i] = shapely.polygons(shapely.get_exterior_ring(piece))
