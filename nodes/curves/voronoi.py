@@ -21,19 +21,27 @@ CELL_COST = 200
 MARGIN = 0.05  # the default region: the points' box, each side moved out by 5 % of its size
 
 
+def _refuse_any(bad: np.ndarray, xy: np.ndarray, where: str, why: str) -> None:
+    """Refuse the points where ``bad`` is true, naming the first and counting them."""
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise InputError(
+            "points",
+            f"point {i} at ({xy[i, 0]:g}, {xy[i, 1]:g}) {where} ({int(bad.sum())} points "
+            f"do){why if why.startswith(':') else ', ' + why}",
+        )
+
+
 def _sites(points: Points, least: int, what: str) -> np.ndarray:
     xy = np.asarray(points.xyz)[:, :2]
     if len(xy) < least:
         raise InputError("points", f"{what} needs at least {least} points, got {len(xy)}")
-    far = np.abs(xy).max(axis=1) > MAX_COORDINATE
-    if far.any():
-        i = int(np.argmax(far))
-        raise InputError(
-            "points",
-            f"point {i} at ({xy[i, 0]:g}, {xy[i, 1]:g}) lies past {MAX_COORDINATE:g} from the "
-            f"origin ({int(far.sum())} points do), where a double no longer holds a tenth "
-            "of a unit: move or scale the points nearer",
-        )
+    _refuse_any(
+        np.abs(xy).max(axis=1) > MAX_COORDINATE,
+        xy,
+        f"lies past {MAX_COORDINATE:g} from the origin",
+        "where a double no longer holds a tenth of a unit: move or scale the points nearer",
+    )
     pair = kvoronoi.coincident(xy)
     if pair is not None:
         i, j = pair
@@ -126,15 +134,12 @@ def voronoi(
     xy = _sites(points, 2, "a Voronoi diagram")
     ctx.guard(CELL_COST * len(xy), f"elements' worth of cells ({CELL_COST} a cell)")
     area = _region(region, xy, ctx)
-    outside = ~shapely.intersects_xy(area, xy[:, 0], xy[:, 1])
-    if outside.any():
-        i = int(np.argmax(outside))
-        raise InputError(
-            "points",
-            f"point {i} at ({xy[i, 0]:g}, {xy[i, 1]:g}) lies outside the region "
-            f"({int(outside.sum())} points do): its cell would not hold it; keep the points "
-            "inside (geometry.filter) or grow the region",
-        )
+    _refuse_any(
+        ~shapely.intersects_xy(area, xy[:, 0], xy[:, 1]),
+        xy,
+        "lies outside the region",
+        ": its cell would not hold it; keep the points inside (geometry.filter) or grow the region",
+    )
     _apart(xy, area)
     polygons, split = _diagram(xy, area)
     if split.any():
