@@ -250,7 +250,12 @@ class PortType:
                 return None
             raise TypeMismatch(f"expected {self.name}, got nothing (null)")
         errors = []
-        for k in self.kinds:
+        kinds = self.kinds
+        if isinstance(value, (list, tuple)) and not value and len(kinds) > 1:
+            # An empty list where a list is one of the choices is that list (no curves), not
+            # an empty point set: what ``Points([])`` would also take.
+            kinds = tuple(sorted(kinds, key=lambda k: not k.is_list))
+        for k in kinds:
             try:
                 out = _coerce_kind(k, value)
             except TypeMismatch as exc:
@@ -350,6 +355,8 @@ def _coerce_kind(k: Kind, value: Any) -> Any:
         if isinstance(value, (list, tuple)):
             if k.base is Vec3:
                 return _vec_list(value)
+            if _is_geometry(k.base) and all(isinstance(v, k.base) for v in value):
+                return value  # a node's list of geometry, already of the class: as it is
             items = [_coerce_kind(Kind(k.base), v) for v in value]
             return Entries(items, value.entries) if isinstance(value, Entries) else items
         if k.base is Vec3 and isinstance(value, np.ndarray) and value.ndim == 2:

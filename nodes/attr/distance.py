@@ -13,7 +13,7 @@ from typing import Annotated, Any
 
 import numpy as np
 
-from formgraph.core.errors import InputError
+from formgraph.core.errors import BudgetError, InputError
 from formgraph.core.registry import Context, Range, node
 from formgraph.core.types import SameAs
 from formgraph.geometry import Curve, Field, Mesh, NurbsCurve, Points
@@ -24,6 +24,9 @@ from formgraph.kernels.geometry.meshdist import fan_triangles
 from formgraph.language.elements import VARIABLES
 
 _TOLERANCE = 1e-5  # curves are sampled within this fraction of their extent by default
+# The finest tolerance, as a fraction of the curves' extent: chord gaps below about 1e-11
+# of it are rounding noise of the curve's evaluation in double precision.
+_FINEST = 1e-11
 CLOSEST = "closest"
 
 
@@ -54,40 +57,68 @@ def check_name(name: str, port: str = "name") -> None:
 def curve_segments(curves: list[Curve], tolerance: float | None, ctx: Context) -> np.ndarray:
     """(m, 2, 3) the segments of polylines within ``tolerance`` of ``curves`` (a degree-1
     NURBS exactly: its own corners); the chords are split at their parameter midpoints
-    until each is within the tolerance (``sampling.refine_chords``)."""
+    until each is within the tolerance (``sampling.refine_chords``).
+
+    Before any refinement the samples the tolerance asks for are counted against the
+    budget: a chord's distance from its curve falls with the square of its parameter
+    width, so a starting chord ``g`` away needs about ``sqrt(g / tolerance)`` pieces (the
+    tolerance suggested leaves room for the midpoint splits, which overshoot by up to 2). A
+    tolerance below what double precision resolves at the curves' extent is refused (the
+    refinement would chase rounding noise)."""
     if tolerance is not None and not tolerance > 0:
         raise InputError("tolerance", f"the tolerance must be positive, got {tolerance}")
-    lines: list[np.ndarray] = []
+    boxes = [
+        np.asarray(c.control_points) if isinstance(c, NurbsCurve) else c.sample(65) for c in curves
+    ]
+    every = np.concatenate(boxes) if boxes else np.zeros((0, 3))
+    extent = float(np.ptp(every, axis=0).max()) if len(every) else 0.0
+    extent = extent if extent > 0 else 1.0
+    tol = _TOLERANCE * extent if tolerance is None else tolerance
+    if tol < _FINEST * extent:
+        raise InputError(
+            "tolerance",
+            f"a tolerance of {tol:g} is below what double precision resolves on curves "
+            f"{extent:g} across: use {_FINEST * extent:.3g} or more",
+        )
+    starts = []  # (evaluate, parameters, points, chord gaps) of each curved curve
+    polylines: list[np.ndarray] = []
+    for c in curves:  # one step per curve; its sampling is vectorized
+        if isinstance(c, NurbsCurve) and c.degree == 1:
+            polylines.append(np.asarray(c.control_points))
+            continue
+        t0, t1 = c.domain
+        if isinstance(c, NurbsCurve):  # each knot span cut in 8 to start
+            k = np.unique(np.asarray(c.knots))
+            k = k[(k >= t0) & (k <= t1)]
+            u = np.unique(np.linspace(k[:-1], k[1:], 9).ravel())
+        else:
+            u = np.linspace(t0, t1, 65)
+
+        def at(uu: np.ndarray, c: Curve = c) -> np.ndarray:
+            return np.asarray(c.evaluate(uu), dtype=np.float64).reshape(-1, 3)
+
+        p = at(u)
+        gap = sampling.chord_gap(p[:-1], p[1:], at(0.5 * (u[:-1] + u[1:])))
+        starts.append((at, u, p, gap))
+    root = sum(float(np.sqrt(g).sum()) for *_, g in starts)
+    wanted = sum(len(p) for p in polylines) + sum(len(u) for _, u, _, _ in starts)
+    wanted += root / np.sqrt(tol)
+    if wanted > ctx.budget:
+        raise BudgetError(
+            f"a tolerance of {tol:g} asks for about {wanted:,.0f} curve samples, over the "
+            f"budget of {ctx.budget:,}: use a tolerance of {(2 * root / ctx.budget) ** 2:.3g} or "
+            "more (or raise the budget with --budget)"
+        )
     total = 0
 
     def guard(n: int) -> None:
         ctx.guard(total + n, "curve samples")
 
-    tol = tolerance
-    if tol is None:
-        boxes = [
-            np.asarray(c.control_points) if isinstance(c, NurbsCurve) else c.sample(65)
-            for c in curves
-        ]
-        every = np.concatenate(boxes)
-        extent = float(np.ptp(every, axis=0).max()) if len(every) else 0.0
-        tol = _TOLERANCE * (extent if extent > 0 else 1.0)
-    for c in curves:  # one step per curve; its sampling is vectorized
-        if isinstance(c, NurbsCurve) and c.degree == 1:
-            p = np.asarray(c.control_points)
-        else:
-            t0, t1 = c.domain
-            if isinstance(c, NurbsCurve):  # each knot span cut in 8 to start
-                k = np.unique(np.asarray(c.knots))
-                k = k[(k >= t0) & (k <= t1)]
-                u = np.unique(np.linspace(k[:-1], k[1:], 9).ravel())
-            else:
-                u = np.linspace(t0, t1, 65)
-
-            def at(uu: np.ndarray, c: Curve = c) -> np.ndarray:
-                return np.asarray(c.evaluate(uu), dtype=np.float64).reshape(-1, 3)
-
-            _, p = sampling.refine_chords(at, u, at(u), tol, guard)
+    lines: list[np.ndarray] = []
+    for at, u, p, _ in starts:
+        _, p = sampling.refine_chords(at, u, p, tol, guard)
+        polylines.append(p)
+    for p in polylines:
         if len(p) < 2:
             continue
         guard(len(p))

@@ -11,15 +11,37 @@ from formgraph.core.registry import Context, node
 from formgraph.geometry import Curve, Mesh, NurbsCurve, Points, frozen_array
 from formgraph.kernels.curves import regions as kregions
 from formgraph.kernels.curves import voronoi as kvoronoi
+from formgraph.kernels.geometry import MAX_COORDINATE
 from formgraph.nodes import _outlines as _o
 
+# What a cell counts against the element budget: each is an object of its own (a GEOS
+# polygon, then a NurbsCurve of three arrays), about 28 us of CPU, the time of some 200
+# elements of a vectorized array job; so 300,000 points (8 s) are over the default budget.
+CELL_COST = 200
 MARGIN = 0.05  # the default region: the points' box, each side moved out by 5 % of its size
+
+
+def _refuse_any(bad: np.ndarray, xy: np.ndarray, where: str, why: str) -> None:
+    """Refuse the points where ``bad`` is true, naming the first and counting them."""
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise InputError(
+            "points",
+            f"point {i} at ({xy[i, 0]:g}, {xy[i, 1]:g}) {where} ({int(bad.sum())} points "
+            f"do){why if why.startswith(':') else ', ' + why}",
+        )
 
 
 def _sites(points: Points, least: int, what: str) -> np.ndarray:
     xy = np.asarray(points.xyz)[:, :2]
     if len(xy) < least:
         raise InputError("points", f"{what} needs at least {least} points, got {len(xy)}")
+    _refuse_any(
+        np.abs(xy).max(axis=1) > MAX_COORDINATE,
+        xy,
+        f"lies past {MAX_COORDINATE:g} from the origin",
+        "where a double no longer holds a tenth of a unit: move or scale the points nearer",
+    )
     pair = kvoronoi.coincident(xy)
     if pair is not None:
         i, j = pair
@@ -48,6 +70,42 @@ def _region(region: Curve | list[Curve] | None, xy: np.ndarray, ctx: Context) ->
     return area
 
 
+def _apart(xy: np.ndarray, area: shapely.Geometry) -> None:
+    """Refuse points too near together for the diagram: nearer than ``NEAREST`` of its
+    extent (the region's box), or a diagram under ``SMALLEST`` across."""
+    lo, hi = np.split(np.asarray(shapely.bounds(area), dtype=np.float64), 2)
+    extent = float((hi - lo).max())
+    if not extent >= kvoronoi.SMALLEST:
+        raise InputError(
+            "points",
+            f"the points and their region span only {extent:g}: a Voronoi diagram needs "
+            f"{kvoronoi.SMALLEST:g} or more (scale them up with geometry.transform)",
+        )
+    i, j, d = kvoronoi.closest_pair(xy)
+    if d < kvoronoi.NEAREST * extent:
+        raise InputError(
+            "points",
+            f"points {i} and {j} are only {d:.3g} apart, under {kvoronoi.NEAREST:g} of the "
+            f"diagram's extent {extent:g}: the edge between their cells is past what double "
+            "arithmetic resolves (drop one, e.g. with geometry.filter)",
+        )
+
+
+def _diagram(xy: np.ndarray, area: shapely.Geometry) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`kvoronoi.cells`, a failure of GEOS said in words (none is expected past the
+    checks above; it would be a robustness limit of its arithmetic)."""
+    try:
+        return kvoronoi.cells(xy, area)
+    except shapely.errors.GEOSException as exc:
+        reason = str(exc).split(" at ")[0].split(":")[-1].strip()
+        raise InputError(
+            "points",
+            f"GEOS could not build the diagram of these points ({reason}): they are too "
+            "near together or too far apart for its arithmetic; spread them or drop the "
+            "closest ones (geometry.filter)",
+        ) from None
+
+
 @node("curves.voronoi", version=1)
 def voronoi(
     points: Points, region: Curve | list[Curve] | None = None, *, ctx: Context
@@ -63,7 +121,8 @@ def voronoi(
     Parameters
     ----------
     points : Points
-        At least 2, no two at the same XY place, all inside the region.
+        At least 2, all inside the region, within 1e15 of the origin, no two nearer
+        than 1e-9 of the region's extent.
     region : Curve | list[Curve] | None
         Closed curves bounding the region (even-odd, as ``curves.boolean`` reads them);
         none: the points' box, each side moved out by 5 % of its larger side.
@@ -73,18 +132,16 @@ def voronoi(
     ``cells: {type: curves.voronoi, points: "@seeds", region: "@panel"}``
     """
     xy = _sites(points, 2, "a Voronoi diagram")
-    ctx.guard(8 * len(xy), "cell corners")
+    ctx.guard(CELL_COST * len(xy), f"elements' worth of cells ({CELL_COST} a cell)")
     area = _region(region, xy, ctx)
-    outside = ~shapely.intersects_xy(area, xy[:, 0], xy[:, 1])
-    if outside.any():
-        i = int(np.argmax(outside))
-        raise InputError(
-            "points",
-            f"point {i} at ({xy[i, 0]:g}, {xy[i, 1]:g}) lies outside the region "
-            f"({int(outside.sum())} points do): its cell would not hold it; keep the points "
-            "inside (geometry.filter) or grow the region",
-        )
-    polygons, split = kvoronoi.cells(xy, area)
+    _refuse_any(
+        ~shapely.intersects_xy(area, xy[:, 0], xy[:, 1]),
+        xy,
+        "lies outside the region",
+        ": its cell would not hold it; keep the points inside (geometry.filter) or grow the region",
+    )
+    _apart(xy, area)
+    polygons, split = _diagram(xy, area)
     if split.any():
         ctx.warn(
             f"the region cuts {int(split.sum())} cells into pieces or holes them: each keeps "

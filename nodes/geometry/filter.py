@@ -86,6 +86,13 @@ def _mask(keep: Any, env: Any, count: int, what: str) -> np.ndarray:
     return np.full(count, bool(keep))
 
 
+def _say_if_none_kept(mask: np.ndarray, what: str, ctx: Context) -> None:
+    """Warn when a test drops all of a non-empty input: the result is empty (of the input's
+    kind), which is rarely what was meant and would otherwise pass without a word."""
+    if mask.size and not mask.any():
+        ctx.warn(f"keep is false for all {mask.size} {what}: nothing was kept")
+
+
 @node("geometry.filter", version=1)
 def filter_elements(
     geometry: Points | Mesh | list[Curve],
@@ -103,7 +110,8 @@ def filter_elements(
     all kept; by face, the faces kept; either way the points no kept face uses are dropped,
     and point and face attributes follow. A list of curves keeps whole curves, the test
     over ``i``, ``count``, ``length``, ``closed``, ``area`` (signed: counter-clockwise seen
-    from +z is positive) and the centroid ``x y z`` of each.
+    from +z is positive) and the centroid ``x y z`` of each. A test that keeps nothing
+    gives an empty value of the input's kind (an empty list of curves) and a warning.
 
     Parameters
     ----------
@@ -123,6 +131,7 @@ def filter_elements(
         if domain is Domain.face:
             raise InputError("domain", "a list of curves keeps whole curves; use domain: point")
         mask = _mask(keep, lambda: curve_env(geometry), len(geometry), "curves")
+        _say_if_none_kept(mask, "curves", ctx)
         return [c for c, k in zip(geometry, mask.tolist(), strict=True) if k]
     if isinstance(geometry, Points):
         if domain is Domain.face:
@@ -131,6 +140,7 @@ def filter_elements(
         ctx.guard(n, "points")
         names = keep.names if isinstance(keep, ElementValue) else set()
         mask = _mask(keep, lambda: element_env(geometry, "point", names), n, "points")
+        _say_if_none_kept(mask, "points", ctx)
         idx = np.flatnonzero(mask)
         return Points(geometry.xyz[idx], carry.carried(geometry, carry.copy(idx))["point_data"])
     m = geometry
@@ -139,6 +149,7 @@ def filter_elements(
     names = keep.names if isinstance(keep, ElementValue) else set()
     what = "faces" if domain is Domain.face else "points"
     mask = _mask(keep, lambda: element_env(m, domain.value, names), count, what)
+    _say_if_none_kept(mask, what, ctx)
     faces = mask if domain is Domain.face else select.faces_of_points(*m.arrays[1:], mask)
     vertex, fi, fo, face = select.keep_faces(m.face_indices, m.face_offsets, m.n_vertices, faces)
     data = carry.carried(m, carry.copy(vertex), carry.copy(face))

@@ -11,6 +11,7 @@ from formgraph.core.errors import BudgetError, InputError
 from formgraph.core.registry import Context, Range, node
 from formgraph.geometry import Mesh, Points, Surface
 from formgraph.kernels.attributes import propagate as carry
+from formgraph.kernels.geometry import MAX_COORDINATE
 from formgraph.kernels.geometry.meshdist import fan_triangles
 from formgraph.kernels.mesh import meshops
 from formgraph.kernels.mesh import scatter as kscatter
@@ -37,7 +38,7 @@ def scatter(
     geometry: Mesh | Surface,
     count: Annotated[int | None, Range(min=0)] = None,
     spacing: Annotated[float | None, Range(min=0)] = None,
-    seed: int = 0,
+    seed: Annotated[int, Range(min=0)] = 0,
     *,
     ctx: Context,
 ) -> Points:
@@ -62,7 +63,7 @@ def scatter(
     spacing : float | None
         The least distance between points (Poisson disk); give this or ``count``.
     seed : int
-        The random stream.
+        The random stream, 0 or more.
 
     Example
     -------
@@ -83,6 +84,13 @@ def scatter(
         ctx.guard((GRID + 1) ** 2, "surface samples")
         v, uv, tri = _surface_triangles(geometry)
         face_of = np.repeat(np.arange(GRID * GRID), 2)
+    far = float(np.abs(v).max()) if len(v) else 0.0
+    if not far <= MAX_COORDINATE:
+        raise InputError(
+            "geometry",
+            f"the surface reaches a coordinate of {far:.3g}, past {MAX_COORDINATE:g}, where "
+            "a double no longer holds a tenth of a unit and its area overflows: scale it down",
+        )
     area = float(kscatter.triangle_areas(v, tri).sum())
     if not area > 0:
         raise InputError("geometry", "the surface has no area to scatter points on")
@@ -90,8 +98,11 @@ def scatter(
     if spacing is not None:
         if not spacing > 0:
             raise InputError("spacing", f"spacing must be > 0, got {spacing:g}")
+        # A spacing past twice the surface's diagonal takes one point, as that does; the
+        # bound keeps spacing^2 finite (a spacing of 1e190 would overflow it)
+        spacing = min(spacing, 2.0 * float(np.linalg.norm(np.ptp(v, axis=0))) or spacing)
         ctx.guard(kscatter.most_points(area, spacing), "points")
-        darts = kscatter.DARTS * area / spacing**2
+        darts = kscatter.DARTS * area / spacing / spacing  # no overflow of spacing**2
         if darts > ctx.budget:
             raise BudgetError(
                 f"spacing {spacing:g} on an area of {area:.6g} needs {darts:,.0f} candidate "

@@ -83,7 +83,7 @@ def circle(
 @node("points.random", version=1)
 def random(
     count: Annotated[int, Range(min=0)],
-    seed: int = 0,
+    seed: Annotated[int, Range(min=0)] = 0,
     min: Vec3 = (0.0, 0.0, 0.0),
     max: Vec3 = (1.0, 1.0, 1.0),
     *,

@@ -79,6 +79,8 @@ def mesh(path: InputPath, weld: bool = False, *, ctx: Context) -> Mesh:
     _, data = ctx.read(path)
     v, fi, fo, attributes = parsed(path, "a mesh", readers.mesh_data, path, data, ctx.budget)
     ctx.guard(len(fo) - 1, "faces")
+    if len(fo) < 2:  # an STL of 'solid x / endsolid x' alone, an OBJ of vertices only
+        ctx.warn(f"{path}: it holds no faces (an STL: no facets), so the mesh is empty")
     if weld:
         if attributes:
             ctx.warn(f"{path}: welding drops the vertex attributes ({', '.join(attributes)})")

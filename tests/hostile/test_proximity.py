@@ -54,6 +54,27 @@ def test_filtering_everything_away_gives_an_empty_value_not_an_error():
     assert out.n_faces == 0 and out.n_vertices == 0
 
 
+TEXT = "  c: {type: curves.text, text: 'Hi', size: 10}\n"
+
+
+@pytest.mark.parametrize("keep", ["'=area < 0'", "false"])
+def test_filtering_all_curves_away_gives_an_empty_list_of_curves_and_says_so(keep, tmp_path):
+    text = TEXT + f"  f: {{type: geometry.filter, geometry: '@c', keep: {keep}}}\n"
+    text += "  s: {type: export.svg, curves: '@f', path: out.svg}\n"
+    g = _graph(text, out_dir=tmp_path)
+    with pytest.warns(fg.FormgraphWarning, match=r"node 'f': keep is false for all 3 curves"):
+        assert g.evaluate("f") == []
+    # the next node sees no curves (not an empty point set of the wrong type)
+    with pytest.raises(fg.NodeError, match="node 's'.*needs at least one path, got none"):
+        g.evaluate("s")
+
+
+def test_a_filter_on_an_empty_list_of_curves_reads_the_curve_names():
+    text = "  c: {type: curves.text, text: ' ', size: 10}\n"
+    text += "  f: {type: geometry.filter, geometry: '@c', keep: '=length > 0'}\n"
+    assert _graph(text).evaluate("f") == []
+
+
 # ------------------------------------------------------------------------- attr.distance
 
 
@@ -129,6 +150,7 @@ def test_a_spacing_too_small_is_over_the_budget_before_anything_is_drawn():
         ("count: 1000000000000", "", "over the budget"),
         ("spacing: 0", "spacing", "spacing must be > 0"),
         ("count: 5, spacing: 1", "count", "not both"),
+        ("count: 5, seed: -3", "seed", "must be >= 0, got -3"),
     ],
 )
 def test_scatter_counts_and_spacings_that_cannot_be(inputs, port, message):
@@ -136,6 +158,30 @@ def test_scatter_counts_and_spacings_that_cannot_be(inputs, port, message):
     where = f", input '{port}'" if port else ""
     with pytest.raises(fg.FormgraphError, match=rf"h.yaml:4: node 's'{where}.*{message}"):
         _graph(text).evaluate("s")
+
+
+def test_scatter_on_a_surface_past_the_largest_coordinate_is_refused_in_words():
+    text = "  box: {type: mesh.box, size: [1e200, 1e200, 1e200]}\n"
+    text += "  s: {type: points.scatter, geometry: '@box', spacing: 1e190}\n"
+    with pytest.raises(
+        fg.NodeError,
+        match=r"h.yaml:4: node 's', input 'geometry'.*reaches a coordinate of 5e\+199, past "
+        r"1e\+15",
+    ):
+        _graph(text).evaluate("s")
+
+
+def test_a_spacing_past_the_surface_takes_one_point_without_overflow():
+    text = "  box: {type: mesh.box, size: [1, 1, 1]}\n"
+    text += "  s: {type: points.scatter, geometry: '@box', spacing: 1e190}\n"
+    out = _graph(text).evaluate("s")
+    assert len(out) == 1 and np.all(np.abs(out.xyz) <= 0.5)
+
+
+def test_a_negative_seed_of_random_points_names_the_input_and_the_rule():
+    text = "  r: {type: points.random, count: 3, seed: -3}\n"
+    with pytest.raises(fg.GraphError, match=r"h.yaml:3: node 'r', input 'seed': must be >= 0"):
+        _graph(text).evaluate("r")
 
 
 def test_scatter_on_a_mesh_without_area_is_a_located_error():
@@ -163,6 +209,38 @@ def test_curvature_of_degenerate_triangles_is_finite():
     assert np.all(np.isfinite(out.point_data["gaussian_curvature"]))
 
 
+CIRCLE = (
+    "  p: {type: points.list, points: [[0, 0, 0], [2, 0, 0], [0, 3, 0], [0.5, 0.5, 0]]}\n"
+    "  c: {type: nurbs.circle, radius: 1}\n"
+)
+
+
+@pytest.mark.parametrize("tol", ["1e-12", "1e-300"])
+def test_a_tolerance_below_double_precision_is_refused_before_sampling(tol):
+    text = CIRCLE + f"  d: {{type: attr.distance, geometry: '@p', to: '@c', tolerance: {tol}}}\n"
+    with pytest.raises(
+        fg.NodeError,
+        match=rf"h.yaml:5: node 'd', input 'tolerance'.*a tolerance of {tol} is below what "
+        r"double precision resolves on curves 2 across: use 2e-11 or more",
+    ):
+        _graph(text).evaluate("d")
+
+
+def test_curve_samples_a_tolerance_asks_for_are_counted_before_sampling():
+    text = CIRCLE + "  d: {type: attr.distance, geometry: '@p', to: '@c', tolerance: 1e-8}\n"
+    # a circle sampled within 1e-8 needs about 2 pi / sqrt(8e-8) = 22,214 chords
+    with pytest.raises(
+        fg.BudgetError,
+        match=r"h.yaml:5: node 'd': a tolerance of 1e-08 asks for about 22,\d{3} curve "
+        r"samples, over the budget of 10,000: use a tolerance of ([\d.]+e-07) or more",
+    ) as err:
+        _graph(text, budget=10_000).evaluate("d")
+    enough = err.value.args[0].split("use a tolerance of ")[1].split()[0]
+    out = _graph(text.replace("1e-8", enough), budget=10_000).evaluate("d")
+    # the tolerance it names does fit, and the distances are within it of the exact ones
+    assert np.allclose(out.point_data["distance"], [1, 1, 2, 1 - np.sqrt(0.5)], atol=float(enough))
+
+
 # ------------------------------------------------------------------------- voronoi
 
 
@@ -181,6 +259,56 @@ def test_voronoi_of_too_few_or_coincident_points_is_located(points, message):
         _graph(text).evaluate("v")
 
 
+@pytest.mark.parametrize(
+    ("points", "message"),
+    [
+        (
+            "[[0, 0], [1e-13, 0], [1, 1]]",
+            r"points 0 and 1 are only 1e-13 apart, under 1e-09 of the diagram's extent 1.1",
+        ),
+        (
+            "[[0, 0], [1e300, 0], [0, 1e300]]",
+            r"point 1 at \(1e\+300, 0\) lies past 1e\+15 from the origin \(2 points do\)",
+        ),
+        (
+            "[[0, 0], [1e-300, 0], [0, 1e-300]]",
+            r"the points and their region span only 1.1e-300: a Voronoi diagram needs 1e-100",
+        ),
+    ],
+)
+def test_voronoi_of_points_past_double_arithmetic_is_refused_in_words(points, message):
+    text = f"  p: {{type: points.list, points: {points}}}\n"
+    text += "  v: {type: curves.voronoi, points: '@p'}\n"
+    with pytest.raises(fg.NodeError, match=rf"h.yaml:4: node 'v', input 'points'.*: {message}"):
+        _graph(text).evaluate("v")
+
+
+def test_voronoi_of_points_just_apart_enough_still_tiles_the_box():
+    text = "  p: {type: points.list, points: [[0, 0], [2e-9, 0], [1, 1]]}\n"
+    text += "  v: {type: curves.voronoi, points: '@p'}\n"
+    cells = _graph(text).evaluate("v")
+    assert len(cells) == 3
+
+
+def test_a_failure_of_geos_is_a_located_sentence(monkeypatch):
+    import shapely
+
+    from formgraph.kernels.curves import voronoi as kvoronoi
+
+    def fails(*_):
+        raise shapely.errors.GEOSException("TopologyException: side location conflict at 0 0")
+
+    monkeypatch.setattr(kvoronoi, "cells", fails)
+    text = "  p: {type: points.list, points: [[0, 0], [1, 0], [1, 1]]}\n"
+    text += "  v: {type: curves.voronoi, points: '@p'}\n"
+    with pytest.raises(
+        fg.NodeError,
+        match=r"h.yaml:4: node 'v', input 'points'.*GEOS could not build the diagram of these "
+        r"points \(side location conflict\): they are too near together or too far apart",
+    ):
+        _graph(text).evaluate("v")
+
+
 def test_voronoi_of_collinear_points_still_tiles_the_box():
     text = "  p: {type: points.list, points: [[0, 0], [1, 0], [2, 0], [3, 0]]}\n"
     text += "  v: {type: curves.voronoi, points: '@p'}\n"
@@ -193,6 +321,18 @@ def test_voronoi_with_an_open_region_curve_is_refused():
     text += "  r: {type: curves.polyline, points: [[0, 0], [1, 0], [1, 1]]}\n"
     text += "  v: {type: curves.voronoi, points: '@p', region: '@r'}\n"
     with pytest.raises(fg.NodeError, match="h.yaml:5: node 'v', input 'region'.*: curve 0 is open"):
+        _graph(text).evaluate("v")
+
+
+def test_a_300000_point_voronoi_is_over_the_default_budget_before_it_is_built():
+    """It ran 37 s: every cell is a curve object of its own, counted as 200 elements."""
+    text = "  p: {type: points.random, count: 300000, seed: 1}\n"
+    text += "  v: {type: curves.voronoi, points: '@p'}\n"
+    with pytest.raises(
+        fg.BudgetError,
+        match=r"h.yaml:4: node 'v': would make 60,000,000 elements' worth of cells \(200 a "
+        r"cell\), over the budget of 50,000,000",
+    ):
         _graph(text).evaluate("v")
 
 

@@ -649,3 +649,96 @@ def test_a_dxf_ezdxf_cannot_read_is_said_without_an_exception_name(tmp_path):
         tmp_path, data, "not a DXF drawing ezdxf can read: Invalid tag", "j.dxf"
     )
     assert "cannot read it as a drawing" in message
+
+
+# ------------------------------------------------- #35 audit: readers still lenient or silent
+
+
+def test_an_off_face_index_that_is_not_whole_is_refused(tmp_path):
+    """``3 0 1 2.5`` read as ``3 0 1 2``; a colour after the indices may still be fractional."""
+    head = b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n"
+    _mesh_refused(tmp_path, "a.off", head + b"3 0 1 2.5\n", r"face 0: '2\.5' is not a whole number")
+    _mesh_refused(tmp_path, "b.off", head + b"3.0 0 1 2\n", r"face 0: '3\.0' is not a whole")
+    status, (v, f) = bounded(_read_mesh, tmp_path, "c.off", head + b"3 0 1 2 0.5 0.25 1\n")
+    assert status == "ok" and f.tolist() == [0, 1, 2]
+
+
+def test_a_ply_face_index_that_is_not_whole_is_refused(tmp_path):
+    head = (
+        b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+        b"property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
+        b"end_header\n0 0 0\n1 0 0\n0 1 0\n"
+    )
+    _mesh_refused(tmp_path, "a.ply", head + b"3 0 1 2.5\n", "face 0: its vertex index 2.5 is not")
+    _mesh_refused(tmp_path, "b.ply", head + b"2.5 0 1 2\n", "face 0: its vertex count 2.5 is not")
+
+
+def test_an_ascii_stl_without_facets_is_read_empty_with_a_warning(tmp_path):
+    import formgraph as fg
+
+    (tmp_path / "s.stl").write_bytes(b"solid x\nendsolid x\n")
+    (tmp_path / "g.yaml").write_text("formgraph: 1\nnodes:\n  m: {type: read.mesh, path: s.stl}\n")
+    with pytest.warns(fg.FormgraphWarning, match=r"s.stl: it holds no faces \(an STL: no facets"):
+        m = fg.load(tmp_path / "g.yaml").evaluate("m")
+    assert m.n_faces == 0
+
+
+@pytest.mark.parametrize("width", ["1e-320mm", "1e-20mm"])
+def test_an_svg_width_too_small_to_draw_is_refused(tmp_path, width):
+    """svgelements gave no shapes at all for it, and the reader no curves and no word."""
+    data = f'{SVG} width="{width}" height="10mm" viewBox="0 0 10 10"><path d="M0 0 L5 5"/></svg>'
+    curves_refused(tmp_path, data.encode(), f"width '{width}' is below 1e-09 of its unit")
+
+
+def _dxf_text(build) -> str:
+    ezdxf = pytest.importorskip("ezdxf")
+    doc = ezdxf.new()
+    build(doc.modelspace())
+    out = io.StringIO()
+    doc.write(out)
+    return out.getvalue()
+
+
+def _dxf_warnings(folder, text: str):
+    import formgraph as fg
+
+    (folder / "d.dxf").write_text(text)
+    (folder / "g.yaml").write_text("formgraph: 1\nnodes:\n  c: {type: read.curves, path: d.dxf}\n")
+    with pytest.warns(fg.FormgraphWarning) as caught:
+        curves = fg.load(folder / "g.yaml").evaluate("c")
+    return curves, " ".join(str(w.message) for w in caught)
+
+
+def test_a_dxf_polyline_of_0_or_1_points_is_warned_about_with_its_handle(tmp_path):
+    def build(m):
+        m.add_lwpolyline([(1, 1)], dxfattribs={"handle": "B0"})
+        m.add_lwpolyline([(2, 2)], dxfattribs={"handle": "B1"})
+        m.add_line((0, 0), (1, 1))
+
+    text = _dxf_text(build)  # ezdxf writes no empty LWPOLYLINE itself: B0's point removed
+    at = text.index("B0\n")
+    text = text[:at] + text[at:].replace(
+        " 90\n1\n 70\n0\n 10\n1.0\n 20\n1.0\n", " 90\n0\n 70\n0\n", 1
+    )
+    curves, said = _dxf_warnings(tmp_path, text)
+    assert len(curves) == 1  # the line
+    assert "LWPOLYLINE that draws nothing (0 points: a polyline needs 2 distinct points" in said
+    assert "LWPOLYLINE that draws nothing (1 point: a polyline needs 2 distinct points" in said
+    assert "handle B0" in said and "handle B1" in said
+
+
+def test_a_dxf_spline_of_coincident_fit_points_says_what_is_wrong(tmp_path):
+    text = _dxf_text(
+        lambda m: m.add_spline(fit_points=[(1, 1, 0), (1, 1, 0)], dxfattribs={"handle": "30"})
+    )
+    curves, said = _dxf_warnings(tmp_path, text)
+    assert curves == []
+    assert "SPLINE that draws nothing (its 2 fit points are one point" in said
+    assert "handle 30" in said
+
+
+def test_a_dxf_arc_past_the_largest_coordinate_is_refused_with_its_handle(tmp_path):
+    text = _dxf_text(lambda m: m.add_arc((0, 0), 1e308, 0, 90, dxfattribs={"handle": "A9"}))
+    curves_refused(tmp_path, text.encode(), r"ARC A9 reaches .*past the 1e\+15 mm", "a.dxf")
+    text = _dxf_text(lambda m: m.add_arc((0, 0), 1e13, 0, 90, dxfattribs={"handle": "A9"}))
+    curves_refused(tmp_path, text.encode(), r"ARC A9 reaches 1e\+16 mm", "b.dxf")

@@ -18,7 +18,15 @@ from __future__ import annotations
 import numpy as np
 import shapely
 
-__all__ = ["cells", "coincident", "triangles"]
+__all__ = ["NEAREST", "SMALLEST", "cells", "coincident", "closest_pair", "triangles"]
+
+# Two points nearer than this fraction of the diagram's extent are refused: GEOS's
+# incremental Delaunay triangulation loses the side of a point at about 1e-13 of it
+# ("side location conflict"), and such a cell would be a sliver no cutter follows anyway.
+NEAREST = 1e-9
+# The smallest extent of a diagram: the circumcentres GEOS computes square coordinate
+# differences, which underflow below about 1e-150.
+SMALLEST = 1e-100
 
 
 def coincident(xy: np.ndarray) -> tuple[int, int] | None:
@@ -32,6 +40,18 @@ def coincident(xy: np.ndarray) -> tuple[int, int] | None:
     pairs = np.sort(np.stack([order[same], order[same + 1]], axis=1), axis=1)
     i, j = pairs[np.lexsort((pairs[:, 1], pairs[:, 0]))[0]]
     return int(i), int(j)
+
+
+def closest_pair(xy: np.ndarray) -> tuple[int, int, float]:
+    """The two nearest points (i < j) of ``xy`` (n, 2), n >= 2, and their distance: a k-d
+    tree's nearest neighbour of every point (scipy's cKDTree), O(n log n)."""
+    from scipy.spatial import cKDTree
+
+    p = np.asarray(xy, dtype=np.float64)
+    d, k = cKDTree(p).query(p, k=2)
+    i = int(np.argmin(d[:, 1]))
+    j = int(k[i, 1])
+    return min(i, j), max(i, j), float(d[i, 1])
 
 
 def cells(xy: np.ndarray, region: shapely.Geometry) -> tuple[np.ndarray, np.ndarray]:
@@ -51,16 +71,26 @@ def cells(xy: np.ndarray, region: shapely.Geometry) -> tuple[np.ndarray, np.ndar
     sites = shapely.multipoints(p)
     diagram = shapely.voronoi_polygons(sites, extend_to=region, ordered=True)
     raw = shapely.get_parts(diagram)
-    clipped = shapely.intersection(raw, region)
+    clipped = raw.copy()
+    # Only the cells that reach out of the region are cut: for a rectangle (the default
+    # region) a cell whose box lies inside it is inside it, and the diagram's cells reach
+    # the region's box only at its rim, so most cells skip the intersection
+    box = np.asarray(shapely.bounds(region), dtype=np.float64)
+    rectangle = shapely.area(region) == shapely.area(shapely.envelope(region))
+    if rectangle:
+        b = shapely.bounds(raw)
+        cut = (b[:, 0] < box[0]) | (b[:, 1] < box[1]) | (b[:, 2] > box[2]) | (b[:, 3] > box[3])
+    else:
+        cut = np.ones(len(raw), dtype=bool)
+    clipped[cut] = shapely.intersection(raw[cut], region)
     odd = (shapely.get_type_id(clipped) != 3) | (shapely.get_num_interior_rings(clipped) > 0)
     split = np.zeros(len(p), dtype=bool)
-    pts = shapely.points(p)
     for i in np.flatnonzero(odd).tolist():  # one step per odd cell: rare
         # a collection (a polygon with a stray line or point where it touches the region's
         # outline at a corner), pieces, or a hole: the polygon round the point, unholed
         parts = shapely.get_parts(clipped[i])
         parts = parts[(shapely.get_type_id(parts) == 3) & (shapely.area(parts) > 0)]
-        hold = shapely.intersects(parts, pts[i])
+        hold = shapely.intersects(parts, shapely.points(p[i]))
         piece = parts[np.argmax(hold)] if hold.any() else parts[np.argmax(shapely.area(parts))]
         split[i] = len(parts) > 1 or shapely.get_num_interior_rings(piece) > 0
         clipped[i] = shapely.polygons(shapely.get_exterior_ring(piece))

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..geometry import MAX_COORDINATE
 from .chains import Chain, CurveArrays, arc_pieces, bulge_arc, line_piece
 
 __all__ = ["DxfCurve", "MAX_DEPTH", "MAX_ENTITIES", "read_dxf"]
@@ -119,7 +120,17 @@ def read_dxf(data: bytes, max_entities: int = MAX_ENTITIES) -> tuple[list[DxfCur
             skipped[kind] += 1
             continue
         for cp, p, k, w in curves:
-            out.append(DxfCurve((cp * scale, p, k, w), here))
+            with np.errstate(all="ignore"):
+                cp = cp * scale
+            big = float(np.abs(cp).max()) if cp.size else 0.0
+            if not big <= MAX_COORDINATE:  # an ARC of radius 1e308: its corners overflow
+                shown = f"{big:.3g} mm" if math.isfinite(big) else "a number past any double"
+                raise ValueError(
+                    f"{kind} {e.dxf.get('handle', '?')} reaches {shown}, past the "
+                    f"{MAX_COORDINATE:g} mm a coordinate may be (a double no longer holds a "
+                    "tenth of a millimetre there)"
+                )
+            out.append(DxfCurve((cp, p, k, w), here))
     for (kind, why), handles in dropped.items():
         shown = ", ".join(handles[:3]) + (", ..." if len(handles) > 3 else "")
         skipped[f"{kind} that draws nothing ({why}; handle {shown})"] += len(handles)
@@ -253,7 +264,17 @@ def _curves(e, kind: str) -> list[CurveArrays] | None:
         chain.add(arc_pieces(_v(e.dxf.center), _v(e.dxf.major_axis), _v(e.minor_axis), t0, t1))
         return [chain.curve()]
     if kind == "SPLINE":
-        tool = e.construction_tool()
+        fit = np.array([list(p) for p in e.fit_points], dtype=np.float64).reshape(-1, 3)
+        if len(e.control_points) == 0 and len(fit) and np.all(fit == fit[0]):
+            raise _Nothing(f"its {len(fit)} fit points are one point and it has no control points")
+        try:
+            tool = e.construction_tool()
+        except (IndexError, ValueError, ZeroDivisionError) as exc:
+            raise ValueError(
+                f"its definition is inconsistent ({len(e.control_points)} control points, "
+                f"{len(fit)} fit points, degree {e.dxf.get('degree', '?')}: "
+                f"{str(exc) or type(exc).__name__})"
+            ) from None
         cp = np.array([list(p) for p in tool.control_points], dtype=np.float64)
         knots = np.array(tool.knots(), dtype=np.float64)
         weights = np.array(tool.weights(), dtype=np.float64) if tool.is_rational else None
@@ -270,6 +291,11 @@ def _bulged(e, pts: list, closed: bool) -> list[CurveArrays]:
             continue
         chain.add(bulge_arc(p0, p1, float(b)) if b else line_piece(p0, p1))
     if not len(chain):
-        return []
+        distinct = len({tuple(p.tolist()) for p, _ in pts})
+        raise _Nothing(
+            f"{len(pts)} point{'s' if len(pts) != 1 else ''}"
+            + (", all one point" if distinct == 1 and len(pts) > 1 else "")
+            + ": a polyline needs 2 distinct points"
+        )
     curve = chain.curve()
     return [_to_wcs(e, curve) if e is not None else curve]

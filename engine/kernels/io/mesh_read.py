@@ -287,13 +287,25 @@ def read_off(data: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     tokens = token_starts(ftext)
     line_of = line_numbers(starts, tokens)
     per_line = np.bincount(line_of, minlength=nf)
-    values, _ = ints_at(ftext, tokens)  # every token of a face line is an integer...
+    values, after = ints_at(ftext, tokens)  # every token of a face line is an integer...
     first = np.concatenate([[0], np.cumsum(per_line)[:-1]]).astype(np.int64)
     k = values[first] if nf else np.zeros(0, np.int64)
     if nf and (k.min() < 3 or np.any(k + 1 > per_line)):
         bad = int(np.argmax((k < 3) | (k + 1 > per_line)))
         raise ValueError(f"face {bad}: a face needs a count of at least 3, then that many indices")
     take = np.repeat(first + 1, k) + (np.arange(int(k.sum())) - np.repeat(np.cumsum(k) - k, k))
+    # ...read to its first non-digit: the count and the indices must end there ('2.5' is
+    # not index 2); what follows them, a colour, may be any number
+    used = np.concatenate([first, take]) if nf else np.zeros(0, np.int64)
+    end = ftext[np.minimum(after[used], max(ftext.size - 1, 0))]
+    bad = (after[used] < ftext.size) & ~_SPACE[end]
+    if bad.any():
+        t = int(used[np.argmax(bad)])
+        word = bytes(ftext[tokens[t] : tokens[t] + 20]).split()[0].decode("latin-1")
+        raise ValueError(
+            f"face {int(line_of[t])}: {word!r} is not a whole number (a face is its vertex "
+            "count, then that many vertex indices)"
+        )
     idx = values[take]
     if idx.size and (idx.min() < 0 or idx.max() >= nv):
         raise ValueError(f"a face refers to a vertex that does not exist ({nv:,} vertices)")

@@ -273,9 +273,20 @@ def _read_ascii(body: bytes, elements: list[PlyElement], want_faces: bool):
             continue
         if e.properties[0][2] is None:
             raise ValueError("ASCII faces are read when the list comes first on each line")
-        k = values[first].astype(np.int64) if e.count else np.zeros(0, np.int64)
+        k = values[first] if e.count else np.zeros(0)
+        whole = np.isfinite(k) & (k == np.round(k)) & (k >= 0)
+        if not whole.all():
+            f = int(np.argmax(~whole))
+            raise ValueError(f"face {f}: its vertex count {k[f]:g} is not a whole number")
+        k = k.astype(np.int64)
         if np.any(k + 1 > per_line):
             raise ValueError("a face line holds fewer indices than its count says")
         take = np.repeat(first + 1, k) + (np.arange(int(k.sum())) - np.repeat(np.cumsum(k) - k, k))
-        faces = (values[take].astype(np.int64), np.concatenate([[0], np.cumsum(k)]))
+        idx = values[take]
+        whole = np.isfinite(idx) & (idx == np.round(idx))  # '2.5' is not vertex 2
+        if not whole.all():
+            t = int(np.argmax(~whole))
+            f = int(np.searchsorted(np.cumsum(k), t, side="right"))
+            raise ValueError(f"face {f}: its vertex index {idx[t]:g} is not a whole number")
+        faces = (idx.astype(np.int64), np.concatenate([[0], np.cumsum(k)]))
     return columns, faces

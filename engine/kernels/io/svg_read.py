@@ -278,6 +278,11 @@ _ROOT_LENGTH = re.compile(
 )
 
 
+# The smallest root width or height: from about 1e-16 svgelements' view-box scaling gives
+# no shapes at all (1e-320, a subnormal, none either), without a word
+_SMALLEST_SIZE = 1e-9
+
+
 def _drawable_size(data: bytes) -> None:
     """Refuse a root ``width`` or ``height`` that is zero, negative, not finite or not a
     length at all (``nanmm``, ``1e400mm``): the SVG specification draws nothing for zero,
@@ -293,6 +298,12 @@ def _drawable_size(data: bytes) -> None:
             raise ValueError(
                 f"the root's {m.group(1).decode()} {text.decode('latin-1')[:30]!r} is not a "
                 "positive finite length: an SVG viewer draws nothing of it"
+            )
+        if value < _SMALLEST_SIZE:  # svgelements scales such a view to nothing, unsaid
+            raise ValueError(
+                f"the root's {m.group(1).decode()} {text.decode('latin-1')[:30]!r} is below "
+                f"{_SMALLEST_SIZE:g} of its unit: too small for its drawing to be resolved "
+                "(subnormal or nearly so), so nothing of it would be drawn"
             )
 
 

@@ -38,7 +38,9 @@ def most_points(area: float, spacing: float) -> int:
     """The most points ``spacing`` apart that an area can hold: the hexagonal packing's
     ``2 / (sqrt(3) spacing^2)`` per unit area, plus one (a bound to charge a budget with
     before anything is drawn; a curved or thin surface holds fewer)."""
-    return int(np.ceil(2.0 * area / (np.sqrt(3.0) * spacing**2))) + 1
+    with np.errstate(over="ignore"):  # a spacing past 1e154: its square is inf, one point
+        per = np.sqrt(3.0) * np.float64(spacing) ** 2
+    return int(np.ceil(2.0 * area / per)) + 1
 
 
 def uniform(
