@@ -179,6 +179,31 @@ def test_a_variant_that_kills_its_worker_fails_alone(tmp_path):
     assert [r["d"] for r in s.rows if r["status"] == "ok"] == [a for a in range(1, 161) if a != 7]
 
 
+def test_a_gather_that_never_returns_is_run_again_on_new_keys(client, tmp_path, monkeypatch):
+    """dask/distributed#3196: a worker killed at the wrong moment can leave a gather of
+    finished tasks waiting forever (a full suite at load 20 sat an hour in one). The sweep
+    waits a bounded time, then runs the task's rows again, each on a new key."""
+    from formgraph.sweeps import cluster as kcluster
+
+    monkeypatch.setattr(kcluster, "GATHER_SECONDS", 1.0)
+    real, calls = Client._gather, []
+
+    async def deadlocked_once(self, futures, *args, **kwargs):
+        calls.append(len(futures))
+        if len(calls) == 1:
+            import asyncio
+
+            await asyncio.sleep(3600)
+        return await real(self, futures, *args, **kwargs)
+
+    monkeypatch.setattr(Client, "_gather", deadlocked_once)
+    g = logged_graph(tmp_path / "calls.log", seconds=0.0)
+    s = fg.sweep(g, {"a": "1:40:40"}, ["sum"], client=client, cache_dir=None)
+    assert len(calls) >= 2
+    assert all(r["status"] == "ok" for r in s.rows)
+    assert [r["sum"] for r in s.rows] == [a + 2.0 for a in range(1, 41)]
+
+
 def test_an_interrupted_sweep_resumes_with_every_row_once(client, tmp_path):
     log = tmp_path / "calls.log"
     out = tmp_path / "out"

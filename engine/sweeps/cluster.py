@@ -271,6 +271,10 @@ FILES_CHUNK_CAP = 16  # ... when each variant brings files back (exports, a draw
 # task's results are held whole on the worker and the client until it ends
 
 HANDSHAKE_SECONDS = 10.0
+# A gather of finished tasks is a copy of their rows: far under this unless Dask deadlocked
+# on a worker that died meanwhile (dask/distributed#3196, seen under a load of 20)
+GATHER_SECONDS = 120.0
+LOST = "Dask lost this variant with a dying worker and did not run it again"
 _HANDSHAKE_BYTES = 1 << 16  # a scheduler's greeting is some 60 bytes
 
 
@@ -451,8 +455,12 @@ def run(
         try:
             for batch in pending.batches():  # one gather per batch: no round trip per task
                 done = [f for f in batch if f.status == "finished"]
+                stuck = False
                 try:
-                    results = dict(zip([f.key for f in done], c.gather(done), strict=True))
+                    got = c.sync(c._gather, done, callback_timeout=GATHER_SECONDS)
+                    results = dict(zip([f.key for f in done], got, strict=True))
+                except TimeoutError:  # dask/distributed#3196: a dying worker can deadlock
+                    results, stuck = {}, True  # the gather; its tasks again, on new keys
                 except Exception:  # lost meanwhile (a worker died): each on its own below
                     results = {}
                 for fut in batch:
@@ -467,7 +475,7 @@ def run(
                         continue
                     if fut.key in results:
                         finished = results[fut.key].rows
-                    elif len(chunks[fut.key]) > 1 and _killed(fut):
+                    elif len(chunks[fut.key]) > 1 and (stuck or _killed(fut)):
                         # one variant of the task kills its worker (out of memory, a crash
                         # in compiled code): each of its rows again on its own, so only that
                         # one fails and the others are not blamed for it
@@ -478,7 +486,7 @@ def run(
                         pending.update(again)
                         fut.release()
                         continue
-                    elif _killed(fut):  # it, or a task beside it on the dying worker
+                    elif stuck or _killed(fut):  # it, or a task beside it on the dying worker
                         suspects.append(fut.key)
                         fut.release()
                         continue
@@ -491,9 +499,11 @@ def run(
             for key in suspects:
                 (alone,) = c.get(dsk, [key], sync=False, optimize_graph=False)
                 futures.append(alone)
-                wait([alone])
                 try:
-                    finished = alone.result().rows
+                    wait([alone], timeout=GATHER_SECONDS)
+                    finished = alone.result(timeout=GATHER_SECONDS).rows
+                except TimeoutError:
+                    finished = [(k, RowResult(LOST, 0.0, {}, {}, None, {})) for k in chunks[key]]
                 except Exception:
                     finished = _chunk_result(alone, chunks[key])
                 alone.release()
