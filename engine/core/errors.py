@@ -77,7 +77,20 @@ class BudgetError(GraphError):
 
 
 class PathError(GraphError):
-    """An output path that would leave the output directory."""
+    """A path that may not be written or read (it leaves its folder, names a folder, ...).
+
+    ``path`` is the refused path when the path itself is what is wrong (not the folder it
+    is in): a run then locates the error on the node's path input.
+    """
+
+    path: str | None = None
+
+    @classmethod
+    def of(cls, path: str, message: str) -> PathError:
+        """The error refusing ``path`` itself."""
+        exc = cls(message)
+        exc.path = path
+        return exc
 
 
 class ExpressionError(GraphError):

@@ -518,11 +518,12 @@ class _Run(LanguageRun, SimulationRun, Replay):
                 raise  # already names the subgraph's file, line and node
             if isinstance(exc, NodeError):
                 raise
+            port = getattr(exc, "port", None)
+            if port is None and getattr(exc, "path", None) is not None:  # its path input
+                paths = (p for p, t in spec.inputs.items() if t.type.is_output_path)
+                port = next(paths, spec.input_paths[0] if spec.input_paths else None)
             raise type(exc)(
-                [
-                    Problem(self.where(name, getattr(exc, "port", None)), p.message)
-                    for p in exc.problems
-                ]
+                [Problem(self.where(name, port), p.message) for p in exc.problems]
             ) from None
         except InputError as exc:
             raise NodeError(self.where(name, exc.port), nd.type, str(exc)) from exc
