@@ -73,7 +73,10 @@ class CycleError(GraphError):
 
 
 class BudgetError(GraphError):
-    """A node whose output would exceed the element budget (refused before allocating)."""
+    """A node whose output would exceed the element budget or the memory left (refused
+    before allocating); ``port``, when known, is the input that asks for so much."""
+
+    port: str | None = None
 
 
 class PathError(GraphError):

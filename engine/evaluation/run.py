@@ -23,7 +23,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from ..core import safety
+from ..core import memory, safety
 from ..core.errors import (
     BudgetError,
     ExpressionError,
@@ -380,6 +380,7 @@ class _Run(LanguageRun, SimulationRun, Replay):
                 if hit:
                     self.results[n] = value
                     size = self.g.memory.size(self.keys.get(n, ""), value)  # or sizeof
+                    self.tally.held += size
                     seconds = time.perf_counter() - t0
                     self.stats[n] = NodeStat("cached", seconds, size, source=source)
                     if nd.repeat is not None:
@@ -400,6 +401,8 @@ class _Run(LanguageRun, SimulationRun, Replay):
                 self.results[n] = self.compute_steps(n, nd, spec)
             else:
                 self.results[n] = self.compute(n, nd, spec)
+            st = self.stats.get(n)
+            self.tally.held += st.nbytes if st is not None and st.nbytes else 0
             stack.pop()
         return self.results[target]
 
@@ -510,9 +513,8 @@ class _Run(LanguageRun, SimulationRun, Replay):
         except BudgetError as exc:
             if isinstance(spec, SubgraphSpec):
                 raise  # already names the subgraph's file, line and node
-            raise BudgetError(
-                [Problem(self.where(name), p.message) for p in exc.problems]
-            ) from None
+            here = self.where(name, exc.port)
+            raise BudgetError([Problem(here, p.message) for p in exc.problems]) from None
         except (NodeError, GraphError) as exc:
             if isinstance(spec, SubgraphSpec):
                 raise  # already names the subgraph's file, line and node
@@ -529,6 +531,14 @@ class _Run(LanguageRun, SimulationRun, Replay):
             raise NodeError(self.where(name, exc.port), nd.type, str(exc)) from exc
         except (ValueError, ZeroDivisionError) as exc:
             raise NodeError(self.where(name), nd.type, str(exc)) from exc
+        except MemoryError as exc:  # a node that does not say what it will make (guard)
+            left = memory.room()
+            raise NodeError(
+                self.where(name),
+                nd.type,
+                f"ran out of memory ({exc or 'MemoryError'})"
+                + (f"; the process has {left.describe()}" if left is not None else ""),
+            ) from None
         except Exception as exc:
             raise NodeError(self.where(name), nd.type, f"{type(exc).__name__}: {exc}") from exc
         finally:

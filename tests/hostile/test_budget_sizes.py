@@ -78,8 +78,8 @@ def test_a_whole_run_is_bounded_by_what_it_holds():
     g = _graph(nodes, budget=1000)
     with pytest.raises(
         fg.BudgetError,
-        match=r"h.yaml:7: node 'p4': would make 999 points while the run already holds about "
-        r"3,996 elements from earlier nodes: together over 4 x the budget of 1,000",
+        match=r"h.yaml:7: node 'p4', input 'count': would make 999 points while the run already "
+        r"holds about 3,996 elements from earlier nodes: together over 4 x the budget of 1,000",
     ):
         g.evaluate([f"p{i}" for i in range(8)])
     # each alone, or four of them, still runs
