@@ -290,6 +290,7 @@ class Context:
     inputs: Callable[[str], tuple[Path, bytes]] | None = None  # input path -> (file, bytes)
     tally: RunTally | None = None  # the run's total (None: this node alone)
     probe: bool = False  # only asking what the node would make: guard raises Estimate
+    start: Any = None  # a step of a simulation: the state it started from (its ``from``)
 
     def guard(
         self,

@@ -488,8 +488,10 @@ class _Run(LanguageRun, SimulationRun, Replay):
         spec: NodeSpec,
         kwargs: dict[str, Any],
         env: dict[str, Any] | None = None,
+        start: Any = None,
     ) -> tuple[Any, float, list[str]]:
-        """Run the node function (or the subgraph) on ``kwargs``: (value, seconds, warnings)."""
+        """Run the node function (or the subgraph) on ``kwargs``: (value, seconds, warnings);
+        ``start``: a simulation's first state, for a step (:attr:`Context.start`)."""
         warnings: list[str] = []
         if spec.wants_context:
             kwargs["ctx"] = Context(
@@ -499,6 +501,7 @@ class _Run(LanguageRun, SimulationRun, Replay):
                 warnings,
                 inputs=lambda relpath: self.read_input(name, relpath),
                 tally=self.tally,
+                start=start,
             )
         if self.g.progress is not None:  # counted as it goes: linear in the graph's size
             self.g.progress(name, len(self.started) - (name in self.started), self.total)
