@@ -63,6 +63,9 @@ class Field(Geometry):
         A box outside which the field is positive (None: not known, give ``bounds``).
     lipschitz : float
         A bound on ``|grad f|`` (1 for a true distance).
+    made_by : str or None
+        The graph node that made it, for messages (not part of its content: the same
+        recipe from another node is the same field).
     """
 
     def __init__(
@@ -72,6 +75,7 @@ class Field(Geometry):
         children: tuple[Field, ...] = (),
         bounds: Any = None,
         lipschitz: float = 1.0,
+        made_by: str | None = None,
     ):
         if op not in _OPS:
             raise ValueError(f"unknown field operation {op!r}")
@@ -84,6 +88,7 @@ class Field(Geometry):
         object.__setattr__(self, "children", tuple(children))
         object.__setattr__(self, "bounds", box)
         object.__setattr__(self, "lipschitz", float(lipschitz))
+        object.__setattr__(self, "made_by", made_by)
 
     def __setattr__(self, name: str, value: Any) -> None:
         raise AttributeError("a Field is immutable")
@@ -202,7 +207,7 @@ class Field(Geometry):
         parts = self.parts
         row = {id(f): i for i, f in enumerate(parts)}
         table = [
-            (f.op, dict(f.args), [row[id(c)] for c in f.children], f.bounds, f.lipschitz)
+            (f.op, dict(f.args), [row[id(c)] for c in f.children], f.bounds, f.lipschitz, f.made_by)
             for f in parts
         ]
         return _from_table, (table,)
@@ -271,9 +276,13 @@ class Field(Geometry):
 
     @classmethod
     def expression(
-        cls, value: Callable[..., Any], bounds: Any = None, lipschitz: float = 1.0
+        cls,
+        value: Callable[..., Any],
+        bounds: Any = None,
+        lipschitz: float = 1.0,
+        made_by: str | None = None,
     ) -> Field:
-        return cls("expression", {"value": value}, (), bounds, lipschitz)
+        return cls("expression", {"value": value}, (), bounds, lipschitz, made_by)
 
     @classmethod
     def union(cls, fields: list[Field], smooth: float = 0.0) -> Field:
@@ -338,8 +347,9 @@ class Field(Geometry):
 def _from_table(table: list[tuple[Any, ...]]) -> Field:
     """The field a pickled table of parts describes (:meth:`Field.__reduce_ex__`)."""
     made: list[Field] = []
-    for op, args, children, bounds, lipschitz in table:
-        made.append(Field(op, args, tuple(made[i] for i in children), bounds, lipschitz))
+    for op, args, children, bounds, lipschitz, made_by in table:
+        kids = tuple(made[i] for i in children)
+        made.append(Field(op, args, kids, bounds, lipschitz, made_by))
     return made[-1]
 
 

@@ -253,3 +253,57 @@ def test_a_recipe_that_shares_its_parts_is_walked_once_a_part():
         f.evaluate(np.stack(np.meshgrid(*[[0, 0.5]] * 3, indexing="ij"), -1).reshape(-1, 3)),
         atol=1e-9,
     )
+
+
+# ------------------------------------------------------------ a Lipschitz bound that lies
+
+STEEP = """\
+formgraph: 1
+nodes:
+  e:
+    type: field.expression
+    value: "VALUE"
+    bounds: [[-2, -2, -2], [2, 2, 2]]
+    lipschitz: LIP
+  m: {type: field.mesh, field: "@e", cell: 0.1}
+"""
+
+
+def test_a_lipschitz_bound_the_samples_contradict_is_named_not_an_empty_mesh():
+    # today: a warning that "the field has no surface inside its bounds" and an empty mesh
+    text = STEEP.replace("VALUE", "sqrt(x*x + y*y + z*z) * 10 - 10").replace("LIP", "0.5")
+    g = fg.Graph.from_text(text, file="steep.yaml")
+    with pytest.raises(
+        fg.NodeError,
+        match=r"steep.yaml:8: node 'm', input 'field' \(field.mesh\): no surface was found, but "
+        r"the field's samples contradict its Lipschitz bound 0.5: its values change by up to "
+        r"9.9\d per unit length .* raise 'lipschitz' of node 'e' "
+        r"\('sqrt\(x\*x \+ y\*y \+ z\*z\) \* 10 - 10': 0.5\) to about 13 or more",
+    ):
+        g.evaluate("m")
+    # the advice works
+    fixed = fg.Graph.from_text(text.replace("lipschitz: 0.5", "lipschitz: 13"), file="s.yaml")
+    m = fixed.evaluate("m")
+    assert m.n_faces > 1000
+    np.testing.assert_allclose(np.linalg.norm(m.vertices, axis=1), 1.0, atol=1e-3)
+
+
+def test_a_bound_that_loses_part_of_the_surface_is_warned_of():
+    # a unit sphere (slope 1) and a small steep one (slope 20) beside it: the bound of 1
+    # keeps the first and loses the second
+    value = "min(sqrt(x*x + y*y + z*z) - 0.8, 20 * (sqrt((x - 1.4)**2 + y*y + z*z) - 0.3))"
+    g = fg.Graph.from_text(STEEP.replace("VALUE", value).replace("LIP", "1"), file="s.yaml")
+    with pytest.warns(
+        fg.FormgraphWarning,
+        match=r"parts of the surface may be missing: the field's samples contradict its "
+        r"Lipschitz bound 1: .* raise 'lipschitz' of node 'e'",
+    ):
+        m = g.evaluate("m")
+    assert m.n_faces > 0
+
+
+def test_a_true_bound_is_not_doubted(recwarn):
+    value = "sqrt(x*x + y*y + z*z) - 1 + 0.1 * sin(3 * x)"  # slope at most 1.3
+    g = fg.Graph.from_text(STEEP.replace("VALUE", value).replace("LIP", "1.3"), file="s.yaml")
+    assert g.evaluate("m").n_faces > 1000
+    assert not [w for w in recwarn if "Lipschitz" in str(w.message)]
