@@ -69,11 +69,16 @@ NOT_DASK = struct.pack("<Q", 16) + b"GET / HTTP/1.1\r\n"
     indirect=["peer"],
 )
 def test_a_peer_that_is_not_a_scheduler_is_refused_in_time(tmp_path, peer, message):
+    import distributed  # noqa: F401  (imported first: a cold import on a busy machine is seconds)
+
     g = fg.Graph.from_text(GRAPH, file="g.yaml")
     t0 = time.monotonic()
     with pytest.raises(cluster.SweepError) as info:
         sweep(g, {"r": "1,2"}, client=f"tcp://127.0.0.1:{peer.port}", cache_dir=None)
-    assert time.monotonic() - t0 < 8
+    # the message says which limit ended it (the 1 s handshake, or the greeting read);
+    # the clock only tells a refusal from a hang (distributed waits without a limit), so
+    # its bound is far above any load the machine may be under
+    assert time.monotonic() - t0 < 30
     text = str(info.value)
     assert (message in text) or (peer.reply == b"" and "no Dask handshake" in text), text
 
