@@ -134,3 +134,11 @@ def fmt_bytes(n: float) -> str:
         if abs(n) >= size:
             return f"{n / size:.3g} {unit}"
     return f"{int(n)} bytes"
+
+
+def ran_out(exc: MemoryError) -> str:
+    """The message for a node that ran out of memory without saying beforehand what it would
+    take (nothing refused it): numpy's own words, and what the process has left now."""
+    left = room()
+    said = f"ran out of memory ({exc or 'MemoryError'})"
+    return said + (f"; the process has {left.describe()}" if left is not None else "")

@@ -13,7 +13,6 @@ from __future__ import annotations
 import contextlib
 import hashlib
 import os
-import stat
 import sys
 import time
 import warnings as _warnings
@@ -43,7 +42,7 @@ from ..language.model import FRAMES, STEP, Expr, Input, Items, Literal, NodeDef,
 from ..language.subgraph import SubgraphSpec
 from . import cache as _cache
 from .cutoff import same_content
-from .items import LanguageRun, file_stamp, input_names, reads_loop
+from .items import LanguageRun, file_stamp, input_names, input_stamp, reads_loop
 from .replay import Replay
 from .simulation import SimulationRun
 from .stats import NodeStat, Step
@@ -257,7 +256,7 @@ class _Run(LanguageRun, SimulationRun, Replay):
             path = safety.resolve_input(self.g.input_root, relpath, self.g.input_base)
         except PathError as exc:
             raise PathError([Problem(here, p.message) for p in exc.problems]) from None
-        stamp = _stamp(path)
+        stamp = input_stamp(path)
         memo = self.g._input_digests.get(str(path))
         if stamp is not None and memo is not None and memo[0] == stamp:
             return {"path": relpath, "bytes": memo[1]}
@@ -535,13 +534,7 @@ class _Run(LanguageRun, SimulationRun, Replay):
         except (ValueError, ZeroDivisionError) as exc:
             raise NodeError(self.where(name), nd.type, str(exc)) from exc
         except MemoryError as exc:  # a node that does not say what it will make (guard)
-            left = memory.room()
-            raise NodeError(
-                self.where(name),
-                nd.type,
-                f"ran out of memory ({exc or 'MemoryError'})"
-                + (f"; the process has {left.describe()}" if left is not None else ""),
-            ) from None
+            raise NodeError(self.where(name), nd.type, memory.ran_out(exc)) from None
         except Exception as exc:
             raise NodeError(self.where(name), nd.type, f"{type(exc).__name__}: {exc}") from exc
         finally:
@@ -615,17 +608,6 @@ class _Run(LanguageRun, SimulationRun, Replay):
                 nd.type,
                 f"returned a value that does not fit its output {out_type.name}: {exc}",
             ) from None
-
-
-def _stamp(path: Path) -> tuple[int, ...] | None:
-    """What changes when a file's bytes do (None for anything but a regular file)."""
-    try:
-        st = os.stat(path)
-    except OSError:
-        return None
-    if not stat.S_ISREG(st.st_mode):
-        return None
-    return (st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns)
 
 
 @contextlib.contextmanager
