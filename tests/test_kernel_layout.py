@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import shapely
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from formgraph.kernels.curves.regions import even_odd_region
@@ -39,6 +39,7 @@ def _star(rng: np.random.Generator, n: int, centre: tuple[float, float]) -> np.n
 
 @settings(max_examples=25, deadline=None)
 @given(st.integers(0, 2**32 - 1), st.integers(3, 16), st.integers(3, 16))
+@example(seed=11, n=11, m=4)
 def test_minkowski_sum_of_star_polygons_matches_the_union_of_convex_pieces(seed, n, m):
     rng = np.random.default_rng(seed)
     a, b = _star(rng, n, (0, 0)), _star(rng, m, (2, 1))
@@ -47,7 +48,10 @@ def test_minkowski_sum_of_star_polygons_matches_the_union_of_convex_pieces(seed,
     ours, ref = _ours(nfp.minkowski_outer(a, b)), _reference_sum(a, b)
     # Clipper rounds the crossings of the cycle to the grid: within a unit
     assert shapely.hausdorff_distance(ours.boundary, ref.boundary) < 1.5
-    assert ours.area == pytest.approx(ref.area, rel=1e-4)
+    # so the two differ by slivers along the boundary, each point moved by at most the
+    # rounding's sqrt(1/2): a relative area bound does not follow from that (seed 11, n = 11,
+    # m = 4: 1.4e-4 of the area, one rounded crossing tilting a 1,600-unit edge by 0.5)
+    assert shapely.symmetric_difference(ours, ref).area <= np.sqrt(0.5) * ref.length
 
 
 @pytest.mark.parametrize(
