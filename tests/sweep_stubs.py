@@ -28,8 +28,12 @@ def calls(log: str | os.PathLike[str]) -> list[str]:
 
 
 @node("stub.logged", version=1)
-def logged(x: float, log: str, label: str = "", seconds: float = 0.0) -> float:
-    """x, after recording ``label:x`` in the file ``log`` (and sleeping ``seconds``).
+def logged(
+    x: float, log: str, label: str = "", seconds: float = 0.0, hold: str = "", after: int = 0
+) -> float:
+    """x, after recording ``label:x`` in the file ``log`` (and sleeping ``seconds``); once
+    ``log`` has ``after`` calls, each waits while the file ``hold`` exists (a test's latch:
+    the sweep stands still where the test wants it, however slow the machine).
 
     Parameters
     ----------
@@ -41,8 +45,15 @@ def logged(x: float, log: str, label: str = "", seconds: float = 0.0) -> float:
         What to record.
     seconds : float
         How long to take.
+    hold : str
+        A file to wait on while it exists ("": none).
+    after : int
+        Calls recorded in ``log`` before ``hold`` is waited on.
     """
     time.sleep(seconds)
+    end = time.monotonic() + 600  # a latch never removed is a test's bug: not forever
+    while hold and os.path.exists(hold) and len(calls(log)) >= after and time.monotonic() < end:
+        time.sleep(0.02)
     fd = os.open(log, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o644)
     try:
         os.write(fd, f"{label}:{x:g}\n".encode())

@@ -99,10 +99,10 @@ def test_svg_layers_by_id_and_inkscape_label(tmp_path):
 
 def test_svg_a_million_nested_groups_is_refused_quickly(tmp_path):
     data = b'<svg xmlns="http://www.w3.org/2000/svg">' + b"<g>" * 1_000_000 + b"</svg>"
-    t0 = time.perf_counter()
+    t0 = time.process_time()
     with pytest.raises(fg.NodeError, match="over the budget"):
         _curves(tmp_path, "bomb.svg", data)
-    assert time.perf_counter() - t0 < 30  # refused before parsing (generous on a busy box)
+    assert time.process_time() - t0 < 30  # CPU seconds: refused before parsing
 
 
 def test_svg_deep_nesting_under_the_tag_budget_is_refused(tmp_path):
@@ -205,10 +205,10 @@ def test_dxf_nested_block_bomb_is_refused_by_the_budget(tmp_path):
         for k in range(10):
             blk.add_blockref(f"L{level - 1}", (k, 0))
     doc.modelspace().add_blockref("L5", (0, 0))  # 100,000 lines
-    t0 = time.perf_counter()
+    t0 = time.process_time()
     with pytest.raises(fg.NodeError, match="over the budget"):
         _curves(tmp_path, "bomb.dxf", _dxf(doc), budget=3_000)
-    assert time.perf_counter() - t0 < 30
+    assert time.process_time() - t0 < 30
 
 
 def test_dxf_round_trips_our_own_export_exactly(tmp_path):

@@ -322,3 +322,48 @@ def test_the_drawing_after_a_run_says_how_many_steps_ran():
     g.evaluate("count")
     g.evaluate("count", steps=25)
     assert "computed 5/25 steps" in draw_graph(g).svg
+
+
+LADDER = """\
+formgraph: 1
+params:
+  steps: {type: int, default: 200, min: 0, max: 2000}
+nodes:
+  net: {type: mesh.plane, size: [8, 1], divisions: [16, 1]}
+  hang:
+    type: mesh.relax
+    simulate: {state: mesh, from: "@net", steps: "=steps"}
+    anchors: [0, 1, 32, 33]          # the ends of both rails (vertex ix * 2 + iy)
+    load: [0, 0, -0.5]               # 1 a unit of the rails' unstretched length (0.5 apart)
+    stiffness: 40.0
+"""
+
+
+def test_a_net_comes_to_rest_without_a_reference():
+    # today each step took its own edge lengths as the rest lengths: the net never rests
+    # (53,000 units of sag on a 10-unit net after 400 steps)
+    import numpy as np
+    from test_kernel_relax import elastic_catenary
+
+    g = fg.Graph.from_text(LADDER)
+    hung = g.evaluate("hang")
+    assert np.abs(hung.point_data["relax_velocity"]).max() < 1e-9  # at rest
+    after = g.evaluate("hang", steps=201)
+    assert np.abs(after.vertices - hung.vertices).max() < 1e-9
+    # each rail of a ladder whose rungs keep their length hangs as an elastic catenary of
+    # unstretched length 8 between points 8 apart: Irvine's closed form (as the kernel's
+    # chain test), to the point loads' second-order error
+    links, a, length = 16, 4.0, 8.0
+    rail = hung.vertices[::2]
+    s = np.linspace(-length / 2, length / 2, links + 1)
+    assert np.allclose(rail[:, 1], -0.5)  # (the rungs keep the rails in their planes)
+    cx, cy = elastic_catenary(a, length, w=1.0, ea=40.0)(s)
+    sag = -rail[:, 2].min()
+    assert 0.3 < sag < 2.0
+    err = max(np.abs(rail[:, 0] - cx).max(), np.abs(rail[:, 2] - rail[8, 2] - cy).max())
+    assert err < 2.0 / links**2, err
+    # the same as wiring the first state as the reference, bit for bit
+    wired = fg.Graph.from_text(
+        LADDER.replace("    stiffness", '    reference: "@net"\n    stiffness')
+    )
+    assert wired.evaluate("hang").vertices.tobytes() == hung.vertices.tobytes()

@@ -235,7 +235,7 @@ def test_an_interrupted_sweep_resumes_with_every_row_once(client, tmp_path):
 
 def scheduler_address(path: Path) -> str:
     """The address in a scheduler file, once the scheduler has written it whole."""
-    deadline = time.monotonic() + 60
+    deadline = time.monotonic() + 180  # a bound against a hang: a loaded box starts slowly
     while time.monotonic() < deadline:
         try:
             return json.loads(path.read_text())["address"]
@@ -456,10 +456,14 @@ def test_the_embedded_cluster_is_started_and_closed_by_the_sweep(tmp_path, capsy
 
 def test_ctrl_c_leaves_a_valid_table_and_the_rerun_completes_it(tmp_path):
     graph = tmp_path / "slow.yaml"
-    log = tmp_path / "calls.log"
+    log, hold = tmp_path / "calls.log", tmp_path / "hold"
+    # three variants run, the fourth waits while `hold` exists: the interrupt always comes
+    # mid-sweep (a fixed pace let a loaded machine finish all twelve before it)
+    hold.touch()
     graph.write_text(
         "formgraph: 1\nparams:\n  a: {default: 1.0, min: 0, max: 100}\nnodes:\n"
-        f'  per: {{type: stub.logged, x: "=a", log: "{log}", label: per, seconds: 0.15}}\n'
+        f'  per: {{type: stub.logged, x: "=a", log: "{log}", label: per, seconds: 0.15, '
+        f'hold: "{hold}", after: 3}}\n'
     )
     out = tmp_path / "out"
     code = (
@@ -471,13 +475,15 @@ def test_ctrl_c_leaves_a_valid_table_and_the_rerun_completes_it(tmp_path):
     args += ["--cache-dir", str(tmp_path / "cache")]
     proc = subprocess.Popen(args, stderr=subprocess.PIPE, text=True)
     try:
-        deadline = time.monotonic() + 120
-        while time.monotonic() < deadline:  # until a few rows are in
+        deadline = time.monotonic() + 300  # a bound against a hang
+        while time.monotonic() < deadline and proc.poll() is None:  # until three rows are in
             if (out / "sweep.csv").exists() and (out / "sweep.csv").read_text().count("\n") > 3:
                 break
             time.sleep(0.05)
         proc.send_signal(signal.SIGINT)
-        _, err = proc.communicate(timeout=60)
+        time.sleep(0.5)
+        hold.unlink()  # the waiting variant ends, so the cluster closes without a kill
+        _, err = proc.communicate(timeout=120)
     finally:
         proc.kill()
     assert proc.returncode == 130 and "interrupted" in err and "Traceback" not in err

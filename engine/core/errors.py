@@ -73,11 +73,27 @@ class CycleError(GraphError):
 
 
 class BudgetError(GraphError):
-    """A node whose output would exceed the element budget (refused before allocating)."""
+    """A node whose output would exceed the element budget or the memory left (refused
+    before allocating); ``port``, when known, is the input that asks for so much."""
+
+    port: str | None = None
 
 
 class PathError(GraphError):
-    """An output path that would leave the output directory."""
+    """A path that may not be written or read (it leaves its folder, names a folder, ...).
+
+    ``path`` is the refused path when the path itself is what is wrong (not the folder it
+    is in): a run then locates the error on the node's path input.
+    """
+
+    path: str | None = None
+
+    @classmethod
+    def of(cls, path: str, message: str) -> PathError:
+        """The error refusing ``path`` itself."""
+        exc = cls(message)
+        exc.path = path
+        return exc
 
 
 class ExpressionError(GraphError):

@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from . import safety
+from . import memory, safety
 from .errors import BudgetError
 from .types import PortType, Range, Variables, port_type
 
@@ -271,10 +271,12 @@ class Estimate(Exception):
 
 @dataclass
 class RunTally:
-    """The elements a run's nodes were allowed so far, against :data:`RUN_FACTOR` budgets."""
+    """The elements a run's nodes were allowed so far, against :data:`RUN_FACTOR` budgets,
+    and the bytes of the outputs it holds (for the message of a node refused for memory)."""
 
     budget: int
     total: float = 0
+    held: int = 0  # bytes of the outputs the run has made or fetched so far
 
     @property
     def limit(self) -> int:
@@ -306,20 +308,52 @@ class Context:
     inputs: Callable[[str], tuple[Path, bytes]] | None = None  # input path -> (file, bytes)
     tally: RunTally | None = None  # the run's total (None: this node alone)
     probe: bool = False  # only asking what the node would make: guard raises Estimate
+    start: Any = None  # a step of a simulation: the state it started from (its ``from``)
 
-    def guard(self, elements: int | float, what: str = "elements") -> None:
-        """Refuse, before allocating, an output of more than the element budget, or one
-        that would bring the run past :data:`RUN_FACTOR` budgets in all."""
+    def guard(
+        self,
+        elements: int | float,
+        what: str = "elements",
+        *,
+        nbytes: int | float | None = None,
+        port: str | None = None,
+    ) -> None:
+        """Refuse, before allocating, an output of more than the element budget, one that
+        would bring the run past :data:`RUN_FACTOR` budgets in all, or (given ``nbytes``,
+        the bytes the output will take) one that would not fit in the memory the process
+        has left with its transient copy (:mod:`formgraph.core.memory`). ``port`` names
+        the input the refusal is located on (the one that asks for so much)."""
         if self.probe:
             raise Estimate(elements)
-        if self.tally is not None and elements <= self.budget:
-            self.tally.charge(elements, what)
-        if elements > self.budget:
-            count = _count(elements)
-            raise BudgetError(
-                f"would make {count} {what}, over the budget of "
-                f"{self.budget:,} (raise it with budget= or --budget if you mean it)"
-            )
+        try:
+            if self.tally is not None and elements <= self.budget:
+                self.tally.charge(elements, what)
+            if elements > self.budget:
+                count = _count(elements)
+                raise BudgetError(
+                    f"would make {count} {what}, over the budget of "
+                    f"{self.budget:,} (raise it with budget= or --budget if you mean it)"
+                )
+            if nbytes is not None:
+                self._fits(elements, what, nbytes)
+        except BudgetError as exc:
+            exc.port = port
+            raise
+
+    def _fits(self, elements: int | float, what: str, nbytes: int | float) -> None:
+        need = memory.PEAK_FACTOR * nbytes
+        if need < memory.UNCHECKED:
+            return
+        room = memory.room()
+        if room is None or need <= room.bytes:
+            return
+        held = self.tally.held if self.tally is not None else 0
+        also = f"; this run holds {memory.fmt_bytes(held)} of earlier outputs" if held else ""
+        raise BudgetError(
+            f"would make {_count(elements)} {what}, {memory.fmt_bytes(nbytes)} (about "
+            f"{memory.fmt_bytes(need)} while it is made), but the process has "
+            f"{room.describe()}{also}: refused before allocating"
+        )
 
     def write(self, path: str, data: bytes | Iterable[bytes]) -> Path:
         """Write ``data`` (bytes-like, or an iterable of bytes-like pieces written as they

@@ -42,12 +42,20 @@ MAX_INPUT_BYTES = 1 << 30  # the largest input file a read node opens
 
 
 def path_problem(
-    relpath: str, what: str = "output path", root: str = "the output directory"
+    relpath: str,
+    what: str = "output path",
+    root: str = "the output directory",
+    *,
+    output: bool = True,
 ) -> str | None:
     """Why ``relpath`` may not be an output path, or None when it may (no file access).
 
     ``what`` and ``root`` name the path and its folder in the message (``"input path"``,
-    ``"the inputs folder"`` for the files a graph reads).
+    ``"the inputs folder"`` for the files a graph reads, with ``output=False``). Every
+    export's path is checked here, at load and again when it writes: a path must name a
+    file (not end in ``/`` or ``.``: ``sub/`` would write a file called ``sub``), and an
+    output may not be named like our temp files (``.NAME.fgtmp-PID-*.tmp``), which the next
+    write into its folder deletes once that process is gone.
     """
     if not isinstance(relpath, str) or not relpath.strip():
         return f"an {what} must be a non-empty relative path"
@@ -71,6 +79,15 @@ def path_problem(
         return f"{what} {shown!r} is {len(parts):,} folders deep (at most {MAX_PATH_PARTS})"
     if any(len(p) > MAX_NAME_CHARS for p in parts):
         return f"{what} {shown!r} has a name longer than {MAX_NAME_CHARS} characters"
+    last = re.split(r"[/\\]", relpath)[-1]
+    if last in ("", "."):
+        return f"{what} {shown!r} names a folder, not a file; give the file's name after it"
+    if output and _TMP.match(last):
+        return (
+            f"{what} {shown!r} is named like formgraph's temporary files "
+            "('.NAME.fgtmp-PID-*.tmp'), which the next write into its folder deletes; "
+            "choose another name"
+        )
     return None
 
 
@@ -101,7 +118,8 @@ def resolve_output(out_dir: str | os.PathLike[str], relpath: str) -> Path:
     PathError
         For absolute paths, ``..``, and symlinks (of folders or of the file) leading out.
     """
-    return _inside(output_root(out_dir), relpath, "output path", "the output directory")
+    root = output_root(out_dir)
+    return _inside(root, relpath, "output path", "the output directory", output=True)
 
 
 def resolve_input(
@@ -119,8 +137,8 @@ def resolve_input(
     where = "the inputs folder"
     top = _root(root, "inputs folder")
     if base is None:
-        return _inside(top, relpath, "input path", where)
-    real = _inside(_root(base, "inputs folder"), relpath, "input path", where)
+        return _inside(top, relpath, "input path", where, output=False)
+    real = _inside(_root(base, "inputs folder"), relpath, "input path", where, output=False)
     if real != top and top not in real.parents:
         raise PathError(
             f"input path {relpath!r} leads outside the inputs folder {str(top)!r} (through a "
@@ -136,21 +154,21 @@ def _root(folder: str | os.PathLike[str], what: str) -> Path:
         raise PathError(f"the {what} {str(folder)!r} cannot be followed: {exc}") from None
 
 
-def _inside(root: Path, relpath: str, what: str, where: str) -> Path:
-    problem = path_problem(relpath, what, where)
+def _inside(root: Path, relpath: str, what: str, where: str, *, output: bool) -> Path:
+    problem = path_problem(relpath, what, where, output=output)
     if problem:
-        raise PathError(problem)
+        raise PathError.of(relpath, problem)
     try:
         target = root / PurePosixPath(relpath.replace("\\", "/"))
         real = target.resolve()  # follows any symlinks that exist along the way
     except (OSError, RuntimeError) as exc:  # RuntimeError: a symlink loop (Python < 3.13)
-        raise PathError(f"{what} {relpath!r} cannot be followed: {exc}") from None
+        raise PathError.of(relpath, f"{what} {relpath!r} cannot be followed: {exc}") from None
     if real != root and root not in real.parents:
-        raise PathError(
-            f"{what} {relpath!r} leads outside {where} {str(root)!r} (through a symlink)"
+        raise PathError.of(
+            relpath, f"{what} {relpath!r} leads outside {where} {str(root)!r} (through a symlink)"
         )
     if real == root:
-        raise PathError(f"{what} {relpath!r} names {where} itself")
+        raise PathError.of(relpath, f"{what} {relpath!r} names {where} itself")
     return real
 
 
@@ -177,7 +195,9 @@ def write_atomic(
     try:
         target.parent.mkdir(parents=True, exist_ok=True)
     except FileExistsError:
-        raise PathError(f"output path {relpath!r} runs through a file, not a folder") from None
+        raise PathError.of(
+            relpath, f"output path {relpath!r} runs through a file, not a folder"
+        ) from None
     target = resolve_output(out_dir, relpath)  # a folder made meanwhile could be a symlink
     if pieces is None:
         try:

@@ -2,8 +2,9 @@
 
 Keys are computed from what went into a node (its type, implementation version, canonical
 literal inputs and the keys of its wired inputs), never from the data. Values on disk are
-plain ``.npz`` archives (``allow_pickle=False``) with a JSON description and a checksum, so
-a truncated, corrupt or foreign entry is detected and recomputed, never trusted. Reading an
+plain ``.npz`` archives (``allow_pickle=False``) with a JSON description and a checksum of
+the whole entry (description, numbers and arrays: :func:`entry_checksum`), so a truncated,
+corrupt, edited or foreign entry is detected and recomputed, never trusted. Reading an
 entry never inflates it past :data:`MAX_INFLATE` times its size on disk (the arrays' headers
 are checked against the bytes that hold them before anything is allocated) and never parses
 a description nested deeper than :data:`MAX_META_DEPTH`: a hostile entry is a miss, not a
@@ -36,7 +37,7 @@ import numpy as np
 
 from ..geometry import STORABLE, Geometry, from_state
 
-FORMAT = 1
+FORMAT = 2  # 2: the checksum covers the description too (entry_checksum)
 MAX_INFLATE = 16  # ours are stored uncompressed (1x); anything far beyond is hostile
 MAX_META_DEPTH = 64  # ours nest a few levels per list of geometry
 
@@ -226,6 +227,30 @@ def _encode(value: Any, arrays: dict[str, np.ndarray]) -> Any:
     raise Unstorable(type(value).__name__)
 
 
+def entry_checksum(meta: dict[str, Any], arrays: dict[str, np.ndarray]) -> str:
+    """The checksum of a disk-cache entry: all of it, not only its arrays.
+
+    A hash of the description (``meta`` without its ``"check"``, as canonical JSON: format,
+    key, identity and the value's description with every number it holds, so a cached
+    ``mesh.measure`` whose volume was edited no longer matches) and of every array (name,
+    dtype, shape and bytes). An entry whose checksum differs is a miss, recomputed.
+    """
+    check = hashlib.blake2b(digest_size=16)
+    described = {k: v for k, v in meta.items() if k != "check"}
+    check.update(json.dumps(described, sort_keys=True, separators=(",", ":")).encode())
+    for name in sorted(arrays):
+        check.update(b"\0" + name.encode() + b"\0")
+        check.update(_hash_bytes(arrays[name]).encode())
+    return check.hexdigest()
+
+
+def _write_entry(fh: Any, meta: dict[str, Any], arrays: dict[str, np.ndarray]) -> None:
+    """Write an entry (an ``.npz``: the description as ``meta``, then the arrays) straight
+    into the open file ``fh``, an array at a time: no copy of the entry in memory."""
+    meta_bytes = np.frombuffer(json.dumps(meta).encode(), dtype=np.uint8)
+    np.savez(fh, meta=meta_bytes, **arrays)
+
+
 def _decode(desc: Any, arrays: Any) -> Any:
     if "geom" in desc:
         state = {k: _decode(v, arrays) for k, v in desc["state"].items()}
@@ -300,11 +325,7 @@ class DiskCache:
                 raise ValueError("description nested too deeply")
             if meta.get("format") != FORMAT or meta.get("key") != key:
                 raise ValueError("foreign entry")
-            check = hashlib.blake2b(digest_size=16)
-            for name in sorted(arrays):
-                check.update(name.encode())
-                check.update(_hash_bytes(arrays[name]).encode())
-            if check.hexdigest() != meta.get("check"):
+            if meta.get("check") != entry_checksum(meta, arrays):
                 raise ValueError("checksum mismatch")
             return True, _decode(meta["value"], arrays), meta.get("identity")
         except (
@@ -331,20 +352,8 @@ class DiskCache:
             desc = _encode(value, arrays)
         except Unstorable:
             return False
-        check = hashlib.blake2b(digest_size=16)
-        for name in sorted(arrays):
-            check.update(name.encode())
-            check.update(_hash_bytes(arrays[name]).encode())
-        meta = {
-            "format": FORMAT,
-            "key": key,
-            "check": check.hexdigest(),
-            "value": desc,
-            "identity": identity or key,
-        }
-        buf = io.BytesIO()
-        meta_bytes = np.frombuffer(json.dumps(meta).encode(), dtype=np.uint8)
-        np.savez(buf, meta=meta_bytes, **arrays)
+        meta = {"format": FORMAT, "key": key, "value": desc, "identity": identity or key}
+        meta["check"] = entry_checksum(meta, arrays)
         path = self._path(key)
         try:
             path.parent.mkdir(parents=True, exist_ok=True)
@@ -353,9 +362,10 @@ class DiskCache:
             fd, tmp = tempfile.mkstemp(prefix=".", suffix=".tmp", dir=path.parent)
             try:
                 with os.fdopen(fd, "wb") as fh:
-                    fh.write(buf.getvalue())
+                    _write_entry(fh, meta, arrays)
+                    size = fh.tell()
                 os.replace(tmp, path)
-                self._account(len(buf.getbuffer()))
+                self._account(size)
             except BaseException:
                 try:
                     os.unlink(tmp)

@@ -13,7 +13,6 @@ from __future__ import annotations
 import contextlib
 import hashlib
 import os
-import stat
 import sys
 import time
 import warnings as _warnings
@@ -23,7 +22,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from ..core import safety
+from ..core import memory, safety
 from ..core.errors import (
     BudgetError,
     ExpressionError,
@@ -43,7 +42,7 @@ from ..language.model import FRAMES, STEP, Expr, Input, Items, Literal, NodeDef,
 from ..language.subgraph import SubgraphSpec
 from . import cache as _cache
 from .cutoff import same_content
-from .items import LanguageRun, file_stamp, input_names, reads_loop
+from .items import LanguageRun, file_stamp, input_names, input_stamp, reads_loop
 from .replay import Replay
 from .simulation import SimulationRun
 from .stats import NodeStat, Step
@@ -257,7 +256,7 @@ class _Run(LanguageRun, SimulationRun, Replay):
             path = safety.resolve_input(self.g.input_root, relpath, self.g.input_base)
         except PathError as exc:
             raise PathError([Problem(here, p.message) for p in exc.problems]) from None
-        stamp = _stamp(path)
+        stamp = input_stamp(path)
         memo = self.g._input_digests.get(str(path))
         if stamp is not None and memo is not None and memo[0] == stamp:
             return {"path": relpath, "bytes": memo[1]}
@@ -380,6 +379,7 @@ class _Run(LanguageRun, SimulationRun, Replay):
                 if hit:
                     self.results[n] = value
                     size = self.g.memory.size(self.keys.get(n, ""), value)  # or sizeof
+                    self.tally.held += size
                     seconds = time.perf_counter() - t0
                     self.stats[n] = NodeStat("cached", seconds, size, source=source)
                     if nd.repeat is not None:
@@ -400,6 +400,8 @@ class _Run(LanguageRun, SimulationRun, Replay):
                 self.results[n] = self.compute_steps(n, nd, spec)
             else:
                 self.results[n] = self.compute(n, nd, spec)
+            st = self.stats.get(n)
+            self.tally.held += st.nbytes if st is not None and st.nbytes else 0
             stack.pop()
         return self.results[target]
 
@@ -485,8 +487,10 @@ class _Run(LanguageRun, SimulationRun, Replay):
         spec: NodeSpec,
         kwargs: dict[str, Any],
         env: dict[str, Any] | None = None,
+        start: Any = None,
     ) -> tuple[Any, float, list[str]]:
-        """Run the node function (or the subgraph) on ``kwargs``: (value, seconds, warnings)."""
+        """Run the node function (or the subgraph) on ``kwargs``: (value, seconds, warnings);
+        ``start``: a simulation's first state, for a step (:attr:`Context.start`)."""
         warnings: list[str] = []
         if spec.wants_context:
             kwargs["ctx"] = Context(
@@ -496,6 +500,7 @@ class _Run(LanguageRun, SimulationRun, Replay):
                 warnings,
                 inputs=lambda relpath: self.read_input(name, relpath),
                 tally=self.tally,
+                start=start,
             )
         if self.g.progress is not None:  # counted as it goes: linear in the graph's size
             self.g.progress(name, len(self.started) - (name in self.started), self.total)
@@ -510,24 +515,26 @@ class _Run(LanguageRun, SimulationRun, Replay):
         except BudgetError as exc:
             if isinstance(spec, SubgraphSpec):
                 raise  # already names the subgraph's file, line and node
-            raise BudgetError(
-                [Problem(self.where(name), p.message) for p in exc.problems]
-            ) from None
+            here = self.where(name, exc.port)
+            raise BudgetError([Problem(here, p.message) for p in exc.problems]) from None
         except (NodeError, GraphError) as exc:
             if isinstance(spec, SubgraphSpec):
                 raise  # already names the subgraph's file, line and node
             if isinstance(exc, NodeError):
                 raise
+            port = getattr(exc, "port", None)
+            if port is None and getattr(exc, "path", None) is not None:  # its path input
+                paths = (p for p, t in spec.inputs.items() if t.type.is_output_path)
+                port = next(paths, spec.input_paths[0] if spec.input_paths else None)
             raise type(exc)(
-                [
-                    Problem(self.where(name, getattr(exc, "port", None)), p.message)
-                    for p in exc.problems
-                ]
+                [Problem(self.where(name, port), p.message) for p in exc.problems]
             ) from None
         except InputError as exc:
             raise NodeError(self.where(name, exc.port), nd.type, str(exc)) from exc
         except (ValueError, ZeroDivisionError) as exc:
             raise NodeError(self.where(name), nd.type, str(exc)) from exc
+        except MemoryError as exc:  # a node that does not say what it will make (guard)
+            raise NodeError(self.where(name), nd.type, memory.ran_out(exc)) from None
         except Exception as exc:
             raise NodeError(self.where(name), nd.type, f"{type(exc).__name__}: {exc}") from exc
         finally:
@@ -601,17 +608,6 @@ class _Run(LanguageRun, SimulationRun, Replay):
                 nd.type,
                 f"returned a value that does not fit its output {out_type.name}: {exc}",
             ) from None
-
-
-def _stamp(path: Path) -> tuple[int, ...] | None:
-    """What changes when a file's bytes do (None for anything but a regular file)."""
-    try:
-        st = os.stat(path)
-    except OSError:
-        return None
-    if not stat.S_ISREG(st.st_mode):
-        return None
-    return (st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns)
 
 
 @contextlib.contextmanager

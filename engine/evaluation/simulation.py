@@ -12,6 +12,9 @@ again from step 1. The node's own key names its last step.
 every step's output) is gathered from the caches when a wire asks for it, a step the
 caches lost recomputed from the one before.
 
+Every step sees the state the simulation started from (``from``) as ``ctx.start``: what
+stays put while the state moves (``mesh.relax`` takes its springs' rest lengths from it).
+
 The budget counts each step as a node run (:data:`~.items.ITEM_ELEMENTS` elements) before
 anything runs, and the steps times the elements of the state before the first step runs.
 
@@ -218,6 +221,7 @@ class _Stepper:
             if port != state and reads_loop(v, STEP, spec.inputs[port].type)
         }
         self.base: dict[str, Any] | None = None  # resolved at the first step that runs
+        self.start: Any = None  # ``from``, the state at step 0 (ctx.start of every step)
         self.seconds = 0.0
         self.warnings: list[str] = []
         self.computed = 0
@@ -228,6 +232,7 @@ class _Stepper:
             for u in dict.fromkeys(nd.upstream()):  # a frame recomputed late needs them
                 run.fetch(u)
             self.base = run.inputs(name, nd, spec, None, skip=self.varying | {nd.simulate.state})
+            self.start = run.start_value(name, nd, spec)
         env = dict(run.values)
         env[STEP] = k
         kwargs = dict(self.base)
@@ -236,7 +241,7 @@ class _Stepper:
         kwargs[nd.simulate.state] = state
         t0 = time.perf_counter()
         try:
-            value, _, w = run.call(name, nd, spec, kwargs, env)
+            value, _, w = run.call(name, nd, spec, kwargs, env, start=self.start)
         except NodeError as exc:
             message = str(exc)[len(f"{exc.where.prefix()} ({exc.node_type}): ") :]
             raise NodeError(exc.where, exc.node_type, f"step {k}: {message}") from exc.__cause__

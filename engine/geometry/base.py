@@ -46,10 +46,18 @@ def frozen_array(values: Any, dtype: Any = np.float64) -> np.ndarray:
     return np.frombuffer(a.tobytes(order="C"), dtype=a.dtype).reshape(a.shape)
 
 
+def all_finite(a: np.ndarray) -> bool:
+    """Whether every number of a float array is finite, with no array of flags as large
+    as it: its least and greatest are (both are NaN when any is, and an infinity is one)."""
+    if a.size == 0:
+        return True
+    return bool(np.isfinite(a.min()) and np.isfinite(a.max()))
+
+
 def as_xyz(values: Any, what: str = "points") -> np.ndarray:
     """``(n, 2)`` or ``(n, 3)`` coordinates as a read-only ``(n, 3)`` float64 array (z = 0)."""
     frozen = is_frozen(values) and values.dtype == np.float64 and values.flags.c_contiguous
-    if frozen and values.ndim == 2 and values.shape[1] == 3 and np.isfinite(values).all():
+    if frozen and values.ndim == 2 and values.shape[1] == 3 and all_finite(values):
         return values  # immutable and valid already (another value's coordinates): shared
     try:
         raw = np.asarray(values)
@@ -72,7 +80,7 @@ def as_xyz(values: Any, what: str = "points") -> np.ndarray:
         )
     if a.shape[1] == 2:
         a = np.column_stack([a, np.zeros(len(a))])
-    if not np.all(np.isfinite(a)):
+    if not all_finite(a):
         bad = int(np.argwhere(~np.isfinite(a))[0, 0])
         raise ValueError(f"{what}: coordinate {bad} is not finite ({a[bad].tolist()})")
     return frozen_array(a)

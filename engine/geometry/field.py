@@ -63,6 +63,9 @@ class Field(Geometry):
         A box outside which the field is positive (None: not known, give ``bounds``).
     lipschitz : float
         A bound on ``|grad f|`` (1 for a true distance).
+    made_by : str or None
+        The graph node that made it, for messages (not part of its content: the same
+        recipe from another node is the same field).
     """
 
     def __init__(
@@ -72,6 +75,7 @@ class Field(Geometry):
         children: tuple[Field, ...] = (),
         bounds: Any = None,
         lipschitz: float = 1.0,
+        made_by: str | None = None,
     ):
         if op not in _OPS:
             raise ValueError(f"unknown field operation {op!r}")
@@ -84,6 +88,7 @@ class Field(Geometry):
         object.__setattr__(self, "children", tuple(children))
         object.__setattr__(self, "bounds", box)
         object.__setattr__(self, "lipschitz", float(lipschitz))
+        object.__setattr__(self, "made_by", made_by)
 
     def __setattr__(self, name: str, value: Any) -> None:
         raise AttributeError("a Field is immutable")
@@ -98,7 +103,7 @@ class Field(Geometry):
         if p.ndim != 2 or p.shape[1] != 3:
             raise ValueError(f"points must be (n, 3), got shape {p.shape}")
         with np.errstate(all="ignore"):
-            out = np.asarray(_OPS[self.op](self, p), dtype=np.float64)
+            out = np.asarray(_walk(self, p, _points_of, _at_points), dtype=np.float64)
         return np.broadcast_to(out, (len(p),)).copy() if out.shape != (len(p),) else out
 
     def __call__(self, points: Any) -> np.ndarray:
@@ -108,11 +113,14 @@ class Field(Geometry):
     def separable(self) -> bool:
         """Whether :meth:`evaluate_grid` works on tables along the axes all through (no
         point-wise fallback), so a lattice costs a fraction of its points."""
-        if self.op not in _GRID:
-            return False
-        if self.op == "transform" and not np.array_equal(self.args["matrix"], np.eye(3)):
-            return False
-        return all(c.separable for c in self.children)
+        return all(_on_tables(f) for f in self.parts)
+
+    @functools.cached_property
+    def parts(self) -> tuple[Field, ...]:
+        """Every field this one is made of, each once (shared ones too), children before
+        the fields they make and this one last. Found without recursion: a recipe may be
+        thousands of operations deep (a graph of that many field nodes)."""
+        return tuple(_parts_of(self))
 
     def evaluate_grid(self, origin: Any, step: Any, shape: Any) -> np.ndarray:
         """Values on lattices of points: ``origin + (i, j, k) * step`` for ``0 <= (i, j,
@@ -157,20 +165,52 @@ class Field(Geometry):
     # ------------------------------------------------------------------ value protocol
 
     def fingerprint(self) -> Any:
+        """The recipe as a flat table: one row per operation (:attr:`parts`, this one
+        last), its children named by their rows. Flat, so hashing it needs no recursion
+        however deep the recipe, and a part shared by several operations is hashed once."""
+        parts = self.parts
+        row = {id(f): i for i, f in enumerate(parts)}
         return {
-            "op": self.op,
-            "args": {k: _fingerprint(v) for k, v in sorted(self.args.items())},
-            "children": [c.fingerprint() for c in self.children],
-            "bounds": None if self.bounds is None else self.bounds.tolist(),
-            "lipschitz": self.lipschitz,
+            "field": [
+                {
+                    "op": f.op,
+                    "args": {k: _fingerprint(v) for k, v in sorted(f.args.items())},
+                    "children": [row[id(c)] for c in f.children],
+                    "bounds": None if f.bounds is None else f.bounds.tolist(),
+                    "lipschitz": f.lipschitz,
+                }
+                for f in parts
+            ]
         }
 
-    @property
-    def nbytes(self) -> int:
-        own = sum(
-            v.nbytes if isinstance(v, (np.ndarray, Geometry)) else 64 for v in self.args.values()
-        )
-        return 256 + own + sum(c.nbytes for c in self.children)
+    @functools.cached_property
+    def nbytes(self) -> int:  # type: ignore[override]
+        """The bytes of its parameters and its parts', 256 an operation.
+
+        Known in constant time once its children's are (a graph sizes every node's output
+        as it is made, deepest first); the parts not yet sized are sized first, without
+        recursion. Children that may share parts (more than :data:`_RECOUNT` bytes beside
+        the largest) are recounted with each part once, so a recipe that shares its parts
+        over and over (a diamond of unions, 2^depth paths) is not sized exponentially.
+        """
+        for f in _parts_of(self, stop=lambda f: "nbytes" in f.__dict__):  # children first
+            sizes = [c.__dict__["nbytes"] for c in {id(c): c for c in f.children}.values()]
+            total = _own_bytes(f) + sum(sizes)
+            if len(sizes) > 1 and sum(sizes) - max(sizes) > _RECOUNT:  # may share parts
+                total = sum(_own_bytes(p) for p in _parts_of(f))
+            f.__dict__["nbytes"] = total
+        return self.__dict__["nbytes"]
+
+    def __reduce_ex__(self, protocol: Any) -> Any:
+        # pickled (to a worker process) as the flat table of its parts, not nested: pickle
+        # would recurse once an operation, and a recipe may be thousands deep
+        parts = self.parts
+        row = {id(f): i for i, f in enumerate(parts)}
+        table = [
+            (f.op, dict(f.args), [row[id(c)] for c in f.children], f.bounds, f.lipschitz, f.made_by)
+            for f in parts
+        ]
+        return _from_table, (table,)
 
     def __repr__(self) -> str:
         return f"Field({self.op}{', bounded' if self.bounds is not None else ''})"
@@ -236,9 +276,13 @@ class Field(Geometry):
 
     @classmethod
     def expression(
-        cls, value: Callable[..., Any], bounds: Any = None, lipschitz: float = 1.0
+        cls,
+        value: Callable[..., Any],
+        bounds: Any = None,
+        lipschitz: float = 1.0,
+        made_by: str | None = None,
     ) -> Field:
-        return cls("expression", {"value": value}, (), bounds, lipschitz)
+        return cls("expression", {"value": value}, (), bounds, lipschitz, made_by)
 
     @classmethod
     def union(cls, fields: list[Field], smooth: float = 0.0) -> Field:
@@ -300,6 +344,44 @@ class Field(Geometry):
         return cls("from_curves", args, (), box)
 
 
+def _from_table(table: list[tuple[Any, ...]]) -> Field:
+    """The field a pickled table of parts describes (:meth:`Field.__reduce_ex__`)."""
+    made: list[Field] = []
+    for op, args, children, bounds, lipschitz, made_by in table:
+        kids = tuple(made[i] for i in children)
+        made.append(Field(op, args, kids, bounds, lipschitz, made_by))
+    return made[-1]
+
+
+_RECOUNT = 1 << 16  # bytes of children beside the largest: recounted part by part
+
+
+def _own_bytes(f: Field) -> int:
+    """One operation's bytes: its parameters, 256 for the rest."""
+    return 256 + sum(
+        v.nbytes if isinstance(v, (np.ndarray, Geometry)) else 64 for v in f.args.values()
+    )
+
+
+def _parts_of(root: Field, stop: Callable[[Field], bool] | None = None) -> list[Field]:
+    """The fields ``root`` is made of, each once, children first (:attr:`Field.parts`);
+    with ``stop``, not those for which it is true (nor what only they are made of)."""
+    order: list[Field] = []
+    seen: set[int] = set()
+    stack: list[tuple[Field, bool]] = [(root, False)]
+    while stack:
+        f, done = stack.pop()
+        if done:
+            order.append(f)
+            continue
+        if id(f) in seen or (stop is not None and stop(f)):
+            continue
+        seen.add(id(f))
+        stack.append((f, True))
+        stack.extend((c, False) for c in reversed(f.children) if id(c) not in seen)
+    return order
+
+
 class _FrozenDict(dict):
     """A dict nobody can change (the field's parameters)."""
 
@@ -330,28 +412,77 @@ def _sdf():
     return sdf
 
 
-def _blend(field: Field, p: np.ndarray, pick: str) -> np.ndarray:
+def _walk(
+    root: Field,
+    at: Any,
+    child_at: Callable[[Field, Any], list[Any] | None],
+    run: Callable[[Field, Any, list[np.ndarray]], np.ndarray],
+) -> np.ndarray:
+    """The values of ``root`` at ``at`` (points, or a lattice's axes or lines), operation
+    by operation without recursion.
+
+    ``child_at(f, at)`` is where ``f``'s children are evaluated (a transform moves the
+    points; None: ``f`` is evaluated as a leaf, its children not visited);
+    ``run(f, at, values)`` makes ``f``'s values from its children's. A part shared
+    by several operations at the same points is evaluated once, and each part's values
+    are let go as soon as every operation waiting for them has used them, so a chain
+    thousands deep holds a few arrays, not one per operation.
+    """
+    values: dict[tuple[int, int], np.ndarray] = {}
+    waiting: dict[tuple[int, int], int] = {}  # operations yet to use a part's values
+    held: list[Any] = [at]  # every place evaluated at stays alive: its id stays its own
+    stack: list[list[Any]] = [[root, at, None]]  # [field, at, its children's (field, at)]
+    while stack:
+        frame = stack[-1]
+        f, here, kids = frame
+        if (id(f), id(here)) in values:
+            stack.pop()
+            continue
+        if kids is None:
+            places = child_at(f, here)
+            kids = [] if places is None else list(zip(f.children, places, strict=True))
+            frame[2] = kids
+            held.extend(places or ())
+            for c, a in kids:
+                waiting[(id(c), id(a))] = waiting.get((id(c), id(a)), 0) + 1
+            stack.extend([c, a, None] for c, a in kids if (id(c), id(a)) not in values)
+            if any((id(c), id(a)) not in values for c, a in kids):
+                continue
+        missing = [(c, a) for c, a in kids if (id(c), id(a)) not in values]
+        if missing:  # let go of too early (a shared part): made again
+            stack.extend([c, a, None] for c, a in missing)
+            continue
+        got = []
+        for c, a in kids:
+            k = (id(c), id(a))
+            got.append(values[k])
+            waiting[k] -= 1
+            if waiting[k] <= 0:
+                del values[k], waiting[k]
+        values[(id(f), id(here))] = run(f, here, got)
+        stack.pop()
+    return values[(id(root), id(at))]
+
+
+def _points_of(f: Field, p: np.ndarray) -> list[np.ndarray]:
+    """Where a field's children are evaluated, for points ``p``: ``p`` itself, or the
+    points in a transform's own frame."""
+    if f.op == "transform":
+        a = f.args
+        return [(p - a["translate"]) @ a["matrix"] / a["scale"]]  # R^T (p - t) / s, row-wise
+    return [p] * len(f.children)
+
+
+def _blend(field: Field, values: list[np.ndarray], pick: str) -> np.ndarray:
     sdf = _sdf()
     k = field.args["smooth"]
-    values = [c.evaluate(p) for c in field.children]
     out = values[0]
     for v in values[1:]:
         out = sdf.smooth_min(out, v, k) if pick == "min" else sdf.smooth_max(out, v, k)
     return out
 
 
-def _difference(field: Field, p: np.ndarray) -> np.ndarray:
-    a, b = field.children
-    return _sdf().smooth_max(a.evaluate(p), -b.evaluate(p), field.args["smooth"])
-
-
-def _transform(field: Field, p: np.ndarray) -> np.ndarray:
-    a = field.args
-    local = (p - a["translate"]) @ a["matrix"] / a["scale"]  # R^T (p - t) / s, row-wise
-    return field.children[0].evaluate(local) * float(a["scale"].min())
-
-
-def _expression(field: Field, p: np.ndarray) -> np.ndarray:
+def _expression(field: Field, p: np.ndarray, _: Any = ()) -> np.ndarray:
     out = np.asarray(field.args["value"](x=p[:, 0], y=p[:, 1], z=p[:, 2]), dtype=np.float64)
     out = np.broadcast_to(out, (len(p),))
     if not np.isfinite(out).all():
@@ -361,18 +492,18 @@ def _expression(field: Field, p: np.ndarray) -> np.ndarray:
     return out
 
 
-def _from_mesh(field: Field, p: np.ndarray) -> np.ndarray:
+def _from_mesh(field: Field, p: np.ndarray, _: Any = ()) -> np.ndarray:
     from ..kernels.geometry import meshdist
 
     cache = field._cache
     if "signed" not in cache:
         mesh = field.args["mesh"]
-        tri, _ = meshdist.fan_triangles(mesh.face_indices, mesh.face_offsets)
+        tri, _faces = meshdist.fan_triangles(mesh.face_indices, mesh.face_offsets)
         cache["signed"] = meshdist.SignedDistance(mesh.vertices, tri)
     return cache["signed"](p)
 
 
-def _from_curves(field: Field, p: np.ndarray) -> np.ndarray:
+def _from_curves(field: Field, p: np.ndarray, _: Any = ()) -> np.ndarray:
     from ..kernels.geometry import meshdist
 
     cache = field._cache
@@ -394,35 +525,34 @@ def _points_grid(field: Field, at: Any) -> np.ndarray:
 
 def _grid(field: Field, at: Any) -> np.ndarray:
     """``field`` on a lattice (``at``: its three axes) or on lines of one (``at``: Lines)."""
-    op = _GRID.get(field.op)
-    return _points_grid(field, at) if op is None else op(field, at)
+    return _walk(field, at, _lattice_of, _on_lattice)
 
 
-def _blend_grid(field: Field, at: Any, pick: str) -> np.ndarray:
-    sdf = _sdf()
-    k = field.args["smooth"]
-    values = [_grid(c, at) for c in field.children]
-    out = values[0]
-    for v in values[1:]:
-        out = sdf.smooth_min(out, v, k) if pick == "min" else sdf.smooth_max(out, v, k)
-    return out
+def _on_tables(f: Field) -> bool:
+    """Whether ``f`` itself works on a lattice's tables (its children aside)."""
+    if f.op not in _GRID:
+        return False
+    return f.op != "transform" or np.array_equal(f.args["matrix"], np.eye(3))
 
 
-def _transform_grid(field: Field, at: Any) -> np.ndarray:
-    a = field.args
-    if not np.array_equal(a["matrix"], np.eye(3)):  # a rotation mixes the axes
-        return _points_grid(field, at)
+def _lattice_of(f: Field, at: Any) -> list[Any] | None:
+    """Where a field's children are evaluated on a lattice (or its lines): the same one,
+    or a transform's moved and scaled along the axes; None for a field sampled point by
+    point (no tables: its children are evaluated with it, at the points)."""
+    if not _on_tables(f):
+        return None
+    if f.op != "transform":
+        return [at] * len(f.children)
+    a = f.args
     if isinstance(at, _sdf().Lines):
-        local = at.moved(a["translate"], a["scale"])
-    else:
-        local = [(x - t) / s for x, t, s in zip(at, a["translate"], a["scale"], strict=True)]
-    return _grid(field.children[0], local) * float(a["scale"].min())
+        return [at.moved(a["translate"], a["scale"])]
+    return [[(x - t) / s for x, t, s in zip(at, a["translate"], a["scale"], strict=True)]]
 
 
 def _leaf(name: str, *params: str) -> Callable[[Field, Any], np.ndarray]:
     """A primitive on a lattice (``<name>_grid``) or on its lines (``<name>_lines``)."""
 
-    def run(field: Field, at: Any) -> np.ndarray:
+    def run(field: Field, at: Any, _: Any = ()) -> np.ndarray:
         sdf = _sdf()
         kernel = getattr(sdf, f"{name}_lines" if isinstance(at, sdf.Lines) else f"{name}_grid")
         return kernel(at, *(field.args[p] for p in params))
@@ -430,35 +560,42 @@ def _leaf(name: str, *params: str) -> Callable[[Field, Any], np.ndarray]:
     return run
 
 
-_GRID: dict[str, Callable[[Field, Any], np.ndarray]] = {
+_GRID: dict[str, Callable[..., np.ndarray]] = {  # on a lattice: (field, at, children's)
     "sphere": _leaf("sphere", "radius", "center"),
     "box": _leaf("box", "size", "center", "radius"),
     "tpms": _leaf("tpms", "kind", "period", "thickness"),
-    "union": lambda f, g: _blend_grid(f, g, "min"),
-    "intersection": lambda f, g: _blend_grid(f, g, "max"),
-    "difference": lambda f, g: _sdf().smooth_max(
-        _grid(f.children[0], g), -_grid(f.children[1], g), f.args["smooth"]
-    ),
-    "shell": lambda f, g: np.abs(_grid(f.children[0], g)) - f.args["thickness"] / 2.0,
-    "offset": lambda f, g: _grid(f.children[0], g) - f.args["distance"],
-    "transform": _transform_grid,
+    "union": lambda f, at, v: _blend(f, v, "min"),
+    "intersection": lambda f, at, v: _blend(f, v, "max"),
+    "difference": lambda f, at, v: _sdf().smooth_max(v[0], -v[1], f.args["smooth"]),
+    "shell": lambda f, at, v: np.abs(v[0]) - f.args["thickness"] / 2.0,
+    "offset": lambda f, at, v: v[0] - f.args["distance"],
+    "transform": lambda f, at, v: v[0] * float(f.args["scale"].min()),
 }
 
-_OPS: dict[str, Callable[[Field, np.ndarray], np.ndarray]] = {
-    "sphere": lambda f, p: _sdf().sphere(p, f.args["radius"], f.args["center"]),
-    "box": lambda f, p: _sdf().box(p, f.args["size"], f.args["center"], f.args["radius"]),
-    "cylinder": lambda f, p: _sdf().cylinder(
+_OPS: dict[str, Callable[..., np.ndarray]] = {  # at points: (field, points, children's)
+    "sphere": lambda f, p, v: _sdf().sphere(p, f.args["radius"], f.args["center"]),
+    "box": lambda f, p, v: _sdf().box(p, f.args["size"], f.args["center"], f.args["radius"]),
+    "cylinder": lambda f, p, v: _sdf().cylinder(
         p, f.args["radius"], f.args["height"], f.args["center"]
     ),
-    "torus": lambda f, p: _sdf().torus(p, f.args["major"], f.args["minor"], f.args["center"]),
-    "tpms": lambda f, p: _sdf().tpms(p, f.args["kind"], f.args["period"], f.args["thickness"]),
+    "torus": lambda f, p, v: _sdf().torus(p, f.args["major"], f.args["minor"], f.args["center"]),
+    "tpms": lambda f, p, v: _sdf().tpms(p, f.args["kind"], f.args["period"], f.args["thickness"]),
     "expression": _expression,
-    "union": lambda f, p: _blend(f, p, "min"),
-    "intersection": lambda f, p: _blend(f, p, "max"),
-    "difference": _difference,
-    "shell": lambda f, p: np.abs(f.children[0].evaluate(p)) - f.args["thickness"] / 2.0,
-    "offset": lambda f, p: f.children[0].evaluate(p) - f.args["distance"],
-    "transform": _transform,
+    "union": lambda f, p, v: _blend(f, v, "min"),
+    "intersection": lambda f, p, v: _blend(f, v, "max"),
+    "difference": lambda f, p, v: _sdf().smooth_max(v[0], -v[1], f.args["smooth"]),
+    "shell": lambda f, p, v: np.abs(v[0]) - f.args["thickness"] / 2.0,
+    "offset": lambda f, p, v: v[0] - f.args["distance"],
+    "transform": lambda f, p, v: v[0] * float(f.args["scale"].min()),
     "from_mesh": _from_mesh,
     "from_curves": _from_curves,
 }
+
+
+def _at_points(f: Field, p: np.ndarray, values: list[np.ndarray]) -> np.ndarray:
+    return _OPS[f.op](f, p, values)
+
+
+def _on_lattice(f: Field, at: Any, values: list[np.ndarray]) -> np.ndarray:
+    """One operation on a lattice: on its tables, else sampled at its points."""
+    return _GRID[f.op](f, at, values) if _on_tables(f) else _points_grid(f, at)

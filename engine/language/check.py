@@ -468,7 +468,7 @@ def _check_literal(g: Outline, pt: PortType, value: Any, loop: _Loop | None = No
         if why:
             problems.append(why)
     if not problems and pt.is_input_path and isinstance(value, str):
-        why = safety.path_problem(value, "input path", "the inputs folder")
+        why = safety.path_problem(value, "input path", "the inputs folder", output=False)
         if why:
             problems.append(why)
     return problems

@@ -48,7 +48,8 @@ def curves_copy_to_points(
     linear = frames(n, per["scale"], per["rotate"], per["align"])
     offsets = points.xyz
     if isinstance(curve, NurbsCurve):
-        ctx.guard(n * len(curve.control_points) * 3, "coordinates")
+        coordinates = n * len(curve.control_points) * 3
+        ctx.guard(coordinates, "coordinates", nbytes=8 * coordinates, port="points")
         cps = instancing.copy_points(curve.control_points, linear, offsets)
         w = curve.weights if curve.rational else None
         return [NurbsCurve(cp, curve.degree, curve.knots, w) for cp in cps]

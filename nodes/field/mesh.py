@@ -4,6 +4,7 @@
 
 from __future__ import annotations
 
+import math
 from typing import Annotated, Any
 
 import numpy as np
@@ -47,6 +48,60 @@ def _thinnest(field: Field) -> tuple[str, float] | None:
             scale *= float(np.min(f.args["scale"]))
         stack.extend((c, scale) for c in f.children)
     return best
+
+
+SAMPLES = 24  # lattice points along the box's longest side for the Lipschitz check
+
+
+def _lipschitz_contradicted(field: Field, box: np.ndarray) -> str | None:
+    """Why the field's samples contradict its Lipschitz bound, naming what to raise; None
+    when they do not, or when the bound is not the user's (only an expression's is).
+
+    The mesher discards a cell whose centre value is farther from zero than the bound
+    times its half-diagonal, so a bound below the field's real slope makes it discard the
+    cells that hold the surface, and the mesh comes out empty or with parts missing. The
+    field sampled on a lattice of about :data:`SAMPLES` points along the box's longest
+    side shows a lower bound of the slope (the largest change between neighbours over
+    their distance): when that is over the bound, the bound is wrong.
+    """
+    given = [p for p in field.parts if p.op == "expression"]
+    if not given:
+        return None
+    lo, hi = box
+    h = max(float((hi - lo).max()) / (SAMPLES - 1), 1e-300)
+    shape = tuple(int(k) for k in np.clip(np.ceil((hi - lo) / h), 1, SAMPLES - 1) + 1)
+    step = (hi - lo) / np.maximum(np.array(shape) - 1, 1)
+    try:
+        values = field.evaluate_grid(lo, step, shape)
+    except ValueError:
+        return None  # not finite somewhere: the mesher has said so already, or will
+    slope = 0.0
+    for axis in range(3):
+        if shape[axis] > 1:
+            d = np.abs(np.diff(values, axis=axis)).max() / step[axis]
+            slope = max(slope, float(d))
+    bound = field.lipschitz
+    if not slope > bound * (1 + 1e-9):
+        return None
+    factor = slope / bound
+    names = ", ".join(
+        (f"node '{p.made_by}'" if p.made_by else "the field.expression")
+        + f" ({getattr(p.args['value'], 'text', 'the expression')!r}: {p.lipschitz:g})"
+        for p in given
+    )
+    need = _round_up(max(p.lipschitz for p in given) * factor * 1.25)
+    return (
+        f"the field's samples contradict its Lipschitz bound {bound:g}: its values change by "
+        f"up to {slope:.3g} per unit length between neighbouring samples, so the mesher "
+        f"discarded cells that hold its surface; raise 'lipschitz' of {names} to about "
+        f"{need:g} or more"
+    )
+
+
+def _round_up(x: float) -> float:
+    """``x`` rounded up to two significant digits (a bound to suggest: never below)."""
+    unit = 10.0 ** (math.floor(math.log10(x)) - 1)
+    return math.ceil(x / unit) * unit
 
 
 def mesh_of(
@@ -106,9 +161,14 @@ def mesh_of(
         raise
     except ValueError as exc:
         raise InputError(port, str(exc)) from None
+    contradicted = _lipschitz_contradicted(field, box)
     if not len(t):
+        if contradicted is not None:
+            raise InputError(port, f"no surface was found, but {contradicted}")
         ctx.warn("the field has no surface inside its bounds: the mesh is empty")
         return Mesh(np.zeros((0, 3)), np.zeros(0, np.int64), np.zeros(1, np.int64))
+    if contradicted is not None:
+        ctx.warn(f"parts of the surface may be missing: {contradicted}")
     _warn_moved_faces(field, v, cell, ctx)
     return Mesh(v, t.reshape(-1), np.arange(0, 3 * len(t) + 1, 3))
 

@@ -13,7 +13,7 @@ from typing import Annotated
 import numpy as np
 
 from formgraph.core.errors import InputError
-from formgraph.core.registry import Range, node
+from formgraph.core.registry import Context, Range, node
 from formgraph.core.types import Expression, Variables, Vec3
 from formgraph.geometry import Field
 from formgraph.nodes.field._common import bounds_box, positive
@@ -105,13 +105,16 @@ def expression(
     value: Annotated[Expression, Variables("x", "y", "z")],
     bounds: list[list[float]] | None = None,
     lipschitz: Annotated[float, Range(min=0)] = 1.0,
+    *,
+    ctx: Context,
 ) -> Field:
     """A field from an expression in ``x y z`` (and the graph params), negative inside.
 
     The mesher discards a cell when the value at its centre is farther from zero than
     ``lipschitz`` times its half-diagonal, so ``lipschitz`` must bound the gradient's length
     (1 for a true distance such as ``sqrt(x*x + y*y + z*z) - 1``); a smaller one is faster
-    but may miss thin parts.
+    but may miss thin parts. ``field.mesh`` checks the bound against samples of the field
+    and names this node's ``lipschitz`` when they contradict it.
 
     Parameters
     ----------
@@ -124,7 +127,7 @@ def expression(
         A bound on the gradient's length, > 0.
     """
     box = bounds_box("bounds", bounds) if bounds is not None else None
-    return Field.expression(value, box, positive("lipschitz", lipschitz))
+    return Field.expression(value, box, positive("lipschitz", lipschitz), made_by=ctx.node)
 
 
 class TPMSKind(str, Enum):

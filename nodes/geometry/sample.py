@@ -44,7 +44,7 @@ def sample_surface(
     v : int
         Cells along v.
     """
-    ctx.guard(u * v, "points")
+    ctx.guard(u * v, "points", nbytes=48 * u * v, port="u" if u >= v else "v")  # xyz, normals
     (u0, u1), (v0, v1) = surface.domain_u, surface.domain_v
     uu = u0 + (np.arange(u) + 0.5) * (u1 - u0) / u
     vv = v0 + (np.arange(v) + 0.5) * (v1 - v0) / v

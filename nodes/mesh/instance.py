@@ -64,7 +64,7 @@ def mesh_copy_to_points(
     """
     n = len(points)
     ctx.guard(n * mesh.n_faces, "faces")
-    ctx.guard(n * mesh.n_vertices * 3, "coordinates")
+    ctx.guard(n * mesh.n_vertices * 3, "coordinates", nbytes=n * mesh.nbytes, port="points")
     per = per_point(points, scale=scale, rotate=rotate, align=align)
     linear = frames(n, per["scale"], per["rotate"], per["align"])
     mirrored = np.linalg.det(linear) < 0

@@ -19,6 +19,10 @@ from formgraph.nodes.mesh._common import (
     within_floats,
 )
 
+# The bytes a quad mesh takes a face (about a vertex a face): 3 coordinates, 4 corner
+# indices and an offset, 8 bytes each -- what a primitive's guard charges against memory.
+MESH_BYTES = 8 * (3 + 4 + 1)
+
 
 @node("mesh.from_faces", version=1)
 def from_faces(vertices: Points, faces: Faces) -> Mesh:
@@ -127,7 +131,8 @@ def sphere(
     center : Vec3
         Centre of the sphere.
     """
-    ctx.guard(segments * max(2, segments // 2), "faces")
+    faces = segments * max(2, segments // 2)
+    ctx.guard(faces, "faces", nbytes=MESH_BYTES * faces, port="segments")
     try:
         arrays = kp.sphere(radius, segments, center)
     except ValueError as exc:
@@ -161,7 +166,10 @@ def torus(
     center : Vec3
         Centre of the torus.
     """
-    ctx.guard(segments_u * segments_v, "faces")
+    port = "segments_u" if segments_u >= segments_v else "segments_v"
+    ctx.guard(
+        segments_u * segments_v, "faces", nbytes=MESH_BYTES * segments_u * segments_v, port=port
+    )
     try:
         arrays = kp.torus(major, minor, segments_u, segments_v, center)
     except ValueError as exc:
@@ -193,7 +201,8 @@ def plane(
         raise InputError("size", f"size takes [width, depth], got {list(size)}")
     if len(divisions) != 2:
         raise InputError("divisions", f"divisions takes [nx, ny], got {list(divisions)}")
-    ctx.guard(float(divisions[0] + 1) * float(divisions[1] + 1), "vertices")
+    count = float(divisions[0] + 1) * float(divisions[1] + 1)
+    ctx.guard(count, "vertices", nbytes=MESH_BYTES * count, port="divisions")
     try:
         arrays = kp.plane(size, divisions, center)
     except ValueError as exc:

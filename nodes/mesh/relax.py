@@ -18,7 +18,7 @@ from formgraph.kernels.mesh import relax as kr
 VELOCITY = "relax_velocity"
 
 
-@node("mesh.relax", version=1)
+@node("mesh.relax", version=2)
 def relax(
     mesh: Mesh,
     anchors: list[int] | None = None,
@@ -43,7 +43,9 @@ def relax(
     as the point attribute ``relax_velocity``, so the steps are one motion. Loads hang a
     net (turned upside down, a vault in pure compression); pressure inflates a closed mesh
     along its area-weighted vertex normals. Anchors do not move at all. Use with
-    ``simulate:``; with the defaults a few hundred steps bring a small net to rest.
+    ``simulate:``; with the defaults a few hundred steps bring a small net to rest. The
+    springs' rest lengths are those of the state the simulation started from (its
+    ``from``), so they stay put while the net moves; alone, those of ``mesh``.
 
     Parameters
     ----------
@@ -53,7 +55,7 @@ def relax(
         Indices of vertices held fixed.
     rest_length : float | None
         One rest length for every spring; by default each spring's length in
-        ``reference`` times ``rest_scale``.
+        ``reference`` (under ``simulate:``, the first state) times ``rest_scale``.
     stiffness : float
         Force per unit strain of each spring (EA): tension = stiffness * (length - rest)
         / rest.
@@ -62,8 +64,8 @@ def relax(
     pressure : float
         Force per unit area along the outward normals (closed, outward meshes inflate).
     reference : Mesh | None
-        The mesh whose edge lengths are the rest lengths (default ``mesh``; in a
-        simulation wire the first state here, e.g. ``"@net"``, so they stay put).
+        The mesh whose edge lengths are the rest lengths, with the mesh's faces. Default:
+        under ``simulate:`` the simulation's first state (``from``), else ``mesh`` itself.
     rest_scale : float
         Rest lengths as a fraction of the reference's (below 1 pulls the net taut).
     anchor_boundary : bool
@@ -76,7 +78,9 @@ def relax(
     """
     v = np.asarray(mesh.vertices)
     n = len(v)
-    ref = mesh if reference is None else reference
+    ref = reference
+    if ref is None:  # a step of a simulation: the net it started as; alone: this one
+        ref = ctx.start if isinstance(ctx.start, Mesh) else mesh
     same = ref is mesh or (
         ref.n_vertices == n
         and ref.face_offsets.shape == mesh.face_offsets.shape

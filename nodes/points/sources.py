@@ -48,11 +48,18 @@ def grid(
     origin : Vec3
         Position of the first point (the minimum corner).
     """
-    ctx.guard(nx * ny * nz, "points")
+    counts = {"nx": nx, "ny": ny, "nz": nz}
+    n = nx * ny * nz
+    ctx.guard(n, "points", nbytes=24 * n, port=max(counts, key=counts.__getitem__))
     step = np.broadcast_to(np.asarray(spacing, dtype=np.float64), (3,))
-    k, j, i = np.meshgrid(np.arange(nz), np.arange(ny), np.arange(nx), indexing="ij")
-    ijk = np.stack([i.ravel(), j.ravel(), k.ravel()], axis=-1)
-    return Points(np.asarray(origin) + ijk * step)
+    o = np.asarray(origin, dtype=np.float64)
+    # each coordinate written in place along its axis: the output is the only array of its
+    # size made here (meshgrids, their stack and the products were four more)
+    out = np.empty((nz, ny, nx, 3))
+    out[..., 0] = o[0] + np.arange(nx) * step[0]
+    out[..., 1] = (o[1] + np.arange(ny) * step[1])[:, None]
+    out[..., 2] = (o[2] + np.arange(nz) * step[2])[:, None, None]
+    return Points(out.reshape(n, 3))
 
 
 @node("points.circle", version=1)
@@ -74,7 +81,7 @@ def circle(
     center : Vec3
         Centre of the circle.
     """
-    ctx.guard(count, "points")
+    ctx.guard(count, "points", nbytes=24 * count, port="count")
     a = np.linspace(0.0, 2.0 * np.pi, count, endpoint=False)
     xyz = np.stack([np.cos(a), np.sin(a), np.zeros(count)], axis=-1) * radius
     return Points(np.asarray(center) + xyz)
@@ -107,6 +114,9 @@ def random(
     lo, hi = np.asarray(min), np.asarray(max)
     if np.any(hi < lo):
         raise ValueError(f"max {hi.tolist()} is below min {lo.tolist()} on some axis")
-    ctx.guard(count, "points")
+    ctx.guard(count, "points", nbytes=24 * count, port="count")
     rng = np.random.Generator(np.random.PCG64(seed))
-    return Points(lo + rng.random((count, 3)) * (hi - lo))
+    xyz = rng.random((count, 3))  # the same draws as ever, scaled in place
+    xyz *= hi - lo
+    xyz += lo
+    return Points(xyz)

@@ -23,7 +23,7 @@ def _peak_mb() -> float:
 
 def test_a_repeat_of_big_items_is_refused_by_their_total_before_any_runs():
     before = _peak_mb()
-    t0 = time.perf_counter()
+    t0 = time.process_time()
     g = _graph("  s: {type: mesh.sphere, repeat: {i: 100}, radius: '=1 + i', segments: 2000}\n")
     with pytest.raises(
         fg.BudgetError,
@@ -31,7 +31,10 @@ def test_a_repeat_of_big_items_is_refused_by_their_total_before_any_runs():
         r"[\d,]+ elements each, [\d,]+ in all, over the budget of 50,000,000",
     ):
         g.evaluate("s")
-    assert time.perf_counter() - t0 < 10 and _peak_mb() - before < 500
+    # refused before any item runs: no memory taken, and no minutes of spheres (this
+    # process's CPU seconds, to which other processes' load adds nothing, only tell that
+    # from a run of 100 spheres)
+    assert _peak_mb() - before < 500 and time.process_time() - t0 < 60
 
 
 def test_a_repeat_of_merges_is_refused_by_their_total():
@@ -78,8 +81,8 @@ def test_a_whole_run_is_bounded_by_what_it_holds():
     g = _graph(nodes, budget=1000)
     with pytest.raises(
         fg.BudgetError,
-        match=r"h.yaml:7: node 'p4': would make 999 points while the run already holds about "
-        r"3,996 elements from earlier nodes: together over 4 x the budget of 1,000",
+        match=r"h.yaml:7: node 'p4', input 'count': would make 999 points while the run already "
+        r"holds about 3,996 elements from earlier nodes: together over 4 x the budget of 1,000",
     ):
         g.evaluate([f"p{i}" for i in range(8)])
     # each alone, or four of them, still runs

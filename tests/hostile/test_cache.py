@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import hashlib
 import io
 import json
 import zipfile
@@ -26,14 +25,10 @@ def _npy(array: np.ndarray | None = None, header: dict | None = None, body: byte
 
 
 def _meta(key: str, value: object, arrays: dict[str, bytes], depth: int = 0) -> bytes:
-    check = hashlib.blake2b(digest_size=16)
-    for name in sorted(arrays):
-        a = np.load(io.BytesIO(arrays[name]), allow_pickle=False)
-        check.update(name.encode())
-        check.update(_cache._hash_bytes(a).encode())
-    text = json.dumps(
-        {"format": _cache.FORMAT, "key": key, "check": check.hexdigest(), "value": value}
-    )
+    loaded = {name: np.load(io.BytesIO(data), allow_pickle=False) for name, data in arrays.items()}
+    meta = {"format": _cache.FORMAT, "key": key, "value": value}
+    meta["check"] = _cache.entry_checksum(meta, loaded)
+    text = json.dumps(meta)
     if depth:  # a description nested absurdly deep
         text = text[:-1] + ', "x": ' + "[" * depth + "]" * depth + "}"
     return _npy(np.frombuffer(text.encode(), dtype=np.uint8))
@@ -118,3 +113,123 @@ def test_a_description_full_of_escaped_quotes_is_a_miss(tmp_path):
     text = '{"format": 1, "key": "' + '\\"' * 200_000  # never closed
     _entry(tmp_path, {"meta": _npy(np.frombuffer(text.encode(), dtype=np.uint8))})
     _miss(tmp_path)
+
+
+# ----------------------------------------------------------------- edited real entries
+
+
+def _members(entry) -> dict[str, bytes]:
+    with zipfile.ZipFile(entry) as zf:
+        return {i.filename: zf.read(i) for i in zf.infolist()}
+
+
+def _rewrite(entry, members: dict[str, bytes]) -> None:
+    """The entry as a well-formed archive again (every CRC right), its checksum as it was:
+    what a hand edit of an unpacked entry leaves."""
+    with zipfile.ZipFile(entry, "w") as zf:
+        for name, data in members.items():
+            zf.writestr(name, data)
+
+
+def _edit_description(entry, old: str, new: str) -> None:
+    members = _members(entry)
+    text = bytes(np.load(io.BytesIO(members["meta.npy"]))).decode()
+    assert old in text
+    members["meta.npy"] = _npy(np.frombuffer(text.replace(old, new, 1).encode(), np.uint8))
+    _rewrite(entry, members)
+
+
+def _edit_array(entry, name: str, change) -> None:
+    members = _members(entry)
+    a = np.load(io.BytesIO(members[f"{name}.npy"])).copy()
+    change(a)
+    members[f"{name}.npy"] = _npy(a)
+    _rewrite(entry, members)
+
+
+def _only_entry(root, before: set) -> object:
+    (entry,) = set(root.rglob("*.npz")) - before
+    return entry
+
+
+def _served(tmp_path, text: str, node: str):
+    """Evaluate ``node`` in a fresh graph over the cache: (value, where it came from)."""
+    g = fg.Graph.from_text(text, file="c.yaml", cache_dir=tmp_path / "cache")
+    value = g.evaluate(node)
+    return value, g.stats[node].source if g.stats[node].status == "cached" else "computed"
+
+
+def test_an_edited_measure_is_recomputed_not_served(tmp_path):
+    text = (
+        "formgraph: 1\nnodes:\n  b: {type: mesh.box, size: [1, 2, 3]}\n"
+        "  m: {type: mesh.measure, mesh: '@b'}\n"
+    )
+    first, _ = _served(tmp_path, text, "b")
+    before = set((tmp_path / "cache").rglob("*.npz"))
+    m, _ = _served(tmp_path, text, "m")
+    assert m.volume == pytest.approx(6.0)
+    entry = _only_entry(tmp_path / "cache", before)
+    _edit_description(entry, json.dumps((6.0).hex()), json.dumps((7.0).hex()))
+    m, source = _served(tmp_path, text, "m")
+    assert source == "computed" and m.volume == pytest.approx(6.0)
+    m, source = _served(tmp_path, text, "m")  # the bad entry was replaced by a good one
+    assert source == "disk" and m.volume == pytest.approx(6.0)
+
+
+def test_an_edited_mesh_is_recomputed_not_served(tmp_path):
+    text = "formgraph: 1\nnodes:\n  b: {type: mesh.box, size: [1, 2, 3]}\n"
+    box, _ = _served(tmp_path, text, "b")
+    (entry,) = (tmp_path / "cache").rglob("*.npz")
+    meta = json.loads(bytes(np.load(io.BytesIO(_members(entry)["meta.npy"]))).decode())
+    ref = meta["value"]["state"]["vertices"]["array"]
+
+    def move(a):
+        a[0, 0] += 1.0
+
+    _edit_array(entry, ref, move)
+    again, source = _served(tmp_path, text, "b")
+    assert source == "computed"
+    np.testing.assert_array_equal(again.vertices, box.vertices)
+    # and the identity recorded with it edited (what its descendants are keyed by)
+    _edit_description(entry, '"identity": "', '"identity": "0')
+    assert _served(tmp_path, text, "b")[1] == "computed"
+
+
+def test_edited_curves_are_recomputed_not_served(tmp_path):
+    text = (
+        "formgraph: 1\nnodes:\n  c: {type: curves.rectangle, size: [4, 2]}\n"
+        "  p: {type: points.grid, nx: 3, ny: 1, spacing: 10}\n"
+        "  cs: {type: curves.copy_to_points, curve: '@c', points: '@p'}\n"
+    )
+    _served(tmp_path, text, "c")
+    _served(tmp_path, text, "p")
+    before = set((tmp_path / "cache").rglob("*.npz"))
+    curves, _ = _served(tmp_path, text, "cs")
+    assert len(curves) == 3
+    entry = _only_entry(tmp_path / "cache", before)
+    # the description of the list, one curve of it dropped: every array still as it was
+    meta = json.loads(bytes(np.load(io.BytesIO(_members(entry)["meta.npy"]))).decode())
+    kept = json.dumps(meta["value"]["list"][:2])
+    whole = json.dumps(meta["value"]["list"])
+    members = _members(entry)
+    members["meta.npy"] = _npy(
+        np.frombuffer(json.dumps(meta).replace(whole, kept).encode(), np.uint8)
+    )
+    _rewrite(entry, members)
+    again, source = _served(tmp_path, text, "cs")
+    assert source == "computed" and len(again) == 3
+
+
+def test_an_edited_text_is_recomputed_not_served(tmp_path):
+    disk = _cache.DiskCache(tmp_path)
+    assert disk.put(KEY, "out/part.stl")
+    _edit_description(tmp_path / KEY[:2] / f"{KEY}.npz", "out/part.stl", "../../etc/x")
+    _miss(tmp_path)
+
+
+def test_a_field_recipe_is_never_on_disk_so_never_served_from_it(tmp_path):
+    text = "formgraph: 1\nnodes:\n  s: {type: field.sphere, radius: 2}\n"
+    field, _ = _served(tmp_path, text, "s")
+    assert not list((tmp_path / "cache").rglob("*.npz"))  # rebuilt, never read back
+    again, source = _served(tmp_path, text, "s")
+    assert source == "computed" and _cache.digest(again) == _cache.digest(field)

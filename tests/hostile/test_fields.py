@@ -179,6 +179,136 @@ def test_the_mesher_refuses_a_box_too_many_cells_across_to_number():
     assert len(v) and (np.unique(edges, axis=0, return_counts=True)[1] == 2).all()
 
 
+# ------------------------------------------------------------ recipes thousands deep
+
+DEPTH = 5000
+
+
+def test_a_graph_of_5000_field_nodes_meshes():
+    # today: RecursionError from 400 deep (Field.nbytes, the evaluation, the hashes), and an
+    # unlocated "internal error" from 700
+    lines = ["formgraph: 1", "nodes:", "  f0: {type: field.sphere, radius: 1}"]
+    lines += [
+        f"  f{i}: {{type: field.offset, field: '@f{i - 1}', distance: 0.0001}}"
+        for i in range(1, DEPTH)
+    ]
+    lines.append(f"  m: {{type: field.mesh, field: '@f{DEPTH - 1}', cell: 0.25}}")
+    g = fg.Graph.from_text("\n".join(lines) + "\n", file="deep.yaml")
+    m = g.evaluate("m")
+    r = np.linalg.norm(m.vertices, axis=1)
+    assert m.n_faces > 100 and m.is_watertight
+    np.testing.assert_allclose(r, 1 + (DEPTH - 1) * 0.0001, atol=0.01)
+
+
+def _chain(op: str, depth: int = DEPTH) -> Field:
+    f = Field.sphere(1.0)
+    for _ in range(depth):
+        if op == "offset":
+            f = Field.offset(f, 0.0001)
+        elif op == "transform":
+            f = Field.transform(f, np.eye(3), [0.0001, 0, 0], 1.0)
+        else:
+            f = Field.union([f, Field.sphere(0.1, [3, 0, 0])])
+    return f
+
+
+@pytest.mark.parametrize("op", ["offset", "transform", "union"])
+def test_a_recipe_5000_deep_is_walked_without_recursion(op):
+    import pickle
+
+    from formgraph.evaluation.cache import digest
+    from formgraph.evaluation.cutoff import same_content
+
+    f = _chain(op)
+    p = np.random.default_rng(1).uniform(-2, 2, (500, 3))
+    shift = {"offset": [0, 0, 0], "transform": [0.5, 0, 0], "union": [0, 0, 0]}[op]
+    expected = np.linalg.norm(p - shift, axis=1) - (1.5 if op == "offset" else 1.0)
+    if op == "union":
+        expected = np.minimum(expected, np.linalg.norm(p - [3, 0, 0], axis=1) - 0.1)
+    np.testing.assert_allclose(f.evaluate(p), expected, atol=1e-9)
+    # on a lattice (tables all through) as at its points
+    grid = f.evaluate_grid([-1, -1, -1], 0.5, (4, 5, 6))
+    ijk = np.stack(np.meshgrid(np.arange(4), np.arange(5), np.arange(6), indexing="ij"), -1)
+    at = ijk.reshape(-1, 3) * 0.5 - 1
+    assert f.separable
+    np.testing.assert_allclose(grid.reshape(-1), f.evaluate(at), atol=1e-9)
+    # sized, hashed, compared and pickled (to a worker) the same way
+    assert 256 * DEPTH < f.nbytes < 1024 * (DEPTH + 2)
+    back = pickle.loads(pickle.dumps(f))
+    assert back is not f and same_content(f, back) and digest(back) == digest(f)
+    np.testing.assert_array_equal(back.evaluate(p[:5]), f.evaluate(p[:5]))
+
+
+def test_a_recipe_that_shares_its_parts_is_walked_once_a_part():
+    # each level the union of the last and its offset: 2^60 paths down, 121 parts
+    f = Field.sphere(1.0)
+    for _ in range(60):
+        f = Field.union([f, Field.offset(f, 0.001)])
+    assert len(f.parts) == 121
+    assert f.nbytes < 121 * 1024  # each part counted once, not once a path
+    p = np.random.default_rng(2).uniform(-2, 2, (200, 3))
+    np.testing.assert_allclose(f.evaluate(p), np.linalg.norm(p, axis=1) - 1.06, atol=1e-9)
+    np.testing.assert_allclose(
+        f.evaluate_grid([0, 0, 0], 0.5, (2, 2, 2)).reshape(-1),
+        f.evaluate(np.stack(np.meshgrid(*[[0, 0.5]] * 3, indexing="ij"), -1).reshape(-1, 3)),
+        atol=1e-9,
+    )
+
+
+# ------------------------------------------------------------ a Lipschitz bound that lies
+
+STEEP = """\
+formgraph: 1
+nodes:
+  e:
+    type: field.expression
+    value: "VALUE"
+    bounds: [[-2, -2, -2], [2, 2, 2]]
+    lipschitz: LIP
+  m: {type: field.mesh, field: "@e", cell: 0.1}
+"""
+
+
+def test_a_lipschitz_bound_the_samples_contradict_is_named_not_an_empty_mesh():
+    # today: a warning that "the field has no surface inside its bounds" and an empty mesh
+    text = STEEP.replace("VALUE", "sqrt(x*x + y*y + z*z) * 10 - 10").replace("LIP", "0.5")
+    g = fg.Graph.from_text(text, file="steep.yaml")
+    with pytest.raises(
+        fg.NodeError,
+        match=r"steep.yaml:8: node 'm', input 'field' \(field.mesh\): no surface was found, but "
+        r"the field's samples contradict its Lipschitz bound 0.5: its values change by up to "
+        r"9.9\d per unit length .* raise 'lipschitz' of node 'e' "
+        r"\('sqrt\(x\*x \+ y\*y \+ z\*z\) \* 10 - 10': 0.5\) to about 13 or more",
+    ):
+        g.evaluate("m")
+    # the advice works
+    fixed = fg.Graph.from_text(text.replace("lipschitz: 0.5", "lipschitz: 13"), file="s.yaml")
+    m = fixed.evaluate("m")
+    assert m.n_faces > 1000
+    np.testing.assert_allclose(np.linalg.norm(m.vertices, axis=1), 1.0, atol=1e-3)
+
+
+def test_a_bound_that_loses_part_of_the_surface_is_warned_of():
+    # a unit sphere (slope 1) and a small steep one (slope 20) beside it: the bound of 1
+    # keeps the first and loses the second
+    value = "min(sqrt(x*x + y*y + z*z) - 0.8, 20 * (sqrt((x - 1.4)**2 + y*y + z*z) - 0.3))"
+    g = fg.Graph.from_text(STEEP.replace("VALUE", value).replace("LIP", "1"), file="s.yaml")
+    with pytest.warns(
+        fg.FormgraphWarning,
+        match=r"parts of the surface may be missing: the field's samples contradict its "
+        r"Lipschitz bound 1: .* raise 'lipschitz' of node 'e'",
+    ):
+        m = g.evaluate("m")
+    assert m.n_faces > 0
+
+
+def test_a_true_bound_is_not_doubted(recwarn):
+    value = "sqrt(x*x + y*y + z*z) - 1 + 0.1 * sin(3 * x)"  # slope at most 1.3
+    g = fg.Graph.from_text(STEEP.replace("VALUE", value).replace("LIP", "1.3"), file="s.yaml")
+    assert g.evaluate("m").n_faces > 1000
+    assert not [w for w in recwarn if "Lipschitz" in str(w.message)]
+
+
 def test_the_flat_face_check_walks_a_deep_recipe_without_recursion():
     from formgraph.nodes.field import _blend
 

@@ -97,10 +97,10 @@ def test_bad_heights_twists_and_scales_are_located_sentences(extra, port, words)
 
 
 def test_a_huge_twist_is_over_the_budget_before_anything_is_made():
-    t0 = time.perf_counter()
+    t0 = time.process_time()
     with pytest.raises(fg.BudgetError, match=r"node 'e'.*over the budget"):
         _extrude("height: 1, twist: 1e9").evaluate("e")
-    assert time.perf_counter() - t0 < 30  # (refused, not built: no timing claim beyond that)
+    assert time.process_time() - t0 < 30  # (refused, not built: no timing claim beyond that)
 
 
 def test_a_tolerance_finer_than_double_precision_is_refused():
@@ -235,10 +235,10 @@ def test_a_minkowski_sum_past_the_budget_is_refused_before_it_runs():
     g.add("t", "mesh.torus", major=2, minor=0.5)  # not convex
     g.add("s", "mesh.sphere", radius=0.2, segments=32)
     g.add("m", "mesh.minkowski", a="@t", b="@s")
-    t0 = time.perf_counter()
+    t0 = time.process_time()
     with pytest.raises(fg.BudgetError, match=r"node 'm'.*elements of Minkowski hulls"):
         g.evaluate("m")
-    assert time.perf_counter() - t0 < 30  # refused at once, not after minutes of hulls
+    assert time.process_time() - t0 < 30  # refused at once, not after minutes of hulls
 
 
 def test_minkowski_of_an_open_mesh_names_the_input():

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import sys
@@ -167,5 +168,60 @@ def test_an_output_path_through_a_file_is_a_located_error(tmp_path):
     (tmp_path / "out" / "afile").write_text("x")
     _graph(tmp_path, "afile/box.stl")
     g = fg.load(tmp_path / "box.yaml", out_dir=tmp_path / "out")
-    with pytest.raises(fg.PathError, match=r"node 'stl': .*runs through a file"):
+    with pytest.raises(fg.PathError, match=r"node 'stl', input 'path': .*runs through a file"):
         g.evaluate_all()
+
+
+@pytest.mark.parametrize(
+    ("path", "why"),
+    [
+        ("sub/", r"output path 'sub/' names a folder, not a file"),
+        ("sub/.", r"output path 'sub/\.' names a folder, not a file"),
+        ("sub\\", r"output path .sub.* names a folder, not a file"),
+        (".x.fgtmp-123-y.tmp", r"output path .* is named like formgraph's temporary files"),
+        (
+            "parts/.box.stl.fgtmp-99999999-abc.tmp",
+            r"output path .* is named like formgraph's temporary files",
+        ),
+    ],
+)
+def test_a_folder_or_a_temp_file_name_is_refused_as_an_output_path(tmp_path, path, why):
+    _graph(tmp_path, json.dumps(path))
+    with pytest.raises(fg.GraphError, match=rf"box.yaml:7: node 'stl', input 'path': {why}"):
+        fg.load(tmp_path / "box.yaml", out_dir=tmp_path / "out")
+    with pytest.raises(fg.PathError, match=why):
+        safety.write_atomic(tmp_path / "out", path, b"x")
+    assert not (tmp_path / "out").exists() or not any((tmp_path / "out").rglob("*"))
+
+
+PARAM_PATH = """\
+formgraph: 1
+params:
+  name: {default: box.stl}
+nodes:
+  box: {type: mesh.box}
+  stl:
+    type: export.stl
+    mesh: "@box"
+    path: "=name"
+"""
+
+
+@pytest.mark.parametrize("name", ["sub/", ".box.stl.fgtmp-1-x.tmp"])
+def test_a_computed_path_is_refused_located_on_its_input(tmp_path, name):
+    (tmp_path / "box.yaml").write_text(PARAM_PATH)
+    g = fg.load(tmp_path / "box.yaml", out_dir=tmp_path / "out")
+    with pytest.raises(fg.PathError, match=r"box.yaml:9: node 'stl', input 'path': output path"):
+        g.evaluate_all(name=name)
+    assert not (tmp_path / "out").exists() or not any((tmp_path / "out").rglob("*"))
+    assert g.evaluate_all(name="box.stl")  # a file's name is still fine
+
+
+def test_a_file_named_like_a_temp_file_is_not_written_to_be_deleted(tmp_path):
+    # today's failure: the export is written, then the next write into its folder takes it
+    # for a dead writer's temp file (pid 1 is never ours... but a gone pid is) and deletes it
+    out = tmp_path / "out"
+    with pytest.raises(fg.PathError):
+        safety.write_atomic(out, ".a.stl.fgtmp-999999999-x.tmp", b"solid")
+    safety.write_atomic(out, "b.stl", b"solid")
+    assert sorted(p.name for p in out.iterdir()) == ["b.stl"]

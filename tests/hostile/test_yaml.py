@@ -86,12 +86,12 @@ def _points_file(n: int) -> str:
 
 def test_a_huge_file_is_refused_by_a_cheap_count_with_a_true_message():
     text = _points_file(1_000_000)  # ~10 MB, under the byte limit: 4 million values
-    t0 = time.perf_counter()
+    t0 = time.process_time()
     with pytest.raises(fg.GraphError) as err:
         fg.Graph.from_text(text, file="h.yaml")
     message = str(err.value)
     assert "values" in message and "aliases" not in message
-    assert time.perf_counter() - t0 < 60  # a bound against a hang, not a benchmark
+    assert time.process_time() - t0 < 60  # CPU seconds: a bound against a hang, not a benchmark
 
 
 def test_the_exact_count_does_not_blame_aliases(monkeypatch):
