@@ -247,3 +247,21 @@ def test_chunk_edges(n):
     assert noise(keys, 0.5, 0.25)[pick].tolist() == [
         noise_mod.SCALE * perlin_reference(keys[j], 0.5, 0.25) for j in pick
     ]
+
+
+def test_noise_far_from_the_origin_matches_the_reference():
+    # the lattice index is masked before it is looked up (np.take's "wrap" mode would walk
+    # a huge negative index back one table length at a time: hours for -1e15)
+    p = np.array([[-1e15 - 0.25, 3.5e14 + 0.5, -7.0e13 - 0.75], [2.0**52, -(2.0**51), 0.5]])
+    got = raw_noise(*p.T)
+    assert got.tolist() == [perlin_reference(*q) for q in p]
+
+
+def test_rand_over_a_million_keys_is_frozen_and_exact():
+    keys = np.arange(1 << 20, dtype=np.float64) * 0.5
+    r = rand(keys, 4.0)
+    from formgraph.geometry import is_frozen
+
+    assert is_frozen(r)  # made in its immutable buffer (kernels.buffers.fill_frozen)
+    pick = [0, 1, 12345, (1 << 20) - 1]
+    assert r[pick].tolist() == [rand_reference(keys[j], 4.0) for j in pick]

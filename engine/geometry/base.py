@@ -9,10 +9,13 @@ from typing import Any, TypeVar
 
 import numpy as np
 
+from ..kernels.buffers import fill_bytes
+
 __all__ = [
     "STORABLE",
     "AttributeMap",
     "Geometry",
+    "all_finite",
     "as_xyz",
     "attribute_map",
     "from_state",
@@ -42,14 +45,30 @@ def frozen_array(values: Any, dtype: Any = np.float64) -> np.ndarray:
     """
     if is_frozen(values) and values.dtype == dtype and values.flags.c_contiguous:
         return values
+    if isinstance(values, np.ndarray):  # a large array: cast straight into new bytes
+        buf = fill_bytes(values, dtype)
+        if buf is not None:
+            return np.frombuffer(buf, dtype=dtype).reshape(values.shape)
     a = np.asarray(values, dtype=dtype)
     return np.frombuffer(a.tobytes(order="C"), dtype=a.dtype).reshape(a.shape)
+
+
+def all_finite(a: np.ndarray) -> bool:
+    """Whether every value of float array ``a`` is finite, in one pass and no temporary when
+    they are: a sum is finite only if every term is (a NaN or an infinity makes it NaN or
+    infinite); only a sum that overflows, or a bad value, takes the exact test."""
+    if a.size == 0:
+        return True
+    with np.errstate(all="ignore"):
+        if np.isfinite(np.add.reduce(a, axis=None)):
+            return True
+    return bool(np.isfinite(a).all())
 
 
 def as_xyz(values: Any, what: str = "points") -> np.ndarray:
     """``(n, 2)`` or ``(n, 3)`` coordinates as a read-only ``(n, 3)`` float64 array (z = 0)."""
     frozen = is_frozen(values) and values.dtype == np.float64 and values.flags.c_contiguous
-    if frozen and values.ndim == 2 and values.shape[1] == 3 and np.isfinite(values).all():
+    if frozen and values.ndim == 2 and values.shape[1] == 3 and all_finite(values):
         return values  # immutable and valid already (another value's coordinates): shared
     try:
         raw = np.asarray(values)
@@ -72,7 +91,7 @@ def as_xyz(values: Any, what: str = "points") -> np.ndarray:
         )
     if a.shape[1] == 2:
         a = np.column_stack([a, np.zeros(len(a))])
-    if not np.all(np.isfinite(a)):
+    if not all_finite(a):
         bad = int(np.argwhere(~np.isfinite(a))[0, 0])
         raise ValueError(f"{what}: coordinate {bad} is not finite ({a[bad].tolist()})")
     return frozen_array(a)
@@ -191,7 +210,7 @@ def _attribute_array(name: Any, values: Any, n: int, what: str) -> np.ndarray:
         raise ValueError(
             f"{what} {name!r} has {a.shape[1]} components; 1 to {MAX_ATTRIBUTE_COMPONENTS} allowed"
         )
-    if not np.all(np.isfinite(a)):
+    if not all_finite(a):
         bad = int(np.argwhere(~np.isfinite(a.reshape(n, -1)))[0, 0])
         raise ValueError(f"{what} {name!r} is not finite at element {bad}")
     return frozen_array(a)

@@ -200,8 +200,9 @@ class Mesh(Geometry):
         return self._content_hash()
 
     def with_data(self, point_data: Any = None, face_data: Any = None) -> Mesh:
-        """The same mesh with other attributes (None: none); the arrays are shared."""
-        return Mesh(*self.arrays, point_data=point_data, face_data=face_data)
+        """The same mesh with other attributes (None: none); the arrays are shared, and not
+        checked again (they are this mesh's own)."""
+        return Mesh.trusted(*self.arrays, point_data=point_data, face_data=face_data)
 
     def to_pyvista(self) -> Any:
         import pyvista as pv

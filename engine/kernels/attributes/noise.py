@@ -58,40 +58,87 @@ def _fade(t: np.ndarray) -> np.ndarray:
     return t * t * t * (t * (t * 6.0 - 15.0) + 10.0)
 
 
+def _take(table: np.ndarray, index: np.ndarray) -> np.ndarray:
+    """``table[index]`` for indices known to be in range: ``np.take`` in ``clip`` mode skips
+    fancy indexing's bounds checks (2-3x faster on these chunks). Never ``wrap`` mode,
+    which walks a huge negative index back into range one table length at a time."""
+    return np.take(table, index, mode="clip")
+
+
 def _chunk(x: np.ndarray, y: np.ndarray, z: np.ndarray) -> np.ndarray:
+    """The raw noise of one chunk, in the reference's operation order (so bit for bit its
+    values), most steps in place. A coordinate that is not finite gives NaN by itself: its
+    fraction is NaN, and NaN times any gradient component (0 too) stays NaN."""
     fx, fy, fz = np.floor(x), np.floor(y), np.floor(z)
-    ix = fx.astype(np.int64) & 255
-    iy = fy.astype(np.int64) & 255
-    iz = fz.astype(np.int64) & 255
-    x, y, z = x - fx, y - fy, z - fz
+    with np.errstate(invalid="ignore"):  # NaN and inf cast to some integer, masked below
+        ix, iy, iz = fx.astype(np.intp), fy.astype(np.intp), fz.astype(np.intp)
+        x, y, z = x - fx, y - fy, z - fz  # inf - inf: NaN
+    ix &= 255
+    iy &= 255
+    iz &= 255
     u, v, w = _fade(x), _fade(y), _fade(z)
-    a = _P[ix] + iy
-    b = _P[ix + 1] + iy
-    aa, ab = _P[a] + iz, _P[a + 1] + iz
-    ba, bb = _P[b] + iz, _P[b + 1] + iz
+    a = _take(_P, ix)
+    a += iy
+    ix += 1
+    b = _take(_P, ix)
+    b += iy
+    aa = _take(_P, a)
+    aa += iz
+    a += 1
+    ab = _take(_P, a)
+    ab += iz
+    ba = _take(_P, b)
+    ba += iz
+    b += 1
+    bb = _take(_P, b)
+    bb += iz
     x1, y1, z1 = x - 1.0, y - 1.0, z - 1.0
 
     def corner(h: np.ndarray, px: np.ndarray, py: np.ndarray, pz: np.ndarray) -> np.ndarray:
-        return _GX[h] * px + _GY[h] * py + _GZ[h] * pz
+        out = _take(_GX, h)  # (gx * px + gy * py) + gz * pz, as the reference sums
+        out *= px
+        t = _take(_GY, h)
+        t *= py
+        out += t
+        t = _take(_GZ, h)
+        t *= pz
+        out += t
+        return out
 
     def lerp(t: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-        return lo + t * (hi - lo)
+        hi -= lo  # lo + t * (hi - lo), into hi (a temporary of this chunk)
+        hi *= t
+        hi += lo
+        return hi
 
     n00 = lerp(u, corner(aa, x, y, z), corner(ba, x1, y, z))
     n10 = lerp(u, corner(ab, x, y1, z), corner(bb, x1, y1, z))
-    n01 = lerp(u, corner(aa + 1, x, y, z1), corner(ba + 1, x1, y, z1))
-    n11 = lerp(u, corner(ab + 1, x, y1, z1), corner(bb + 1, x1, y1, z1))
+    aa += 1
+    ab += 1
+    ba += 1
+    bb += 1
+    n01 = lerp(u, corner(aa, x, y, z1), corner(ba, x1, y, z1))
+    n11 = lerp(u, corner(ab, x, y1, z1), corner(bb, x1, y1, z1))
     return lerp(w, lerp(v, n00, n10), lerp(v, n01, n11))
 
 
 def raw_noise(x: Any, y: Any, z: Any) -> np.ndarray:
     """Perlin's improved noise exactly as the reference code computes it (unscaled)."""
+    return _noise(x, y, z, scaled=False)
+
+
+def _noise(x: Any, y: Any, z: Any, scaled: bool) -> np.ndarray:
     x, y, z = np.broadcast_arrays(*(np.asarray(c, np.float64) for c in (x, y, z)))
     shape = x.shape
     x, y, z = (c.reshape(-1) for c in (x, y, z))
     out = np.empty(x.size)
     for s in range(0, x.size, _CHUNK):
-        out[s : s + _CHUNK] = _chunk(x[s : s + _CHUNK], y[s : s + _CHUNK], z[s : s + _CHUNK])
+        part = slice(s, s + _CHUNK)
+        r = _chunk(x[part], y[part], z[part])
+        if scaled:  # scaled and clipped chunk by chunk, while it is in cache
+            r *= SCALE
+            np.clip(r, -1.0, 1.0, out=r)
+        out[part] = r
     return out.reshape(shape)
 
 
@@ -114,10 +161,4 @@ def noise(x: Any, y: Any = 0.0, z: Any = 0.0) -> np.ndarray:
     >>> float(noise(1.0, 2.0, 3.0)), bool(abs(noise(0.5, 0.25, 0.1)) > 0)
     (0.0, True)
     """
-    x, y, z = np.broadcast_arrays(*(np.asarray(c, np.float64) for c in (x, y, z)))
-    finite = np.isfinite(x) & np.isfinite(y) & np.isfinite(z)
-    if finite.all():
-        return np.clip(raw_noise(x, y, z) * SCALE, -1.0, 1.0)
-    out = np.full(x.shape, np.nan)
-    out[finite] = np.clip(raw_noise(x[finite], y[finite], z[finite]) * SCALE, -1.0, 1.0)
-    return out
+    return _noise(x, y, z, scaled=True)

@@ -26,6 +26,8 @@ from typing import Any
 
 import numpy as np
 
+from ..buffers import fill_frozen
+
 __all__ = ["VERSION", "mix64", "rand"]
 
 VERSION = 2  # 1: two lowbias32 chains; 2: SplitMix64's Mix13 (both 52 bits)
@@ -87,6 +89,7 @@ def rand(key: Any, seed: Any = 0.0) -> np.ndarray:
     -------
     ndarray of float64, the broadcast shape of ``key`` and ``seed``
         52 random bits each (multiples of 2**-52); NaN where the key or the seed is NaN.
+        Read-only (frozen, as an attribute keeps it).
 
     Example
     -------
@@ -103,10 +106,34 @@ def rand(key: Any, seed: Any = 0.0) -> np.ndarray:
     else:
         k, s = (a.reshape(-1) for a in np.broadcast_arrays(k, s))
         shape = np.broadcast_shapes(np.shape(key), np.shape(seed))
+    if k.size == 0:
+        return np.empty(shape, "<f8")
+    stream = _stream(s)
+    # made straight into a frozen buffer: an attribute's values are kept as they are
+    return fill_frozen(k.size, "<f8", lambda out: _fill(out, k, s, stream)).reshape(shape)
+
+
+def _fill(out: np.ndarray, k: np.ndarray, s: np.ndarray, stream: np.ndarray) -> None:
+    """``out[j] = rand(k[j], s[j])`` (``s`` and ``stream``: one seed, or one per key)."""
     n = k.size
-    out = np.empty(n, "<f8")
-    if n == 0:
-        return out.reshape(shape)
+    per_element = stream.size > 1
+    size = min(_CHUNK, n)
+    key_bits = np.empty(size, "<f8")
+    x = key_bits.view("<u8")  # the key's bits, mixed in place
+    t = np.empty(size, _U)
+    for start in range(0, n, size):
+        stop = min(start + size, n)
+        m = stop - start
+        if m < size:
+            key_bits, x, t = key_bits[:m], x[:m], t[:m]
+        np.add(k[start:stop], 0.0, out=key_bits)  # -0 -> +0
+        np.bitwise_xor(x, stream[start:stop] if per_element else stream[0], out=x)
+        _mix(x, t)
+        np.right_shift(x, _S12, out=x)  # the top 52 bits, as the mantissa of [1, 2)
+        np.bitwise_or(x, _ONE, out=x)
+        np.subtract(key_bits, 1.0, out=out[start:stop])
+    if np.isnan(k.min()) or np.isnan(s.min()):  # min propagates NaN: one cheap pass
+        out[np.isnan(k) | np.isnan(s)] = np.nan
     stream = _stream(s)
     per_element = stream.size > 1
     size = min(_CHUNK, n)
@@ -126,4 +153,3 @@ def rand(key: Any, seed: Any = 0.0) -> np.ndarray:
         np.subtract(key_bits, 1.0, out=out[start:stop])
     if np.isnan(k.min()) or np.isnan(s.min()):  # min propagates NaN: one cheap pass
         out[np.isnan(k) | np.isnan(s)] = np.nan
-    return out.reshape(shape)
