@@ -278,9 +278,9 @@ class _Run(LanguageRun, SimulationRun, Replay):
     def read_input(self, name: str, relpath: str) -> tuple[Path, bytes]:
         """What a node's ``ctx.read`` returns: the bytes keyed, else the file read now (a
         path that came down a wire)."""
-        held = self.input_files.get(name, {}).get(relpath)
-        if held is not None:
-            return held
+        held = self.input_files.get(name, {}).pop(relpath, None)
+        if held is not None:  # handed over: the node holds the only reference (it may let
+            return held  # go of a large file's bytes once parsed, before the run ends)
         path = safety.resolve_input(self.g.input_root, relpath, self.g.input_base)
         return path, safety.read_input(path)
 

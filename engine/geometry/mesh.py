@@ -57,12 +57,13 @@ class Mesh(Geometry):
         else:
             fi = _indices(face_indices, "face_indices")
             fo = _indices(face_offsets, "face_offsets")
-        if fo.size == 0 or fo[0] != 0 or fo[-1] != fi.size or np.any(np.diff(fo) < 0):
+        sizes = np.diff(fo)
+        least = sizes.min() if sizes.size else 3
+        if fo.size == 0 or fo[0] != 0 or fo[-1] != fi.size or least < 0:
             raise ValueError(
                 "face_offsets must start at 0, never decrease and end at len(face_indices)"
             )
-        sizes = np.diff(fo)
-        if sizes.size and sizes.min() < 3:
+        if least < 3:
             bad = int(np.argmax(sizes < 3))
             raise ValueError(f"face {bad} has {int(sizes[bad])} vertices; a face needs at least 3")
         if fi.size and (fi.min() < 0 or fi.max() >= len(v)):

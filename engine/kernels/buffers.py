@@ -2,33 +2,32 @@
 
 A frozen array (:func:`~formgraph.geometry.base.frozen_array`) views an immutable ``bytes``
 object, so nobody can make it writable again. ``ndarray.tobytes`` makes that object by
-copying into memory fresh from the allocator, touched 4 KiB page by 4 KiB page (about 2,000
-page faults for 8 MB, 40-60 % of the copy's time), and needs the array in the final dtype
-first (a second copy for a cast). :func:`fill_bytes` instead asks CPython for a new,
-uninitialised ``bytes`` object (``PyBytes_FromStringAndSize(NULL, n)``: the C API's own way
-to build one, filled before anyone else can see it), advises the kernel to back it with huge
-pages where Linux allows (``madvise(MADV_HUGEPAGE)``, as numpy does for its own large
-arrays), and casts the values straight into it. The ``bytes`` object is handed out only once
-filled; the writable view used to fill it never leaves this module.
+copying an array that must exist first, in the final dtype (for a cast, a second copy), and
+a file read in chunks is joined into it (a second copy again). Here CPython is asked for a
+new, uninitialised ``bytes`` object (``PyBytes_FromStringAndSize(NULL, n)``: the C API's own
+way to build one, filled before anyone else can see it) and the values are written straight
+into it: a kernel's output (:func:`fill_frozen`), a cast (:func:`fill_bytes`), a file's
+contents (:func:`filled_bytes`). The ``bytes`` object is handed out only once filled; the
+writable view used to fill it never leaves this module.
 
-Where any of that is unavailable (another Python, no ``libc``), :func:`fill_bytes` returns
-None and the caller copies with ``tobytes``: the values are the same either way.
+(Advising huge pages for these buffers was measured and left out: where the kernel compacts
+memory on such a fault, 72 MB took 190 ms to fault in instead of 35.)
+
+Where CPython's C API is unavailable, the same functions fill a numpy array or a
+``bytearray`` and copy it once: the values are the same either way.
 """
 
 from __future__ import annotations
 
 import ctypes
-import sys
 from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 
-__all__ = ["MIN_BYTES", "fill_bytes", "fill_frozen"]
+__all__ = ["MIN_BYTES", "fill_bytes", "fill_frozen", "filled_bytes"]
 
-MIN_BYTES = 1 << 20  # below this the page faults saved do not pay for the ctypes calls
-_HUGE = 1 << 21  # a transparent huge page on x86-64 and arm64 (Linux)
-_MADV_HUGEPAGE = 14  # <linux/mman.h>
+MIN_BYTES = 1 << 20  # below this a copy costs less than the ctypes calls
 
 
 def _bytes_api() -> Any:
@@ -41,31 +40,13 @@ def _bytes_api() -> Any:
     return new
 
 
-def _madvise() -> Any:
-    if not sys.platform.startswith("linux"):
-        return None
-    try:
-        fn = ctypes.CDLL(None, use_errno=True).madvise
-    except (AttributeError, OSError):
-        return None
-    fn.argtypes = [ctypes.c_void_p, ctypes.c_size_t, ctypes.c_int]
-    fn.restype = ctypes.c_int
-    return fn
-
-
 _NEW_BYTES = _bytes_api()
-_MADVISE = _madvise()
 
 
 def _new_bytes(nbytes: int) -> tuple[bytes, Any]:
     """A new uninitialised ``bytes`` object and a ctypes array over its contents."""
     buf = _NEW_BYTES(None, nbytes)
     address = np.frombuffer(buf, np.uint8).ctypes.data
-    if _MADVISE is not None:  # whole huge pages inside the buffer; only advice, never fatal
-        start = -(-address // _HUGE) * _HUGE
-        stop = (address + nbytes) // _HUGE * _HUGE
-        if stop > start:
-            _MADVISE(start, stop - start, _MADV_HUGEPAGE)
     return buf, (ctypes.c_uint8 * nbytes).from_address(address)
 
 
@@ -90,6 +71,26 @@ def fill_frozen(shape: Any, dtype: Any, fill: Callable[[np.ndarray], None]) -> n
     fill(out)
     del out, raw  # the only writable views: gone before the bytes are handed out
     return np.frombuffer(buf, dtype).reshape(shape)
+
+
+def filled_bytes(nbytes: int, fill: Callable[[memoryview], int]) -> bytes:
+    """A new ``bytes`` object of at most ``nbytes`` that ``fill(view)`` writes, e.g. a
+    file's contents read by one ``readinto`` (no list of chunks joined: no second copy).
+
+    ``fill`` receives a writable memoryview of ``nbytes`` and returns how many bytes it
+    wrote from the start; the result is cut to that many (a copy only when it fell short).
+    It must not keep the view.
+    """
+    if _NEW_BYTES is None or nbytes < MIN_BYTES:
+        scratch = bytearray(nbytes)
+        with memoryview(scratch) as view:
+            n = fill(view)
+        return bytes(scratch[:n]) if n < nbytes else bytes(scratch)
+    buf, raw = _new_bytes(nbytes)
+    with memoryview(raw).cast("B") as view:
+        n = fill(view)
+    del raw
+    return buf if n == nbytes else buf[:n]
 
 
 def fill_bytes(values: np.ndarray, dtype: Any) -> bytes | None:
