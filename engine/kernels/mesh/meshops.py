@@ -334,7 +334,8 @@ def triangulate(
     vertices : (n, 3) float64
         Unchanged.
     face_indices : (3 * (m - 2 n_faces),) int64
-        The triangles of face 0, then of face 1, ...
+        The triangles of face 0, then of face 1, ... (a mesh of triangles only: its own
+        arrays, not copied).
     face_offsets : (m - 2 n_faces + 1,) int64
 
     Raises
@@ -347,6 +348,8 @@ def triangulate(
     fi = np.asarray(face_indices, dtype=np.int64)
     fo = np.asarray(face_offsets, dtype=np.int64)
     sizes = np.diff(fo)
+    if sizes.size and sizes.min() == 3 == sizes.max():  # triangles already: as they are
+        return v, fi, fo
     n_tri = sizes - 2
     tri_off = np.zeros(sizes.size + 1, dtype=np.int64)
     np.cumsum(n_tri, out=tri_off[1:])
