@@ -141,10 +141,24 @@ def _hash_bytes(a: np.ndarray) -> str:
 
 
 def digest(value: Any) -> str | None:
-    """A cheap content hash of a node output (for early cutoff); None when not hashable."""
+    """A content hash of a value (a key's part for a Python input, early cutoff's test);
+    None when not hashable.
+
+    A geometry value is immutable, so its hash is made once and kept with it: a mesh
+    handed to ``evaluate`` again, or keyed three times in one run (the key, and the state
+    a run's keys are kept under), is not hashed again.
+    """
+    if isinstance(value, Geometry):
+        kept = value.__dict__.get("_digest")
+        if kept is not None:
+            return kept
+        try:
+            h = key_of({"type": type(value).__name__, "state": value.fingerprint()})
+        except (TypeError, NotImplementedError):
+            return None
+        object.__setattr__(value, "_digest", h)
+        return h
     try:
-        if isinstance(value, Geometry):
-            return key_of({"type": type(value).__name__, "state": value.fingerprint()})
         return key_of(value)
     except (TypeError, NotImplementedError):
         return None

@@ -11,6 +11,7 @@ are evaluated by the :class:`formgraph.evaluation.items.LanguageRun` mixin.
 from __future__ import annotations
 
 import contextlib
+import functools
 import hashlib
 import os
 import stat
@@ -96,26 +97,36 @@ class _Run(LanguageRun, SimulationRun, Replay):
         self.inner: dict[str, dict[str, NodeStat]] = {}  # subgraph node -> its run's stats
         self.results: dict[str, Any] = {}
         self.stats: dict[str, NodeStat] = {}
-        memo = getattr(g, "_pure_root", None) if pure else None
-        if memo is not None and memo[0] == str(g.out_dir):
-            # A plan or a step keys with the folder's name only (a sweep plans every variant
-            # and runs every step through one: one look at the file system, not thousands);
-            # an export still checks where it writes.
-            self.out_path = memo[1]
-        else:
-            try:
-                self.out_path = safety.output_root(g.out_dir)
-            except PathError:  # only an export needs it: each says why, at its own line
-                self.out_path = Path(os.path.abspath(g.out_dir))
-            if pure:
-                g._pure_root = (str(g.out_dir), self.out_path)
-        self.out_dir = str(self.out_path)
         self.total = 0
         self.tally = RunTally(g.budget)  # what this run's nodes hold together
         self.started: set[str] = set()  # nodes that began computing, for the progress line
         self.quiet = False  # inside run(): numpy's warnings are silenced once, not per node
         # node -> input path -> (file, bytes): read once when keyed, handed to the node
         self.input_files: dict[str, dict[str, tuple[Path, bytes]]] = {}
+
+    @functools.cached_property
+    def out_path(self) -> Path:
+        """The output folder, resolved when a run first needs it (an export's key or a
+        node's context), not by every run (a slider's step of a graph without exports
+        never looks at the file system)."""
+        g = self.g
+        memo = getattr(g, "_pure_root", None) if self.pure else None
+        if memo is not None and memo[0] == str(g.out_dir):
+            # A plan or a step keys with the folder's name only (a sweep plans every variant
+            # and runs every step through one: one look at the file system, not thousands);
+            # an export still checks where it writes.
+            return memo[1]
+        try:
+            path = safety.output_root(g.out_dir)
+        except PathError:  # only an export needs it: each says why, at its own line
+            path = Path(os.path.abspath(g.out_dir))
+        if self.pure:
+            g._pure_root = (str(g.out_dir), path)
+        return path
+
+    @functools.cached_property
+    def out_dir(self) -> str:
+        return str(self.out_path)
 
     def where(self, name: str, port: str | None = None) -> Where:
         nd = self.g._nodes[name]
@@ -491,7 +502,9 @@ class _Run(LanguageRun, SimulationRun, Replay):
         if spec.wants_context:
             kwargs["ctx"] = Context(
                 name,
-                self.out_path,
+                # resolved for an export (its key holds it); any other node that writes
+                # resolves it then (ctx.write goes through safety.resolve_output)
+                self.out_path if spec.is_export else Path(self.g.out_dir),
                 self.g.budget,
                 warnings,
                 inputs=lambda relpath: self.read_input(name, relpath),
