@@ -74,7 +74,7 @@ def run(table) -> None:
 
         lists = (v.tolist(), faces.tolist(), fi.tolist(), np.diff(fo).tolist())
 
-        def opensubdiv_ready(lv=levels):
+        def opensubdiv_ready(lv=levels, lists=lists):
             from pyOpenSubdiv.pysubdivision import pysubdivide
 
             return pysubdivide(lv, *lists)
@@ -172,7 +172,9 @@ def _doo_sabin_points(table, v: np.ndarray, fi: np.ndarray, fo: np.ndarray) -> N
         table.compare(
             case,
             api=lambda x=x, he=he: ours(x, he),
-            references={"per-size einsum (the kernel before)": lambda x=x, he=he: doo_sabin_points(x, he)},
+            references={
+                "per-size einsum (the kernel before)": lambda x=x, he=he: doo_sabin_points(x, he)
+            },
             rounds=5,
             note="the kernel: cosine form, 2 sparse products",
         )
