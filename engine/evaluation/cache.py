@@ -69,6 +69,8 @@ def canonical(value: Any) -> Any:
     if isinstance(value, Geometry):
         h = digest(value)
         return {"g": type(value).__name__, "h": h if h is not None else _token(value)}
+    if isinstance(value, Keyed):
+        return json.loads(value.text)  # (its text is this canonical form's JSON)
     raise TypeError(f"cannot make a cache key of {type(value).__name__}")
 
 
@@ -80,6 +82,29 @@ def _token(value: Any) -> str:
     if value not in _TOKENS:
         _TOKENS[value] = "obj:" + uuid.uuid4().hex
     return _TOKENS[value]
+
+
+class Keyed:
+    """A value's key text, made once: :func:`key_text` writes it as it is.
+
+    A graph's literal inputs do not change while the graph does not (a change replaces
+    them), so a long one (a polyline's 1,200 points, each number written by ``float.hex``)
+    is written once, not at every evaluation; and one longer than :data:`KEYED_INLINE`
+    characters stands in its node's key as the hash of that text (its 60 kB are not
+    hashed again with the rest of the key at every evaluation).
+    """
+
+    __slots__ = ("text",)
+
+    def __init__(self, value: Any):
+        text = key_text(value)
+        if len(text) > KEYED_INLINE:
+            h = hashlib.blake2b(text.encode(), digest_size=20).hexdigest()
+            text = '{"keyed":"' + h + '"}'
+        self.text = text
+
+
+KEYED_INLINE = 256  # characters of a literal's key text written into its node's key
 
 
 def key_of(parts: Any) -> str:
@@ -126,6 +151,8 @@ def key_text(value: Any) -> str:
         return "null"
     if t is list or t is tuple:
         return "[" + ",".join([key_text(v) for v in value]) + "]"
+    if t is Keyed:
+        return value.text
     return _JSON.encode(canonical(value))
 
 

@@ -328,6 +328,13 @@ class _Run(LanguageRun, SimulationRun, Replay):
                 "expr": value.text,
                 "params": {n: self.tokens.get(n, self.values[n]) for n in names},
             }
+        if isinstance(value, Literal) and type(value.value) in (list, dict):
+            # a literal list's key text, written once and kept with it (the same text)
+            kept = value.__dict__.get("_keyed")
+            if kept is None:
+                kept = _cache.Keyed(value.value)
+                object.__setattr__(value, "_keyed", kept)
+            return kept
         return self.resolve(name, port, value)
 
     def resolve(self, name: str, port: str, value: Input, env: dict[str, Any] | None = None) -> Any:
