@@ -108,14 +108,17 @@ class Table:
         clock: str | None = None,
         note: str = "",
         notes: dict[str, str] | None = None,
+        warmup: bool = True,
     ) -> dict[str, Stat]:
         """Time ``api`` (ours as a user calls it), ``kernel`` (ours without the graph) and
         each reference in ``rounds`` interleaved rounds whose order turns by one each round.
 
         Each implementation is called once to warm up (imports, caches a user would also have
         warm, JIT compilation); the number of calls per timing is fixed from that call so a
-        timing lasts about ``min_seconds``. A reference that fails to import is noted as not
-        installed, never silently dropped. Returns the per-implementation :class:`Stat`.
+        timing lasts about ``min_seconds``. ``warmup=False`` skips that call (a reference of
+        a minute: one call a round, its imports in its first). A reference that fails to
+        import is noted as not installed, never silently dropped. Returns the
+        per-implementation :class:`Stat`.
         """
         now = _CLOCKS[clock] if clock else _now
         impls: list[tuple[str, str, Callable[[], object]]] = [("formgraph", "api", api)]
@@ -126,6 +129,9 @@ class Table:
             impls.append((name, "reference", fn))
         numbers: dict[str, int] = {}
         for name, _, fn in list(impls):
+            if not warmup:
+                numbers[name] = 1
+                continue
             try:
                 t0 = now()
                 fn()
@@ -139,12 +145,20 @@ class Table:
         for r in range(rounds):
             k = r % len(impls)
             for name, _, fn in impls[k:] + impls[:k]:
+                if name in missing:
+                    continue
                 gc.collect()
                 n = numbers[name]
                 t0 = now()
-                for _ in range(n):
-                    fn()
+                try:
+                    for _ in range(n):
+                        fn()
+                except ImportError as exc:  # (not warmed up: found missing here)
+                    missing[name] = f"not installed ({exc.name})"
+                    continue
                 times[name].append((now() - t0) / n)
+        impls = [i for i in impls if i[0] not in missing]
+        times = {name: t for name, t in times.items() if name not in missing}
         stats = {name: Stat(v) for name, v in times.items()}
         ours = times["formgraph"]
         notes = notes or {}

@@ -11,6 +11,7 @@ import numpy as np
 from formgraph.core.errors import InputError
 from formgraph.core.registry import Context, Range, node
 from formgraph.geometry import Field, Mesh
+from formgraph.geometry.base import as_xyz
 from formgraph.kernels.field import mesher
 from formgraph.nodes.field._common import bounds_box
 
@@ -108,7 +109,11 @@ def mesh_of(
     if not len(t):
         ctx.warn("the field has no surface inside its bounds: the mesh is empty")
         return Mesh(np.zeros((0, 3)), np.zeros(0, np.int64), np.zeros(1, np.int64))
-    return Mesh(v, t.reshape(-1), np.arange(0, 3 * len(t) + 1, 3))
+    try:  # the mesher's triangles index its own vertices: only the positions are checked
+        v = as_xyz(v, "vertices")
+    except ValueError as exc:
+        raise InputError(port, f"the field gives a surface that is not finite: {exc}") from None
+    return Mesh.trusted(v, t.reshape(-1), np.arange(0, 3 * len(t) + 1, 3))
 
 
 @node("field.mesh", version=2)
