@@ -16,12 +16,14 @@ module has moved to :meth:`Table.compare`.
 from __future__ import annotations
 
 import gc
+import itertools
 import os
 import statistics
 import time
 import tracemalloc
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
 
 # ``BENCH_CLOCK=cpu`` times CPU seconds of this process instead of wall seconds: on a
 # machine shared with other jobs, far steadier (every row here is single-threaded: one
@@ -57,6 +59,32 @@ def best_time(
             fn()
         best = min(best, (_now() - t0) / number)
     return best
+
+
+def through(node: str, params: dict[str, Callable[[int], Any]], /, **inputs: Any) -> Callable:
+    """A call of node type ``node`` as a user makes it: a graph of that one node (named
+    ``n``; its ``inputs`` may read the ``params`` as ``"=name"``), evaluated with each param
+    set to ``params[name](k)`` for k = 1, 2, ... call after call: a new value every call,
+    so neither the cache nor early cutoff answers (a geometry value is made in the call,
+    as a user's own arrays would be)."""
+    import formgraph as fg
+    from formgraph.geometry import Geometry
+
+    g = fg.Graph()
+    for name, make in params.items():
+        first = make(0)
+        if isinstance(first, Geometry):
+            g.add_param(name, type=type(first).__name__)
+        else:
+            g.add_param(name, first)
+    g.add("n", node, **inputs)
+    steps = itertools.count(1)
+
+    def call() -> Any:
+        k = next(steps)
+        return g.evaluate("n", **{name: make(k) for name, make in params.items()})
+
+    return call
 
 
 @dataclass
