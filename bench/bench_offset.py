@@ -83,6 +83,7 @@ def _offset_rows(table, n: int) -> None:  # noqa: ANN001
         cell = default_cell(extent, d)
         default = fg.Graph.from_text(graph_text(pts))
         marching = fg.Graph.from_text(graph_text(pts, cell))
+
         def call(g, d=d):
             steps = itertools.count(1)
             return lambda: g.evaluate("off", d=d * (1 + next(steps) * 1e-9))
