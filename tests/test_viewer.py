@@ -427,6 +427,16 @@ def test_gallery_renders_every_graph_and_prints_a_table(tmp_path, capsys):
     assert_not_blank(out / "ring.png")
     assert picture(out / "ring.png").shape[:2] == (480, 640)
     assert not (out / "broken.png").exists()
+    # each picture records what it was drawn from: an edit of its graph makes it stale
+    (graphs / "broken.yaml").unlink()
+    assert gallery.stale(graphs, out) == []
+    write(graphs / "ring.yaml", RING.format(count=8))
+    write(graphs / "new.yaml", RING.format(count=5))
+    assert gallery.stale(graphs, out) == ["new", "ring"]
+    assert gallery.main(["--graphs", str(graphs), "--out", str(out), "--stale"]) == 0
+    assert gallery.stale(graphs, out) == []
+    assert gallery.main(["--graphs", str(graphs), "--out", str(out), "nope"]) == 1
+    assert "gallery: no graph nope" in capsys.readouterr().err
 
 
 def test_bool_params_get_check_boxes(plotter):

@@ -1,9 +1,9 @@
 """The node registry: one decorated, typed, documented function per node type.
 
 The registry is the single source of the YAML validation, the catalogue (``formgraph
-nodes``), the JSON Schema (``formgraph schema``) and ``docs/nodes.md``. A node is declared
-by its signature: parameter names are the ports, hints their types, defaults their
-defaults; the numpydoc ``Parameters`` section documents each port.
+nodes``), the JSON Schema (``formgraph schema``) and the documentation's node reference. A
+node is declared by its signature: parameter names are the ports, hints their types,
+defaults their defaults; the numpydoc ``Parameters`` section documents each port.
 """
 
 from __future__ import annotations

@@ -1,14 +1,20 @@
 """Everything generated from the registry: the JSON Schema, the text catalogue and the docs.
 
 ``formgraph schema`` prints :func:`json_schema`; ``formgraph nodes`` prints
-:func:`catalogue_text` / :func:`node_text`; ``docs/nodes.md`` is :func:`markdown` (a test
-checks it is current; regenerate with ``formgraph nodes --markdown > docs/nodes.md``).
+:func:`catalogue_text` / :func:`node_text`, and ``formgraph nodes --markdown`` the whole
+catalogue as one Markdown file (:func:`markdown`). The documentation site's node reference
+is built from the same functions at every build (``docs/hooks.py``): :func:`index_markdown`
+and one :func:`family_markdown` page per family, so a new node is documented by its own
+docstring and signature, with no page to edit.
 """
 
 from __future__ import annotations
 
 import enum
+import importlib
+import re
 import typing
+from collections.abc import Callable
 from typing import Any
 
 from ..core.registry import REQUIRED, NodeSpec, Port, node_types
@@ -251,68 +257,187 @@ def catalogue_text() -> str:
     return "\n".join(out)
 
 
-def markdown() -> str:
-    """The node catalogue as Markdown (``docs/nodes.md``)."""
-    lines = [
-        "# Node catalogue",
+def families() -> dict[str, list[NodeSpec]]:
+    """Every registered node type by family (the part of its name before the dot), sorted."""
+    out: dict[str, list[NodeSpec]] = {}
+    for spec in node_types().values():
+        out.setdefault(spec.family, []).append(spec)
+    return out
+
+
+_ROLE = re.compile(r":[a-z]+:`~?([^`]+)`")
+_SECTION = re.compile(r"^(\w[\w ]*)\n-{3,}$", re.M)
+
+
+def _module_doc(name: str) -> str:
+    """The first paragraph of a module's docstring, on one line ('' if there is none)."""
+    try:
+        doc = importlib.import_module(name).__doc__ or ""
+    except ImportError:
+        return ""
+    return " ".join(_ROLE.sub(r"``\1``", doc).strip().split("\n\n", 1)[0].split())
+
+
+def _source(spec: NodeSpec) -> str:
+    """Where a node's code is, as a path in the repository (``nodes/mesh/offset.py``)."""
+    module = spec.func.__module__
+    prefix = "formgraph.nodes."
+    if module.startswith(prefix):
+        return "nodes/" + module[len(prefix) :].replace(".", "/") + ".py"
+    return module
+
+
+def _doc_sections(doc: str) -> tuple[str, dict[str, str]]:
+    """A numpydoc docstring as its prose (before the first section) and its sections."""
+    doc = _ROLE.sub(lambda m: f"``{m.group(1)}``", doc)
+    heads = list(_SECTION.finditer(doc))
+    prose = doc[: heads[0].start()] if heads else doc
+    sections = {}
+    for i, h in enumerate(heads):
+        end = heads[i + 1].start() if i + 1 < len(heads) else len(doc)
+        sections[h.group(1)] = doc[h.end() : end].strip("\n")
+    return prose.strip(), sections
+
+
+def _cell(text: str) -> str:
+    return " ".join(text.split()).replace("|", "\\|")
+
+
+def node_markdown(
+    spec: NodeSpec,
+    level: int = 3,
+    see_also: Callable[[NodeSpec], str] | None = None,
+    anchor: bool = False,
+) -> str:
+    """One node type as Markdown: its doc, a table of its inputs (type, default, doc), its
+    outputs and its other docstring sections (an example). ``see_also(spec)`` adds a line of
+    links (the site's manual pages and examples that use the node); ``anchor`` gives the
+    heading the node's name as its id (``{ #mesh.box }``, Markdown's attribute lists)."""
+    prose, sections = _doc_sections(spec.doc)
+    head = f"{'#' * level} `{spec.name}`" + (f" {{ #{spec.name} }}" if anchor else "")
+    lines = [head, "", prose, ""]
+    if spec.inputs:
+        lines += ["| input | type | default | description |", "|---|---|---|---|"]
+        for p in spec.inputs.values():
+            ty = _cell(_type_text(p.type))
+            lines.append(f"| `{p.name}` | {ty} | {_cell(_default_text(p))} | {_cell(p.doc)} |")
+        lines.append("")
+    if spec.multi_output:
+        outs = ", ".join(f"`{k}` ({_out_text(t)})" for k, t in spec.outputs.items())
+        lines += [f"**Outputs:** {outs}, wired as `@node.output`.", ""]
+    else:
+        lines += [f"**Output:** {_out_text(next(iter(spec.outputs.values())))}.", ""]
+    for title, body in sections.items():
+        if title == "Parameters":  # the inputs' table says it
+            continue
+        lines += [f"**{title}:** " + " ".join(body.split()), ""]
+    lines += [f"Version {spec.version}; the code: `{_source(spec)}`.", ""]
+    if see_also is not None and (extra := see_also(spec)):
+        lines += [extra, ""]
+    return "\n".join(lines)
+
+
+def _ports_text(spec: NodeSpec) -> str:
+    return ", ".join(p.name if p.required else f"[{p.name}]" for p in spec.inputs.values())
+
+
+def _family_doc(family: str) -> str:
+    """A family package's docstring (``nodes/<family>/__init__.py``), paragraphs kept."""
+    try:
+        doc = importlib.import_module(f"formgraph.nodes.{family}").__doc__ or ""
+    except ImportError:
+        return ""
+    doc = _ROLE.sub(r"``\1``", doc)
+    return "\n\n".join(" ".join(par.split()) for par in doc.strip().split("\n\n"))
+
+
+def family_markdown(
+    family: str, see_also: Callable[[NodeSpec], str] | None = None, intro: str = ""
+) -> str:
+    """The reference page of one family: its package's docstring, a table of its nodes, then
+    every node (:func:`node_markdown`) under the module that defines it."""
+    specs = families()[family]
+    lines = [f"# {family}", "", _family_doc(family), ""]
+    if intro:
+        lines += [intro, ""]
+    lines += [
+        f"Generated from the registry at every build: each node's signature and docstring "
+        f"(the code is in `nodes/{family}/`).",
         "",
-        "Generated from the registry by `formgraph nodes --markdown`; do not edit by hand.",
-        "Angles are in degrees; a coordinate given as [x, y] gets z = 0.",
-        "",
+        "| node | inputs ([optional]) | output | what it does |",
+        "|---|---|---|---|",
     ]
-    registry = node_types()
-    families = sorted({s.family for s in registry.values()})
-    lines.append("Families: " + ", ".join(f"[{f}](#{f})" for f in families) + ".")
-    family = None
-    for name, spec in registry.items():
-        if spec.family != family:
-            family = spec.family
-            lines += ["", f"## {family}", ""]
-        ret = ", ".join(
-            f"{k}: {_out_text(t)}" if spec.multi_output else _out_text(t)
-            for k, t in spec.outputs.items()
+    for spec in specs:
+        ret = ", ".join(_out_text(t) for t in spec.outputs.values())
+        lines.append(
+            f"| [`{spec.name}`](#{spec.name}) | {_cell(_ports_text(spec))} | {_cell(ret)} "
+            f"| {_cell(spec.summary)} |"
         )
-        lines += [f"### `{name}` -> {ret}", "", spec.summary, ""]
-        if spec.inputs:
-            lines += ["| input | type | default | description |", "|---|---|---|---|"]
-            for p in spec.inputs.values():
-                doc = p.doc.replace("|", "\\|")
-                ty = _type_text(p.type).replace("|", "\\|")
-                lines.append(f"| `{p.name}` | {ty} | {_default_text(p)} | {doc} |")
-            lines.append("")
+    lines.append("")
+    by_module: dict[str, list[NodeSpec]] = {}
+    for spec in specs:
+        by_module.setdefault(spec.func.__module__, []).append(spec)
+    # the modules in the order the package's docstring names them (``primitives``, ...)
+    doc = _family_doc(family)
+
+    def place(module: str) -> tuple[int, str]:
+        at = doc.find(f"``{module.rsplit('.', 1)[-1]}``")
+        return (at if at >= 0 else len(doc), module)
+
+    for module in sorted(by_module, key=place):
+        members = by_module[module]
+        topic = module.rsplit(".", 1)[-1]
+        lines += [
+            f"## {topic}",
+            "",
+            _module_doc(module),
+            "",
+            f"The code: `{_source(members[0])}`.",
+            "",
+        ]
+        for spec in members:
+            lines.append(node_markdown(spec, 3, see_also, anchor=True))
     return "\n".join(lines).rstrip() + "\n"
 
 
-BEGIN = "<!-- catalogue:begin (generated: python -m formgraph.language.catalogue README.md) -->"
-END = "<!-- catalogue:end -->"
+def index_markdown() -> str:
+    """The node reference's first page: every family with a one-line row per node."""
+    lines = [
+        "# Node reference",
+        "",
+        "Every node type, generated from the registry at every build (a node added to "
+        "`nodes/` appears here with no page to edit). A family is the part of a node's name "
+        "before the dot, and its code is the package of that name under `nodes/`; "
+        "`formgraph nodes TYPE` prints one node's ports, `formgraph nodes --markdown` the "
+        "whole catalogue as one file. Angles are in degrees; a coordinate given as [x, y] "
+        "gets z = 0.",
+        "",
+    ]
+    for family, specs in families().items():
+        summary = _family_doc(family).split("\n\n", 1)[0]
+        lines += [f"## [{family}]({family}.md)", "", summary, ""]
+        lines += ["| node | inputs ([optional]) | what it does |", "|---|---|---|"]
+        for spec in specs:
+            lines.append(
+                f"| [`{spec.name}`]({family}.md#{spec.name}) | {_cell(_ports_text(spec))} "
+                f"| {_cell(spec.summary)} |"
+            )
+        lines.append("")
+    return "\n".join(lines).rstrip() + "\n"
 
 
-def readme_table() -> str:
-    """The compact catalogue the README shows: one row per node type."""
-    rows = ["| node | inputs ([optional]) | output | what it does |", "|---|---|---|---|"]
-    for name, spec in node_types().items():
-        ports = ", ".join(p.name if p.required else f"[{p.name}]" for p in spec.inputs.values())
-        ret = ", ".join(_out_text(t) for t in spec.outputs.values())
-        summary = spec.summary.replace("|", "\\|")
-        rows.append(f"| `{name}` | {ports} | {ret} | {summary} |")
-    return "\n".join(rows)
-
-
-def update_readme(path: str) -> bool:
-    """Rewrite the generated catalogue section of ``path``; True when it changed."""
-    from pathlib import Path
-
-    p = Path(path)
-    text = p.read_text(encoding="utf-8")
-    start, end = text.index(BEGIN), text.index(END)
-    new = text[:start] + BEGIN + "\n" + readme_table() + "\n" + text[end:]
-    if new != text:
-        p.write_text(new, encoding="utf-8")
-    return new != text
-
-
-if __name__ == "__main__":  # pragma: no cover
-    import sys
-
-    for arg in sys.argv[1:]:
-        print(f"{arg}: {'updated' if update_readme(arg) else 'current'}")
+def markdown() -> str:
+    """The whole node catalogue as one Markdown file (``formgraph nodes --markdown``)."""
+    lines = [
+        "# Node catalogue",
+        "",
+        "Generated from the registry by `formgraph nodes --markdown`.",
+        "Angles are in degrees; a coordinate given as [x, y] gets z = 0.",
+        "",
+    ]
+    groups = families()
+    lines.append("Families: " + ", ".join(f"[{f}](#{f})" for f in sorted(groups)) + ".")
+    for family, specs in groups.items():
+        lines += ["", f"## {family}", "", _family_doc(family), ""]
+        lines += [node_markdown(spec, 3) for spec in specs]
+    return "\n".join(lines).rstrip() + "\n"

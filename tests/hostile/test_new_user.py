@@ -100,14 +100,13 @@ def test_evaluate_takes_a_named_output_as_a_wire_spells_it():
         g.evaluate("b.x")
 
 
-def test_the_readme_shows_the_geometry_constructors_and_they_run():
-    text = (ROOT / "README.md").read_text()
-    section = text[text.index("## Embedding in Python") : text.index("## Exploring")]
+def test_the_manual_shows_the_geometry_constructors_and_they_run():
+    section = (ROOT / "docs" / "python.md").read_text()
     for call in ("fg.Mesh(", "fg.Points(", "fg.NurbsCurve(", "fg.NurbsSurface("):
         assert call in section, call
     blocks = [b.split("```")[0] for b in section.split("```python")[1:]]
     block = next(b for b in blocks if "fg.Mesh(" in b)
     scope: dict = {"fg": fg}
-    exec(block, scope)  # the README's own example, as a reader would paste it
+    exec(block, scope)  # the manual's own example, as a reader would paste it
     assert scope["quad"].n_faces == 1 and scope["pts"].xyz.shape == (3, 3)
     np.testing.assert_allclose(np.linalg.norm(scope["arc"].evaluate(0.37)), 1.0)
