@@ -132,6 +132,7 @@ def _ear_clipping(table, k: int) -> None:  # noqa: ANN001
         references={
             "mapbox_earcut": lambda: _earcut(xy),
             "shapely (constrained Delaunay)": lambda: _shapely_cdt(xy),
+            "our own clipper (the fallback, numpy rounds)": lambda: _own_clipper(xy),
         },
         rounds=9 if k < 5000 else 5,
         note="the arrays made into a new fg.Mesh each call, in our time",
@@ -190,6 +191,14 @@ def _earcut(xy: np.ndarray):
     import mapbox_earcut
 
     return mapbox_earcut.triangulate_float64(xy, np.array([len(xy)], dtype=np.uint32))
+
+
+def _own_clipper(xy: np.ndarray):
+    """The vectorized ear clipping ``triangulate_polygon`` falls back on where earcut's
+    answer does not tile the loop: why mapbox-earcut is a dependency."""
+    from formgraph.kernels.mesh.polygon import _ear_clip_rounds, polygon_plane
+
+    return _ear_clip_rounds(polygon_plane(xy), None)
 
 
 def _shapely_cdt(xy: np.ndarray):

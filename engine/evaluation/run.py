@@ -12,9 +12,7 @@ from __future__ import annotations
 
 import contextlib
 import functools
-import hashlib
 import os
-import stat
 import sys
 import time
 import warnings as _warnings
@@ -45,6 +43,7 @@ from ..language.subgraph import SubgraphSpec
 from . import cache as _cache
 from .cutoff import same_content
 from .items import LanguageRun, file_stamp, input_names, reads_loop
+from .keys import InputKeys
 from .replay import Replay
 from .simulation import SimulationRun
 from .stats import NodeStat, Step
@@ -75,7 +74,7 @@ class GraphView(Protocol):
     def _child(self, spec: SubgraphSpec) -> GraphView: ...
 
 
-class _Run(LanguageRun, SimulationRun, Replay):
+class _Run(LanguageRun, SimulationRun, Replay, InputKeys):
     """One evaluation call: memoized keys, identities and values, and the run record."""
 
     def __init__(
@@ -251,40 +250,6 @@ class _Run(LanguageRun, SimulationRun, Replay):
         if wires_of(value):  # a path known only when its wire runs: never trusted
             return {"wired": part, "unkeyed": os.urandom(8).hex()}
         return self.input_file(name, port, part)
-
-    def input_file(self, name: str, port: str, relpath: Any) -> Any:
-        """The key part of an input file: its path and a hash of its bytes (kept for the
-        node, which parses exactly the bytes its key holds).
-
-        A file whose stamp (device, inode, size, modification and change times in ns) is
-        the one it had when last hashed is not read again: a sweep plans every variant's
-        keys, and watch every version's, without rereading a large scan each time.
-        """
-        if not isinstance(relpath, str):
-            return relpath  # the check or the node says what is wrong with it
-        self.keyed_files = True  # keys that hold file bytes: never replayed (_Run.remember)
-        here = self.where(name, port)
-        try:
-            path = safety.resolve_input(self.g.input_root, relpath, self.g.input_base)
-        except PathError as exc:
-            raise PathError([Problem(here, p.message) for p in exc.problems]) from None
-        stamp = _stamp(path)
-        memo = self.g._input_digests.get(str(path))
-        if stamp is not None and memo is not None and memo[0] == stamp:
-            return {"path": relpath, "bytes": memo[1]}
-        try:
-            data = safety.read_input(path)
-        except PathError as exc:
-            raise PathError(
-                [Problem(here, f"cannot read input {relpath!r}: {p.message}") for p in exc.problems]
-            ) from None
-        self.input_files.setdefault(name, {})[relpath] = (path, data)
-        digest = hashlib.blake2b(data, digest_size=20).hexdigest()
-        if stamp is not None:  # taken before the read: a change during it shows next time
-            if len(self.g._input_digests) > 10_000:
-                self.g._input_digests.clear()
-            self.g._input_digests[str(path)] = (stamp, digest)
-        return {"path": relpath, "bytes": digest}
 
     def read_input(self, name: str, relpath: str) -> tuple[Path, bytes]:
         """What a node's ``ctx.read`` returns: the bytes keyed, else the file read now (a
@@ -621,17 +586,6 @@ class _Run(LanguageRun, SimulationRun, Replay):
                 nd.type,
                 f"returned a value that does not fit its output {out_type.name}: {exc}",
             ) from None
-
-
-def _stamp(path: Path) -> tuple[int, ...] | None:
-    """What changes when a file's bytes do (None for anything but a regular file)."""
-    try:
-        st = os.stat(path)
-    except OSError:
-        return None
-    if not stat.S_ISREG(st.st_mode):
-        return None
-    return (st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns)
 
 
 @contextlib.contextmanager
