@@ -26,7 +26,7 @@ import itertools
 
 import numpy as np
 
-from formgraph.kernels.field import meshdist
+from formgraph.kernels.geometry import meshdist
 from formgraph.kernels.mesh import remesh as krem
 from formgraph.kernels.mesh import simplify as ksimp
 

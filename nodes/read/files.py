@@ -43,7 +43,9 @@ def parsed(path: str, what: str, fn, *args):
     except RecursionError:
         raise InputError("path", f"{path!r}: nested too deeply to read as {what}") from None
     except PARSE_ERRORS as exc:
-        raise InputError("path", f"{path!r}: cannot read it as {what}: {exc}") from None
+        raise InputError(
+            "path", f"{path!r}: cannot read it as {what}: {readers.in_words(exc)}"
+        ) from None
 
 
 @node("read.mesh", version=2)
@@ -80,7 +82,7 @@ def mesh(path: InputPath, weld: bool = False, *, ctx: Context) -> Mesh:
     if PurePath(path).suffix.lower() == ".stl":
         soup = parsed(path, "a mesh", mesh_read.stl_binary_vertices, data)
     if soup is None:
-        v, fi, fo, attributes = parsed(path, "a mesh", readers.mesh_data, path, data)
+        v, fi, fo, attributes = parsed(path, "a mesh", readers.mesh_data, path, data, ctx.budget)
     else:  # a binary STL: its vertices made (and checked finite), its bytes are let go
         del data  # before its faces are made (the peak holds two of the three, not all)
         v = soup
