@@ -221,6 +221,18 @@ def test_noise_nan_and_broadcast():
     assert np.isfinite(out[0]) and np.isnan(out[1:]).all()
 
 
+def test_noise_reads_strided_columns_as_their_copies():
+    # the compiled loop reads a points array's columns where they are (no copy first)
+    pts = np.random.default_rng(3).uniform(-40, 40, (2000, 3))
+    cols = [np.ascontiguousarray(c) for c in pts.T]
+    assert not pts[:, 1].flags.c_contiguous
+    assert np.array_equal(noise(pts[:, 0], pts[:, 1], pts[:, 2]), noise(*cols))
+    assert np.array_equal(
+        noise(pts[::2, 0], 0.5, pts[::2, 2]), noise(cols[0][::2], 0.5, cols[2][::2])
+    )
+    assert np.array_equal(noise(pts[:, :2], 0.25, 0.5), noise(pts[:, :2].copy(), 0.25, 0.5))
+
+
 def test_rand_and_noise_are_the_same_in_another_process():
     code = (
         "import numpy as np, hashlib;"

@@ -179,14 +179,19 @@ class AttributeMap(Mapping):
         index = np.asarray(index, dtype=np.int64)
         return AttributeMap({k: frozen_array(v[index]) for k, v in self._data.items()}, len(index))
 
-    def with_(self, name: str, values: Any) -> AttributeMap:
-        """This map with attribute ``name`` set to ``values`` (added or replaced)."""
+    def with_(self, name: str, values: Any, *, finite: bool = False) -> AttributeMap:
+        """This map with attribute ``name`` set to ``values`` (added or replaced).
+
+        ``finite=True``: the caller has checked every value finite already (a per-element
+        expression's result is: a second pass over a million values is not needed)."""
         data = dict(self._data)
-        data[name] = _attribute_array(name, values, self.n, "attribute")
+        data[name] = _attribute_array(name, values, self.n, "attribute", finite=finite)
         return AttributeMap(data, self.n)
 
 
-def _attribute_array(name: Any, values: Any, n: int, what: str) -> np.ndarray:
+def _attribute_array(
+    name: Any, values: Any, n: int, what: str, *, finite: bool = False
+) -> np.ndarray:
     if not isinstance(name, str) or not name.isidentifier() or name.startswith("_"):
         raise ValueError(
             f"{what} name {name!r} must be a name as in expressions: letters, digits and _, "
@@ -210,7 +215,7 @@ def _attribute_array(name: Any, values: Any, n: int, what: str) -> np.ndarray:
         raise ValueError(
             f"{what} {name!r} has {a.shape[1]} components; 1 to {MAX_ATTRIBUTE_COMPONENTS} allowed"
         )
-    if not all_finite(a):
+    if not finite and not all_finite(a):
         bad = int(np.argwhere(~np.isfinite(a.reshape(n, -1)))[0, 0])
         raise ValueError(f"{what} {name!r} is not finite at element {bad}")
     return frozen_array(a)

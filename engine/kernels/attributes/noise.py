@@ -69,7 +69,9 @@ def _noise(x: Any, y: Any, z: Any, scaled: bool) -> np.ndarray:
 
     x, y, z = np.broadcast_arrays(*(np.asarray(c, np.float64) for c in (x, y, z)))
     shape = x.shape
-    x, y, z = (np.ascontiguousarray(c).reshape(-1) for c in (x, y, z))
+    # the loop reads any strides: a points array's columns (and a number broadcast, stride
+    # 0) are read where they are, not copied first (three copies were a third of the time)
+    x, y, z = (c if c.ndim == 1 else c.reshape(-1) for c in (x, y, z))
     scale = SCALE if scaled else 0.0
     # made straight into a frozen buffer: an attribute's values are kept as they are
     return fill_frozen(
