@@ -50,7 +50,17 @@ class Mesh(Geometry):
         face_data: Any = None,
     ):
         v = as_xyz(vertices, "vertices")
-        if face_offsets is None:  # a list of faces
+        if (
+            face_offsets is None
+            and isinstance(face_indices, np.ndarray)
+            and face_indices.ndim == 2
+            and face_indices.dtype.kind in "iu"
+            and face_indices.shape[1] >= 3
+        ):  # (n_faces, k) faces of one size: flat as they are (no Python loop per face)
+            fi = face_indices.astype(np.int64, copy=False).ravel()
+            k = face_indices.shape[1]
+            fo = np.arange(0, k * len(face_indices) + 1, k, dtype=np.int64)
+        elif face_offsets is None:  # a list of faces
             faces = [np.asarray(f, dtype=np.int64).ravel() for f in face_indices]
             sizes = np.array([len(f) for f in faces], dtype=np.int64)
             fi = np.concatenate(faces) if faces else np.zeros(0, np.int64)

@@ -12,9 +12,10 @@ import numpy as np
 
 from .halfedge import HalfEdges, build_halfedges
 from .measure import face_vectors
-from .polygon import WorkLimitError, triangulate_polygon  # noqa: F401 (re-exported)
+from .polygon import WorkLimitError, large_face, triangulate_polygon  # noqa: F401 (re-exported)
 
 _BATCH_UP_TO = 32  # concave faces up to this size are clipped together (O(k^3) each)
+_ALONE_UP_TO = 8  # larger faces of one size, up to this many: each on its own
 
 __all__ = [
     "box",
@@ -366,6 +367,14 @@ def triangulate(
             (faces.size, k - 2, 3),
         ).copy()
         p = v[corners]
+        if k > _BATCH_UP_TO and faces.size <= _ALONE_UP_TO:
+            # a few large faces (a polygon made a face): each tested and clipped in its
+            # own plane, made once (the batched test below costs a face's clipping again)
+            for f in range(faces.size):
+                local[f] = large_face(p[f], max_tests)
+            rows = np.arange(faces.size)[:, None, None]
+            out[tri_off[faces][:, None] + np.arange(k - 2)] = corners[rows, local]
+            continue
         normal = _newell_normals(p)
         edge_in = p - np.roll(p, 1, axis=1)
         edge_out = np.roll(p, -1, axis=1) - p
