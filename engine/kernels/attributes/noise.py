@@ -67,8 +67,10 @@ def raw_noise(x: Any, y: Any, z: Any) -> np.ndarray:
 def _noise(x: Any, y: Any, z: Any, scaled: bool) -> np.ndarray:
     from .noise_jit import fill  # numba, imported when noise is first asked for
 
-    x, y, z = np.broadcast_arrays(*(np.asarray(c, np.float64) for c in (x, y, z)))
-    shape = x.shape
+    x, y, z = (np.asarray(c, np.float64) for c in (x, y, z))
+    shape = np.broadcast_shapes(x.shape, y.shape, z.shape)
+    # read-only views (broadcast_arrays' views warn when numba reads their flags)
+    x, y, z = (np.broadcast_to(c, shape) for c in (x, y, z))
     # the loop reads any strides: a points array's columns (and a number broadcast, stride
     # 0) are read where they are, not copied first (three copies were a third of the time)
     x, y, z = (c if c.ndim == 1 else c.reshape(-1) for c in (x, y, z))
