@@ -1,37 +1,32 @@
-"""Attributes benchmark: rand and noise, the kernels behind per-element variation.
+"""Attributes: ``rand`` and ``noise`` through ``attr.set``, attributes through Catmull-Clark
+and decimation.
 
-- ``rand`` of 1,000,000 keys (the indices 0..n-1, one seed) against numpy's
-  ``Generator.random`` drawing 1,000,000 values from PCG64: ours hashes each key on its
-  own (no state), numpy advances one stream, so numpy is the speed of light here;
-- ``noise`` (Perlin's improved noise) at 97,336 points against opensimplex's array API on
-  a 46 x 46 x 46 grid (the same number of evaluations; opensimplex evaluates only grids).
-  opensimplex runs its loops in numba when numba is installed and in plain Python
-  otherwise, which is what ``pip install opensimplex`` gives; the note says which ran.
-  Ours also at 1,000,000 scattered points;
-- ``mesh.catmull_clark`` of the 10,000-quad torus, 2 levels, with and without two point
-  attributes (two scalars), and with a scalar, a 3-vector colour and a face attribute:
-  the attributes ride the same stencils as the coordinates (each level two sparse
-  products over all the point columns at once), so a column more costs a small part of a
-  level, plus its copy into the result. The node is timed through a graph (``g.evaluate``
-  on a fresh graph each call, no cache);
-- carrying attributes onto a surface made anew (``propagate.onto``: each new vertex's
-  nearest input triangle and its barycentric weights, each new face's nearest input face),
-  for the vertices of the torus decimated to 20 %, against trimesh's ``closest_point`` for
-  the same vertices (closest points only); and ``mesh.decimate`` with and without them.
-
-The rand, Catmull-Clark and decimate rows time ours and the reference in turns, round after
-round: the times are each one's best round, the note's ratio the median over rounds of the
-two times of the same round (a shared machine's slow spells fall on both alike).
+- ``rand`` of 1,000,000 points through ``attr.set`` (``value: "=rand(i, s)"`` on a cached
+  ``points.random``; each call a new seed ``s``, so the node runs and its attribute is
+  stored on a new, frozen ``Points``) against numpy's ``Generator.random(1_000_000)``
+  (PCG64 advancing one stream in C, the array discarded: the speed of light here; ours
+  hashes each key on its own, with no state);
+- ``noise`` (Perlin's improved noise) at the 1,000,000 points of a 100^3 grid through
+  ``attr.set`` (``"=noise(x + s, y, z)"``, a new ``s`` each call) against opensimplex's
+  ``noise3array`` on the same 100 x 100 x 100 grid (it evaluates grids only), with numba
+  when numba is installed (the note says which ran; opensimplex without numba runs its
+  loops in plain Python, thousands of times slower);
+- ``mesh.catmull_clark`` of the 10,000-quad torus, 2 levels, through a graph whose mesh is
+  a param: a plain mesh, two point attributes, and a scalar, a 3-vector colour and a face
+  attribute (each call the points moved by a new tiny amount, as a slider's step moves
+  them: the mesh is new content, hashed once, and the node runs);
+- ``mesh.decimate`` of that torus to 20 % with and without the attributes, and the
+  carrying of attributes onto the decimated surface (``propagate.onto``: each new vertex's
+  nearest input triangle and barycentric weights, each new face's nearest input face)
+  against trimesh's ``closest_point`` for the same vertices (the closest points only).
 """
 
 from __future__ import annotations
 
 import importlib.util
-import time
-from collections.abc import Callable
+import itertools
 
 import numpy as np
-from harness import CLOCK
 
 import formgraph as fg
 from formgraph.geometry import Mesh
@@ -39,129 +34,138 @@ from formgraph.kernels.attributes.noise import noise
 from formgraph.kernels.attributes.random import rand
 from formgraph.kernels.mesh import primitives
 
-_now = time.process_time if CLOCK == "cpu" else time.perf_counter
+N = 1_000_000
 
 
-def interleaved(
-    fns: dict[str, Callable[[], object]], rounds: int
-) -> tuple[dict[str, float], dict[str, np.ndarray]]:
-    """Each function's best time (s) over ``rounds`` rounds that call every one in turn
-    (in a turning order), and every round's times (for ratios within a round)."""
-    for fn in fns.values():
-        fn()  # warm up
-    times: dict[str, list[float]] = {name: [] for name in fns}
-    names = list(fns)
-    for r in range(rounds):
-        # the order turns each round: a call's time depends on what ran just before it
-        # (freed and new large buffers: page faults), so every one takes every place
-        for name in names[r % len(names) :] + names[: r % len(names)]:
-            t0 = _now()
-            fns[name]()
-            times[name].append(_now() - t0)
-    return {k: min(t) for k, t in times.items()}, {k: np.array(t) for k, t in times.items()}
+def _attr_graph(points: str, value: str) -> fg.Graph:
+    g = fg.Graph()
+    g.add_param("s", 0.0)
+    if points == "random":
+        g.add("pts", "points.random", count=N)
+    else:
+        g.add("pts", "points.grid", nx=100, ny=100, nz=100, spacing=0.2)
+    g.add("attr", "attr.set", geometry="@pts", name="v", value=value)
+    g.evaluate("attr")  # the points made once and cached, as a slider's steps find them
+    return g
 
 
-def ratio(times: dict[str, np.ndarray], name: str, base: str) -> float:
-    """The median over rounds of ``name``'s time over ``base``'s in the same round:
-    steadier on a busy machine than the ratio of two bests."""
-    return float(np.median(times[name] / times[base]))
-
-
-def extra(times: dict[str, np.ndarray], name: str, base: str) -> str:
-    return f"{100 * (ratio(times, name, base) - 1):+.0f}%"
+def _fresh(g: fg.Graph, scale: float = 1.0):
+    seeds = itertools.count(1)
+    return lambda: g.evaluate("attr", s=next(seeds) * scale)
 
 
 def run(table) -> None:
-    n = 1_000_000
-    keys = np.arange(n, dtype=np.float64)
+    keys = np.arange(N, dtype=np.float64)
     gen = np.random.default_rng(7)
-    best, times = interleaved({"ours": lambda: rand(keys, 7), "numpy": lambda: gen.random(n)}, 30)
-    case = "rand: 1M keys"
-    note = f"{ratio(times, 'ours', 'numpy'):.2f}x numpy's (median of rounds)"
-    table.add(case, "formgraph", best["ours"], note)
-    table.add(case, "numpy Generator.random", best["numpy"])
+    table.compare(
+        "rand through attr.set, 1M points",
+        api=_fresh(_attr_graph("random", "=rand(i, s)")),
+        kernel=lambda: rand(keys, 7.0),
+        references={"numpy Generator.random": lambda: gen.random(N)},
+        rounds=9,
+        note="a new seed each call: the attribute made and frozen on a new Points",
+    )
 
-    side = np.linspace(0.0, 20.0, 46)
-    gx, gy, gz = np.meshgrid(side, side, side, indexing="ij")
-    gx, gy, gz = gx.ravel(), gy.ravel(), gz.ravel()
-    case = "noise: 97k points (46^3 grid)"
-    table.time(case, "formgraph", lambda: noise(gx, gy, gz), repeat=3)
-    try:
+    side = np.arange(100) * 0.2
+    grid = np.stack(np.meshgrid(side, side, side, indexing="ij"), -1).reshape(-1, 3)
+    gx, gy, gz = (np.ascontiguousarray(c) for c in grid.T)
+
+    def opensimplex_grid():
         import opensimplex
-    except ImportError:
-        table.add(case, "opensimplex", None, "not installed (opensimplex)")
-    else:
-        opensimplex.seed(0)
-        jit = "numba" if importlib.util.find_spec("numba") else "no numba: plain Python"
-        table.time(
-            case,
-            "opensimplex noise3array",
-            lambda: opensimplex.noise3array(side, side, side),
-            repeat=1,
-            note=jit,
-        )
-    p = np.random.default_rng(1).uniform(-100, 100, (n, 3))
-    table.time("noise: 1M scattered points", "formgraph", lambda: noise(*p.T), repeat=3)
 
+        return opensimplex.noise3array(side, side, side)
+
+    jit = "numba" if importlib.util.find_spec("numba") else "no numba: plain Python loops"
+    table.compare(
+        "noise through attr.set, 1M points (100^3 grid)",
+        api=_fresh(_attr_graph("grid", "=noise(x + s, y, z)"), 1e-3),
+        kernel=lambda: noise(gx, gy, gz),
+        references={f"opensimplex noise3array ({jit})": opensimplex_grid},
+        rounds=7,
+        note="a new offset s each call",
+    )
+
+    _catmull_clark(table)
+    _decimate(table)
+
+
+def _torus_with_attributes() -> tuple[Mesh, Mesh, Mesh]:
     m = Mesh(*primitives.torus(2.0, 0.7, 100, 100))  # 10,000 quads
     v = m.vertices
     two = m.with_data({"h": v[:, 2], "w": v[:, 0] * v[:, 1]})
     rgb = (v - v.min(axis=0)) / np.ptp(v, axis=0)
     more = m.with_data({"h": v[:, 2], "color": rgb}, {"id": np.arange(m.n_faces)})
+    return m, two, more
 
-    def subdivide(mesh: Mesh) -> object:
-        g = fg.Graph()
-        g.add_param("m", type="Mesh")
-        g.add("cc", "mesh.catmull_clark", mesh="=m", levels=2)
-        return g.evaluate("cc", m=mesh)
 
-    best, times = interleaved(
-        {
-            "plain": lambda: subdivide(m),
-            "two": lambda: subdivide(two),
-            "more": lambda: subdivide(more),
-        },
-        rounds=30,
+def _through(node: str, **inputs):
+    """``make(mesh)``: a call evaluating ``node(mesh=param m)`` on ``mesh`` with its points
+    moved by a new tiny amount each call (a slider's step: new content, so the node runs;
+    the faces the same, as a slider leaves them)."""
+    g = fg.Graph()
+    g.add_param("m", type="Mesh")
+    g.add("n", node, mesh="=m", **inputs)
+
+    def make(mesh: Mesh):
+        steps = itertools.count(1)
+
+        def call():
+            v = mesh.vertices * (1.0 + next(steps) * 1e-12)
+            moved = Mesh.trusted(v, mesh.face_indices, mesh.face_offsets, *mesh_data(mesh))
+            return g.evaluate("n", m=moved)
+
+        return call
+
+    return make
+
+
+def mesh_data(mesh: Mesh) -> tuple:
+    return mesh.point_data, mesh.face_data
+
+
+def _catmull_clark(table) -> None:
+    from formgraph.kernels.mesh.subdivision import catmull_clark
+
+    m, two, more = _torus_with_attributes()
+    cc = _through("mesh.catmull_clark", levels=2)
+    arrays = m.arrays
+    table.compare(
+        "catmull_clark 10k-quad torus 2 lvl, attributes",
+        api=cc(two),
+        kernel=lambda: catmull_clark(*arrays, 2),
+        references={"plain mesh through the graph": cc(m), "h + color + face id": cc(more)},
+        rounds=9,
+        note="two point scalars; ours/theirs against the plain mesh is their cost",
     )
-    case = "catmull_clark 10k-quad torus 2 lvl, 2 point attributes"
-    table.add(case, "plain mesh", best["plain"])
-    table.add(case, "formgraph", best["two"], f"{extra(times, 'two', 'plain')} for two scalars")
-    case = "catmull_clark 10k-quad torus 2 lvl, h + color + face id"
-    table.add(case, "plain mesh", best["plain"])
-    note = f"{extra(times, 'more', 'plain')} for 4 point columns, 1 face"
-    table.add(case, "formgraph", best["more"], note)
 
-    # a surface made anew carries attributes from the input's closest points: the query
-    # (exact nearest triangle, barycentric weights, faces' nearest) against trimesh's
-    # closest_point for the same vertices, and the decimate node with and without them
-    import trimesh
 
+def _decimate(table) -> None:
     from formgraph.kernels.attributes import propagate as carry
     from formgraph.kernels.mesh import meshops
 
-    def decimate(mesh: Mesh) -> Mesh:
-        g = fg.Graph()
-        g.add_param("m", type="Mesh")
-        g.add("d", "mesh.decimate", mesh="=m", ratio=0.2)
-        return g.evaluate("d", m=mesh)
-
-    tri = meshops.triangulate(*m.arrays)[1].reshape(-1, 3)
-    out = decimate(m)
-    faces = (out.face_indices, out.face_offsets)
-    tm = trimesh.Trimesh(m.vertices, tri, process=False)
-    best, times = interleaved(
-        {
-            "ours": lambda: carry.onto(more, out.vertices, faces, tri),
-            "trimesh": lambda: trimesh.proximity.closest_point(tm, out.vertices),
-            "plain": lambda: decimate(m),
-            "more": lambda: decimate(more),
-        },
-        rounds=5,
+    m, _, more = _torus_with_attributes()
+    dec = _through("mesh.decimate", ratio=0.2)
+    table.compare(
+        "mesh.decimate 10k-quad torus to 20%, h + color + face id",
+        api=dec(more),
+        references={"plain mesh through the graph": dec(m)},
+        rounds=7,
     )
-    case = f"attributes onto the decimated torus ({out.n_vertices} vertices)"
-    table.add(case, "formgraph", best["ours"], "nearest triangles, weights, faces' nearest")
-    table.add(case, "trimesh closest_point", best["trimesh"], "the closest points only")
-    case = "mesh.decimate 10k-quad torus to 20%, h + color + face id"
-    table.add(case, "plain mesh", best["plain"])
-    note = f"{extra(times, 'more', 'plain')} for the attributes"
-    table.add(case, "formgraph", best["more"], note)
+    tri = meshops.triangulate(*m.arrays)[1].reshape(-1, 3)
+    out = dec(m)()
+    faces = (out.face_indices, out.face_offsets)
+
+    def trimesh_closest():
+        import trimesh
+
+        tm = trimesh.Trimesh(m.vertices, tri, process=False)
+        return trimesh.proximity.closest_point(tm, out.vertices)
+
+    table.compare(
+        f"attributes onto the decimated torus ({out.n_vertices:,} vertices)",
+        api=lambda: carry.onto(more, out.vertices, faces, tri),
+        references={"trimesh closest_point": trimesh_closest},
+        rounds=7,
+        note="the kernel: nearest triangles, weights, faces' nearest",
+        notes={"trimesh closest_point": "the closest points only (its tree built each call)"},
+    )

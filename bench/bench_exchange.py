@@ -1,28 +1,38 @@
 """Exchange formats: reading a 1M-triangle STL and OBJ, writing GLB and 3MF, a STEP surface.
 
-- binary STL read (our ``read_stl``: one structured ``np.frombuffer``, then float64) against
-  numpy-stl's ``Mesh.from_file`` on the same file;
-- OBJ read (our vectorized line scan: numbers by ``np.fromstring``, face indices by integer
-  arithmetic on the digit runs) against ``trimesh.load`` (``process=False``);
-- GLB and 3MF written from the same triangles against trimesh's exporters (GLB: trimesh
-  writes no normals unless asked; the row that asks computes them from a fresh mesh, as
-  ours does);
-- STEP of a 100 x 100 control-point bicubic B-spline surface (bytes of an AP214 file with
-  the face and its four edges) against OpenCASCADE's ``STEPControl_Writer`` writing the same
-  surface as a face (from a ``Geom_BSplineSurface`` built before the clock starts).
+Readers read the file from disk on both sides (a warm page cache):
 
-Every reader starts from the file's bytes in memory, or the file on a warm page cache for
-the references that insist on a path.
+- ``read.mesh`` of a binary STL, through a graph made anew each call (so neither the cache
+  nor the graph's memo of the file's hash answers: the file is read, hashed for the key,
+  parsed and frozen into a ``Mesh``) against numpy-stl's ``Mesh.from_file``; the parser
+  alone (``read_stl`` on bytes already in memory) beside; and the peak memory of each
+  (tracemalloc: what Python and numpy allocate while the call runs);
+- ``read.mesh`` of an OBJ likewise against ``trimesh.load`` (``process=False``);
+
+Writers write a file into a temporary folder on both sides:
+
+- GLB from the same triangles, ours through ``export.gltf`` (normals computed) against
+  trimesh's exporter with and without normals;
+- 3MF through ``export.3mf`` against trimesh's exporter, the time and the peak memory;
+- STEP of a 100 x 100 control-point bicubic B-spline surface, ours through
+  ``export.step`` (an AP214 file with the face and its four edges) against OpenCASCADE's
+  ``STEPControl_Writer`` writing the same surface as a face (from a ``Geom_BSplineSurface``
+  built before the clock starts).
+
+Each export call writes a new file name, so the export runs every time.
 """
 
 from __future__ import annotations
 
+import itertools
 import os
 import tempfile
+from pathlib import Path
 
 import numpy as np
 from bench_export import torus_mesh
 
+import formgraph as fg
 from formgraph.kernels.io.exporters import obj_bytes, stl_binary
 from formgraph.kernels.io.gltf import write_glb
 from formgraph.kernels.io.mesh_read import read_obj, read_stl
@@ -74,74 +84,150 @@ def _occ_step(cp, k, path: str):
     return write
 
 
+def reader(folder: str, name: str):
+    """``read.mesh`` of ``folder/name`` through a new graph each call."""
+
+    def call():
+        g = fg.Graph(inputs_dir=folder)
+        g.add("m", "read.mesh", path=name)
+        return g.evaluate("m")
+
+    return call
+
+
+def exporter(folder: str, node: str, value, **inputs):
+    """An export node writing ``value`` (a param) to a new file name each call."""
+    g = fg.Graph(out_dir=folder)
+    g.add_param("m", type="Mesh")
+    g.add_param("name", "x")
+    g.add("e", node, meshes=["=m"], path="=name", **inputs)
+    names = itertools.count()
+    ext = {"export.gltf": "glb", "export.3mf": "3mf", "export.step": "step"}[node]
+    return lambda: g.evaluate("e", m=value, name=f"out{next(names)}.{ext}")
+
+
 def run(table) -> None:
     v, fi, fo = torus_mesh()
     tris = fi.reshape(-1, 3)
     n = len(tris)
+    mesh = fg.Mesh(v, fi, fo)
     with tempfile.TemporaryDirectory() as d:
         stl_path, obj_path = os.path.join(d, "m.stl"), os.path.join(d, "m.obj")
         stl = stl_binary(v, fi, fo)
         obj = obj_bytes(v, fi, fo)
-        for path, data in ((stl_path, stl), (obj_path, obj)):
-            with open(path, "wb") as fh:
-                fh.write(data)
+        Path(stl_path).write_bytes(stl)
+        Path(obj_path).write_bytes(obj)
 
-        case = f"read {n:,} triangles: binary STL"
-        table.time(case, "formgraph", lambda: read_stl(stl), repeat=3)
-        try:
+        def numpy_stl():
             from stl import mesh as npstl
 
-            table.time(case, "numpy-stl", lambda: npstl.Mesh.from_file(stl_path), repeat=3)
-        except ImportError as exc:
-            table.add(case, "numpy-stl", None, f"not installed ({exc.name})")
+            return npstl.Mesh.from_file(stl_path)
 
-        import trimesh
-
-        case = f"read {n:,} triangles: OBJ"
-        table.time(case, "formgraph", lambda: read_obj(obj), repeat=2)
-        table.time(
+        case = f"read.mesh, binary STL of {n:,} triangles"
+        table.compare(
             case,
-            "trimesh",
-            lambda: trimesh.load(obj_path, process=False, force="mesh"),
-            repeat=1,
+            api=reader(d, "m.stl"),
+            kernel=lambda: read_stl(stl),
+            references={"numpy-stl Mesh.from_file": numpy_stl},
+            rounds=7,
+            note="the file read, hashed for the key, parsed, frozen",
+        )
+        table.memory(
+            f"read.mesh, binary STL of {n:,} triangles: peak memory",
+            api=reader(d, "m.stl"),
+            references={"numpy-stl Mesh.from_file": numpy_stl},
         )
 
-        tm = trimesh.Trimesh(v, tris, process=False)
-        case = f"write {n:,} triangles: GLB"
-        table.time(case, "formgraph", lambda: write_glb([(v, tris)]), repeat=2)
-        table.time(case, "trimesh", lambda: tm.export(file_type="glb"), repeat=2, note="no normals")
-        table.time(
-            case,
-            "trimesh (normals)",
-            lambda: trimesh.Trimesh(v, tris, process=False).export(
-                file_type="glb", include_normals=True
-            ),
-            repeat=2,
-            note="normals computed, as ours",
+        def trimesh_obj():
+            import trimesh
+
+            return trimesh.load(obj_path, process=False, force="mesh")
+
+        table.compare(
+            f"read.mesh, OBJ of {n:,} triangles",
+            api=reader(d, "m.obj"),
+            kernel=lambda: read_obj(obj),
+            references={"trimesh.load": trimesh_obj},
+            rounds=3,
         )
 
-        case = f"write {n:,} triangles: 3MF"
-        table.time(case, "formgraph", lambda: write_3mf([(v, tris)]), repeat=1)
-        try:
-            import lxml  # noqa: F401  (trimesh's 3MF writer needs it)
+        def trimesh_export(file_type: str, **kw):
+            import trimesh
 
-            table.time(case, "trimesh", lambda: tm.export(file_type="3mf"), repeat=1)
-        except ImportError as exc:
-            table.add(case, "trimesh", None, f"not installed ({exc.name})")
+            names = itertools.count()
+            tm = trimesh.Trimesh(v, tris, process=False)
+
+            def call():
+                tm.export(os.path.join(d, f"t{next(names)}.{file_type}"), **kw)
+
+            return call
+
+        def trimesh_glb_normals():
+            import trimesh
+
+            # a fresh mesh each call: trimesh caches the normals on the object
+            names = itertools.count()
+
+            def call():
+                tm = trimesh.Trimesh(v, tris, process=False)
+                tm.export(os.path.join(d, f"tn{next(names)}.glb"), include_normals=True)
+
+            return call
+
+        table.compare(
+            f"export.gltf (GLB) of {n:,} triangles",
+            api=exporter(d, "export.gltf", mesh),
+            kernel=lambda: write_glb([(v, tris)]),
+            references={
+                "trimesh (normals)": trimesh_glb_normals(),
+                "trimesh (no normals)": trimesh_export("glb"),
+            },
+            rounds=5,
+            note="normals computed",
+        )
+
+        table.compare(
+            f"export.3mf of {n:,} triangles",
+            api=exporter(d, "export.3mf", mesh),
+            kernel=lambda: write_3mf([(v, tris)]),
+            references={"trimesh": trimesh_export("3mf")},
+            rounds=3,
+        )
+        table.memory(
+            f"export.3mf of {n:,} triangles: peak memory",
+            api=exporter(d, "export.3mf", mesh),
+            references={"trimesh": trimesh_export("3mf")},
+        )
 
         surface = _surface()
-        case = "write STEP: 100 x 100 bicubic surface"
-        table.time(case, "formgraph", lambda: write_step(surfaces=[surface]), repeat=3)
+        nurbs = fg.NurbsSurface(surface[0], 3, 3, surface[3], surface[4])
+        references = {}
         try:
-            occ = _occ_step(surface[0], surface[3], os.path.join(d, "occ.step"))
-            table.time(case, "OpenCASCADE", occ, repeat=3)
+            references["OpenCASCADE STEPControl_Writer"] = _occ_step(
+                surface[0], surface[3], os.path.join(d, "occ.step")
+            )
         except ImportError as exc:
-            table.add(case, "OpenCASCADE", None, f"not installed ({exc.name})")
+            references["OpenCASCADE STEPControl_Writer"] = _missing(exc)
+        table.compare(
+            "export.step: 100 x 100 bicubic surface",
+            api=_step_export(d, nurbs),
+            kernel=lambda: write_step(surfaces=[surface]),
+            references=references,
+            rounds=7,
+        )
 
 
-if __name__ == "__main__":
-    from harness import Table
+def _step_export(folder: str, surface):
+    g = fg.Graph(out_dir=folder)
+    g.add_param("s", type="Surface")
+    g.add_param("name", "x")
+    g.add("e", "export.step", surfaces=["=s"], path="=name")
+    names = itertools.count()
+    return lambda: g.evaluate("e", s=surface, name=f"s{next(names)}.step")
 
-    t = Table()
-    run(t)
-    print(t.render())
+
+def _missing(exc: ImportError):
+    def call():
+        raise exc
+
+    return call

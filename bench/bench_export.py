@@ -1,23 +1,24 @@
 """Mesh export: a 1,000,000-triangle mesh to binary STL, ASCII STL and OBJ.
 
-The ASCII STL is timed twice for us: built whole (``stl_ascii``) and written in blocks
-(``stl_ascii_chunks``, as ``export.stl`` writes it), the latter with its peak memory over
-the mesh (tracemalloc, in a call of its own: the timed calls run untraced).
-
-Ours (``formgraph.kernels.io``) against numpy-stl, trimesh, meshio and pyvista (VTK's
-compiled writers), all writing a real file into a temporary directory; our times include
-triangulation, normals, formatting and the file write. Each reference gets its own mesh
-object built before the clock starts.
+Ours through ``export.stl`` / ``export.obj`` (the mesh a param, a new file name each call,
+so the export runs: triangulation, normals, formatting and the atomic file write), the
+kernel's bytes written to a file beside; against meshio, numpy-stl, trimesh and pyvista
+(VTK's compiled writers), all writing a real file into a temporary folder, each
+reference with its own mesh object built before the clock starts (trimesh's made each
+call: it keeps face normals on the object). The ASCII STL is written in blocks; its peak
+memory (tracemalloc) is set against the same text built whole. The slow references
+(ASCII STL, OBJ) run one call each.
 """
 
 from __future__ import annotations
 
+import itertools
 import os
 import tempfile
-import tracemalloc
 
 import numpy as np
 
+import formgraph as fg
 from formgraph.kernels.io import obj_bytes, stl_ascii, stl_ascii_chunks, stl_binary
 from formgraph.kernels.mesh import grid_faces
 
@@ -50,97 +51,93 @@ def _write_pieces(path: str, pieces) -> None:
             f.write(piece)
 
 
-def _peak_mib(fn) -> float:
-    """The most memory ``fn`` holds at once beyond what was allocated before, in MiB."""
-    tracemalloc.start()
-    try:
-        fn()
-        return tracemalloc.get_traced_memory()[1] / 2**20
-    finally:
-        tracemalloc.stop()
+def _exporter(folder: str, node: str, mesh, **inputs):
+    """``node`` writing ``mesh`` (a param) to a new file name each call."""
+    g = fg.Graph(out_dir=folder)
+    g.add_param("m", type="Mesh")
+    g.add_param("name", "x")
+    g.add("e", node, mesh="=m", path="=name", **inputs)
+    names = itertools.count()
+    ext = "obj" if node == "export.obj" else "stl"
+    return lambda: g.evaluate("e", m=mesh, name=f"e{next(names)}.{ext}")
+
+
+def _named(folder: str, stem: str, write):
+    """``write(path)`` to a new file name each call."""
+    names = itertools.count()
+    return lambda: write(os.path.join(folder, f"{stem}{next(names)}"))
 
 
 def run(table) -> None:
     v, fi, fo = torus_mesh()
     tris = fi.reshape(-1, 3)
-    case = f"export {len(tris):,} triangles"
+    mesh = fg.Mesh(v, fi, fo)
+    case = f"{len(tris):,} triangles"
     with tempfile.TemporaryDirectory() as d:
-        p = lambda name: os.path.join(d, name)  # noqa: E731
-
-        table.time(
-            f"{case}: binary STL", "formgraph", lambda: _write(p("a.stl"), stl_binary(v, fi, fo))
-        )
-        table.time(
-            f"{case}: ASCII STL", "formgraph", lambda: _write(p("b.stl"), stl_ascii(v, fi, fo))
-        )
-        in_blocks = lambda: _write_pieces(p("b2.stl"), stl_ascii_chunks(v, fi, fo))  # noqa: E731
-        whole_mib = _peak_mib(lambda: _write(p("b.stl"), stl_ascii(v, fi, fo)))
-        table.time(
-            f"{case}: ASCII STL",
-            "formgraph, in blocks",
-            in_blocks,
-            note=f"peak memory +{_peak_mib(in_blocks):.1f} MiB over the mesh "
-            f"(built whole: +{whole_mib:.0f} MiB)",
-        )
-        table.time(f"{case}: OBJ", "formgraph", lambda: _write(p("c.obj"), obj_bytes(v, fi, fo)))
-
         import meshio
-
-        mm = meshio.Mesh(v, [("triangle", tris)])
-        table.time(
-            f"{case}: binary STL",
-            "meshio",
-            lambda: meshio.write(p("m.stl"), mm, file_format="stl", binary=True),
-        )
-
+        import pyvista as pv
         import stl
-
-        sm = stl.mesh.Mesh(np.zeros(len(tris), dtype=stl.mesh.Mesh.dtype))
-        sm.vectors[:] = v[tris]
-        table.time(
-            f"{case}: binary STL", "numpy-stl", lambda: sm.save(p("s.stl"), mode=stl.Mode.BINARY)
-        )
-
         import trimesh
 
-        tm = trimesh.Trimesh(v, tris, process=False)
-        table.time(
-            f"{case}: binary STL",
-            "trimesh",
-            lambda: tm.export(p("t.stl")),
-            note="face normals cached after the first call",
-        )
-
-        import pyvista as pv
-
+        mm = meshio.Mesh(v, [("triangle", tris)])
+        sm = stl.mesh.Mesh(np.zeros(len(tris), dtype=stl.mesh.Mesh.dtype))
+        sm.vectors[:] = v[tris]
         pm = pv.PolyData.from_regular_faces(v, tris)
-        table.time(f"{case}: binary STL", "pyvista (VTK)", lambda: pm.save(p("v.stl"), binary=True))
 
-        table.time(
-            f"{case}: ASCII STL",
-            "pyvista (VTK)",
-            lambda: pm.save(p("v2.stl"), binary=False),
-            repeat=1,
-        )
-        table.time(
-            f"{case}: ASCII STL",
-            "trimesh",
-            lambda: _write(p("t2.stl"), trimesh.exchange.stl.export_stl_ascii(tm).encode()),
-            repeat=1,
-        )
-        table.time(
-            f"{case}: ASCII STL",
-            "numpy-stl",
-            lambda: sm.save(p("s2.stl"), mode=stl.Mode.ASCII),
-            repeat=1,
-        )
-        table.time(
-            f"{case}: ASCII STL",
-            "meshio",
-            lambda: meshio.write(p("m2.stl"), mm, file_format="stl", binary=False),
-            repeat=1,
-        )
+        def trimesh_fresh(write):
+            # a mesh made each call: trimesh caches face normals on the object
+            return lambda path: write(trimesh.Trimesh(v, tris, process=False), path)
 
-        table.time(f"{case}: OBJ", "pyvista (VTK)", lambda: pm.save(p("v.obj")))
-        table.time(f"{case}: OBJ", "trimesh", lambda: tm.export(p("t.obj")), repeat=1)
-        table.time(f"{case}: OBJ", "meshio", lambda: meshio.write(p("m.obj"), mm), repeat=1)
+        table.compare(
+            f"export.stl (binary) of {case}",
+            api=_exporter(d, "export.stl", mesh),
+            kernel=lambda: _write(os.path.join(d, "k.stl"), stl_binary(v, fi, fo)),
+            references={
+                "meshio": _named(d, "m.stl", lambda p: meshio.write(p, mm, "stl", binary=True)),
+                "numpy-stl": _named(d, "s.stl", lambda p: sm.save(p, mode=stl.Mode.BINARY)),
+                "trimesh": _named(d, "t.stl", trimesh_fresh(lambda m, p: m.export(p))),
+                "pyvista (VTK)": _named(d, "v.stl", lambda p: pm.save(p, binary=True)),
+            },
+            rounds=5,
+        )
+        table.compare(
+            f"export.stl (ASCII) of {case}",
+            api=_exporter(d, "export.stl", mesh, ascii=True),
+            kernel=lambda: _write_pieces(os.path.join(d, "k2.stl"), stl_ascii_chunks(v, fi, fo)),
+            references={
+                "pyvista (VTK)": _named(d, "v2.stl", lambda p: pm.save(p, binary=False)),
+                "trimesh": _named(
+                    d,
+                    "t2.stl",
+                    trimesh_fresh(
+                        lambda m, p: _write(p, trimesh.exchange.stl.export_stl_ascii(m).encode())
+                    ),
+                ),
+                "numpy-stl": _named(d, "s2.stl", lambda p: sm.save(p, mode=stl.Mode.ASCII)),
+                "meshio": _named(d, "m2.stl", lambda p: meshio.write(p, mm, "stl", binary=False)),
+            },
+            rounds=1,
+            warmup=False,
+            note="written in blocks",
+        )
+        table.memory(
+            f"export.stl (ASCII) of {case}: peak memory",
+            api=_exporter(d, "export.stl", mesh, ascii=True),
+            references={
+                "the same text built whole (stl_ascii)": lambda: _write(
+                    os.path.join(d, "w.stl"), stl_ascii(v, fi, fo)
+                )
+            },
+        )
+        table.compare(
+            f"export.obj of {case}",
+            api=_exporter(d, "export.obj", mesh),
+            kernel=lambda: _write(os.path.join(d, "k.obj"), obj_bytes(v, fi, fo)),
+            references={
+                "pyvista (VTK)": _named(d, "v.obj", lambda p: pm.save(p)),
+                "trimesh": _named(d, "t.obj", trimesh_fresh(lambda m, p: m.export(p))),
+                "meshio": _named(d, "m.obj", lambda p: meshio.write(p, mm)),
+            },
+            rounds=1,
+            warmup=False,
+        )

@@ -10,6 +10,8 @@ hand-written nodes.
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 
 import formgraph as fg
@@ -80,37 +82,53 @@ def written_graph(n: int) -> fg.Graph:
 
 
 def run(table) -> None:
+    pts, rot, scale = _placements()
     try:
         part = _part()
     except ImportError:
         part = None
-    pts, rot, scale = _placements()
     if part is not None:
         mesh = Mesh(part.vertices, part.faces.reshape(-1), np.arange(0, 3001, 3))
-        points, scales = Points(pts), scale.tolist()
-        case = f"copy_to_points: 1,000 faces onto {N_COPIES:,} points"
-        table.time(case, "formgraph", lambda: ours(mesh, points, rot, scales), repeat=3)
-        table.time(case, "trimesh", lambda: with_trimesh(part, pts, rot, scale), repeat=1)
+        points, scales, rots = Points(pts), scale.tolist(), rot.tolist()
+        g = fg.Graph()
+        g.add_param("m", type="Mesh")
+        g.add_param("p", type="Points")
+        g.add("c", "mesh.copy_to_points", mesh="=m", points="=p", scale=scales, rotate=rots)
+        steps = itertools.count(1)
+
+        def ours_graph():
+            # the points moved a hair each call (made and hashed in our time); each copy's
+            # rotation and scale literal lists (keyed once, with the graph)
+            return g.evaluate("c", m=mesh, p=Points(pts * (1 + next(steps) * 1e-12)))
+
+        table.compare(
+            f"mesh.copy_to_points: 1,000 faces onto {N_COPIES:,} points",
+            api=ours_graph,
+            kernel=lambda: ours(mesh, points, rot, scales),
+            references={"trimesh": lambda: with_trimesh(part, pts, rot, scale)},
+            notes={"trimesh": "apply_transform on a copy per point + util.concatenate"},
+            rounds=3,
+            note="each copy its own rotation and scale",
+        )
 
     names = [f"n{i}" for i in range(N_ITEMS)]
-    fresh: list[fg.Graph] = []
-    written: list[fg.Graph] = []
-    for _ in range(6):  # building and checking untimed: cold evaluation only
-        fresh.append(repeated_graph(N_ITEMS))
-        fresh[-1].check()
-        written.append(written_graph(N_ITEMS))
-        written[-1].check()
-    case = f"{N_ITEMS:,} items of one repeated node vs {N_ITEMS:,} nodes, cold"
-    table.time(case, "formgraph", lambda: fresh.pop().evaluate("items"), repeat=5, number=1)
-    table.time(
-        case, "hand-written nodes", lambda: written.pop().evaluate(names), repeat=5, number=1
+    repeated = [repeated_graph(N_ITEMS) for _ in range(40)]
+    written = [written_graph(N_ITEMS) for _ in range(40)]
+    for g in repeated + written:  # building and checking untimed: cold evaluation only
+        g.check()
+    table.compare(
+        f"{N_ITEMS:,} items of one repeated node vs {N_ITEMS:,} nodes, cold",
+        api=lambda: repeated.pop().evaluate("items"),
+        references={"hand-written nodes": lambda: written.pop().evaluate(names)},
+        rounds=5,
+        min_seconds=0.0,
+        note="a new checked graph each call",
     )
     g = repeated_graph(N_ITEMS)
     g.evaluate("items")
     counts = iter(range(N_ITEMS + 1, 10**6))
-    table.time(
+    table.compare(
         f"repeated node of {N_ITEMS:,} items: one more item",
-        "formgraph",
-        lambda: g.evaluate("items", n=next(counts)),
-        repeat=3,
+        api=lambda: g.evaluate("items", n=next(counts)),
+        rounds=5,
     )

@@ -1,5 +1,6 @@
-"""NURBS kernel benchmark: ours vs scipy.interpolate.BSpline (compiled, non-rational only),
-splipy and geomdl (pure Python).
+"""NURBS: ours through the public API (``NurbsCurve.evaluate``, ``NurbsSurface.evaluate_grid``
+and the ``nurbs.*`` nodes on a curve moved a hair each call), the kernel beside, against
+scipy.interpolate.BSpline (compiled, non-rational only), splipy and geomdl (pure Python).
 
 Cases: a degree-3 curve with 100 control points at 100,000 parameters (non-rational and
 rational); a 20 x 20 degree-3 surface on a 300 x 300 grid (both); knot insertion and
@@ -19,7 +20,9 @@ from __future__ import annotations
 import copy
 
 import numpy as np
+from harness import through
 
+import formgraph as fg
 from formgraph.kernels import nurbs as K
 
 N_CP, DEGREE, N_PARAMS = 100, 3, 100_000
@@ -34,14 +37,16 @@ def _curve(rng: np.random.Generator, n: int, degree: int) -> tuple:
     return cp, degree, knots, w
 
 
+def _moved_curve(cp, p, knots, w=None):
+    """A NurbsCurve param moved a hair each call (a new value: the node runs)."""
+    return lambda k: fg.NurbsCurve(cp * (1 + k * 1e-12), p, knots, w)
+
+
 def run(table) -> None:  # noqa: ANN001 - the harness's Table
     rng = np.random.default_rng(0)
     cp, p, knots, w = _curve(rng, N_CP, DEGREE)
     t = np.linspace(0.0, 1.0, N_PARAMS)
-
-    # ---- curve, non-rational
-    case = f"curve p=3, {N_CP} cp, {N_PARAMS:,} params"
-    ours = table.time(case, "formgraph", lambda: K.curve_evaluate(cp, p, knots, None, t))
+    curve, rcurve = fg.NurbsCurve(cp, p, knots), fg.NurbsCurve(cp, p, knots, w)
 
     def scipy_curve():
         from scipy.interpolate import BSpline
@@ -49,15 +54,17 @@ def run(table) -> None:  # noqa: ANN001 - the harness's Table
         spline = BSpline(knots, cp, p)
         return lambda: spline(t)
 
-    table.time(case, "scipy BSpline", _lazy(scipy_curve))
+    def splipy_curve(rational: bool):
+        def make():
+            from splipy import BSplineBasis, Curve
 
-    def splipy_curve():
-        from splipy import BSplineBasis, Curve
+            if rational:
+                c = Curve(BSplineBasis(p + 1, knots), K.homogeneous(cp, w), rational=True)
+            else:
+                c = Curve(BSplineBasis(p + 1, knots), cp)
+            return lambda: c(t)
 
-        c = Curve(BSplineBasis(p + 1, knots), cp)
-        return lambda: c(t)
-
-    table.time(case, "splipy", _lazy(splipy_curve))
+        return make
 
     def geomdl_curve(rational: bool):
         def make():
@@ -74,27 +81,24 @@ def run(table) -> None:  # noqa: ANN001 - the harness's Table
 
         return make
 
-    table.time(case, "geomdl", _lazy(geomdl_curve(False)), repeat=1)
-
-    # ---- curve, rational
-    case_r = f"rational curve p=3, {N_CP} cp, {N_PARAMS:,} params"
-    ours_r = table.time(case_r, "formgraph", lambda: K.curve_evaluate(cp, p, knots, w, t))
-
-    def splipy_rcurve():
-        from splipy import BSplineBasis, Curve
-
-        c = Curve(BSplineBasis(p + 1, knots), K.homogeneous(cp, w), rational=True)
-        return lambda: c(t)
-
-    table.time(case_r, "splipy", _lazy(splipy_rcurve))
-    table.time(case_r, "geomdl", _lazy(geomdl_curve(True)), repeat=1)
-    if ours and ours_r:
-        table.add(
-            case_r,
-            "formgraph non-rational",
-            ours,
-            f"rational / non-rational = {ours_r / ours:.2f}x",
-        )
+    table.compare(
+        f"NurbsCurve.evaluate, p=3, {N_CP} cp, {N_PARAMS:,} params",
+        api=lambda: curve.evaluate(t),
+        kernel=lambda: K.curve_evaluate(cp, p, knots, None, t),
+        references={
+            "scipy BSpline": _lazy(scipy_curve),
+            "splipy": _lazy(splipy_curve(False)),
+            "geomdl": _lazy(geomdl_curve(False)),
+        },
+        rounds=3,
+    )
+    table.compare(
+        f"NurbsCurve.evaluate, rational, p=3, {N_CP} cp, {N_PARAMS:,} params",
+        api=lambda: rcurve.evaluate(t),
+        kernel=lambda: K.curve_evaluate(cp, p, knots, w, t),
+        references={"splipy": _lazy(splipy_curve(True)), "geomdl": _lazy(geomdl_curve(True))},
+        rounds=3,
+    )
 
     # ---- surface on a grid
     net = rng.normal(size=(NET, NET, 3))
@@ -104,10 +108,8 @@ def run(table) -> None:  # noqa: ANN001 - the harness's Table
     g = np.linspace(0.0, 1.0, GRID)
     for rational in (False, True):
         ww = net_w if rational else None
-        case_s = f"{'rational ' if rational else ''}surface {NET}x{NET} p=3, {GRID}x{GRID} grid"
-        table.time(
-            case_s, "formgraph", lambda ww=ww: K.surface_evaluate_grid(net, 3, 3, ku, kv, ww, g, g)
-        )
+        surface = fg.NurbsSurface(net, 3, 3, ku, kv, ww)
+        refs = {}
         if not rational:
 
             def scipy_surface():
@@ -120,7 +122,7 @@ def run(table) -> None:  # noqa: ANN001 - the harness's Table
 
                 return go
 
-            table.time(case_s, "scipy design matrix", _lazy(scipy_surface))
+            refs["scipy design matrix"] = _lazy(scipy_surface)
 
         def splipy_surface(ww=ww):
             from splipy import BSplineBasis, Surface
@@ -134,8 +136,6 @@ def run(table) -> None:  # noqa: ANN001 - the harness's Table
             )
             return lambda: s(g, g)
 
-        table.time(case_s, "splipy", _lazy(splipy_surface))
-
         def geomdl_surface(ww=ww):
             from geomdl import NURBS
 
@@ -148,12 +148,18 @@ def run(table) -> None:  # noqa: ANN001 - the harness's Table
             uv = [(a, b) for a in g.tolist() for b in g.tolist()]
             return lambda: s.evaluate_list(uv)
 
-        table.time(case_s, "geomdl", _lazy(geomdl_surface), repeat=1)
+        refs["splipy"] = _lazy(splipy_surface)
+        refs["geomdl"] = _lazy(geomdl_surface)
+        table.compare(
+            f"NurbsSurface.evaluate_grid, {'rational ' if rational else ''}{NET}x{NET} p=3, "
+            f"{GRID}x{GRID} grid",
+            api=lambda surface=surface: surface.evaluate_grid(g, g),
+            kernel=lambda ww=ww: K.surface_evaluate_grid(net, 3, 3, ku, kv, ww, g, g),
+            references=refs,
+            rounds=3,
+        )
 
     # ---- knot insertion and refinement
-    case_k = f"insert knot (x2) into p=3 curve, {N_CP} cp"
-    table.time(case_k, "formgraph", lambda: K.insert_knot(cp, p, knots, w, 0.4321, 2))
-
     def geomdl_insert():
         from geomdl import NURBS, operations
 
@@ -164,19 +170,26 @@ def run(table) -> None:  # noqa: ANN001 - the harness's Table
         c.knotvector = knots.tolist()
         return lambda: operations.insert_knot(copy.deepcopy(c), [0.4321], [2])
 
-    table.time(case_k, "geomdl (incl. copy)", _lazy(geomdl_insert))
-
     def splipy_insert():
         from splipy import BSplineBasis, Curve
 
         c = Curve(BSplineBasis(p + 1, knots), K.homogeneous(cp, w), rational=True)
         return lambda: c.clone().insert_knot([0.4321, 0.4321])
 
-    table.time(case_k, "splipy (incl. clone)", _lazy(splipy_insert))
+    table.compare(
+        f"nurbs.insert_knot (x2) into a rational p=3 curve, {N_CP} cp",
+        api=through(
+            "nurbs.insert_knot", {"c": _moved_curve(cp, p, knots, w)}, curve="=c", t=0.4321, times=2
+        ),
+        kernel=lambda: K.insert_knot(cp, p, knots, w, 0.4321, 2),
+        references={
+            "geomdl (incl. copy)": _lazy(geomdl_insert),
+            "splipy (incl. clone)": _lazy(splipy_insert),
+        },
+        rounds=5,
+    )
 
     new = rng.uniform(0, 1, 1000)
-    case_r2 = f"refine p=3 curve, {N_CP} cp, +1,000 knots"
-    table.time(case_r2, "formgraph", lambda: K.refine_knots(cp, p, knots, w, new))
 
     def splipy_refine():
         from splipy import BSplineBasis, Curve
@@ -184,10 +197,13 @@ def run(table) -> None:  # noqa: ANN001 - the harness's Table
         c = Curve(BSplineBasis(p + 1, knots), K.homogeneous(cp, w), rational=True)
         return lambda: c.clone().insert_knot(new.tolist())
 
-    table.time(case_r2, "splipy (incl. clone)", _lazy(splipy_refine))
-
-    case_e = f"elevate degree 3->5, {N_CP} cp"
-    table.time(case_e, "formgraph", lambda: K.elevate_degree(cp, p, knots, w, 2))
+    table.compare(
+        f"refine a rational p=3 curve, {N_CP} cp, +1,000 knots",
+        api=lambda: K.refine_knots(cp, p, knots, w, new),
+        references={"splipy (incl. clone)": _lazy(splipy_refine)},
+        rounds=3,
+        note="the kernel (formgraph.kernels.nurbs.refine_knots): no node inserts many at once",
+    )
 
     def splipy_elevate():
         from splipy import BSplineBasis, Curve
@@ -195,23 +211,38 @@ def run(table) -> None:  # noqa: ANN001 - the harness's Table
         c = Curve(BSplineBasis(p + 1, knots), K.homogeneous(cp, w), rational=True)
         return lambda: c.clone().raise_order(2)
 
-    table.time(case_e, "splipy (incl. clone)", _lazy(splipy_elevate))
+    table.compare(
+        f"nurbs.elevate_degree 3->5, rational, {N_CP} cp",
+        api=through(
+            "nurbs.elevate_degree", {"c": _moved_curve(cp, p, knots, w)}, curve="=c", times=2
+        ),
+        kernel=lambda: K.elevate_degree(cp, p, knots, w, 2),
+        references={"splipy (incl. clone)": _lazy(splipy_elevate)},
+        rounds=5,
+    )
 
     # ---- loft
     curves = []
     for i in range(10):
         c = _curve(rng, 200, 3)
         curves.append((c[0] + [0, 0, i], 3, c[2], None))
-    case_l = "loft of 10 curves x 200 cp (distinct knots)"
-    table.time(case_l, "formgraph", lambda: K.loft(curves))
+    params = {f"c{i}": _moved_curve(*c) for i, c in enumerate(curves)}
+    table.compare(
+        "nurbs.loft of 10 curves x 200 cp (distinct knots)",
+        api=through("nurbs.loft", params, curves=[f"={n}" for n in params]),
+        kernel=lambda: K.loft(curves),
+        rounds=5,
+    )
     curves_same = [(c[0], 3, curves[0][2], None) for c in curves]
-    table.time(
-        "loft of 10 curves x 200 cp (shared knots)", "formgraph", lambda: K.loft(curves_same)
+    params = {f"c{i}": _moved_curve(*c) for i, c in enumerate(curves_same)}
+    table.compare(
+        "nurbs.loft of 10 curves x 200 cp (shared knots)",
+        api=through("nurbs.loft", params, curves=[f"={n}" for n in params]),
+        kernel=lambda: K.loft(curves_same),
+        rounds=5,
     )
 
-    case_i = "interpolate 200 points, p=3"
     pts = np.cumsum(rng.normal(size=(200, 3)), axis=0)
-    table.time(case_i, "formgraph", lambda: K.interpolate(pts, 3))
 
     def geomdl_interp():
         from geomdl import fitting
@@ -219,14 +250,19 @@ def run(table) -> None:  # noqa: ANN001 - the harness's Table
         pl = pts.tolist()
         return lambda: fitting.interpolate_curve(pl, 3)
 
-    table.time(case_i, "geomdl", _lazy(geomdl_interp), repeat=1)
+    moved = {"p": lambda k: fg.Points(pts * (1 + k * 1e-12))}
+    table.compare(
+        "nurbs.interpolate 200 points, p=3",
+        api=through("nurbs.interpolate", moved, points="=p"),
+        kernel=lambda: K.interpolate(pts, 3),
+        references={"geomdl": _lazy(geomdl_interp)},
+        rounds=5,
+    )
 
     # ---- interpolation of many points: the banded solve (a dense one would need 80 GB)
     big = 100_000
     tb = np.linspace(0, 60 * np.pi, big)
     pts_big = np.stack([np.cos(tb), np.sin(tb), np.sin(0.37 * tb)], -1)
-    case_b = f"interpolate {big:,} points, p=3 (open)"
-    table.time(case_b, "formgraph", lambda: K.interpolate(pts_big, 3), repeat=3)
 
     def scipy_interp():
         from scipy.interpolate import make_interp_spline
@@ -235,18 +271,29 @@ def run(table) -> None:  # noqa: ANN001 - the harness's Table
         knots_b = K.interpolate(pts_big, 3)[2]  # the same knots (A9.1's averaging)
         return lambda: make_interp_spline(u, pts_big, k=3, t=knots_b)
 
-    table.time(case_b, "scipy make_interp_spline", _lazy(scipy_interp), repeat=3)
-    table.time(
-        f"interpolate {big:,} points, p=3 (closed)",
-        "formgraph",
-        lambda: K.interpolate(pts_big[: big - 1], 3, closed=True),
-        repeat=3,
+    moved_big = {"p": lambda k: fg.Points(pts_big * (1 + k * 1e-12))}
+    table.compare(
+        f"nurbs.interpolate {big:,} points, p=3 (open)",
+        api=through("nurbs.interpolate", moved_big, points="=p"),
+        kernel=lambda: K.interpolate(pts_big, 3),
+        references={"scipy make_interp_spline (the same knots)": _lazy(scipy_interp)},
+        rounds=3,
+    )
+    closed_pts = pts_big[: big - 1]
+    table.compare(
+        f"nurbs.interpolate {big:,} points, p=3 (closed)",
+        api=through(
+            "nurbs.interpolate",
+            {"p": lambda k: fg.Points(closed_pts * (1 + k * 1e-12))},
+            points="=p",
+            closed=True,
+        ),
+        kernel=lambda: K.interpolate(closed_pts, 3, closed=True),
+        rounds=3,
     )
 
     # ---- degree elevation by many degrees at once
     cp_e, _, knots_e, _ = _curve(rng, 1000, 3)
-    case_e29 = "elevate degree 3->32, 1,000 cp"
-    table.time(case_e29, "formgraph", lambda: K.elevate_degree(cp_e, 3, knots_e, None, 29))
 
     def splipy_elevate29():
         from splipy import BSplineBasis, Curve
@@ -254,14 +301,34 @@ def run(table) -> None:  # noqa: ANN001 - the harness's Table
         c = Curve(BSplineBasis(4, knots_e), cp_e)
         return lambda: c.clone().raise_order(29)
 
-    table.time(case_e29, "splipy (incl. clone)", _lazy(splipy_elevate29), repeat=1)
+    table.compare(
+        "nurbs.elevate_degree 3->32, 1,000 cp",
+        api=through(
+            "nurbs.elevate_degree", {"c": _moved_curve(cp_e, 3, knots_e)}, curve="=c", times=29
+        ),
+        kernel=lambda: K.elevate_degree(cp_e, 3, knots_e, None, 29),
+        references={"splipy (incl. clone)": _lazy(splipy_elevate29)},
+        rounds=1,
+        warmup=False,
+    )
 
     hx = np.linspace(0, 6 * np.pi, 512)
     path = np.stack([2 * np.cos(hx), 2 * np.sin(hx), hx / np.pi], -1)
     tang = np.stack([-2 * np.sin(hx), 2 * np.cos(hx), np.full_like(hx, 1 / np.pi)], -1)
     circ = K.circle(0.3)
-    table.time(
-        "sweep circle along helix, 512 stations", "formgraph", lambda: K.sweep(circ, path, tang)
+    helix = fg.NurbsCurve(*K.interpolate(path, 3))
+    table.compare(
+        "nurbs.sweep of a circle along a helix, 512 stations",
+        api=through(
+            "nurbs.sweep",
+            {"r": lambda k: fg.NurbsCurve(*K.circle(0.3 * (1 + k * 1e-12)))},
+            profile="=r",
+            path=helix,
+            stations=512,
+        ),
+        kernel=lambda: K.sweep(circ, path, tang),
+        rounds=5,
+        note="the path a cubic through 512 helix points (the kernel: those points, tangents)",
     )
 
 

@@ -4,15 +4,13 @@ Cases:
 
 * the offset of a 1,000- and a 10,000-vertex wiggly closed polyline (a circle with two sine
   wiggles, extent 2.3), outward and inward by 0.05, at the default 0.1 %-of-extent accuracy,
-  through the ``offset.marching_squares`` node itself (so the times hold the node's reading
-  of the curve, the even-odd region, the orientation of the loops and the output curves, not
-  only the offset): its default path (GEOS's buffer, chords chosen from the tolerance) and
-  its marching path (the distance field and marching squares, as an explicit ``cell`` --
-  the one the default would choose -- asks for), against shapely's round-join buffer of
-  the prebuilt polygon (GEOS, compiled; its default 8 chords a quarter circle). Timed in
-  alternating rounds (`Table.time_together`). The notes give each path's time as a
-  multiple of shapely's and the Hausdorff distance between its result and shapely's, as a
-  fraction of the extent;
+  through a graph read from a file's text as a user writes one (the loop's points a
+  literal list, the distance a param moved a hair each call): the node's default path
+  (GEOS's buffer, chords chosen from the tolerance) and its marching path (the distance
+  field and marching squares, as an explicit ``cell`` -- the one the default would
+  choose -- asks for), against shapely's round-join buffer of the prebuilt polygon (GEOS,
+  compiled; its default 8 chords a quarter circle). The notes give the Hausdorff distance
+  between each result and shapely's, as a fraction of the extent;
 * the contouring step alone: ``marching_squares`` on a 2000 x 2000 field with one contour
   (a cone) and on a busy field of about 120 contours, against
   ``skimage.measure.find_contours`` on the same array (scikit-image returns (row, col) and
@@ -21,6 +19,8 @@ Cases:
 """
 
 from __future__ import annotations
+
+import itertools
 
 import numpy as np
 
@@ -60,41 +60,55 @@ def run(table) -> None:  # noqa: ANN001 - the harness's Table
     _contour_rows(table)
 
 
-def _offset_rows(table, n: int) -> None:  # noqa: ANN001
-    from pathlib import Path
+def graph_text(pts: np.ndarray, cell: float | None = None) -> str:
+    """A graph file as a user writes one: the loop's points a literal list, the distance
+    a param."""
+    rows = ", ".join(f"[{float(x)!r}, {float(y)!r}]" for x, y in pts)
+    extra = f", cell: {cell!r}" if cell is not None else ""
+    return (
+        "formgraph: 1\nparams:\n  d: 0.05\nnodes:\n"
+        f"  pts: {{type: points.list, points: [{rows}]}}\n"
+        "  loop: {type: curves.polyline, points: '@pts', closed: true}\n"
+        f"  off: {{type: offset.marching_squares, curves: ['@loop'], distance: '=d'{extra}}}\n"
+    )
 
-    from formgraph.core.registry import Context
-    from formgraph.geometry import NurbsCurve
-    from formgraph.nodes.offset import marching_squares as offset_node
+
+def _offset_rows(table, n: int) -> None:  # noqa: ANN001
+    import formgraph as fg
 
     pts = wiggly(n)
-    curve = NurbsCurve.polyline(np.c_[pts, np.zeros(n)], closed=True)
-    ctx = Context("bench", Path("."))
     extent = float(np.ptp(pts, axis=0).max())
     for d in (0.05, -0.05):
         side = "outward" if d > 0 else "inward"
-        case = f"offset {n:,}-vertex wiggly loop {side} {abs(d)}"
         cell = default_cell(extent, d)
-        default = lambda d=d: offset_node.marching_squares([curve], d, ctx=ctx)  # noqa: E731
-        marching = lambda d=d, c=cell: offset_node.marching_squares(  # noqa: E731
-            [curve], d, cell=c, ctx=ctx
-        )
-        try:
-            import shapely
-        except ImportError:
-            table.time(case, "formgraph", default)
-            continue
+        default = fg.Graph.from_text(graph_text(pts))
+        marching = fg.Graph.from_text(graph_text(pts, cell))
+
+        def call(g, d=d):
+            steps = itertools.count(1)
+            return lambda: g.evaluate("off", d=d * (1 + next(steps) * 1e-9))
+
+        import shapely
+
         polygon = shapely.Polygon(pts)
         reference = polygon.buffer(d)
-        impls = [
-            ("formgraph", default, _hausdorff_note(default(), reference, extent)),
-            ("formgraph, marching", marching, _hausdorff_note(marching(), reference, extent)),
-            ("shapely buffer", lambda d=d, p=polygon: p.buffer(d), "8 chords a quarter circle"),
-        ]
-        table.time_together(case, impls)
-        rows = table.rows[-3:]
-        for row in rows[:2]:
-            row.note = f"{row.seconds / rows[2].seconds:.1f}x shapely; {row.note}"
+        table.compare(
+            f"offset.marching_squares of a {n:,}-vertex wiggly loop {side} {abs(d)}",
+            api=call(default),
+            references={
+                "shapely buffer": lambda d=d, p=polygon: p.buffer(d),
+                "formgraph, marching path (an explicit cell)": call(marching),
+            },
+            rounds=7,
+            note="a graph file's literal loop, the distance a param; "
+            + _hausdorff_note(default.evaluate("off", d=d), reference, extent),
+            notes={
+                "shapely buffer": "8 chords a quarter circle",
+                "formgraph, marching path (an explicit cell)": _hausdorff_note(
+                    marching.evaluate("off", d=d), reference, extent
+                ),
+            },
+        )
 
 
 def _hausdorff_note(curves, reference, extent: float) -> str:
@@ -108,20 +122,19 @@ def _contour_rows(table) -> None:  # noqa: ANN001
     busy = busy_field()
     for name, field, level in (("one contour", 1 - cone, 0.5), ("busy", busy, 0.5)):
         count = len(marching_squares(field, level))
-        case = f"contour {GRID}x{GRID} {name}"
-        table.time(
-            case,
-            "formgraph",
-            lambda f=field, lv=level: marching_squares(f, lv),
-            note=f"{count} loops",
-        )
 
         def skimage_contours(f=field, lv=level):
             from skimage import measure
 
             return lambda: measure.find_contours(f, lv)
 
-        table.time(case, "skimage find_contours", _lazy(skimage_contours))
+        table.compare(
+            f"contour {GRID}x{GRID} {name}",
+            api=lambda f=field, lv=level: marching_squares(f, lv),
+            references={"skimage find_contours": _lazy(skimage_contours)},
+            rounds=5,
+            note=f"the kernel (formgraph.kernels.offset.marching_squares); {count} loops",
+        )
 
 
 def _lazy(make):

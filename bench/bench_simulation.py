@@ -1,4 +1,4 @@
-"""Simulation kernels: one differential-growth step at 1k / 10k / 100k vertices (its cost
+"""Simulation: one differential-growth step (``curves.grow``) at 1k / 10k / 100k vertices (its cost
 should grow as n log n) against a straightforward all-pairs numpy step at 10k, and 1,000
 dynamic-relaxation steps of a 100 x 100 spring net (and the same through ``simulate:``).
 
@@ -7,6 +7,8 @@ apart, vertices half a split apart), so each vertex has the neighbours it would 
 """
 
 from __future__ import annotations
+
+import itertools
 
 import numpy as np
 
@@ -64,42 +66,53 @@ def square_net(n: int) -> tuple[np.ndarray, np.ndarray, list[int]]:
 
 
 def run(table) -> None:
+    from harness import through
+
+    import formgraph as fg
+
     for n in (1_000, 10_000, 100_000):
         p = meander(n)
-        case = f"growth step, {n:,}-vertex curve"
-        table.time(
-            case,
-            "formgraph",
-            lambda p=p: growth.grow_step(p, True, split=SPLIT, radius=RADIUS, jitter=0.3),
-            repeat=3,
+        refs = {"numpy all pairs": lambda p=p: all_pairs_step(p)} if n == 10_000 else {}
+        xyz = np.c_[p, np.zeros(n)]
+        table.compare(
+            f"curves.grow, one step of a {n:,}-vertex curve",
+            api=through(
+                "curves.grow",
+                {"c": lambda k, xyz=xyz: fg.NurbsCurve.polyline(xyz * (1 + k * 1e-12), True)},
+                curve="=c",
+                split=SPLIT,
+                radius=RADIUS,
+            ),
+            kernel=lambda p=p: growth.grow_step(p, True, split=SPLIT, radius=RADIUS, jitter=0.3),
+            references=refs,
+            rounds=3 if n < 100_000 else 1,
+            warmup=n < 100_000,
             note="hash grid, crossing guard",
         )
         if n == 10_000:
-            table.time(case, "numpy all pairs", lambda p=p: all_pairs_step(p), repeat=1)
-            case = "neighbour pairs within 2, 10,000-vertex curve"
-            table.time(case, "formgraph", lambda p=p: growth.pairs_within(p, RADIUS))
-            try:
+
+            def kdtree(p=p):
                 from scipy.spatial import cKDTree
 
-                table.time(
-                    case,
-                    "scipy cKDTree",
-                    lambda p=p: cKDTree(p).query_pairs(RADIUS, output_type="ndarray"),
-                    note="tree built each step, as a step would",
-                )
-            except ImportError as exc:
-                table.add(case, "scipy cKDTree", None, f"not installed ({exc.name})")
+                return cKDTree(p).query_pairs(RADIUS, output_type="ndarray")
+
+            table.compare(
+                "neighbour pairs within 2, 10,000-vertex curve",
+                api=lambda p=p: growth.pairs_within(p, RADIUS),
+                references={"scipy cKDTree": kdtree},
+                notes={"scipy cKDTree": "tree built each step, as a step would"},
+                rounds=5,
+                note="the kernel (formgraph.kernels.curves.growth.pairs_within)",
+            )
 
     x, edges, corners = square_net(100)
     rest = 0.95 * np.linalg.norm(x[edges[:, 1]] - x[edges[:, 0]], axis=1)
     net = kr.network(len(x), edges, rest, stiffness=10.0, load=[0, 0, -0.01], anchors=corners)
-    case = "relax 1,000 steps, 100 x 100 net (19,800 springs)"
-    table.time(case, "formgraph", lambda: kr.relax(x, net, steps=1000), repeat=1)
-
-    import formgraph as fg
 
     text = """\
 formgraph: 1
+params:
+  sag: -0.01
 nodes:
   net: {type: mesh.plane, size: [99, 99], divisions: [99, 99]}
   hang:
@@ -107,13 +120,16 @@ nodes:
     simulate: {state: mesh, from: "@net", steps: 1000}
     reference: "@net"
     anchors: [0, 99, 9900, 9999]
-    load: [0, 0, -0.01]
+    load: [0, 0, "=sag"]
     iterations: 1
 """
-
-    def through_simulate() -> None:
-        g = fg.Graph.from_text(text)
-        g.evaluate("hang")
-
-    case = "mesh.relax, simulate: 1,000 steps of 1 iteration, 100 x 100"
-    table.time(case, "formgraph", through_simulate, repeat=1, note="engine + caches per step")
+    g = fg.Graph.from_text(text)
+    sags = itertools.count(1)
+    table.compare(
+        "mesh.relax, simulate: 1,000 steps of 1 iteration, 100 x 100 net",
+        api=lambda: g.evaluate("hang", sag=-0.01 * (1 + next(sags) * 1e-9)),
+        kernel=lambda: kr.relax(x, net, steps=1000),
+        rounds=1,
+        warmup=False,
+        note="through simulate: (engine + caches per step); the kernel: 1,000 steps at once",
+    )

@@ -1,22 +1,29 @@
-"""Solids benchmark: a boolean of two 100k-triangle spheres, and the repair chain on 1M.
+"""Solids: a boolean of two 100k-triangle spheres, and the repair chain on 1M triangles.
 
-- union of two overlapping 100,488-triangle UV spheres: ours (``mesh.boolean``'s path:
-  refuse-or-convert, manifold3d, back to a frozen ``Mesh``) against manifold3d called
-  directly on ready-made arrays, and against trimesh's ``boolean.union`` with the manifold
-  engine;
+- ``mesh.union`` of two overlapping 100,488-triangle UV spheres through a graph whose
+  meshes are params (each call the first moved a tiny amount: new content, so the node
+  runs; its input checked, manifold3d, back to a frozen ``Mesh``) beside the kernel path,
+  against manifold3d called directly on ready-made arrays (``Mesh64``, ``+``,
+  ``to_mesh64``), and trimesh's ``boolean.union`` with the manifold engine;
 - weld + orient + cap of a 1,000,000-triangle open tube given as a triangle soup (every
-  triangle with its own 3 vertices, half of them flipped, as an unrepaired STL holds it)
-  against pymeshlab's ``remove_duplicate_vertices`` + ``re_orient_faces_coherently`` +
-  ``close_holes`` (the same work: exact duplicates, as our weld's default tolerance finds
-  here, and both ends capped), and trimesh's ``merge_vertices`` + ``fix_normals`` +
-  ``fill_holes``. trimesh's ``fill_holes`` fills only holes of 3 or 4 edges, so its chain
-  leaves the tube's two 1000-edge ends open, where ours caps them.
+  triangle with its own 3 vertices, half of them flipped, as an unrepaired STL holds it):
+  ours through ``mesh.weld`` (tolerance 0: exact duplicates) -> ``mesh.orient`` ->
+  ``mesh.cap`` in a graph made anew each call from the user's arrays (``fg.Mesh`` built
+  and hashed in our time; the kernels' connectivity memo cleared: a cold call), the
+  kernels alone beside, against pymeshlab's ``meshing_remove_duplicate_vertices`` +
+  ``meshing_re_orient_faces_coherently`` + ``meshing_close_holes`` from the same arrays
+  (its ``Mesh`` built in its time), the same work: both ends capped. trimesh's
+  ``merge_vertices`` + ``fix_normals`` + ``fill_holes`` fills only holes of 3 or 4 edges
+  (it leaves the two 1000-edge ends open) and takes over a minute: one timed call.
 """
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 
+import formgraph as fg
 from formgraph.geometry import Mesh
 from formgraph.kernels.mesh import boolean as kb
 from formgraph.kernels.mesh import memo
@@ -95,42 +102,72 @@ def _pymeshlab_repair(v, fi):
     return ms.current_mesh().face_number()
 
 
+def _union_graph(a: Mesh, b: Mesh):
+    g = fg.Graph()
+    g.add_param("a", type="Mesh")
+    g.add_param("b", type="Mesh")
+    g.add("u", "mesh.union", meshes=["=a", "=b"])
+    steps = itertools.count(1)
+
+    def call():
+        moved = Mesh.trusted(a.vertices * (1 + next(steps) * 1e-12), a.face_indices, a.face_offsets)
+        return g.evaluate("u", a=moved, b=b)
+
+    return call
+
+
+def _repair_graph(v, fi, fo):
+    def call():
+        memo.clear()  # a cold call: the memo only serves the same faces again (a slider step)
+        g = fg.Graph()
+        g.add_param("m", type="Mesh")
+        g.add("w", "mesh.weld", mesh="=m", tolerance=0)
+        g.add("o", "mesh.orient", mesh="@w")
+        g.add("c", "mesh.cap", mesh="@o")
+        return g.evaluate("c", m=fg.Mesh(v, fi, fo))
+
+    return call
+
+
 def run(table) -> None:
     a, b = _sphere((0.0, 0.0, 0.0)), _sphere((0.6, 0.2, 0.1))
-    case = f"union of two {a.n_faces // 1000}k-triangle spheres"
-    table.time(case, "formgraph", lambda: _ours_union(a, b), repeat=3)
     raw = [
         (np.array(m.vertices), np.array(m.face_indices, np.uint64).reshape(-1, 3)) for m in (a, b)
     ]
-    table.time(case, "manifold3d direct", lambda: _manifold_direct(*raw), repeat=3)
-    try:
+
+    def trimesh_union():
         import trimesh
 
         ta = trimesh.Trimesh(raw[0][0], raw[0][1].astype(np.int64), process=False)
         tb = trimesh.Trimesh(raw[1][0], raw[1][1].astype(np.int64), process=False)
-        table.time(case, "trimesh (manifold)", lambda: _trimesh_union(ta, tb), repeat=3)
-    except ImportError as exc:
-        table.add(case, "trimesh (manifold)", None, f"not installed ({exc.name})")
+        return _trimesh_union(ta, tb)
+
+    table.compare(
+        f"mesh.union of two {a.n_faces // 1000}k-triangle spheres",
+        api=_union_graph(a, b),
+        kernel=lambda: _ours_union(a, b),
+        references={
+            "manifold3d direct": lambda: _manifold_direct(*raw),
+            "trimesh (manifold engine)": trimesh_union,
+        },
+        rounds=5,
+    )
 
     v, fi, fo = tube_soup()
-    case = "weld + orient + cap, 1M-triangle soup (open tube)"
-    table.time(case, "formgraph", lambda: _ours_repair(v, fi, fo), repeat=2)
-    table.time(
-        case,
-        "trimesh",
-        lambda: _trimesh_repair(v, fi),
-        repeat=1,
-        note="merge_vertices + fix_normals + fill_holes; leaves the two ends open",
+    table.compare(
+        "weld + orient + cap, 1M-triangle soup (open tube)",
+        api=_repair_graph(v, fi, fo),
+        kernel=lambda: _ours_repair(v, fi, fo),
+        references={"pymeshlab": lambda: _pymeshlab_repair(v, fi)},
+        rounds=3,
+        note="each call cold: a new graph, the connectivity memo cleared",
+        notes={"pymeshlab": "remove_duplicate_vertices + re_orient_faces_coherently + close_holes"},
     )
-    try:
-        import pymeshlab  # noqa: F401
-
-        table.time(
-            case,
-            "pymeshlab",
-            lambda: _pymeshlab_repair(v, fi),
-            repeat=2,
-            note="remove_duplicate_vertices + re_orient_faces_coherently + close_holes",
-        )
-    except ImportError as exc:
-        table.add(case, "pymeshlab", None, f"not installed ({exc.name})")
+    table.compare(
+        "weld + orient + cap, 1M-triangle soup: trimesh (one call)",
+        api=_repair_graph(v, fi, fo),
+        references={"trimesh": lambda: _trimesh_repair(v, fi)},
+        rounds=1,
+        warmup=False,
+        notes={"trimesh": "merge_vertices + fix_normals + fill_holes; leaves the two ends open"},
+    )

@@ -39,9 +39,6 @@ def run(table) -> None:
     def in_place() -> None:
         assert session.apply_params(height=1.0 + next(steps) * 1e-6)
 
-    table.time(case, "formgraph", in_place, note="Session.apply_params, actors updated")
-    plotter.close()
-
     g2 = _graph()
     steps2 = itertools.count(1)
 
@@ -54,7 +51,15 @@ def run(table) -> None:
         p.render()
         p.close()
 
-    table.time(case, "pyvista rebuild", rebuild, note="new plotter per step")
+    table.compare(
+        case,
+        api=in_place,
+        references={"pyvista rebuild": rebuild},
+        rounds=5,
+        note="Session.apply_params, actors updated in place",
+        notes={"pyvista rebuild": "the same graph evaluated, a new plotter per step"},
+    )
+    plotter.close()
 
     _graph_drawing(table)
 
@@ -71,8 +76,6 @@ def _graph_drawing(table) -> None:
     largest = max(graphs.glob("*.yaml"), key=lambda p: len(fg.load(p).nodes))
     g = fg.load(largest)
     case = f"drawing the graph of {largest.name} ({len(g.nodes)} nodes, {len(g.params)} params)"
-    table.time(case, "formgraph SVG", lambda: fg.draw_graph(g).svg, note="layout + SVG text")
-    table.time(case, "formgraph PNG", lambda: fg.draw_graph(g).png(), note="Pillow, 2x")
 
     def reference() -> None:
         import matplotlib
@@ -95,4 +98,14 @@ def _graph_drawing(table) -> None:
         fig.savefig(buf, format="svg")
         plt.close(fig)
 
-    table.time(case, "networkx + matplotlib SVG", reference, note="multipartite layout")
+    table.compare(
+        case,
+        api=lambda: fg.draw_graph(g).svg,
+        references={
+            "formgraph PNG (Pillow, 2x)": lambda: fg.draw_graph(g).png(),
+            "networkx + matplotlib SVG": reference,
+        },
+        rounds=5,
+        note="layout + SVG text",
+        notes={"networkx + matplotlib SVG": "multipartite layout, circles, no text boxes"},
+    )

@@ -7,21 +7,21 @@ evaluated as a user calls it, or ``fg.*``), beside **the kernel alone**, against
 order turns, reported as medians with their range (min-max) and the ratio of ours to each
 reference per round (its median and range). :meth:`Table.memory` does the same for peak
 memory. ``python bench/run.py [name ...]`` prints the table; ``--markdown`` prints the table
-the documentation shows, from that one run.
-
-The older :meth:`Table.time` / :meth:`Table.time_together` (best-of rows) remain until every
-module has moved to :meth:`Table.compare`.
+the documentation shows, from that one run. :func:`through` makes the call of one node as
+a user makes it, on new values each call.
 """
 
 from __future__ import annotations
 
 import gc
+import itertools
 import os
 import statistics
 import time
 import tracemalloc
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
 
 # ``BENCH_CLOCK=cpu`` times CPU seconds of this process instead of wall seconds: on a
 # machine shared with other jobs, far steadier (every row here is single-threaded: one
@@ -34,29 +34,30 @@ _CLOCKS = {"wall": time.perf_counter, "cpu": time.process_time}
 _now = _CLOCKS[CLOCK]
 
 
-def best_time(
-    fn: Callable[[], object],
-    *,
-    repeat: int = 5,
-    min_seconds: float = 0.2,
-    number: int | None = None,
-) -> float:
-    """Best time of one call of ``fn`` in seconds (warm-up call first; each round loops
-    enough calls to last ``min_seconds``)."""
-    t0 = _now()
-    fn()
-    first = _now() - t0
-    if number is None:
-        number = max(1, int(min_seconds / max(first, 1e-9)))
-    if first > 2.0:  # slow reference: one more call is enough
-        repeat, number = 1, 1
-    best = float("inf")
-    for _ in range(repeat):
-        t0 = _now()
-        for _ in range(number):
-            fn()
-        best = min(best, (_now() - t0) / number)
-    return best
+def through(node: str, params: dict[str, Callable[[int], Any]], /, **inputs: Any) -> Callable:
+    """A call of node type ``node`` as a user makes it: a graph of that one node (named
+    ``n``; its ``inputs`` may read the ``params`` as ``"=name"``), evaluated with each param
+    set to ``params[name](k)`` for k = 1, 2, ... call after call: a new value every call,
+    so neither the cache nor early cutoff answers (a geometry value is made in the call,
+    as a user's own arrays would be)."""
+    import formgraph as fg
+    from formgraph.geometry import Geometry
+
+    g = fg.Graph()
+    for name, make in params.items():
+        first = make(0)
+        if isinstance(first, Geometry):
+            g.add_param(name, type=type(first).__name__)
+        else:
+            g.add_param(name, first)
+    g.add("n", node, **inputs)
+    steps = itertools.count(1)
+
+    def call() -> Any:
+        k = next(steps)
+        return g.evaluate("n", **{name: make(k) for name, make in params.items()})
+
+    return call
 
 
 @dataclass
@@ -88,7 +89,7 @@ class Row:
     stat: Stat | None = None
     ratio: Stat | None = None
     unit: str = "s"  # "s" or "bytes" (memory rows)
-    role: str = ""  # "api", "kernel", "reference" (compare rows); "" for older rows
+    role: str = ""  # "api", "kernel", "reference" (compare rows); "" for rows added
 
 
 @dataclass
@@ -108,14 +109,17 @@ class Table:
         clock: str | None = None,
         note: str = "",
         notes: dict[str, str] | None = None,
+        warmup: bool = True,
     ) -> dict[str, Stat]:
         """Time ``api`` (ours as a user calls it), ``kernel`` (ours without the graph) and
         each reference in ``rounds`` interleaved rounds whose order turns by one each round.
 
         Each implementation is called once to warm up (imports, caches a user would also have
         warm, JIT compilation); the number of calls per timing is fixed from that call so a
-        timing lasts about ``min_seconds``. A reference that fails to import is noted as not
-        installed, never silently dropped. Returns the per-implementation :class:`Stat`.
+        timing lasts about ``min_seconds``. ``warmup=False`` skips that call (a reference of
+        a minute: one call a round, its imports in its first). A reference that fails to
+        import is noted as not installed, never silently dropped. Returns the
+        per-implementation :class:`Stat`.
         """
         now = _CLOCKS[clock] if clock else _now
         impls: list[tuple[str, str, Callable[[], object]]] = [("formgraph", "api", api)]
@@ -126,6 +130,9 @@ class Table:
             impls.append((name, "reference", fn))
         numbers: dict[str, int] = {}
         for name, _, fn in list(impls):
+            if not warmup:
+                numbers[name] = 1
+                continue
             try:
                 t0 = now()
                 fn()
@@ -139,12 +146,20 @@ class Table:
         for r in range(rounds):
             k = r % len(impls)
             for name, _, fn in impls[k:] + impls[:k]:
+                if name in missing:
+                    continue
                 gc.collect()
                 n = numbers[name]
                 t0 = now()
-                for _ in range(n):
-                    fn()
+                try:
+                    for _ in range(n):
+                        fn()
+                except ImportError as exc:  # (not warmed up: found missing here)
+                    missing[name] = f"not installed ({exc.name})"
+                    continue
                 times[name].append((now() - t0) / n)
+        impls = [i for i in impls if i[0] not in missing]
+        times = {name: t for name, t in times.items() if name not in missing}
         stats = {name: Stat(v) for name, v in times.items()}
         ours = times["formgraph"]
         notes = notes or {}
@@ -212,43 +227,18 @@ class Table:
                 )
         return peaks
 
-    # -- older best-of rows (kept until every module uses compare) ---------------------------
-    def time(
+    # -- rows measured elsewhere (the studio's page clock) ----------------------------------
+    def add(
         self,
         case: str,
         impl: str,
-        fn: Callable[[], object],
-        *,
-        repeat: int = 5,
+        values: list[float] | None,
         note: str = "",
-        number: int | None = None,
-    ) -> float | None:
-        """Time ``fn`` (best of rounds) and record it; a reference that fails is noted."""
-        try:
-            seconds = best_time(fn, repeat=repeat, number=number)
-        except ImportError as exc:
-            self.rows.append(Row(case, impl, None, f"not installed ({exc.name})"))
-            return None
-        self.rows.append(Row(case, impl, seconds, note))
-        return seconds
-
-    def time_together(
-        self,
-        case: str,
-        impls: list[tuple[str, Callable[[], object], str]],
-        *,
-        rounds: int = 7,
     ) -> None:
-        """Several implementations of one case in alternating rounds, best of each."""
-        best = {impl: float("inf") for impl, _, _ in impls}
-        for _ in range(rounds):
-            for impl, fn, _ in impls:
-                best[impl] = min(best[impl], best_time(fn, repeat=1))
-        for impl, _, note in impls:
-            self.rows.append(Row(case, impl, best[impl], note))
-
-    def add(self, case: str, impl: str, seconds: float | None, note: str = "") -> None:
-        self.rows.append(Row(case, impl, seconds, note))
+        """A row measured by the module itself (e.g. in a browser): its values' median and
+        range; None when it could not be measured (the note says why)."""
+        stat = Stat(list(values)) if values else None
+        self.rows.append(Row(case, impl, stat.median if stat else None, note, stat=stat))
 
     # -- output ------------------------------------------------------------------------------
     def _cases(self) -> dict[str, list[Row]]:
@@ -264,11 +254,8 @@ class Table:
             "-" * 140,
         ]
         for case, rows in self._cases().items():
-            ours = next((r.seconds for r in rows if r.impl == "formgraph"), None)
             for r in rows:
-                lines.append(
-                    f"{case:<52} {r.impl:<24} {_value(r):>30} {_ratio(r, ours):>22}  {r.note}"
-                )
+                lines.append(f"{case:<52} {r.impl:<24} {_value(r):>30} {_ratio(r):>22}  {r.note}")
         return "\n".join(lines)
 
     def markdown(self) -> str:
@@ -280,10 +267,9 @@ class Table:
             "|---|---|---|---|---|",
         ]
         for case, rows in self._cases().items():
-            ours = next((r.seconds for r in rows if r.impl == "formgraph"), None)
             for i, r in enumerate(rows):
                 label = case if i == 0 else ""
-                lines.append(f"| {label} | {r.impl} | {_value(r)} | {_ratio(r, ours)} | {r.note} |")
+                lines.append(f"| {label} | {r.impl} | {_value(r)} | {_ratio(r)} | {r.note} |")
         return "\n".join(lines)
 
 
@@ -296,16 +282,14 @@ def _value(r: Row) -> str:
     return f"{fmt(r.stat.median)} [{fmt(r.stat.low)}-{fmt(r.stat.high)}]"
 
 
-def _ratio(r: Row, ours: float | None) -> str:
+def _ratio(r: Row) -> str:
     """Ours divided by theirs: below 1 we are faster (or smaller)."""
     if r.ratio is not None:
         s = r.ratio
         if len(s.values) < 2:
             return f"{s.median:.2f}"
         return f"{s.median:.2f} [{s.low:.2f}-{s.high:.2f}]"
-    if r.role or r.impl == "formgraph" or not ours or r.seconds is None:
-        return ""
-    return f"{ours / r.seconds:.2f}"  # older best-of rows: ours / theirs
+    return ""
 
 
 def _fmt(seconds: float) -> str:

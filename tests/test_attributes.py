@@ -526,3 +526,19 @@ def test_onto_finds_the_closest_triangle_exactly():
     assert np.all(
         np.linalg.norm(p - q, axis=1) <= trimesh.proximity.closest_point(tm, p)[1] + 1e-12
     )
+
+
+def test_a_rule_is_made_only_when_there_are_attributes_to_carry(monkeypatch):
+    from formgraph.kernels.attributes import propagate
+
+    soup = fg.Mesh([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]],
+                   [[0, 1, 2], [3, 5, 4]])  # fmt: skip
+    g = fg.Graph()
+    g.add_param("m", type="Mesh")
+    g.add("w", "mesh.weld", mesh="=m", tolerance=0)
+    calls = []
+    real = propagate.by_position
+    monkeypatch.setattr(propagate, "by_position", lambda *a: calls.append(1) or real(*a))
+    assert g.evaluate("w", m=soup).n_vertices == 4 and calls == []  # nothing to carry
+    h = g.evaluate("w", m=soup.with_data({"h": [0, 1, 2, 1, 2, 3.0]}))
+    assert calls == [1] and h.point_data["h"].tolist() == [0, 1, 2, 3]

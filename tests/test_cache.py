@@ -15,7 +15,14 @@ from hypothesis import strategies as st
 from stubs import CALLS
 
 import formgraph as fg
-from formgraph.evaluation.cache import DiskCache, MemoryCache, canonical, key_of, key_text
+from formgraph.evaluation.cache import (
+    DiskCache,
+    MemoryCache,
+    canonical,
+    digest,
+    key_of,
+    key_text,
+)
 
 
 def graph(cache_dir: Path) -> fg.Graph:
@@ -178,3 +185,43 @@ def test_a_node_key_is_pinned():
     parts["inputs"]["points"]["output"] = None
     parts["inputs"]["k"] = 0.5
     assert key_of(parts) == "d2f95f5a5424d0b22be338ac64470fb0af31448e"
+
+
+def test_a_long_literal_is_keyed_once_and_by_its_content():
+    from formgraph.evaluation.cache import KEYED_INLINE, Keyed
+
+    pts = [[float(i), i * 0.5, 0.0] for i in range(500)]
+    short, long_ = Keyed([1.5, 2.0]), Keyed(pts)
+    assert short.text == key_text([1.5, 2.0])  # short: its own text, unchanged keys
+    assert len(key_text(pts)) > KEYED_INLINE and long_.text.startswith('{"keyed":')
+    assert Keyed(json.loads(json.dumps(pts))).text == long_.text  # content, not identity
+    assert Keyed(pts[:-1] + [[499.0, 249.5, 1e-300]]).text != long_.text
+    assert json.dumps(canonical({"p": long_}), sort_keys=True, separators=(",", ":")) == (
+        key_text({"p": long_})
+    )
+
+    g = fg.Graph()
+    g.add("p", "points.list", points=pts)
+    first = g.evaluate("p")
+    g.node_inputs("p")["points"][0][0] = 99.0  # a copy: the graph's literal is untouched
+    assert g.evaluate("p") is first and g.stats["p"].status == "cached"
+    changed = [list(row) for row in pts]
+    changed[0][0] = 99.0
+    g.set_input("p", "points", changed)  # through the graph: a new literal, a new key
+    assert g.evaluate("p").xyz[0, 0] == 99.0 and g.stats["p"].status == "computed"
+
+
+def test_a_geometry_value_is_hashed_once(monkeypatch):
+    m = fg.Mesh([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 2]])
+    calls = []
+    real = fg.Mesh.fingerprint
+    monkeypatch.setattr(fg.Mesh, "fingerprint", lambda self: calls.append(1) or real(self))
+    g = fg.Graph()
+    g.add_param("m", type="Mesh")
+    g.add("t", "mesh.transform", mesh="=m", translate=[1, 0, 0])
+    g.evaluate("t", m=m)
+    g.evaluate("t", m=m)
+    assert digest(m) == key_of({"type": "Mesh", "state": real(m)})
+    assert len(calls) == 1  # kept with the value (immutable), whatever asks for it
+    other = fg.Mesh(m.vertices + 1, m.face_indices, m.face_offsets)
+    assert digest(other) != digest(m)

@@ -403,6 +403,32 @@ def test_step_rational_curve_stays_a_circle_in_opencascade(tmp_path):
         np.testing.assert_allclose([p.X(), p.Y(), p.Z()], c.evaluate([t])[0], atol=1e-12)
 
 
+def test_3mf_is_deflated_as_it_is_formatted(tmp_path):
+    # the model's text (about 33 MB here) never exists whole: the writer holds its
+    # compressed bytes and one block of rows' formatting; and it reads back the same
+    import tracemalloc
+    import zipfile
+
+    from formgraph.kernels.io.threemf import write_3mf
+
+    rng = np.random.default_rng(3)
+    v = rng.random((200_000, 3)) * 100
+    t = rng.integers(0, len(v), (400_000, 3))
+    write_3mf([(v[:10], t[:5] % 10)])  # imports out of the count
+    tracemalloc.start()
+    try:
+        data = write_3mf([(v, t)])
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    model = zipfile.ZipFile(io.BytesIO(data)).read("3D/3dmodel.model")
+    assert peak < len(model)  # (whole, the text alone would be more than the peak)
+    assert model.count(b"<triangle ") == len(t) and model.count(b"<vertex ") == len(v)
+    assert model.endswith(b"</build>\n</model>\n")
+    tail = model[model.rindex(b"<triangle ") :].split(b'"')
+    assert [int(tail[k]) for k in (1, 3, 5)] == t[-1].tolist()
+
+
 def test_3mf_writes_a_base_material_only_for_a_mesh_without_vertex_colours(tmp_path):
     """#33 item 19: the ``colors`` entry of a vertex-coloured mesh was written as a base
     material nothing referenced."""

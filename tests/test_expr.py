@@ -102,3 +102,15 @@ def test_arithmetic_matches_numpy(a, b):
     f = compile_expression("a * b - a / (abs(b) + 1) + max(a, b)")
     expected = a * b - a / (abs(b) + 1) + max(a, b)
     assert f(a=a, b=b) == pytest.approx(expected, rel=1e-12, abs=1e-9)
+
+
+def test_a_compiled_expression_is_kept_and_its_names_still_checked():
+    # the same text compiled again is the kept (immutable) object; the allowed names are
+    # part of what is kept, so a name refused under one set is refused every time
+    a = compile_expression("radius * cos(t)")
+    assert compile_expression("radius * cos(t)") is a
+    assert a(radius=2.0, t=0.0) == 2.0
+    assert compile_expression("radius * cos(t)", {"radius", "t"}).names == a.names
+    for _ in range(2):
+        with pytest.raises(ExpressionError, match="radius"):
+            compile_expression("radius * cos(t)", {"t"})

@@ -116,3 +116,17 @@ def test_attribute_map_take_and_with():
     assert isinstance(w, AttributeMap) and w != m
     assert "v: (2,)" in repr(m)
     assert m.nbytes == 9 * 8
+
+
+def test_with_data_shares_the_arrays_and_still_checks_the_attributes():
+    m = Mesh([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], [[0, 1, 2], [0, 1, 3]])
+    h = m.with_data({"h": [1.0, 2.0, 3.0, 4.0]}, {"id": [0.0, 1.0]})
+    assert h.vertices is m.vertices and h.face_indices is m.face_indices
+    assert h.face_offsets is m.face_offsets and h == Mesh(*m.arrays, h.point_data, h.face_data)
+    with pytest.raises(ValueError, match="'h' is not finite at element 2"):
+        m.with_data({"h": [1.0, 2.0, np.nan, 4.0]})
+    p = Points([[0, 0, 0], [1, 1, 1]])
+    q = p.with_point_data({"w": [5.0, 6.0]})
+    assert q.xyz is p.xyz and q.point_data["w"].tolist() == [5.0, 6.0]
+    with pytest.raises(ValueError, match="has shape"):
+        p.with_point_data({"w": [5.0]})

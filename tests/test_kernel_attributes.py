@@ -224,6 +224,18 @@ def test_noise_nan_and_broadcast():
     assert np.isfinite(out[0]) and np.isnan(out[1:]).all()
 
 
+def test_noise_reads_strided_columns_as_their_copies():
+    # the compiled loop reads a points array's columns where they are (no copy first)
+    pts = np.random.default_rng(3).uniform(-40, 40, (2000, 3))
+    cols = [np.ascontiguousarray(c) for c in pts.T]
+    assert not pts[:, 1].flags.c_contiguous
+    assert np.array_equal(noise(pts[:, 0], pts[:, 1], pts[:, 2]), noise(*cols))
+    assert np.array_equal(
+        noise(pts[::2, 0], 0.5, pts[::2, 2]), noise(cols[0][::2], 0.5, cols[2][::2])
+    )
+    assert np.array_equal(noise(pts[:, :2], 0.25, 0.5), noise(pts[:, :2].copy(), 0.25, 0.5))
+
+
 def test_rand_and_noise_are_the_same_in_another_process():
     code = (
         "import numpy as np, hashlib;"
@@ -262,3 +274,21 @@ def test_noise_says_it_is_perlins_reference_times_its_scale():
     assert "0.96 (:data:`SCALE`) times Perlin's improved noise" in " ".join(noise.__doc__.split())
     manual = " ".join((ROOT / "docs" / "attributes.md").read_text().split())
     assert "`noise(x, [y], [z])` is 0.96 times Ken Perlin's improved gradient noise" in manual
+
+
+def test_noise_far_from_the_origin_matches_the_reference():
+    # the lattice index is masked before it is looked up (np.take's "wrap" mode would walk
+    # a huge negative index back one table length at a time: hours for -1e15)
+    p = np.array([[-1e15 - 0.25, 3.5e14 + 0.5, -7.0e13 - 0.75], [2.0**52, -(2.0**51), 0.5]])
+    got = raw_noise(*p.T)
+    assert got.tolist() == [perlin_reference(*q) for q in p]
+
+
+def test_rand_over_a_million_keys_is_frozen_and_exact():
+    keys = np.arange(1 << 20, dtype=np.float64) * 0.5
+    r = rand(keys, 4.0)
+    from formgraph.geometry import is_frozen
+
+    assert is_frozen(r)  # made in its immutable buffer (kernels.buffers.fill_frozen)
+    pick = [0, 1, 12345, (1 << 20) - 1]
+    assert r[pick].tolist() == [rand_reference(keys[j], 4.0) for j in pick]

@@ -109,6 +109,25 @@ def test_mesh_triangulate_clips_a_large_concave_face():
     assert_tiles(xy, tris)
 
 
+def test_large_faces_alone_and_batched_are_triangulated_alike():
+    # up to 8 large faces of one size take the one-plane path, more the batched test:
+    # a convex face is a fan from its first corner either way, a concave one is clipped
+    k = 40
+    a = 2 * np.pi * np.arange(k) / k
+    convex = np.column_stack([np.cos(a), np.sin(a)])
+    concave = star(k)
+    tilt = np.array([[1.0, 0, 0], [0, 0.6, 0.8]])  # a plane in space
+    for loop in (convex, concave):
+        v = np.tile(loop @ tilt, (9, 1))
+        fi = np.arange(9 * k)
+        alone = meshops.triangulate(v[:k], fi[:k], np.array([0, k]))[1].reshape(-1, 3)
+        batched = meshops.triangulate(v, fi, np.arange(0, 9 * k + 1, k))[1].reshape(-1, 3)
+        assert np.array_equal(alone, batched[: k - 2])
+        assert_tiles(loop, alone)
+    fan = meshops.triangulate(convex @ tilt, np.arange(k), np.array([0, k]))[1].reshape(-1, 3)
+    assert (fan[:, 0] == 0).all() and np.array_equal(fan[:, 1], np.arange(1, k - 1))
+
+
 def test_bad_polygons_are_refused():
     with pytest.raises(ValueError, match="at least 3 corners"):
         triangulate_polygon(np.zeros((2, 2)))

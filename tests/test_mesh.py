@@ -48,6 +48,20 @@ def test_from_faces_mixed_sizes():
     assert m.vertices.shape == (7, 3) and m.halfedges.euler_characteristic == 1
 
 
+def test_a_faces_array_of_one_size_is_taken_whole():
+    # fg.Mesh(v, (n, k) int array): flat as it is, the same mesh as from its rows
+    v = np.random.default_rng(1).random((6, 3))
+    quads = np.array([[0, 1, 2, 3], [2, 3, 4, 5]], dtype=np.int32)
+    whole, rows = fg.Mesh(v, quads), fg.Mesh(v, [list(r) for r in quads])
+    assert whole.face_indices.tolist() == rows.face_indices.tolist() == quads.ravel().tolist()
+    assert whole.face_offsets.tolist() == rows.face_offsets.tolist() == [0, 4, 8]
+    assert fg.Mesh(v, np.zeros((0, 3), dtype=np.int64)).n_faces == 0
+    with pytest.raises(ValueError, match="face 1 refers to vertex 6, but there are 6"):
+        fg.Mesh(v, np.array([[0, 1, 2], [3, 4, 6]]))
+    with pytest.raises(ValueError, match="face 0 has 2 vertices"):
+        fg.Mesh(v, np.array([[0, 1], [2, 3]]))
+
+
 @pytest.mark.parametrize(
     "faces, message",
     [

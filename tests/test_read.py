@@ -127,6 +127,53 @@ def test_stl_binary_and_ascii_from_trimesh(tmp_path, ball):
     _same_triangles(_read(tmp_path, "a.stl"), ball, atol=1e-6)
 
 
+def test_binary_stl_is_its_float32_corners_in_order_a_soup_of_valid_faces(tmp_path, ball):
+    v, f = ball.vertices, ball.faces.ravel()
+    (tmp_path / "b.stl").write_bytes(stl_binary(v, f, np.arange(0, f.size + 1, 3)))
+    m = _read(tmp_path, "b.stl")
+    want = v[ball.faces].astype(np.float32).astype(np.float64).reshape(-1, 3)
+    assert np.array_equal(m.vertices, want)  # exactly the file's numbers, in facet order
+    assert m.face_indices.tolist() == list(range(3 * len(ball.faces)))
+    assert m.face_offsets.tolist() == list(range(0, 3 * len(ball.faces) + 1, 3))
+    assert m == fg.Mesh(m.vertices, m.face_indices, m.face_offsets)  # what validation makes
+
+
+@pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
+def test_a_binary_stl_with_a_coordinate_that_is_not_a_number_is_refused(tmp_path, bad):
+    v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], np.float64)
+    tris = np.array([[0, 1, 2], [0, 1, 3], [1, 2, 3]] * 3000)  # past a block of the cast
+    data = bytearray(stl_binary(v, tris.ravel(), np.arange(0, tris.size + 1, 3)))
+    facet = 7000
+    at = 84 + 50 * facet + 12 + 4 * 7  # the third corner's y
+    data[at : at + 4] = np.float32(bad).tobytes()
+    (tmp_path / "b.stl").write_bytes(bytes(data))
+    with pytest.raises(fg.NodeError, match=f"facet {facet} has a vertex coordinate"):
+        _read(tmp_path, "b.stl")
+
+
+def test_reading_a_binary_stl_holds_little_beyond_the_file_and_the_mesh(tmp_path):
+    import tracemalloc
+
+    rng = np.random.default_rng(0)
+    n = 100_000
+    v = rng.random((3 * n, 3))
+    (tmp_path / "b.stl").write_bytes(stl_binary(v, np.arange(3 * n), np.arange(0, 3 * n + 1, 3)))
+    path = _graph(tmp_path, "  m: {type: read.mesh, path: b.stl}\n")
+    fg.load(path).evaluate("m")  # imports and first-call allocations out of the count
+    file_bytes, vertices = 84 + 50 * n, 72 * n
+    faces = 8 * (3 * n) + 8 * (n + 1)
+    tracemalloc.start()
+    try:
+        m = fg.load(path).evaluate("m")
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert m.n_faces == n
+    # the bytes go once the vertices are cast (the faces come after): never all three
+    # at once, and nothing the size of the file or the vertices twice
+    assert peak < max(file_bytes + vertices, vertices + faces) + 2_000_000
+
+
 def test_stl_round_trips_with_our_exporters_and_welds_closed(tmp_path, ball):
     v, f = ball.vertices, ball.faces.ravel()
     fo = np.arange(0, f.size + 1, 3)

@@ -20,6 +20,7 @@ folder (the graph's folder unless the run names one): :func:`resolve_input`, the
 from __future__ import annotations
 
 import errno
+import io
 import os
 import re
 import stat
@@ -28,6 +29,7 @@ import time
 from collections.abc import Iterable
 from pathlib import Path, PurePosixPath, PureWindowsPath
 
+from ..kernels.buffers import filled_bytes
 from .errors import PathError
 
 MAX_PATH_CHARS = 1024
@@ -280,7 +282,10 @@ def read_regular(path: str | os.PathLike[str], *, max_bytes: int) -> bytes:
             raise OSError(errno.EINVAL, f"it is {kind}, not a regular file", str(path))
         if st.st_size > max_bytes:
             raise OSError(errno.EFBIG, f"it is larger than {_size(max_bytes)}", str(path))
-        chunks, total = [], 0
+        # the size fstat gave, read straight into the bytes returned (one buffer, no
+        # chunks joined: the file's size in memory, not twice it)
+        data = filled_bytes(st.st_size, lambda view: _read_into(fd, view))
+        chunks, total = [data], len(data)
         while total <= max_bytes:  # the file may grow while it is read
             chunk = os.read(fd, min(1 << 20, max_bytes + 1 - total))
             if not chunk:
@@ -289,9 +294,22 @@ def read_regular(path: str | os.PathLike[str], *, max_bytes: int) -> bytes:
             total += len(chunk)
         if total > max_bytes:
             raise OSError(errno.EFBIG, f"it is larger than {_size(max_bytes)}", str(path))
-        return b"".join(chunks)
+        return data if len(chunks) == 1 else b"".join(chunks)
     finally:
         os.close(fd)
+
+
+def _read_into(fd: int, view: memoryview) -> int:
+    """Fill ``view`` from ``fd`` (short reads continued); the bytes read (fewer at the
+    end of a file that shrank)."""
+    total = 0
+    with io.FileIO(fd, closefd=False) as f:
+        while total < len(view):
+            n = f.readinto(view[total:])
+            if not n:
+                break
+            total += n
+    return total
 
 
 def _size(n: int) -> str:

@@ -15,7 +15,6 @@ recently used entries go first when it is pruned.
 
 from __future__ import annotations
 
-import enum
 import hashlib
 import io
 import json
@@ -25,8 +24,6 @@ import re
 import stat
 import tempfile
 import time
-import uuid
-import weakref
 import zipfile
 from collections import OrderedDict
 from dataclasses import dataclass
@@ -36,119 +33,19 @@ from typing import Any
 import numpy as np
 
 from ..geometry import STORABLE, Geometry, from_state
+from .keys import (  # noqa: F401  (the keys' home before keys.py; imported from here too)
+    KEYED_INLINE,
+    Keyed,
+    _hash_bytes,
+    canonical,
+    digest,
+    key_of,
+    key_text,
+)
 
 FORMAT = 2  # 2: the checksum covers the description too (entry_checksum)
 MAX_INFLATE = 16  # ours are stored uncompressed (1x); anything far beyond is hostile
 MAX_META_DEPTH = 64  # ours nest a few levels per list of geometry
-
-
-def canonical(value: Any) -> Any:
-    """A JSON-able, order-stable form of a literal input (for cache keys)."""
-    t = type(value)  # exact types first: the common case, and no str-Enum mistaken for str
-    if t is str or t is int or t is bool or value is None:
-        return value
-    if t is float:
-        return {"f": value.hex()}
-    if t is dict:
-        return {str(k): canonical(v) for k, v in sorted(value.items())}
-    if t is list:
-        return [canonical(v) for v in value]
-    if isinstance(value, enum.Enum):
-        return {"enum": str(value.value)}
-    if isinstance(value, (bool, int, str)) or value is None:
-        return value
-    if isinstance(value, float):
-        return {"f": value.hex()}
-    if isinstance(value, np.generic):
-        return canonical(value.item())
-    if isinstance(value, np.ndarray):
-        return {"a": str(value.dtype), "s": list(value.shape), "h": _hash_bytes(value)}
-    if isinstance(value, (list, tuple)):
-        return [canonical(v) for v in value]
-    if isinstance(value, dict):
-        return {str(k): canonical(v) for k, v in sorted(value.items())}
-    if isinstance(value, Geometry):
-        h = digest(value)
-        return {"g": type(value).__name__, "h": h if h is not None else _token(value)}
-    raise TypeError(f"cannot make a cache key of {type(value).__name__}")
-
-
-_TOKENS: weakref.WeakKeyDictionary[Any, str] = weakref.WeakKeyDictionary()
-
-
-def _token(value: Any) -> str:
-    """A unique, never reused name for a value whose content cannot be hashed."""
-    if value not in _TOKENS:
-        _TOKENS[value] = "obj:" + uuid.uuid4().hex
-    return _TOKENS[value]
-
-
-def key_of(parts: Any) -> str:
-    """The cache key of ``parts``: a hash of the JSON text of ``canonical(parts)``."""
-    return hashlib.blake2b(key_text(parts).encode(), digest_size=20).hexdigest()
-
-
-def key_text(value: Any) -> str:
-    """``json.dumps(canonical(value), sort_keys=True, separators=(",", ":"))``, in one pass.
-
-    Every node's key is built from this text on every run, so the plain values that inputs
-    are made of (str, int, bool, None, float, lists and str-keyed dicts of them) are written
-    directly, the leaves of a container without a call of their own; anything else goes
-    through `canonical` and `json`. The text is the same either way, so keys do not change.
-    """
-    t = type(value)
-    if t is dict:
-        try:
-            keys = sorted(value)
-        except TypeError:  # mixed key types: canonical says so
-            return _JSON.encode(canonical(value))
-        out = []
-        for k in keys:
-            if type(k) is not str:
-                return _JSON.encode(canonical(value))
-            v = value[k]
-            tv = type(v)
-            if tv is str:
-                out.append(_quote(k) + ":" + _quote(v))
-            elif tv is float:
-                out.append(_quote(k) + ':{"f":"' + v.hex() + '"}')
-            else:
-                out.append(_quote(k) + ":" + key_text(v))
-        return "{" + ",".join(out) + "}"
-    if t is str:
-        return _quote(value)
-    if t is float:
-        return '{"f":"' + value.hex() + '"}'
-    if t is bool:
-        return "true" if value else "false"
-    if t is int:
-        return str(value)
-    if value is None:
-        return "null"
-    if t is list or t is tuple:
-        return "[" + ",".join([key_text(v) for v in value]) + "]"
-    return _JSON.encode(canonical(value))
-
-
-_quote = json.encoder.encode_basestring_ascii  # what json.dumps writes a str as
-_JSON = json.JSONEncoder(sort_keys=True, separators=(",", ":"))
-
-
-def _hash_bytes(a: np.ndarray) -> str:
-    h = hashlib.blake2b(digest_size=16)
-    h.update(str(a.dtype).encode() + str(a.shape).encode())
-    h.update(np.ascontiguousarray(a).view(np.uint8).reshape(-1))
-    return h.hexdigest()
-
-
-def digest(value: Any) -> str | None:
-    """A cheap content hash of a node output (for early cutoff); None when not hashable."""
-    try:
-        if isinstance(value, Geometry):
-            return key_of({"type": type(value).__name__, "state": value.fingerprint()})
-        return key_of(value)
-    except (TypeError, NotImplementedError):
-        return None
 
 
 def sizeof(value: Any) -> int:

@@ -351,8 +351,9 @@ class Graph(Plans):
         return {n: nd.type for n, nd in self._nodes.items()}
 
     def node_inputs(self, name: str) -> dict[str, Any]:
-        """The inputs of node ``name`` as authored."""
-        return dict(self._nodes[name].raw)
+        """The inputs of node ``name`` as authored (a copy: changing it changes nothing;
+        ``set_input`` does)."""
+        return plain(dict(self._nodes[name].raw))
 
     def set_input(self, node: str, port: str, value: Any) -> None:
         """Change one input of a node as authored (a literal, wire or expression)."""

@@ -38,7 +38,9 @@ class Replay:
         except (TypeError, ValueError):
             return None
         specs = tuple(self.registry.get(self.g._nodes[n].type) for n in order)
-        return values, self.out_dir, specs
+        # the output folder is in the keys of exports only (resolved only then)
+        exports = any(getattr(spec, "is_export", False) for spec in specs)
+        return values, self.out_dir if exports else None, specs
 
     def replay(self, targets: list[str]) -> list[str] | None:
         memo = self.g._replay.get(tuple(targets))

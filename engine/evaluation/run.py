@@ -11,7 +11,7 @@ are evaluated by the :class:`formgraph.evaluation.items.LanguageRun` mixin.
 from __future__ import annotations
 
 import contextlib
-import hashlib
+import functools
 import os
 import sys
 import time
@@ -42,7 +42,8 @@ from ..language.model import FRAMES, STEP, Expr, Input, Items, Literal, NodeDef,
 from ..language.subgraph import SubgraphSpec
 from . import cache as _cache
 from .cutoff import same_content
-from .items import LanguageRun, file_stamp, input_names, input_stamp, reads_loop
+from .items import LanguageRun, file_stamp, input_names, reads_loop
+from .keys import InputKeys
 from .replay import Replay
 from .simulation import SimulationRun
 from .stats import NodeStat, Step
@@ -73,7 +74,7 @@ class GraphView(Protocol):
     def _child(self, spec: SubgraphSpec) -> GraphView: ...
 
 
-class _Run(LanguageRun, SimulationRun, Replay):
+class _Run(LanguageRun, SimulationRun, Replay, InputKeys):
     """One evaluation call: memoized keys, identities and values, and the run record."""
 
     def __init__(
@@ -95,26 +96,36 @@ class _Run(LanguageRun, SimulationRun, Replay):
         self.inner: dict[str, dict[str, NodeStat]] = {}  # subgraph node -> its run's stats
         self.results: dict[str, Any] = {}
         self.stats: dict[str, NodeStat] = {}
-        memo = getattr(g, "_pure_root", None) if pure else None
-        if memo is not None and memo[0] == str(g.out_dir):
-            # A plan or a step keys with the folder's name only (a sweep plans every variant
-            # and runs every step through one: one look at the file system, not thousands);
-            # an export still checks where it writes.
-            self.out_path = memo[1]
-        else:
-            try:
-                self.out_path = safety.output_root(g.out_dir)
-            except PathError:  # only an export needs it: each says why, at its own line
-                self.out_path = Path(os.path.abspath(g.out_dir))
-            if pure:
-                g._pure_root = (str(g.out_dir), self.out_path)
-        self.out_dir = str(self.out_path)
         self.total = 0
         self.tally = RunTally(g.budget)  # what this run's nodes hold together
         self.started: set[str] = set()  # nodes that began computing, for the progress line
         self.quiet = False  # inside run(): numpy's warnings are silenced once, not per node
         # node -> input path -> (file, bytes): read once when keyed, handed to the node
         self.input_files: dict[str, dict[str, tuple[Path, bytes]]] = {}
+
+    @functools.cached_property
+    def out_path(self) -> Path:
+        """The output folder, resolved when a run first needs it (an export's key or a
+        node's context), not by every run (a slider's step of a graph without exports
+        never looks at the file system)."""
+        g = self.g
+        memo = getattr(g, "_pure_root", None) if self.pure else None
+        if memo is not None and memo[0] == str(g.out_dir):
+            # A plan or a step keys with the folder's name only (a sweep plans every variant
+            # and runs every step through one: one look at the file system, not thousands);
+            # an export still checks where it writes.
+            return memo[1]
+        try:
+            path = safety.output_root(g.out_dir)
+        except PathError:  # only an export needs it: each says why, at its own line
+            path = Path(os.path.abspath(g.out_dir))
+        if self.pure:
+            g._pure_root = (str(g.out_dir), path)
+        return path
+
+    @functools.cached_property
+    def out_dir(self) -> str:
+        return str(self.out_path)
 
     def where(self, name: str, port: str | None = None) -> Where:
         nd = self.g._nodes[name]
@@ -240,46 +251,12 @@ class _Run(LanguageRun, SimulationRun, Replay):
             return {"wired": part, "unkeyed": os.urandom(8).hex()}
         return self.input_file(name, port, part)
 
-    def input_file(self, name: str, port: str, relpath: Any) -> Any:
-        """The key part of an input file: its path and a hash of its bytes (kept for the
-        node, which parses exactly the bytes its key holds).
-
-        A file whose stamp (device, inode, size, modification and change times in ns) is
-        the one it had when last hashed is not read again: a sweep plans every variant's
-        keys, and watch every version's, without rereading a large scan each time.
-        """
-        if not isinstance(relpath, str):
-            return relpath  # the check or the node says what is wrong with it
-        self.keyed_files = True  # keys that hold file bytes: never replayed (_Run.remember)
-        here = self.where(name, port)
-        try:
-            path = safety.resolve_input(self.g.input_root, relpath, self.g.input_base)
-        except PathError as exc:
-            raise PathError([Problem(here, p.message) for p in exc.problems]) from None
-        stamp = input_stamp(path)
-        memo = self.g._input_digests.get(str(path))
-        if stamp is not None and memo is not None and memo[0] == stamp:
-            return {"path": relpath, "bytes": memo[1]}
-        try:
-            data = safety.read_input(path)
-        except PathError as exc:
-            raise PathError(
-                [Problem(here, f"cannot read input {relpath!r}: {p.message}") for p in exc.problems]
-            ) from None
-        self.input_files.setdefault(name, {})[relpath] = (path, data)
-        digest = hashlib.blake2b(data, digest_size=20).hexdigest()
-        if stamp is not None:  # taken before the read: a change during it shows next time
-            if len(self.g._input_digests) > 10_000:
-                self.g._input_digests.clear()
-            self.g._input_digests[str(path)] = (stamp, digest)
-        return {"path": relpath, "bytes": digest}
-
     def read_input(self, name: str, relpath: str) -> tuple[Path, bytes]:
         """What a node's ``ctx.read`` returns: the bytes keyed, else the file read now (a
         path that came down a wire)."""
-        held = self.input_files.get(name, {}).get(relpath)
-        if held is not None:
-            return held
+        held = self.input_files.get(name, {}).pop(relpath, None)
+        if held is not None:  # handed over: the node holds the only reference (it may let
+            return held  # go of a large file's bytes once parsed, before the run ends)
         path = safety.resolve_input(self.g.input_root, relpath, self.g.input_base)
         return path, safety.read_input(path)
 
@@ -316,6 +293,13 @@ class _Run(LanguageRun, SimulationRun, Replay):
                 "expr": value.text,
                 "params": {n: self.tokens.get(n, self.values[n]) for n in names},
             }
+        if isinstance(value, Literal) and type(value.value) in (list, dict):
+            # a literal list's key text, written once and kept with it (the same text)
+            kept = value.__dict__.get("_keyed")
+            if kept is None:
+                kept = _cache.Keyed(value.value)
+                object.__setattr__(value, "_keyed", kept)
+            return kept
         return self.resolve(name, port, value)
 
     def resolve(self, name: str, port: str, value: Input, env: dict[str, Any] | None = None) -> Any:
@@ -495,7 +479,9 @@ class _Run(LanguageRun, SimulationRun, Replay):
         if spec.wants_context:
             kwargs["ctx"] = Context(
                 name,
-                self.out_path,
+                # resolved for an export (its key holds it); any other node that writes
+                # resolves it then (ctx.write goes through safety.resolve_output)
+                self.out_path if spec.is_export else Path(self.g.out_dir),
                 self.g.budget,
                 warnings,
                 inputs=lambda relpath: self.read_input(name, relpath),

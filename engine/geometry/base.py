@@ -9,10 +9,13 @@ from typing import Any, TypeVar
 
 import numpy as np
 
+from ..kernels.buffers import fill_bytes
+
 __all__ = [
     "STORABLE",
     "AttributeMap",
     "Geometry",
+    "all_finite",
     "as_xyz",
     "attribute_map",
     "from_state",
@@ -42,16 +45,24 @@ def frozen_array(values: Any, dtype: Any = np.float64) -> np.ndarray:
     """
     if is_frozen(values) and values.dtype == dtype and values.flags.c_contiguous:
         return values
+    if isinstance(values, np.ndarray):  # a large array: cast straight into new bytes
+        buf = fill_bytes(values, dtype)
+        if buf is not None:
+            return np.frombuffer(buf, dtype=dtype).reshape(values.shape)
     a = np.asarray(values, dtype=dtype)
     return np.frombuffer(a.tobytes(order="C"), dtype=a.dtype).reshape(a.shape)
 
 
 def all_finite(a: np.ndarray) -> bool:
-    """Whether every number of a float array is finite, with no array of flags as large
-    as it: its least and greatest are (both are NaN when any is, and an infinity is one)."""
+    """Whether every value of float array ``a`` is finite, in one pass and no temporary when
+    they are: a sum is finite only if every term is (a NaN or an infinity makes it NaN or
+    infinite); only a sum that overflows, or a bad value, takes the exact test."""
     if a.size == 0:
         return True
-    return bool(np.isfinite(a.min()) and np.isfinite(a.max()))
+    with np.errstate(all="ignore"):
+        if np.isfinite(np.add.reduce(a, axis=None)):
+            return True
+    return bool(np.isfinite(a).all())
 
 
 def as_xyz(values: Any, what: str = "points") -> np.ndarray:
@@ -168,14 +179,19 @@ class AttributeMap(Mapping):
         index = np.asarray(index, dtype=np.int64)
         return AttributeMap({k: frozen_array(v[index]) for k, v in self._data.items()}, len(index))
 
-    def with_(self, name: str, values: Any) -> AttributeMap:
-        """This map with attribute ``name`` set to ``values`` (added or replaced)."""
+    def with_(self, name: str, values: Any, *, finite: bool = False) -> AttributeMap:
+        """This map with attribute ``name`` set to ``values`` (added or replaced).
+
+        ``finite=True``: the caller has checked every value finite already (a per-element
+        expression's result is: a second pass over a million values is not needed)."""
         data = dict(self._data)
-        data[name] = _attribute_array(name, values, self.n, "attribute")
+        data[name] = _attribute_array(name, values, self.n, "attribute", finite=finite)
         return AttributeMap(data, self.n)
 
 
-def _attribute_array(name: Any, values: Any, n: int, what: str) -> np.ndarray:
+def _attribute_array(
+    name: Any, values: Any, n: int, what: str, *, finite: bool = False
+) -> np.ndarray:
     if not isinstance(name, str) or not name.isidentifier() or name.startswith("_"):
         raise ValueError(
             f"{what} name {name!r} must be a name as in expressions: letters, digits and _, "
@@ -199,7 +215,7 @@ def _attribute_array(name: Any, values: Any, n: int, what: str) -> np.ndarray:
         raise ValueError(
             f"{what} {name!r} has {a.shape[1]} components; 1 to {MAX_ATTRIBUTE_COMPONENTS} allowed"
         )
-    if not np.all(np.isfinite(a)):
+    if not finite and not all_finite(a):
         bad = int(np.argwhere(~np.isfinite(a.reshape(n, -1)))[0, 0])
         raise ValueError(f"{what} {name!r} is not finite at element {bad}")
     return frozen_array(a)

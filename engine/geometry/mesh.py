@@ -50,7 +50,17 @@ class Mesh(Geometry):
         face_data: Any = None,
     ):
         v = as_xyz(vertices, "vertices")
-        if face_offsets is None:  # a list of faces
+        if (
+            face_offsets is None
+            and isinstance(face_indices, np.ndarray)
+            and face_indices.ndim == 2
+            and face_indices.dtype.kind in "iu"
+            and face_indices.shape[1] >= 3
+        ):  # (n_faces, k) faces of one size: flat as they are (no Python loop per face)
+            fi = face_indices.astype(np.int64, copy=False).ravel()
+            k = face_indices.shape[1]
+            fo = np.arange(0, k * len(face_indices) + 1, k, dtype=np.int64)
+        elif face_offsets is None:  # a list of faces
             faces = [np.asarray(f, dtype=np.int64).ravel() for f in face_indices]
             sizes = np.array([len(f) for f in faces], dtype=np.int64)
             fi = np.concatenate(faces) if faces else np.zeros(0, np.int64)
@@ -58,12 +68,13 @@ class Mesh(Geometry):
         else:
             fi = _indices(face_indices, "face_indices")
             fo = _indices(face_offsets, "face_offsets")
-        if fo.size == 0 or fo[0] != 0 or fo[-1] != fi.size or np.any(np.diff(fo) < 0):
+        sizes = np.diff(fo)
+        least = sizes.min() if sizes.size else 3
+        if fo.size == 0 or fo[0] != 0 or fo[-1] != fi.size or least < 0:
             raise ValueError(
                 "face_offsets must start at 0, never decrease and end at len(face_indices)"
             )
-        sizes = np.diff(fo)
-        if sizes.size and sizes.min() < 3:
+        if least < 3:
             bad = int(np.argmax(sizes < 3))
             raise ValueError(f"face {bad} has {int(sizes[bad])} vertices; a face needs at least 3")
         if fi.size and (fi.min() < 0 or fi.max() >= len(v)):
@@ -210,8 +221,9 @@ class Mesh(Geometry):
         return self._content_hash()
 
     def with_data(self, point_data: Any = None, face_data: Any = None) -> Mesh:
-        """The same mesh with other attributes (None: none); the arrays are shared."""
-        return Mesh(*self.arrays, point_data=point_data, face_data=face_data)
+        """The same mesh with other attributes (None: none); the arrays are shared, and not
+        checked again (they are this mesh's own)."""
+        return Mesh.trusted(*self.arrays, point_data=point_data, face_data=face_data)
 
     def to_pyvista(self) -> Any:
         import pyvista as pv

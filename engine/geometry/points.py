@@ -63,8 +63,13 @@ class Points(Geometry):
         return self.xyz.nbytes + self.point_data.nbytes
 
     def with_point_data(self, point_data: Any) -> Points:
-        """The same points with other attributes (the coordinates shared, not copied)."""
-        return Points(self.xyz, point_data)
+        """The same points with other attributes (the coordinates shared, not copied, and
+        not checked again: they are this value's own)."""
+        out = type(self).__new__(type(self))
+        object.__setattr__(out, "xyz", self.xyz)
+        data = attribute_map(point_data, len(self.xyz), "point attribute")
+        object.__setattr__(out, "point_data", data)
+        return out
 
     def to_pyvista(self) -> Any:
         import pyvista as pv

@@ -18,10 +18,12 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
 
+from ..geometry.base import all_finite, frozen_array
 from .bound import Bound
 from .model import Expr, Input, Items, Literal
 
@@ -147,7 +149,7 @@ class ElementValue:
         out = np.stack(cols, axis=1) if self.vector else cols[0]
         if out.ndim > 2:
             raise ValueError(f"{self.text} gives an array of shape {out.shape}")
-        if not np.all(np.isfinite(out)):
+        if not all_finite(out):
             bad = int(np.argwhere(~np.isfinite(out.reshape(count, -1)))[0, 0])
             raise ValueError(f"{self.text} is not finite at element {bad}")
         return out
@@ -201,13 +203,20 @@ def element_env(
             "x": xyz[:, 0],
             "y": xyz[:, 1],
             "z": xyz[:, 2],
-            "i": np.arange(n, dtype=np.float64),
+            "i": _indices(n),
             "count": float(n),
         }
     )
     if normals is not None and np.shape(normals) == (n, 3):
         env.update(nx=normals[:, 0], ny=normals[:, 1], nz=normals[:, 2])
     return env
+
+
+@lru_cache(maxsize=2)
+def _indices(n: int) -> np.ndarray:
+    """``i`` for ``n`` elements, 0.0 .. n - 1 (frozen: shared by every evaluation of a
+    slider's steps over the same elements, not made anew each time)."""
+    return frozen_array(np.arange(n, dtype=np.float64))
 
 
 def _face_centres(mesh: Any) -> np.ndarray:

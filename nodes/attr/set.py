@@ -79,7 +79,8 @@ def set_attribute(
         count = len(geometry)
     ctx.guard(count, "elements")
     what = "faces" if domain is Domain.face else "points"
-    if isinstance(value, ElementValue):
+    checked = isinstance(value, ElementValue)  # its evaluate refuses a value not finite
+    if checked:
         env = element_env(geometry, domain.value, value.names)
         try:
             values: Any = value.evaluate(env, count, what)
@@ -89,9 +90,9 @@ def set_attribute(
         v = np.asarray(value, dtype=np.float64)
         values = np.broadcast_to(v, (count,) + v.shape)
     if domain is Domain.face:
-        data = geometry.face_data.with_(name, values)
+        data = geometry.face_data.with_(name, values, finite=checked)
         return geometry.with_data(geometry.point_data, data)
-    data = geometry.point_data.with_(name, values)
+    data = geometry.point_data.with_(name, values, finite=checked)
     if isinstance(geometry, Mesh):
         return geometry.with_data(data, geometry.face_data)
     return geometry.with_point_data(data)

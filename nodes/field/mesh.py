@@ -12,6 +12,7 @@ import numpy as np
 from formgraph.core.errors import InputError
 from formgraph.core.registry import Context, Range, node
 from formgraph.geometry import Field, Mesh
+from formgraph.geometry.base import as_xyz
 from formgraph.kernels.field import mesher, planar
 from formgraph.nodes.field import _blend
 from formgraph.nodes.field._common import bounds_box
@@ -167,10 +168,14 @@ def mesh_of(
             raise InputError(port, f"no surface was found, but {contradicted}")
         ctx.warn("the field has no surface inside its bounds: the mesh is empty")
         return Mesh(np.zeros((0, 3)), np.zeros(0, np.int64), np.zeros(1, np.int64))
+    try:  # the mesher's triangles index its own vertices: only the positions are checked
+        v = as_xyz(v, "vertices")
+    except ValueError as exc:
+        raise InputError(port, f"the field gives a surface that is not finite: {exc}") from None
     if contradicted is not None:
         ctx.warn(f"parts of the surface may be missing: {contradicted}")
     _warn_moved_faces(field, v, cell, ctx)
-    return Mesh(v, t.reshape(-1), np.arange(0, 3 * len(t) + 1, 3))
+    return Mesh.trusted(v, t.reshape(-1), np.arange(0, 3 * len(t) + 1, 3))
 
 
 def _face_words(normal: np.ndarray, offset: float) -> str:

@@ -45,15 +45,20 @@ def weld(
     except ValueError as exc:
         raise InputError("tolerance", str(exc)) from None
     dropped = mesh.n_faces - (fo.size - 1)
-    # each group keeps its first vertex's position, and so its attributes
-    points = carry.copy(carry.by_position(mesh.vertices, v))
+
+    # each group keeps its first vertex's position, and so its attributes (found only
+    # when there are attributes to carry: a sort of every vertex)
+    def points() -> carry.Carry:
+        return carry.copy(carry.by_position(mesh.vertices, v))
+
     faces = carry.SAME
     if dropped:
         ctx.warn(f"{dropped} faces collapsed and were dropped")
         if mesh.face_data:
             faces = carry.DROP
             ctx.warn("with faces dropped, the face attributes were dropped too")
-    return Mesh(v, fi, fo, **carry.carried(mesh, points, faces))
+    # merged vertices, the surviving faces renumbered: valid by construction
+    return Mesh.trusted(v, fi, fo, **carry.carried(mesh, points, faces))
 
 
 @node("mesh.orient", version=1)

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import struct
 import zlib
+from pathlib import PurePath
 from typing import NamedTuple
 
 import numpy as np
@@ -20,7 +21,7 @@ from formgraph.core.errors import InputError
 from formgraph.core.registry import Context, node
 from formgraph.core.types import InputPath
 from formgraph.geometry import Curve, Mesh, NurbsCurve, NurbsSurface, Points, Surface
-from formgraph.kernels.io import readers, rhino
+from formgraph.kernels.io import mesh_read, readers, rhino
 from formgraph.kernels.mesh import repair
 
 # what a parser may raise on a malformed file (its sentence is kept, the traceback dropped)
@@ -77,7 +78,17 @@ def mesh(path: InputPath, weld: bool = False, *, ctx: Context) -> Mesh:
     ``part: {type: read.mesh, path: scan.stl, weld: true}``
     """
     _, data = ctx.read(path)
-    v, fi, fo, attributes = parsed(path, "a mesh", readers.mesh_data, path, data, ctx.budget)
+    soup = None
+    if PurePath(path).suffix.lower() == ".stl":
+        soup = parsed(path, "a mesh", mesh_read.stl_binary_vertices, data)
+    if soup is None:
+        v, fi, fo, attributes = parsed(path, "a mesh", readers.mesh_data, path, data, ctx.budget)
+    else:  # a binary STL: its vertices made (and checked finite), its bytes are let go
+        del data  # before its faces are made (the peak holds two of the three, not all)
+        v = soup
+        ctx.guard(len(v) // 3, "faces")
+        fi, fo = mesh_read.soup_faces(len(v) // 3)
+        attributes = {}
     ctx.guard(len(fo) - 1, "faces")
     if len(fo) < 2:  # an STL of 'solid x / endsolid x' alone, an OBJ of vertices only
         ctx.warn(f"{path}: it holds no faces (an STL: no facets), so the mesh is empty")
@@ -86,6 +97,8 @@ def mesh(path: InputPath, weld: bool = False, *, ctx: Context) -> Mesh:
             ctx.warn(f"{path}: welding drops the vertex attributes ({', '.join(attributes)})")
         attributes = {}
         v, fi, fo = repair.weld(v, fi, fo, 0.0)
+    elif soup is not None:  # three new vertices a facet: valid faces by construction
+        return Mesh.trusted(v, fi, fo)
     try:
         return Mesh(v, fi, fo, point_data=attributes or None)
     except ValueError as exc:

@@ -23,7 +23,7 @@ maps it by the inverse transpose of the linear part and renormalizes it.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -133,7 +133,13 @@ def barycentric(corners: Any, vw: Any) -> Carry:
     )
 
 
-def _apply_all(data: Mapping[str, np.ndarray], rule: Carry) -> dict[str, np.ndarray]:
+def _apply_all(
+    data: Mapping[str, np.ndarray], rule: Carry | Callable[[], Carry]
+) -> dict[str, np.ndarray]:
+    if not data:
+        return {}  # nothing to carry: the rule is not even made
+    if not isinstance(rule, Carry):
+        rule = rule()
     out = {}
     for name, a in data.items():
         b = rule.apply(a)
@@ -142,9 +148,18 @@ def _apply_all(data: Mapping[str, np.ndarray], rule: Carry) -> dict[str, np.ndar
     return out
 
 
-def carried(source: Any, point: Carry = SAME, face: Carry = DROP) -> dict[str, Any]:
+def carried(
+    source: Any,
+    point: Carry | Callable[[], Carry] = SAME,
+    face: Carry | Callable[[], Carry] = DROP,
+) -> dict[str, Any]:
     """Keyword arguments ``point_data`` (and ``face_data`` for a mesh) for the output of an
-    operation on ``source`` (a Points or a Mesh), by the two rules."""
+    operation on ``source`` (a Points or a Mesh), by the two rules.
+
+    A rule that costs work to find (weld's provenance by position: a sort of every vertex)
+    may be given as a function making it: it is called only when ``source`` has attributes
+    of that kind to carry.
+    """
     out = {"point_data": _apply_all(source.point_data, point)}
     if hasattr(source, "face_data"):
         out["face_data"] = _apply_all(source.face_data, face)

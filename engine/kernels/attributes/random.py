@@ -11,10 +11,10 @@ The hash is SplitMix64's output function (Steele, Lea and Flood 2014; its finali
 bits plus the golden-ratio gamma are mixed into a 64-bit stream constant, once per seed;
 each key's bits XOR that constant are mixed once more, and the top 52 bits of the result
 are the mantissa of a float in [1, 2), from which 1 is taken (exact). One 64-bit lane per
-key, eight in-place numpy passes for the mixer and five around it, in chunks that stay in
-L2. (The first version ran two 32-bit ``lowbias32`` chains per key: twice the passes over
-the same bytes; a 53-bit float would need numpy's int-to-float cast, slower than the three
-passes of the mantissa trick.)
+key, hashed in a compiled loop (:mod:`.random_jit`, numba: thirteen numpy passes over the
+keys took about twice its time). (The first version ran two 32-bit ``lowbias32`` chains per key:
+twice the work; a 53-bit float would need an int-to-float conversion, slower than the
+mantissa trick.)
 
 ``VERSION`` names the hash: it is part of every cache key (a change of the values must bump
 it, so no cached result made with the old numbers is reused).
@@ -26,6 +26,8 @@ from typing import Any
 
 import numpy as np
 
+from ..buffers import fill_frozen
+
 __all__ = ["VERSION", "mix64", "rand"]
 
 VERSION = 2  # 1: two lowbias32 chains; 2: SplitMix64's Mix13 (both 52 bits)
@@ -36,7 +38,6 @@ _M2 = _U(0x94D049BB133111EB)
 _S30, _S27, _S31, _S12 = _U(30), _U(27), _U(31), _U(12)
 _GAMMA = _U(0x9E3779B97F4A7C15)  # SplitMix64's increment: 2**64 / the golden ratio
 _ONE = _U(0x3FF0000000000000)  # the bits of 1.0
-_CHUNK = 1 << 14  # keys per round: its 128 KiB buffers and output stay in L2
 
 
 def _mix(x: np.ndarray, t: np.ndarray) -> None:
@@ -87,6 +88,7 @@ def rand(key: Any, seed: Any = 0.0) -> np.ndarray:
     -------
     ndarray of float64, the broadcast shape of ``key`` and ``seed``
         52 random bits each (multiples of 2**-52); NaN where the key or the seed is NaN.
+        Read-only (frozen, as an attribute keeps it).
 
     Example
     -------
@@ -103,27 +105,18 @@ def rand(key: Any, seed: Any = 0.0) -> np.ndarray:
     else:
         k, s = (a.reshape(-1) for a in np.broadcast_arrays(k, s))
         shape = np.broadcast_shapes(np.shape(key), np.shape(seed))
-    n = k.size
-    out = np.empty(n, "<f8")
-    if n == 0:
-        return out.reshape(shape)
+    if k.size == 0:
+        return np.empty(shape, "<f8")
     stream = _stream(s)
-    per_element = stream.size > 1
-    size = min(_CHUNK, n)
-    key_bits = np.empty(size, "<f8")
-    x = key_bits.view("<u8")  # the key's bits, mixed in place
-    t = np.empty(size, _U)
-    for start in range(0, n, size):
-        stop = min(start + size, n)
-        m = stop - start
-        if m < size:
-            key_bits, x, t = key_bits[:m], x[:m], t[:m]
-        np.add(k[start:stop], 0.0, out=key_bits)  # -0 -> +0
-        np.bitwise_xor(x, stream[start:stop] if per_element else stream[0], out=x)
-        _mix(x, t)
-        np.right_shift(x, _S12, out=x)  # the top 52 bits, as the mantissa of [1, 2)
-        np.bitwise_or(x, _ONE, out=x)
-        np.subtract(key_bits, 1.0, out=out[start:stop])
+    # made straight into a frozen buffer: an attribute's values are kept as they are
+    return fill_frozen(k.size, "<f8", lambda out: _fill(out, k, s, stream)).reshape(shape)
+
+
+def _fill(out: np.ndarray, k: np.ndarray, s: np.ndarray, stream: np.ndarray) -> None:
+    """``out[j] = rand(k[j], s[j])`` (``s`` and ``stream``: one seed, or one per key)."""
+    from .random_jit import fill  # numba, imported when rand is first asked for
+
+    fill(np.ascontiguousarray(k).view("<u8"), stream, out.view("<u8"))
+    out -= 1.0  # exact: [1, 2) -> [0, 1)
     if np.isnan(k.min()) or np.isnan(s.min()):  # min propagates NaN: one cheap pass
         out[np.isnan(k) | np.isnan(s)] = np.nan
-    return out.reshape(shape)

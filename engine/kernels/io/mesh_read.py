@@ -14,9 +14,17 @@ import re
 
 import numpy as np
 
+from ..buffers import fill_frozen
 from .textscan import Lines, TokenError, ints_at, line_numbers, parse_floats, token_starts
 
-__all__ = ["read_obj", "read_off", "read_stl", "triangles_flat"]
+__all__ = [
+    "read_obj",
+    "read_off",
+    "read_stl",
+    "soup_faces",
+    "stl_binary_vertices",
+    "triangles_flat",
+]
 
 _SPACE = np.zeros(256, dtype=bool)
 _SPACE[[9, 10, 11, 12, 13, 32]] = True
@@ -45,12 +53,10 @@ def read_stl(data: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         ASCII file whose numbers do not come in facets of three vertices.
     """
     size = len(data)
-    if size >= 84:
-        count = int.from_bytes(data[80:84], "little")
-        if 84 + 50 * count == size:
-            rec = np.frombuffer(data, dtype=_STL_RECORD, count=count, offset=84)
-            v = rec["v"].reshape(-1, 3).astype(np.float64)
-            return triangles_flat(v, np.arange(3 * count).reshape(-1, 3))
+    vertices = stl_binary_vertices(data)
+    if vertices is not None:
+        return (vertices, *soup_faces(len(vertices) // 3))
+    count = int.from_bytes(data[80:84], "little") if size >= 84 else 0
     head = data[:512].lstrip()
     if head[:5].lower() == b"solid" and re.search(rb"\bfacet\b|\bendsolid\b", data[:4096]):
         return _stl_ascii(data)
@@ -60,6 +66,56 @@ def read_stl(data: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         f"the header claims {count:,} triangles ({84 + 50 * count:,} bytes) but the file is "
         f"{size:,} bytes: truncated, padded or not an STL"
     )
+
+
+def stl_binary_vertices(data: bytes) -> np.ndarray | None:
+    """The vertices of a binary STL, three per facet: ``(3 n, 3)`` float64, frozen, cast
+    from the records' float32 in one pass straight into their immutable buffer (and checked
+    finite block by block while each block is in cache); None when ``data`` is not laid out
+    as a binary STL (84 + 50 n bytes, n the header's count).
+
+    Raises
+    ------
+    ValueError
+        For a coordinate that is not finite, naming its facet.
+    """
+    if len(data) < 84:
+        return None
+    count = int.from_bytes(data[80:84], "little")
+    if 84 + 50 * count != len(data):
+        return None
+    corners = np.frombuffer(data, dtype=_STL_RECORD, count=count, offset=84)["v"]  # (n, 9)
+    return fill_frozen((3 * count, 3), np.float64, lambda out: _cast(out, corners))
+
+
+def _cast(out: np.ndarray, corners: np.ndarray, block: int = 1 << 12) -> None:
+    rows = out.reshape(corners.shape)
+    for start in range(0, len(rows), block):
+        part = rows[start : start + block]
+        np.copyto(part, corners[start : start + block])
+        with np.errstate(all="ignore"):  # a sum is finite only if every term is
+            if np.isfinite(np.add.reduce(part, axis=None)):
+                continue
+        bad = ~np.isfinite(part).all(axis=1)
+        if bad.any():
+            facet = start + int(np.argmax(bad))
+            raise ValueError(f"facet {facet} has a vertex coordinate that is not a number")
+
+
+def soup_faces(count: int) -> tuple[np.ndarray, np.ndarray]:
+    """``(face_indices, face_offsets)`` of ``count`` triangles on their own three vertices
+    each (0, 1, 2, 3, 4, 5, ...), frozen, made in place (no array copied to freeze it)."""
+    fi = fill_frozen(3 * count, np.int64, lambda out: _arange(out, 1))
+    fo = fill_frozen(count + 1, np.int64, lambda out: _arange(out, 3))
+    return fi, fo
+
+
+def _arange(out: np.ndarray, step: int, block: int = 1 << 16) -> None:
+    """``out[:] = 0, step, 2 step, ...`` a block at a time (no temporary of its size)."""
+    ramp = np.arange(0, step * block, step, dtype=np.int64)
+    for start in range(0, len(out), block):
+        part = out[start : start + block]
+        np.add(ramp[: len(part)], step * start, out=part)
 
 
 def _stl_ascii(data: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -6,14 +6,15 @@ one ``<object>`` per mesh (vertices and triangles), optional base materials for 
 a ``<build>`` with one ``<item>`` per object (3MF Core Specification 1.3, chapters 3-4).
 
 The model's text is built in bulk (numbers through :mod:`formgraph.kernels.io.numfmt`, rows
-assembled with one ``join_rows`` per block). Reading is :mod:`.threemf_read`.
+assembled with one ``join_rows`` per block, deflated into the zip as they are made).
+Reading is :mod:`.threemf_read`.
 """
 
 from __future__ import annotations
 
 import io
 import zipfile
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
@@ -33,7 +34,7 @@ UNITS = {  # the unit's length in millimetres
     "foot": 304.8,
     "meter": 1000.0,
 }
-_BLOCK = 1 << 16
+_BLOCK = 1 << 14
 
 _CONTENT_TYPES = (
     '<?xml version="1.0" encoding="UTF-8"?>\n'
@@ -87,6 +88,49 @@ def write_3mf(
     n = len(meshes)
     names = list(names) if names is not None else [f"mesh {k + 1}" for k in range(n)]
     vertex_colors = list(vertex_colors) if vertex_colors is not None else [None] * n
+    for c in vertex_colors:  # refused before anything is written
+        width = np.asarray(c).reshape(len(c), -1).shape[1] if c is not None else 3
+        if width not in (3, 4):
+            raise ValueError(f"vertex colours need 3 or 4 components, got {width}")
+    out = io.BytesIO()
+    with zipfile.ZipFile(out, "w", compression=zipfile.ZIP_DEFLATED, compresslevel=1) as z:
+        for name, data in (
+            ("[Content_Types].xml", _CONTENT_TYPES.encode()),
+            ("_rels/.rels", _RELS.encode()),
+        ):
+            z.writestr(_member_info(name), data, compresslevel=1)
+        # the model is deflated as it is formatted, a block of rows at a time: the text of
+        # a million triangles (80 MB) never exists whole, only its compressed bytes do
+        size = sum(_MAX_ROW * (len(v) + len(t)) for v, t in meshes)
+        with z.open(_member_info("3D/3dmodel.model"), "w", force_zip64=size > 1 << 30) as f:
+            for piece in _model(meshes, names, colors, unit, vertex_colors):
+                f.write(piece)
+    return out.getvalue()  # (BytesIO hands over its buffer: no copy)
+
+
+_MAX_ROW = 160  # bytes a vertex or triangle row can take, colour indices included
+
+
+def _member_info(name: str) -> zipfile.ZipInfo:
+    """A member with a fixed time (the same meshes give the same bytes), deflated."""
+    info = zipfile.ZipInfo(name, date_time=(1980, 1, 1, 0, 0, 0))
+    info.compress_type = zipfile.ZIP_DEFLATED
+    # the level ZipFile.open(info, "w") deflates at: writestr takes it as an argument,
+    # open only from the ZipInfo (``compress_level`` from Python 3.13, before it private)
+    for attr in ("compress_level", "_compresslevel"):
+        if hasattr(info, attr):
+            setattr(info, attr, 1)
+    return info
+
+
+def _model(
+    meshes: Sequence[tuple[np.ndarray, np.ndarray]],
+    names: list[str],
+    colors: Sequence[tuple[float, float, float, float]] | None,
+    unit: str,
+    vertex_colors: list[np.ndarray | None],
+) -> Iterator[bytes]:
+    """The model part's text, in pieces of at most a block of rows."""
     parts = [
         '<?xml version="1.0" encoding="UTF-8"?>\n'
         f'<model unit="{unit}" xml:lang="en-US" xmlns="{CORE}" xmlns:m="{MATERIAL}">\n'
@@ -95,7 +139,7 @@ def write_3mf(
     next_id = 1
     # a base material only for a mesh its object points at: one with vertex colours uses
     # its colour group instead (an unreferenced material is what strict consumers flag)
-    plain = [k for k in range(n) if vertex_colors[k] is None] if colors is not None else []
+    plain = [k for k, c in enumerate(vertex_colors) if c is None] if colors is not None else []
     if plain:
         bases = "".join(
             f'<base name={quoteattr(names[k])} displaycolor="{_hex(colors[k])}"/>\n' for k in plain
@@ -103,19 +147,17 @@ def write_3mf(
         parts.append(f'<basematerials id="1">\n{bases}</basematerials>\n')
         next_id = 2
     base_index = {k: j for j, k in enumerate(plain)}
-    chunks: list[bytes] = ["".join(parts).encode()]
+    yield "".join(parts).encode()
     object_ids = []
     for k, (v, tris) in enumerate(meshes):
         v = np.asarray(v, dtype=np.float64)
         group = None
-        if (
-            vertex_colors[k] is not None
-        ):  # the materials extension's colour group, a colour a vertex
+        if vertex_colors[k] is not None:  # the materials extension's colour group
             group = next_id
             next_id += 1
-            chunks.append(f'<m:colorgroup id="{group}">\n'.encode())
-            chunks.extend(_color_rows(np.asarray(vertex_colors[k], dtype=np.float64)))
-            chunks.append(b"</m:colorgroup>\n")
+            yield f'<m:colorgroup id="{group}">\n'.encode()
+            yield from _color_rows(np.asarray(vertex_colors[k], dtype=np.float64))
+            yield b"</m:colorgroup>\n"
         if group is not None:
             pid = f' pid="{group}" pindex="0"'
         elif k in base_index:
@@ -123,29 +165,17 @@ def write_3mf(
         else:
             pid = ""
         object_ids.append(next_id)
-        chunks.append(
+        yield (
             f'<object id="{next_id}" type="model" name={quoteattr(names[k])}{pid}>'
             "<mesh>\n<vertices>\n".encode()
         )
         next_id += 1
-        chunks.extend(_vertex_rows(v))
-        chunks.append(b"</vertices>\n<triangles>\n")
-        chunks.extend(_triangle_rows(np.asarray(tris, dtype=np.int64).reshape(-1, 3), group))
-        chunks.append(b"</triangles>\n</mesh></object>\n")
+        yield from _vertex_rows(v)
+        yield b"</vertices>\n<triangles>\n"
+        yield from _triangle_rows(np.asarray(tris).reshape(-1, 3), group)
+        yield b"</triangles>\n</mesh></object>\n"
     items = "".join(f'<item objectid="{i}"/>' for i in object_ids)
-    chunks.append(f"</resources>\n<build>{items}</build>\n</model>\n".encode())
-    model = b"".join(chunks)
-    out = io.BytesIO()
-    with zipfile.ZipFile(out, "w", compression=zipfile.ZIP_DEFLATED, compresslevel=1) as z:
-        for name, data in (
-            ("[Content_Types].xml", _CONTENT_TYPES.encode()),
-            ("_rels/.rels", _RELS.encode()),
-            ("3D/3dmodel.model", model),
-        ):
-            info = zipfile.ZipInfo(name, date_time=(1980, 1, 1, 0, 0, 0))
-            info.compress_type = zipfile.ZIP_DEFLATED
-            z.writestr(info, data, compresslevel=1)
-    return out.getvalue()
+    yield f"</resources>\n<build>{items}</build>\n</model>\n".encode()
 
 
 def _hex(c: Sequence[float]) -> str:
@@ -153,11 +183,10 @@ def _hex(c: Sequence[float]) -> str:
     return "#" + "".join(f"{x:02X}" for x in rgba)
 
 
-def _vertex_rows(v: np.ndarray) -> list[bytes]:
-    out = []
+def _vertex_rows(v: np.ndarray) -> Iterator[bytes]:
     for s in range(0, len(v), _BLOCK):
         b = v[s : s + _BLOCK]
-        out.append(
+        yield (
             join_rows(
                 [
                     b'<vertex x="',
@@ -170,29 +199,26 @@ def _vertex_rows(v: np.ndarray) -> list[bytes]:
                 b'"/>\n',
             )
         )
-    return out
 
 
-def _triangle_rows(t: np.ndarray, group: int | None = None) -> list[bytes]:
-    out = []
+def _triangle_rows(t: np.ndarray, group: int | None = None) -> Iterator[bytes]:
     for s in range(0, len(t), _BLOCK):
-        b = t[s : s + _BLOCK]
+        b = t[s : s + _BLOCK].astype(np.int64, copy=False)
         cols = [format_int(b[:, c]) for c in range(3)]
         parts = [b'<triangle v1="', cols[0], b'" v2="', cols[1], b'" v3="', cols[2]]
         if group is not None:  # the corners' colours are the vertices' own, by index
             parts += [f'" pid="{group}" p1="'.encode(), cols[0], b'" p2="', cols[1], b'" p3="',
                       cols[2]]  # fmt: skip
-        out.append(join_rows(parts, b'"/>\n'))
-    return out
+        yield join_rows(parts, b'"/>\n')
 
 
-def _color_rows(c: np.ndarray) -> list[bytes]:
-    """``<m:color color="#RRGGBBAA"/>`` rows, hex digits laid out as one canvas."""
-    c = np.clip(np.round(c.reshape(len(c), -1) * 255), 0, 255).astype(np.uint8)
-    if c.shape[1] not in (3, 4):
-        raise ValueError(f"vertex colours need 3 or 4 components, got {c.shape[1]}")
-    if c.shape[1] == 3:
-        c = np.column_stack([c, np.full(len(c), 255, np.uint8)])
+def _color_rows(c: np.ndarray) -> Iterator[bytes]:
+    """``<m:color color="#RRGGBBAA"/>`` rows, hex digits laid out as one canvas a block."""
     digits = np.frombuffer(b"0123456789ABCDEF", np.uint8)
-    hexes = np.stack([digits[c >> 4], digits[c & 15]], axis=2).reshape(len(c), 8)
-    return [join_rows([b'<m:color color="#', hexes], b'"/>\n')] if len(c) else []
+    c = c.reshape(len(c), -1)
+    for s in range(0, len(c), _BLOCK):
+        b = np.clip(np.round(c[s : s + _BLOCK] * 255), 0, 255).astype(np.uint8)
+        if b.shape[1] == 3:
+            b = np.column_stack([b, np.full(len(b), 255, np.uint8)])
+        hexes = np.stack([digits[b >> 4], digits[b & 15]], axis=2).reshape(len(b), 8)
+        yield join_rows([b'<m:color color="#', hexes], b'"/>\n')

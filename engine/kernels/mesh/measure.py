@@ -497,11 +497,9 @@ def flat_open_parts(
     fo = np.asarray(face_offsets, dtype=np.int64)
     if fi.size == 0:
         return 0
-    used, part, count, starts, has_open = by_faces(
+    used, part, count, starts = by_faces(
         "sheets", fi, fo, len(v), lambda: _vertex_parts(fi, fo, len(v))
     )
-    if not has_open.any():
-        return 0
     n_parts = count.size
     # the used vertices run part by part, each part in vertex order (so every sum over a
     # part adds what a sum in vertex order adds, in the same order)
@@ -517,22 +515,43 @@ def flat_open_parts(
     far = np.maximum.reduceat(np.abs((d[0] * n0 + d[2] * n2) + d[1] * n1), starts)
     extent = np.maximum.reduceat(p, starts, axis=1) - np.minimum.reduceat(p, starts, axis=1)
     flat = far <= planar_tolerance * np.linalg.norm(extent.T, axis=1)
+    if not flat.any():  # (the common case: no edge table needed to say which are open)
+        return 0
+    has_open = by_faces("sheets open", fi, fo, len(v), lambda: _open_parts(fi, fo, len(v)))
     return int(np.count_nonzero(flat & has_open))
 
 
 def _vertex_parts(fi: np.ndarray, fo: np.ndarray, n_vertices: int) -> tuple:
     """The used vertices sorted by the part they join (by shared vertices; parts numbered
-    by their roots, vertices in order within a part), each one's part, the vertices per
-    part, where each part's run starts, and which parts have a boundary edge."""
-    root, _ = union_find(n_vertices, fi, fi[next_corner(fo)])
+    by their smallest vertex, vertices in order within a part), each one's part, the
+    vertices per part and where each part's run starts.
+
+    The parts are scipy's connected components of the vertex graph of the faces' edges
+    (compiled: twice as fast as our vectorized union-find here, and the same partition)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    edges = coo_matrix(
+        (np.ones(fi.size, np.int8), (fi, fi[next_corner(fo)])), shape=(n_vertices, n_vertices)
+    )
+    _, label = connected_components(edges.tocsr(), directed=False)
     used = np.zeros(n_vertices, dtype=bool)
     used[fi] = True
-    parts, part = np.unique(root[used], return_inverse=True)
+    parts, part = np.unique(label[used], return_inverse=True)
     order = np.argsort(part, kind="stable")
     count = np.bincount(part, minlength=parts.size)
     starts = np.concatenate([[0], np.cumsum(count)[:-1]])
+    return np.flatnonzero(used)[order], part[order], count, starts
+
+
+def _open_parts(fi: np.ndarray, fo: np.ndarray, n_vertices: int) -> np.ndarray:
+    """Which parts (numbered as :func:`_vertex_parts` numbers them) have a boundary edge."""
+    used, part, count, _ = by_faces(
+        "sheets", fi, fo, n_vertices, lambda: _vertex_parts(fi, fo, n_vertices)
+    )
+    part_of = np.zeros(n_vertices, dtype=np.int64)
+    part_of[used] = part
     t = edge_table(fi, fo, n_vertices)
-    open_vertex = t.vertices[t.counts == 1, 0]
-    has_open = np.zeros(parts.size, dtype=bool)
-    has_open[np.searchsorted(parts, root[open_vertex])] = True
-    return np.flatnonzero(used)[order], part[order], count, starts, has_open
+    has_open = np.zeros(count.size, dtype=bool)
+    has_open[part_of[t.vertices[t.counts == 1, 0]]] = True
+    return has_open

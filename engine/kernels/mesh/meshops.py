@@ -12,9 +12,10 @@ import numpy as np
 
 from .halfedge import HalfEdges, build_halfedges
 from .measure import face_vectors
-from .polygon import WorkLimitError, triangulate_polygon  # noqa: F401 (re-exported)
+from .polygon import WorkLimitError, large_face, triangulate_polygon  # noqa: F401 (re-exported)
 
 _BATCH_UP_TO = 32  # concave faces up to this size are clipped together (O(k^3) each)
+_ALONE_UP_TO = 8  # larger faces of one size, up to this many: each on its own
 
 __all__ = [
     "box",
@@ -334,7 +335,8 @@ def triangulate(
     vertices : (n, 3) float64
         Unchanged.
     face_indices : (3 * (m - 2 n_faces),) int64
-        The triangles of face 0, then of face 1, ...
+        The triangles of face 0, then of face 1, ... (a mesh of triangles only: its own
+        arrays, not copied).
     face_offsets : (m - 2 n_faces + 1,) int64
 
     Raises
@@ -347,6 +349,8 @@ def triangulate(
     fi = np.asarray(face_indices, dtype=np.int64)
     fo = np.asarray(face_offsets, dtype=np.int64)
     sizes = np.diff(fo)
+    if sizes.size and sizes.min() == 3 == sizes.max():  # triangles already: as they are
+        return v, fi, fo
     n_tri = sizes - 2
     tri_off = np.zeros(sizes.size + 1, dtype=np.int64)
     np.cumsum(n_tri, out=tri_off[1:])
@@ -363,6 +367,14 @@ def triangulate(
             (faces.size, k - 2, 3),
         ).copy()
         p = v[corners]
+        if k > _BATCH_UP_TO and faces.size <= _ALONE_UP_TO:
+            # a few large faces (a polygon made a face): each tested and clipped in its
+            # own plane, made once (the batched test below costs a face's clipping again)
+            for f in range(faces.size):
+                local[f] = large_face(p[f], max_tests)
+            rows = np.arange(faces.size)[:, None, None]
+            out[tri_off[faces][:, None] + np.arange(k - 2)] = corners[rows, local]
+            continue
         normal = _newell_normals(p)
         edge_in = p - np.roll(p, 1, axis=1)
         edge_out = np.roll(p, -1, axis=1) - p

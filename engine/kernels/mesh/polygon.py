@@ -31,7 +31,13 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["WorkLimitError", "polygon_plane", "triangulate_polygon"]
+__all__ = [
+    "WorkLimitError",
+    "large_face",
+    "polygon_plane",
+    "triangulate_plane",
+    "triangulate_polygon",
+]
 
 _CHUNK = 1 << 21  # triangle-corner pairs tested at once (bounds the memory of a round)
 
@@ -99,7 +105,30 @@ def triangulate_polygon(points: np.ndarray, max_tests: int | None = None) -> np.
     >>> triangulate_polygon([[0, 0], [2, 0], [2, 2], [1, 1], [0, 2]]).shape
     (3, 3)
     """
+    return triangulate_plane(polygon_plane(points), max_tests)
+
+
+def large_face(points: np.ndarray, max_tests: int | None = None) -> np.ndarray:
+    """Triangles (k - 2, 3) of one face (k, 3) of a mesh: a fan from its first corner when
+    it is convex (or has no area), else :func:`triangulate_plane` of its plane coordinates,
+    which are made once for both tests (``meshops.triangulate``'s path for faces of more
+    than 32 corners)."""
     xy = polygon_plane(points)
+    k = len(xy)
+    x, y = xy[:, 0], xy[:, 1]
+    ex, ey = x - np.roll(x, 1), y - np.roll(y, 1)  # the edge into each corner
+    turn = ex * np.roll(ey, -1) - ey * np.roll(ex, -1)  # (in x out): > 0 turns left
+    twice_area = float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
+    # the tolerance of the Newell test, |n|^2 * 1e-12, in the plane: |n| = twice the area
+    if twice_area <= 0 or turn.min() >= -1e-12 * twice_area:
+        j = np.arange(1, k - 1)
+        return np.stack([np.zeros(k - 2, dtype=np.int64), j, j + 1], axis=1)
+    return triangulate_plane(xy, max_tests)
+
+
+def triangulate_plane(xy: np.ndarray, max_tests: int | None = None) -> np.ndarray:
+    """:func:`triangulate_polygon` of a loop already in its plane, counter-clockwise (what
+    :func:`polygon_plane` returns)."""
     k = len(xy)
     if k < 3:
         raise ValueError(f"a polygon needs at least 3 corners, got {k}")
@@ -121,8 +150,9 @@ def _earcut(xy: np.ndarray) -> np.ndarray | None:
     if flat.size != 3 * (k - 2):
         return None
     tris = flat.reshape(-1, 3).astype(np.int64)
-    a, b, c = xy[tris[:, 0]], xy[tris[:, 1]], xy[tris[:, 2]]
-    area = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
+    t = xy[tris]  # (k - 2, 3, 2): one gather
+    ab, ac = t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]
+    area = ab[:, 0] * ac[:, 1] - ab[:, 1] * ac[:, 0]
     x, y = xy[:, 0], xy[:, 1]
     total = float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
     if total <= 0:
