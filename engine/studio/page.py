@@ -175,6 +175,12 @@ class Page:
         ctrl.add("reload")(lambda: self.worker.submit("disk", self._open_disk))
         ctrl.add("reset_all")(lambda: self.worker.submit("params", self.session.reset_params))
         ctrl.add("show_results")(lambda: self.worker.submit("show", self.session.show, None))
+        from formgraph.core.registry import node_types
+
+        from .canvas import Canvas, palette
+
+        self.canvas = Canvas(self)
+        s.palette = palette(node_types())
 
     # --------------------------------------------------------------------- server life
 
@@ -268,6 +274,10 @@ class Page:
             if result is not None and self.loop is not None:
                 self.loop.call_soon_threadsafe(self._show_drawing, *result)
             return
+        if kind.startswith("canvas-") or kind in ("sheet", "subgraph"):
+            if self.loop is not None:
+                self.loop.call_soon_threadsafe(self._canvas_result, kind, result)
+            return
         t0 = time.perf_counter()
         prepared = None
         # a slider step's drawing of the graph is made and sent once the steps settle
@@ -289,6 +299,14 @@ class Page:
                 self._early.append((kind, result, seconds, prepared))
                 return
         self.loop.call_soon_threadsafe(self._apply, kind, result, seconds, prepared)
+
+    def _canvas_result(self, kind: str, result: Any) -> None:
+        if kind == "sheet":
+            self.state.sheet = result
+        elif kind == "subgraph":
+            self.state.subgraph_view = result
+        else:
+            self.canvas.reply(result)
 
     def _snapshot(self) -> dict[str, Any]:
         """What the page shows of the session, read in the worker thread, between two of
@@ -409,6 +427,8 @@ class Page:
                 s.status_bad = True
             s.busy = not self.worker.idle(ignore=BACKGROUND)
             s.cook_id = s.cook_id + 1
+            if s.sheet_open and cooked.ok:
+                self.worker.submit("sheet", self.canvas.make_sheet)
             s.timing = {
                 "cook_ms": round(cooked.seconds * 1000, 2),
                 # in the worker: queue, recook, datasets and drawing prepared
@@ -480,16 +500,24 @@ class Page:
         from formgraph.core.errors import FormgraphError
         from formgraph.drawgraph.layout import draw_graph
 
-        from .layout import clickable_svg
+        from .canvas import canvas_svg
 
         graph = self.session.graph
         if graph is None:
             return None
         try:
-            drawing = draw_graph(graph, stats=cooked.stats, failed=cooked.failed)
+            drawing = draw_graph(
+                graph,
+                stats=cooked.stats,
+                failed=cooked.failed,
+                positions=self.canvas.positions(graph),
+                all_ports=True,
+            )
         except FormgraphError:
             return None
-        return clickable_svg(drawing)
+        self.canvas.drawn(drawing)
+        subgraphs = frozenset(n for n, t in graph.nodes.items() if t.endswith((".yaml", ".yml")))
+        return canvas_svg(drawing, subgraphs)
 
     def _picture(self, datasets: Any) -> None:
         from formgraph.viewer.app import _camera_lost

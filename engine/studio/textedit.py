@@ -200,16 +200,24 @@ def _add_entry(doc: _Doc, mapping: yaml.MappingNode, key: str, value: str, inden
 
 
 def wire(
-    text: str, src: str, output: str, dst: str, port: str, *, listed: bool = False
+    text: str,
+    src: str,
+    output: str,
+    dst: str,
+    port: str,
+    *,
+    listed: bool = False,
+    ref: str | None = None,
 ) -> list[Edit]:
     """Wire ``src`` (its ``output``, or its only one for "") into ``dst``'s ``port``.
 
     An absent port gains an entry; a port holding a value has it replaced, unless the port
     takes a list (``listed``): then the list gains an element (a single wire there becomes a
-    list of both).
+    list of both). ``ref`` is the value to write instead of the wire (a param's
+    ``"=name"``).
     """
     doc = _Doc(text)
-    ref = _quoted(f"@{src}.{output}" if output else f"@{src}")
+    ref = _quoted(ref if ref is not None else f"@{src}.{output}" if output else f"@{src}")
     _, body = doc.node(dst)
     for k, v in body.value:
         if not (isinstance(k, yaml.ScalarNode) and k.value == port):
