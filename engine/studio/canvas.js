@@ -199,8 +199,15 @@
         const y = Math.max(0, Math.round(d.y + p.y - d.at.y));
         ask('canvas_move', [d.name, x, y]);
       } else {
+        // a second click on the node soon after: a double click (the drawing may have
+        // been put in anew between the two, so the browser's own dblclick is not used)
+        const now = performance.now();
+        const again = fg.lastClick && fg.lastClick.name === d.name
+          && now - fg.lastClick.t < 450;
+        fg.lastClick = again ? null : {name: d.name, t: now};
         select({kind: 'node', name: d.name});
-        trigger('show_node', [d.name]);
+        if (again) opened(d.name);
+        else trigger('show_node', [d.name]);
       }
     }
   };
@@ -214,11 +221,10 @@
     fg.k = k;
     paint();
   };
-  const dblclick = (ev) => {
-    const node = ev.target.closest('[data-node]');
-    if (!node) return;
-    if (node.dataset.subgraph) trigger('open_subgraph', [node.dataset.node]);
-    else rename(node.dataset.node);
+  const opened = (name) => {  // a double click: a subgraph's file, any other's name
+    const node = host().querySelector(`[data-node="${CSS.escape(name)}"]`);
+    if (node && node.dataset.subgraph) trigger('open_subgraph', [name]);
+    else if (node && !node.dataset.param) rename(name);
   };
   const key = (ev) => {
     if (ev.target.closest('.fg-palette, .fg-rename')) return;
@@ -359,7 +365,6 @@
     h.addEventListener('pointermove', move);
     h.addEventListener('pointerup', up);
     h.addEventListener('wheel', wheel, {passive: false});
-    h.addEventListener('dblclick', dblclick);
     h.addEventListener('keydown', key);
     paint();
   };

@@ -301,12 +301,11 @@ class Page:
         self.loop.call_soon_threadsafe(self._apply, kind, result, seconds, prepared)
 
     def _canvas_result(self, kind: str, result: Any) -> None:
-        if kind == "sheet":
-            self.state.sheet = result
-        elif kind == "subgraph":
-            self.state.subgraph_view = result
-        else:
+        if kind.startswith("canvas-"):
             self.canvas.reply(result)
+            return
+        with self.state:
+            self.state[kind if kind == "sheet" else "subgraph_view"] = result
 
     def _snapshot(self) -> dict[str, Any]:
         """What the page shows of the session, read in the worker thread, between two of
@@ -497,23 +496,23 @@ class Page:
 
     def _drawing(self, cooked: Cooked) -> str | None:
         """The graph's drawing, coloured by the last evaluation (None: nothing to draw)."""
-        from formgraph.core.errors import FormgraphError
         from formgraph.drawgraph.layout import draw_graph
 
         from .canvas import canvas_svg
 
-        graph = self.session.graph
+        graph = self.session.draft or self.session.graph  # as written, checked or not
         if graph is None:
             return None
+        failed = cooked.failed or [p.where.node for p in cooked.problems if p.where.node]
         try:
             drawing = draw_graph(
                 graph,
                 stats=cooked.stats,
-                failed=cooked.failed,
+                failed=failed,
                 positions=self.canvas.positions(graph),
                 all_ports=True,
             )
-        except FormgraphError:
+        except Exception:  # noqa: BLE001 (a version the checker refused may not draw: a cycle)
             return None
         self.canvas.drawn(drawing)
         subgraphs = frozenset(n for n, t in graph.nodes.items() if t.endswith((".yaml", ".yml")))
