@@ -277,17 +277,21 @@ def test_a_500_node_graph_opens(browser, tmp_path):
         pg.wait_for_function("document.querySelectorAll('#graph-canvas [data-node]').length >= 500")
         opened = time.perf_counter() - t0
         # a pan: the time to paint a frame after a move of the view
-        frame = pg.evaluate(
-            """() => new Promise((done) => { const t = performance.now();
-            window.fgCanvas.tx -= 50;
-            document.getElementById('graph-canvas').style.setProperty('--fg-t',
-              `translate(${window.fgCanvas.tx}px, 0px) scale(${window.fgCanvas.k})`);
-            requestAnimationFrame(() => requestAnimationFrame(() => done(performance.now() - t)));
-            })"""
-        )
+        pg.wait_for_selector("#editor .view-lines")  # (the page's own loading done)
+        frames = [
+            pg.evaluate(
+                """() => new Promise((done) => { const t = performance.now();
+                window.fgCanvas.tx -= 50; window.fgCanvas.paint();
+                requestAnimationFrame(() => requestAnimationFrame(
+                  () => done(performance.now() - t)));
+                })"""
+            )
+            for _ in range(7)
+        ]
+        frame = sorted(frames)[3]
         print(
             f"\n500-node graph: drawing shown {opened:.2f} s after the page was asked for; "
-            f"a pan frame {frame:.0f} ms"
+            f"a pan step painted in {frame:.0f} ms (median of 7)"
         )
         assert pg.locator("#graph-canvas [data-node='n499']").count() == 1
         pg.close()

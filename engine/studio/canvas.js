@@ -20,11 +20,17 @@
   const trigger = (name, args) => window.trame.trigger(name, args);
 
   // ------------------------------------------------------------------ view transform
+  // (on the two elements themselves: a property inherited from the canvas would restyle
+  // every shape of the drawing at each step of a pan)
   const paint = () => {
     const h = host();
     if (!h) return;
-    h.style.setProperty('--fg-t', `translate(${fg.tx}px, ${fg.ty}px) scale(${fg.k})`);
+    const t = `translate(${fg.tx}px, ${fg.ty}px) scale(${fg.k})`;
+    h.querySelectorAll('.fg-drawing > svg, #fg-overlay').forEach((e) => {
+      e.style.transform = t;
+    });
   };
+  fg.paint = paint;
   const toDrawing = (ev) => {
     const r = host().getBoundingClientRect();
     return {x: (ev.clientX - r.left - fg.tx) / fg.k, y: (ev.clientY - r.top - fg.ty) / fg.k};
@@ -35,9 +41,10 @@
     const svg = h && h.querySelector('.fg-drawing svg');
     if (!svg) return;
     const w = +svg.getAttribute('width'), ht = +svg.getAttribute('height');
-    const k = Math.min(h.clientWidth / w, h.clientHeight / ht, 1.5);
+    // the whole drawing, unless that is too small to read (a long graph: its start)
+    const k = Math.max(Math.min(h.clientWidth / w, h.clientHeight / ht, 1.5), 0.35);
     fg.k = k > 0 ? k : 1;
-    fg.tx = (h.clientWidth - w * fg.k) / 2;
+    fg.tx = Math.max((h.clientWidth - w * fg.k) / 2, 0);
     fg.ty = 0;
     paint();
   };
@@ -384,6 +391,7 @@
       fg.fitted = true;
       fg.fit();
     }
+    paint();
     fg.reselect();
   };
   fg.later = () => setTimeout(fg.drawn, 0);  // (once Vue has put the new drawing in)

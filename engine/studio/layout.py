@@ -31,7 +31,7 @@ html, body { overflow: hidden; }
 .fg-canvas { position: relative; flex: 1 1 auto; overflow: hidden; outline: none;
   touch-action: none; background: #fbfbfb; }
 .fg-canvas .fg-drawing svg, #fg-overlay { position: absolute; left: 0; top: 0;
-  transform: var(--fg-t); transform-origin: 0 0; }
+  transform-origin: 0 0; will-change: transform; }
 #fg-overlay { overflow: visible; pointer-events: none; }
 .fg-hit { fill: transparent; cursor: move; }
 .fg-hit.fg-selected { stroke: #1976d2; stroke-width: 2.5; }
