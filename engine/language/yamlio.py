@@ -146,6 +146,7 @@ def parse(text: str, file: str = "<graph>") -> Document:
             problem("'outputs' must be a mapping of output name to a wire ('@node')", _line(k))
 
     if "layout" in top:
+        _value(top["layout"][1], problem, None, None)  # (tags refused, as anywhere)
         doc.layout = layout_of(top["layout"][1])
 
     if "nodes" not in top:
@@ -228,6 +229,8 @@ def layout_of(node: yaml.Node) -> dict[str, tuple[float, float]]:
         return out
     for k, v in node.value:
         if not isinstance(k, yaml.ScalarNode) or not isinstance(v, yaml.SequenceNode):
+            continue
+        if v.tag != "tag:yaml.org,2002:seq":
             continue
         if len(v.value) != 2 or not all(isinstance(c, yaml.ScalarNode) for c in v.value):
             continue

@@ -17,6 +17,7 @@ last drawing, so a node laid out once stays put while others come and go.
 from __future__ import annotations
 
 import itertools
+import math
 import re
 from collections.abc import Mapping
 from pathlib import Path
@@ -89,6 +90,17 @@ def canvas_svg(drawing: Any, subgraphs: frozenset[str] = frozenset()) -> str:
     svg = drawing.svg
     svg = svg[svg.index("<svg") :]  # no XML declaration inside a page
     return svg.replace("</svg>", "".join(hits) + "</svg>")
+
+
+MAX_XY = 1e6  # a position further out is the page's bug or a hostile request
+
+
+def _xy(x: Any, y: Any) -> tuple[float, float]:
+    """A box's position from a request: two finite numbers, put within the page."""
+    p = (float(x), float(y))
+    if not all(math.isfinite(c) for c in p):
+        raise textedit.EditError("a position is two finite numbers")
+    return (min(max(p[0], 0.0), MAX_XY), min(max(p[1], 0.0), MAX_XY))
 
 
 class Canvas:
@@ -203,7 +215,7 @@ class Canvas:
                 )
             return textedit.unwire(text, src, "", dst, port), None
         if op == "add":
-            type_name, x, y = str(args[0]), float(args[1]), float(args[2])
+            type_name, (x, y) = str(args[0]), _xy(args[1], args[2])
             spec = types.get(type_name)
             if spec is None:
                 raise textedit.EditError(f"there is no node type '{type_name}'")
@@ -224,11 +236,11 @@ class Canvas:
                 self.placed[new] = self.placed[old]
             return edits, None
         if op == "move":
-            name, x, y = str(args[0]), float(args[1]), float(args[2])
+            name, (x, y) = str(args[0]), _xy(args[1], args[2])
             if name not in doc.nodes and name not in doc.params:
                 raise textedit.EditError(f"there is no node '{name}'")
-            self.placed[name] = (max(0.0, x), max(0.0, y))
-            return textedit.move_nodes(text, {name: (max(0.0, x), max(0.0, y))}), None
+            self.placed[name] = (x, y)
+            return textedit.move_nodes(text, {name: (x, y)}), None
         raise ValueError(op)
 
     def _types(self) -> dict[str, Any]:

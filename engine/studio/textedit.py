@@ -18,6 +18,8 @@ which the checker reads but never checks and no cache key includes.
 
 from __future__ import annotations
 
+import json
+import math
 import re
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
@@ -41,6 +43,8 @@ __all__ = [
 ]
 
 INDENT = 2  # a new section's indentation, when the file shows none to follow
+NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_-]*\Z")  # a node, param or port name
+TYPE = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_./-]*\Z")  # a node type (a subgraph's file)
 
 
 class EditError(ValueError):
@@ -177,7 +181,15 @@ class _Doc:
 
 
 def _quoted(value: str) -> str:
-    return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    """``value`` as a double-quoted YAML scalar (JSON's escapes are YAML's)."""
+    return json.dumps(value, ensure_ascii=False)
+
+
+def _name(text: str, what: str = "name") -> str:
+    """``text`` if it can be written as a key as it is (a request's names are not trusted)."""
+    if not isinstance(text, str) or not NAME.match(text):
+        raise EditError(f"{text!r} is not a {what} the canvas can write")
+    return text
 
 
 def _key_indent(doc: _Doc, mapping: yaml.MappingNode, fallback: int) -> int:
@@ -216,6 +228,7 @@ def wire(
     list of both). ``ref`` is the value to write instead of the wire (a param's
     ``"=name"``).
     """
+    _name(port, "port name")
     doc = _Doc(text)
     ref = _quoted(ref if ref is not None else f"@{src}.{output}" if output else f"@{src}")
     _, body = doc.node(dst)
@@ -317,6 +330,11 @@ def add_node(
     """A node ``name`` of ``type_name`` at the end of ``nodes:``, each of ``placeholders``
     (its required inputs) written ``port: ~`` for the checker to report, and its place
     ``at`` in ``layout:``."""
+    _name(name, "node name")
+    if not TYPE.match(type_name):
+        raise EditError(f"{type_name!r} is not a node type the canvas can write")
+    for p in placeholders:
+        _name(p, "port name")
     doc = _Doc(text)
     nodes = doc.nodes()
     if any(isinstance(k, yaml.ScalarNode) and k.value == name for k, _ in nodes.value):
@@ -367,9 +385,6 @@ def _entry_removal(doc: _Doc, mapping: yaml.MappingNode, k: yaml.Node, v: yaml.N
     if mapping.flow_style:
         return _flow_entry_span(doc, mapping, k, v)
     return Edit(*doc.entry_lines(k, v), "")
-
-
-NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_-]*\Z")
 
 
 def rename_node(text: str, old: str, new: str) -> list[Edit]:
@@ -442,10 +457,14 @@ def move_nodes(text: str, where: Mapping[str, tuple[float, float]]) -> list[Edit
 
 
 def _xy(p: tuple[float, float]) -> str:
+    if not all(math.isfinite(c) for c in p):
+        raise EditError("a position is two finite numbers")
     return f"[{round(p[0])}, {round(p[1])}]"
 
 
 def _layout_edits(doc: _Doc, where: Mapping[str, tuple[float, float]]) -> list[Edit]:
+    for name in where:
+        _name(name, "node name")
     found = doc.section("layout")
     if found is None or (
         isinstance(found[1], yaml.ScalarNode) and found[1].value in ("", "~", "null")
