@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from formgraph.kernels.field import meshdist
+from formgraph.kernels.geometry import meshdist
 from formgraph.kernels.mesh import remesh as krem
 from formgraph.kernels.mesh import simplify as ksimp
 

@@ -36,6 +36,7 @@ from .geometry import (
     ParametricCurve,
     ParametricSurface,
     Points,
+    Solid,
     Surface,
 )
 from .sweeps.api import Sweep, sweep
@@ -74,6 +75,7 @@ __all__ = [
     "ParametricSurface",
     "PathError",
     "Points",
+    "Solid",
     "Surface",
     "Sweep",
     "draw_graph",

@@ -27,7 +27,9 @@ __all__ = [
     "divisions",
     "even_parameters",
     "make_region",
+    "region_loops",
     "outline_curves",
+    "region_rings",
     "sample_rings",
     "sampling_tolerance",
     "span_of",
@@ -41,14 +43,12 @@ _LARGEST = 1e150  # the largest extent whose areas (its square, times vertex cou
 def span_of(curves: list[Curve]) -> float:
     """The largest side of the XY box around the curves (their control points when NURBS:
     the curve lies in their hull)."""
-    box = np.array([np.inf, np.inf, -np.inf, -np.inf])
-    for c in curves:  # one step per curve; a column at a time (numpy's axis=0 min is slow)
-        p = np.asarray(c.control_points) if isinstance(c, NurbsCurve) else c.sample(65)
-        x, y = p[:, 0], p[:, 1]
-        box = np.r_[
-            np.minimum(box[:2], [x.min(), y.min()]), np.maximum(box[2:], [x.max(), y.max()])
-        ]
-    return float((box[2:] - box[:2]).max())
+    pts = [
+        c.control_points if isinstance(c, NurbsCurve) else np.asarray(c.sample(65)) for c in curves
+    ]
+    p = pts[0] if len(pts) == 1 else np.concatenate(pts)
+    x, y = p[:, 0], p[:, 1]  # a column at a time (numpy's axis=0 min is slow)
+    return float(max(x.max() - x.min(), y.max() - y.min()))
 
 
 def closes(c: Curve) -> bool:
@@ -108,11 +108,12 @@ def even_parameters(
 
 
 def sample_rings(
-    curves: list[Curve], port: str, tol: float, ctx: Context
+    curves: list[Curve], port: str, tol: float, ctx: Context, exact: bool = True
 ) -> tuple[list[np.ndarray], list[np.ndarray | None], list[karcs.Source | None]]:
     """Each closed curve sampled to ``tol`` in XY; (for curves that are not polylines) the
     same rings again, to recognize the curves a boolean leaves whole; and (for NURBS of
-    degree >= 2) the curve with its samples' parameters, to rebuild the arcs it cuts."""
+    degree >= 2, with ``exact``) the curve with its samples' parameters, to rebuild the
+    arcs it cuts (a solid made of the region needs neither: ``exact=False``)."""
     rings: list[np.ndarray] = []
     sampled: list[np.ndarray | None] = []
     sources: list[karcs.Source | None] = [None] * len(curves)
@@ -157,7 +158,7 @@ def sample_rings(
             for i in members
         ]
         sampled_batch = InputError.call(
-            port, ksampling.sample_closed_batch, batch, tol, guard, params=True
+            port, ksampling.sample_closed_batch, batch, tol, guard, params=exact, validate=False
         )
         batched.update(zip(members, sampled_batch, strict=True))
     for i, c in enumerate(curves):  # one step per curve; its samples are vectorized
@@ -172,7 +173,9 @@ def sample_rings(
             rings.append(ring)
             sampled.append(None)
             continue
-        if i in batched:
+        if i in batched and not exact:
+            ring = batched[i]
+        elif i in batched:
             ring, t = batched[i]
             x, y = ring[:, 0], ring[:, 1]
             keep = np.r_[True, (x[1:] != x[:-1]) | (y[1:] != y[:-1])]
@@ -223,6 +226,72 @@ def make_region(make: Any, rings: list[np.ndarray], port: str) -> Any:
         raise InputError(
             port, f"curve {exc.ring} encloses no area (fewer than 3 distinct points)"
         ) from None
+
+
+def region_loops(
+    curves: list[Curve], ctx: Context
+) -> tuple[list[np.ndarray], list[Curve], np.ndarray]:
+    """The even-odd region of closed curves (port ``curves``) for the nodes that work on its
+    pieces (``layout.nest``, ``cam.*``): its rings in XY (closing point left out), its
+    outlines as curves (exact where the input was; outer counter-clockwise, holes
+    clockwise) in the same order, and which of them are holes (each piece is an outer
+    ring and the holes after it)."""
+    tol = sampling_tolerance(None, curves)
+    rings, sampled, sources = sample_rings(curves, "curves", tol, ctx)
+    shape = make_region(kregions.even_odd_region, rings, "curves")
+    outline = outline_curves(shape, curves, sampled, sources, tol, ctx)
+    coords, offsets, hole = kregions.rings_of(shape)
+    loops = [coords[offsets[i] : offsets[i + 1] - 1] for i in range(len(offsets) - 1)]
+    return loops, outline, hole
+
+
+def region_rings(
+    curves: list[Curve], tolerance: float | None, ctx: Context, port: str = "curves"
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+    """The even-odd region of closed curves in XY, as ``curves.boolean`` reads it, given
+    back as its boundary rings: the solids made from outlines (``mesh.extrude``,
+    ``mesh.revolve``) read their region here and nowhere else.
+
+    Returns
+    -------
+    xy : (N, 2) float
+        Every ring's points, ring after ring, each without its closing point; no point
+        repeats the one before it.
+    offsets : (r + 1,) int
+        Ring i is ``xy[offsets[i]:offsets[i + 1]]``; a polygon's outer ring (counter-
+        clockwise) comes before its holes (clockwise).
+    hole : (r,) bool
+    tol : float
+        The sampling tolerance: ``tolerance``, or 1e-5 of the size of the region.
+
+    Raises
+    ------
+    InputError
+        On ``port``: no curves, an open curve, a curve that encloses nothing, or a region
+        of no area (e.g. a curve given twice: by the even-odd rule the two cancel).
+    """
+    if isinstance(curves, Curve):
+        curves = [curves]
+    if not curves:
+        raise InputError(port, "give closed curves bounding a region, got none")
+    tol = sampling_tolerance(tolerance, curves, port)
+    rings, _, _ = sample_rings(curves, port, tol, ctx, exact=False)
+    region = make_region(kregions.even_odd_region, rings, port)
+    coords, offsets, hole = kregions.rings_of(region)
+    if len(offsets) < 2:
+        raise InputError(
+            port,
+            f"the {len(curves)} curve(s) bound a region of no area (by the even-odd rule a "
+            "curve given twice, or two that coincide, cancel out)",
+        )
+    # each ring without its closing point: ring i loses its last row
+    r = len(offsets) - 1
+    keep = np.ones(len(coords), dtype=bool)
+    keep[offsets[1:] - 1] = False
+    xy = coords[keep]
+    if tolerance is None:  # (polylines were taken as they are: 1e-5 of the region's size)
+        tol = _TOLERANCE * float(max(np.ptp(xy[:, 0]), np.ptp(xy[:, 1])))
+    return xy, offsets - np.arange(r + 1), hole, tol
 
 
 def _distinct(ring: np.ndarray) -> np.ndarray:

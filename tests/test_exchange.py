@@ -4,6 +4,7 @@ reader (lib3mf, trimesh and pygltflib, OpenCASCADE, rhino3dm) and by our own rea
 from __future__ import annotations
 
 import io
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -84,9 +85,9 @@ def test_3mf_units_scale_on_reading(tmp_path):
     g, out = _run(
         tmp_path, TWO + "  x: {type: export.3mf, meshes: ['@box'], path: p.3mf, units: inch}\n", "x"
     )
-    from formgraph.kernels.io.threemf import read_3mf
+    from formgraph.kernels.io.threemf_read import read_3mf
 
-    ((_, v, _, _),) = read_3mf(Path(out).read_bytes())
+    v = read_3mf(Path(out).read_bytes()).vertices
     np.testing.assert_allclose(v, g.evaluate("box").vertices * 25.4)
 
 
@@ -318,16 +319,22 @@ def test_glb_carries_a_color_attribute_as_color_0(tmp_path):
     np.testing.assert_allclose(back.point_data["color"], want, atol=1e-7)
 
 
+def _strict_lib3mf(lib3mf, path):
+    """The file read by lib3mf in strict mode, which must raise no warning."""
+    model = lib3mf.get_wrapper().CreateModel()
+    reader = model.QueryReader("3mf")
+    reader.SetStrictModeActive(True)
+    reader.ReadFromFile(path)
+    assert reader.GetWarningCount() == 0
+    return model
+
+
 def test_3mf_carries_a_color_attribute_as_a_colour_group(tmp_path):
     lib3mf = pytest.importorskip("lib3mf")
     g, out = _run(
         tmp_path, COLOURED + "  x: {type: export.3mf, meshes: ['@paint'], path: c.3mf}\n", "x"
     )
-    model = lib3mf.get_wrapper().CreateModel()
-    reader = model.QueryReader("3mf")
-    reader.SetStrictModeActive(True)
-    reader.ReadFromFile(out)
-    assert reader.GetWarningCount() == 0
+    model = _strict_lib3mf(lib3mf, out)
     groups = model.GetColorGroups()
     assert groups.MoveNext()
     group = groups.GetCurrentColorGroup()
@@ -394,3 +401,41 @@ def test_step_rational_curve_stays_a_circle_in_opencascade(tmp_path):
     for t in np.linspace(c.knots[0], c.knots[-1], 17):
         p = curve.Value(float(t))
         np.testing.assert_allclose([p.X(), p.Y(), p.Z()], c.evaluate([t])[0], atol=1e-12)
+
+
+def test_3mf_writes_a_base_material_only_for_a_mesh_without_vertex_colours(tmp_path):
+    """#33 item 19: the ``colors`` entry of a vertex-coloured mesh was written as a base
+    material nothing referenced."""
+    lib3mf = pytest.importorskip("lib3mf")
+    g, out = _run(
+        tmp_path,
+        COLOURED + "  box: {type: mesh.box, size: [1, 1, 1]}\n"
+        "  x: {type: export.3mf, meshes: ['@paint', '@box'], path: c.3mf,"
+        " colors: [red, '#0080ff']}\n",
+        "x",
+    )
+    with zipfile.ZipFile(out) as z:
+        text = z.read("3D/3dmodel.model").decode()
+    assert text.count("<base ") == 1 and 'displaycolor="#0080FFFF"' in text
+    model = _strict_lib3mf(lib3mf, out)
+    objects = model.GetMeshObjects()
+    props = []
+    while objects.MoveNext():
+        props.append(objects.GetCurrentMeshObject().GetObjectLevelProperty())
+    bases = model.GetBaseMaterialGroups()
+    assert bases.MoveNext()
+    base = bases.GetCurrentBaseMaterialGroup()
+    assert base.GetCount() == 1 and props[1][:2] == (
+        base.GetResourceID(),
+        base.GetAllPropertyIDs()[0],
+    )
+    colour = base.GetDisplayColor(base.GetAllPropertyIDs()[0])
+    assert (colour.Red, colour.Green, colour.Blue) == (0, 128, 255)
+    with zipfile.ZipFile(
+        _run(
+            tmp_path,
+            COLOURED + "  y: {type: export.3mf, meshes: ['@paint'], path: d.3mf, colors: [red]}\n",
+            "y",
+        )[1]
+    ) as z:
+        assert "basematerials" not in z.read("3D/3dmodel.model").decode()

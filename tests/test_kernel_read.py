@@ -16,7 +16,8 @@ from formgraph.kernels.io.gltf import read_gltf, write_glb
 from formgraph.kernels.io.mesh_read import read_obj, read_off, read_stl
 from formgraph.kernels.io.ply_read import read_ply
 from formgraph.kernels.io.textscan import ints_at, token_starts
-from formgraph.kernels.io.threemf import read_3mf, write_3mf
+from formgraph.kernels.io.threemf import write_3mf
+from formgraph.kernels.io.threemf_read import read_3mf
 
 FAST = settings(max_examples=40, deadline=None)
 
@@ -58,7 +59,8 @@ def test_stl_binary_round_trips_as_float32_facets(mesh):
 def test_3mf_round_trips_exactly(mesh, unit):
     v, fi, _ = mesh
     tris = fi[: (fi.size // 3) * 3].reshape(-1, 3)
-    ((_, back, t, _),) = read_3mf(write_3mf([(v, tris)], unit=unit))
+    back, t, _, items = read_3mf(write_3mf([(v, tris)], unit=unit))
+    assert items == 1
     scale = {"millimeter": 1.0, "inch": 25.4}[unit]
     assert np.array_equal(back, v * scale) and np.array_equal(t, tris)
 

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 import trimesh
 
-from formgraph.kernels.field import meshdist
+from formgraph.kernels.geometry import meshdist
 from formgraph.kernels.mesh import remesh as krem
 from formgraph.kernels.mesh import simplify as ksimp
 

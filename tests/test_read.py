@@ -247,7 +247,7 @@ def test_garbage_names_the_node_the_input_and_the_file(tmp_path, name, data, mat
 def test_a_3mf_zip_bomb_is_refused_by_its_budget(tmp_path):
     import zipfile
 
-    from formgraph.kernels.io.threemf import read_3mf
+    from formgraph.kernels.io.threemf_read import read_3mf
 
     buf = io.BytesIO()
     with zipfile.ZipFile(buf, "w", zipfile.ZIP_DEFLATED) as z:

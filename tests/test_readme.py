@@ -105,3 +105,18 @@ def test_every_dependency_is_explained():
     for requirement in names:
         name = re.split(r"[<>=\[ ;]", requirement, maxsplit=1)[0].lower()
         assert name in deps, f"{name} is installed but the README does not say why"
+
+
+def test_solids_from_outlines_example_runs():
+    (example,) = [b for b in blocks("yaml") if "A tag with a hole" in b]
+    g = fg.Graph.from_text(example)
+    tag = g.evaluate("tag")
+    assert tag.is_watertight and tag.volume > 0
+    assert (g.evaluate("check.parts"), g.evaluate("check.cavities")) == (1, 0)
+    assert len(g.evaluate("layers")) == 8  # four layers: an outline and the hole each
+    assert len(g.evaluate("shadow")) == 2
+    size = g.evaluate("box.size")
+    assert size[0] <= 40 + 1e-9 and size[1] <= 10 + 1e-9 and max(size[0] - 40, size[1] - 10) > -1e-9
+    for node in ("knob", "rounded"):
+        assert g.evaluate(node).is_watertight, node
+    assert g.evaluate("rounded").volume > g.evaluate("knob").volume

@@ -274,7 +274,9 @@ def test_the_readme_repeat_example_runs():
 
     readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
     (block,) = [
-        b for b in re.findall(r"```yaml\n(.*?)```", readme, flags=re.S) if "repeat: {i:" in b
+        b
+        for b in re.findall(r"```yaml\n(.*?)```", readme, flags=re.S)
+        if "repeat: {i:" in b and "rings:" in b
     ]
     g = fg.Graph.from_text("formgraph: 1\n" + block)
     assert len(g.evaluate("rings")) == 7

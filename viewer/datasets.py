@@ -20,6 +20,7 @@ from formgraph.geometry import (
     NurbsCurve,
     NurbsSurface,
     Points,
+    Solid,
     Surface,
 )
 
@@ -128,7 +129,8 @@ def datasets_of(items: Sequence[Geometry]) -> dict[str, Any]:
     curves = [g for g in items if isinstance(g, Curve)]
     surfaces = [g for g in items if isinstance(g, Surface)]
     meshes = [g for g in items if isinstance(g, Mesh) and g.n_faces]
-    previews = [g.display_mesh() for g in items if isinstance(g, Field)]  # fields: a preview
+    # fields: a preview; solids: brep.mesh's tessellation at its default tolerance
+    previews = [g.display_mesh() for g in items if isinstance(g, (Field, Solid))]
     meshes += [m for m in previews if m is not None and m.n_faces]
     surface_data = _merge([s.tessellate(*_surface_resolution(s)).to_pyvista() for s in surfaces])
     mesh_data = _merge([m.to_pyvista() for m in meshes])

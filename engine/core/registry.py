@@ -63,6 +63,13 @@ class NodeSpec:
     wants_context: bool
     multi_output: bool = False
     output_class: Any = None  # the NamedTuple of a node with several outputs
+    # an optional dependency the node needs: a callable that says, in a sentence, what is
+    # missing and how to install it (None when it is there); asked by the check
+    requires: Callable[[], str | None] | None = None
+
+    def missing(self) -> str | None:
+        """What this node needs and is not installed (a sentence), or None."""
+        return self.requires() if self.requires is not None else None
 
     @property
     def family(self) -> str:
@@ -131,10 +138,15 @@ _SORTED: dict[str, NodeSpec] = {}  # _REGISTRY in name order, rebuilt after a ch
 _SORTED_AT = [-1]  # the _REGISTRY.changes that _SORTED was built at
 
 
-def node(name: str, *, version: int = 1) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
+def node(
+    name: str, *, version: int = 1, requires: Callable[[], str | None] | None = None
+) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
     """Register a function as the node type ``name`` (e.g. ``"points.circle"``).
 
     ``version`` is part of every cache key: bump it when the node's results change.
+    ``requires`` names an optional dependency: a callable giving None when it is
+    installed, else the sentence the check reports (what is missing, how to install it),
+    so a graph using the node fails at ``formgraph check``, located, not at run time.
     """
     if not re.fullmatch(r"[a-z][a-z0-9_]*\.[a-z0-9][a-z0-9_]*", name):  # export.3mf
         raise ValueError(f"node type names are 'family.name' in lower case, got {name!r}")
@@ -142,7 +154,7 @@ def node(name: str, *, version: int = 1) -> Callable[[Callable[..., Any]], Calla
     def register(func: Callable[..., Any]) -> Callable[..., Any]:
         if name in _REGISTRY and _REGISTRY[name].func.__qualname__ != func.__qualname__:
             raise ValueError(f"node type {name!r} is registered twice")
-        _REGISTRY[name] = _spec_from_function(name, version, func)
+        _REGISTRY[name] = _spec_from_function(name, version, func, requires)
         return func
 
     return register
@@ -161,7 +173,12 @@ def node_types() -> dict[str, NodeSpec]:
     return dict(_SORTED)
 
 
-def _spec_from_function(name: str, version: int, func: Callable[..., Any]) -> NodeSpec:
+def _spec_from_function(
+    name: str,
+    version: int,
+    func: Callable[..., Any],
+    requires: Callable[[], str | None] | None = None,
+) -> NodeSpec:
     hints = typing.get_type_hints(func, include_extras=True)
     sig = inspect.signature(func)
     docs = parse_param_docs(func.__doc__ or "")
@@ -197,6 +214,7 @@ def _spec_from_function(name: str, version: int, func: Callable[..., Any]) -> No
         wants_context,
         multi,
         ret if multi else None,
+        requires,
     )
 
 

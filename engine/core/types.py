@@ -26,6 +26,7 @@ from ..geometry import (
     NurbsCurve,
     NurbsSurface,
     Points,
+    Solid,
     Surface,
     as_xyz,
     frozen_array,
@@ -149,6 +150,7 @@ GEOMETRY_TYPES: dict[str, type] = {
     "NurbsSurface": NurbsSurface,
     "Mesh": Mesh,
     "Field": Field,
+    "Solid": Solid,
 }
 SCALARS: dict[str, type] = {"int": int, "float": float, "bool": bool, "str": str}
 

@@ -15,6 +15,7 @@ part of their equality, hash, state and ``to_pyvista()``. The math lives in
 - ``surfaces``: :class:`Surface`, :class:`NurbsSurface`, :class:`ParametricSurface`
 - ``mesh``: :class:`Mesh`
 - ``field``: :class:`Field`, a signed distance function kept as its recipe
+- ``solid``: :class:`Solid`, an exact B-rep solid (OpenCASCADE, the extra ``formgraph[brep]``)
 """
 
 from __future__ import annotations
@@ -34,6 +35,7 @@ from .curves import Curve, NurbsCurve, ParametricCurve
 from .field import Field
 from .mesh import Mesh
 from .points import Points
+from .solid import Solid
 from .surfaces import NurbsSurface, ParametricSurface, Surface
 
 __all__ = [
@@ -48,6 +50,7 @@ __all__ = [
     "ParametricCurve",
     "ParametricSurface",
     "Points",
+    "Solid",
     "Surface",
     "as_xyz",
     "attribute_map",

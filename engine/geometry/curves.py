@@ -89,18 +89,29 @@ class NurbsCurve(Curve):
         object.__setattr__(self, "rational", bool(rational))
 
     @classmethod
-    def _of_valid(cls, control_points: np.ndarray, degree: int, knots: np.ndarray) -> NurbsCurve:
+    def _of_valid(
+        cls,
+        control_points: np.ndarray,
+        degree: int,
+        knots: np.ndarray,
+        ones: np.ndarray | None = None,
+    ) -> NurbsCurve:
         """A non-rational curve of frozen arrays a kernel built valid (finite (n, 3) points,
         non-decreasing knots of the right count): made without checking them again. For
-        kernels that make many or long curves, e.g. the outlines of a region boolean."""
+        kernels that make many or long curves, e.g. the outlines of a region boolean;
+        ``ones``, a frozen array of ones as long as the control points, lets many curves
+        share one buffer of weights (each a view of it)."""
         from .base import is_frozen
 
         assert is_frozen(control_points) and is_frozen(knots)
+        if ones is None:
+            ones = frozen_array(np.ones(len(control_points)))
+        assert len(ones) == len(control_points) and is_frozen(ones)
         curve = object.__new__(cls)
         object.__setattr__(curve, "control_points", control_points)
         object.__setattr__(curve, "degree", int(degree))
         object.__setattr__(curve, "knots", knots)
-        object.__setattr__(curve, "weights", frozen_array(np.ones(len(control_points))))
+        object.__setattr__(curve, "weights", ones)
         object.__setattr__(curve, "rational", False)
         return curve
 

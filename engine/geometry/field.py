@@ -362,28 +362,18 @@ def _expression(field: Field, p: np.ndarray) -> np.ndarray:
 
 
 def _from_mesh(field: Field, p: np.ndarray) -> np.ndarray:
-    from ..kernels.field import meshdist
+    from ..kernels.geometry import meshdist
 
     cache = field._cache
     if "signed" not in cache:
         mesh = field.args["mesh"]
-        cache["signed"] = meshdist.SignedDistance(mesh.vertices, _triangles(mesh))
+        tri, _ = meshdist.fan_triangles(mesh.face_indices, mesh.face_offsets)
+        cache["signed"] = meshdist.SignedDistance(mesh.vertices, tri)
     return cache["signed"](p)
 
 
-def _triangles(mesh: Any) -> np.ndarray:
-    """(t, 3) triangle corners of a polygon mesh (fans: faces of a closed mesh stay closed)."""
-    fo = np.asarray(mesh.face_offsets)
-    fi = np.asarray(mesh.face_indices)
-    sizes = np.diff(fo)
-    face = np.repeat(np.arange(len(sizes)), sizes - 2)
-    k = np.arange(len(face)) - np.repeat(np.cumsum(sizes - 2) - (sizes - 2), sizes - 2)
-    first = fo[:-1][face]
-    return np.stack([fi[first], fi[first + k + 1], fi[first + k + 2]], axis=1)
-
-
 def _from_curves(field: Field, p: np.ndarray) -> np.ndarray:
-    from ..kernels.field import meshdist
+    from ..kernels.geometry import meshdist
 
     cache = field._cache
     if "nearest" not in cache:

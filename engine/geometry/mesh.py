@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import functools
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -102,6 +103,15 @@ class Mesh(Geometry):
             out, "face_data", attribute_map(face_data, len(fo) - 1, "face attribute")
         )
         return out
+
+    def derived(self, kind: str, make: Callable[[], Any]) -> Any:
+        """``make()``, computed once per mesh and ``kind`` and kept with the mesh (which
+        never changes): an index a node builds to answer many questions about one mesh,
+        such as the sections of a stack (the items of a ``repeat:``)."""
+        kept = self.__dict__.setdefault("_derived", {})
+        if kind not in kept:
+            kept[kind] = make()
+        return kept[kind]
 
     @property
     def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -316,6 +316,9 @@ def _check_node(
 
     for port, message in nd.parse_errors.items():
         add(message, port)
+    missing = spec.missing()
+    if missing:  # an optional dependency that is not installed: said before anything runs
+        out.append(Problem(Where(file, nd.input_lines.get("type", nd.line), nd.name), missing))
     repeat_problems, loop = _check_repeat(g, nd, registry)
     for message in repeat_problems:
         add(message, "repeat")

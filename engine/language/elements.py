@@ -71,16 +71,9 @@ class ElementValue:
     def names(self) -> set[str]:
         return {n for p in self.parts if isinstance(p, Bound) for n in p.compiled.names}
 
-    def evaluate(self, env: Mapping[str, Any], count: int, what: str = "elements") -> np.ndarray:
-        """The value for each of ``count`` elements: ``(count,)`` for one expression that
-        gives a number per element, ``(count, k)`` for a vector.
-
-        Raises
-        ------
-        ValueError
-            A name that is neither a param, a variable nor an attribute (the message lists
-            the attributes that exist); a result that is not finite or has the wrong shape.
-        """
+    def _check_names(self, env: Mapping[str, Any], what: str) -> None:
+        """Raise ValueError naming the first name that is neither a param, a variable nor
+        an attribute, with the attributes that exist."""
         for p in self.parts:
             if not isinstance(p, Bound):
                 continue
@@ -93,6 +86,47 @@ class ElementValue:
                     f"variable ({', '.join(n for n in VARIABLES if n in env)}) or an "
                     f"attribute of the {what} (attributes: {have})"
                 )
+
+    def mask(self, env: Mapping[str, Any], count: int, what: str = "elements") -> np.ndarray:
+        """The value as one bool per element, ``(count,)``: the expression must give true or
+        false (a comparison, combined by ``and`` / ``or`` / ``not``), not numbers.
+
+        Raises
+        ------
+        ValueError
+            A list of components, a name that does not exist, a result of numbers.
+        """
+        if self.vector:
+            raise ValueError(f"{self.text} is a list; a test is one expression, e.g. '=z > 10'")
+        p = self.parts[0]
+        if not isinstance(p, Bound):
+            return np.full(count, bool(p))
+        self._check_names(env, what)
+        with np.errstate(all="ignore"):
+            v = np.asarray(p.compiled(p.params, **env))
+        if v.dtype != np.bool_:
+            kind = "numbers" if np.issubdtype(v.dtype, np.number) else f"{v.dtype} values"
+            raise ValueError(
+                f"'={p.text}' gives {kind}, not true or false: write a test such as "
+                f"'=z > 10' or '=rand(i) < 0.5' (and, or, not combine tests)"
+            )
+        if v.ndim == 0:
+            return np.full(count, bool(v))
+        if v.shape != (count,):
+            raise ValueError(f"'={p.text}' gives an array of shape {v.shape}, not one per element")
+        return v
+
+    def evaluate(self, env: Mapping[str, Any], count: int, what: str = "elements") -> np.ndarray:
+        """The value for each of ``count`` elements: ``(count,)`` for one expression that
+        gives a number per element, ``(count, k)`` for a vector.
+
+        Raises
+        ------
+        ValueError
+            A name that is neither a param, a variable nor an attribute (the message lists
+            the attributes that exist); a result that is not finite or has the wrong shape.
+        """
+        self._check_names(env, what)
         cols = []
         for j, p in enumerate(self.parts):
             if isinstance(p, Bound):

@@ -164,7 +164,7 @@ def file_value(name: str, declared: Any, text: str) -> Any:
         raise GraphError(f"--set {name}: {exc}") from None
     try:
         if base is Mesh and not many:
-            v, fi, fo, attributes = readers.mesh_data(text, data)
+            v, fi, fo, attributes = readers.mesh_data(text, data, DEFAULT_BUDGET)
             return Mesh(v, fi, fo, point_data=attributes or None)
         if base is Points and not many:
             ext = readers.extension(text, readers.POINT_FORMATS)
@@ -184,7 +184,7 @@ def file_value(name: str, declared: Any, text: str) -> Any:
             return curves[0]
     except (ValueError, IndexError, KeyError, TypeError, OverflowError, RecursionError,
             struct.error, zlib.error) as exc:  # fmt: skip
-        raise GraphError(f"--set {name}: cannot read {text!r}: {exc}") from None
+        raise GraphError(f"--set {name}: cannot read {text!r}: {readers.in_words(exc)}") from None
     raise GraphError(
         f"--set {name}: a {declared.name} param is not read from a file (Mesh, Points, Curve "
         f"and list[Curve] are)"

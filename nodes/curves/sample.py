@@ -63,6 +63,23 @@ class CurveMeasures(NamedTuple):
     closed: bool
 
 
+def breaks_of(curve: Curve) -> np.ndarray:
+    """The quadrature intervals of a curve: every knot span of a NURBS curve split in 8 (a
+    polyline's spans whole); a parametric curve's ``samples`` intervals, split where needed
+    until the length is good to 1e-12 of itself (its derivatives are exact)."""
+    t0, t1 = curve.domain
+    if isinstance(curve, NurbsCurve):
+        knots = np.unique(curve.knots[(curve.knots >= t0) & (curve.knots <= t1)])
+        split = 1 if curve.degree == 1 else 8
+        steps = np.arange(split) / split
+        inner = knots[:-1, None] + np.diff(knots)[:, None] * steps
+        return np.append(inner.reshape(-1), knots[-1])
+    breaks = np.linspace(t0, t1, max(2, getattr(curve, "samples", 256)) + 1)
+    return refine_breaks(  # exact derivatives, so the quadrature alone limits it
+        lambda t: np.linalg.norm(curve.derivative(t), axis=1), breaks, rtol=1e-12
+    )
+
+
 @node("curves.measure", version=2)
 def measure(curve: Curve) -> CurveMeasures:
     """Length of a curve, the area it encloses if closed and planar, and whether it is closed.
@@ -78,20 +95,10 @@ def measure(curve: Curve) -> CurveMeasures:
     curve : Curve
         Any curve.
     """
-    t0, t1 = curve.domain
-    if isinstance(curve, NurbsCurve):
-        knots = np.unique(curve.knots[(curve.knots >= t0) & (curve.knots <= t1)])
-        split = 1 if curve.degree == 1 else 8
-        steps = np.arange(split) / split
-        inner = knots[:-1, None] + np.diff(knots)[:, None] * steps
-        breaks = np.append(inner.reshape(-1), knots[-1])
-    else:
-        breaks = np.linspace(t0, t1, max(2, getattr(curve, "samples", 256)) + 1)
-        breaks = refine_breaks(  # exact derivatives, so the quadrature alone limits it
-            lambda t: np.linalg.norm(curve.derivative(t), axis=1), breaks, rtol=1e-12
-        )
     closed = curve.closed
-    length, area = kmeasure.length_and_area(curve.evaluate, curve.derivative, breaks, closed)
+    length, area = kmeasure.length_and_area(
+        curve.evaluate, curve.derivative, breaks_of(curve), closed
+    )
     return CurveMeasures(length=length, area=area, closed=closed)
 
 

@@ -14,6 +14,7 @@ from formgraph.core.registry import Context, Range, node
 from formgraph.core.types import InputPath, Vec3
 from formgraph.geometry import Curve, NurbsCurve, frozen_array
 from formgraph.kernels.curves import text as ktext
+from formgraph.kernels.geometry import MAX_COORDINATE
 
 
 class Align(str, Enum):
@@ -102,6 +103,16 @@ def text(
             "missing-glyph box"
         )
     ctx.guard(len(pts), "glyph control points")
+    with np.errstate(all="ignore"):
+        extent = np.abs(np.asarray(pts, dtype=float)).max(initial=0) + np.abs(position).max()
+    if not extent <= MAX_COORDINATE:
+        raise InputError(
+            "size",
+            f"size {size:g} (at position {[float(x) for x in position]}) puts the text's outline "
+            f"{'past any finite number' if not np.isfinite(extent) else f'at {extent:.3g}'}, "
+            f"beyond {MAX_COORDINATE:g} mm where a double no longer holds a tenth of a "
+            "millimetre",
+        )
     # one frozen array for all the control points: each curve's are a view of it (shared,
     # not copied), and the knots of each piece count are made once
     xyz = frozen_array(np.c_[pts, np.zeros(len(pts))] + np.asarray(position))

@@ -16,7 +16,7 @@ import numpy as np
 from formgraph.core.errors import InputError
 from formgraph.core.registry import Context, node
 from formgraph.core.types import OutputPath
-from formgraph.geometry import Curve, Mesh, NurbsCurve, NurbsSurface, Surface
+from formgraph.geometry import Curve, Mesh, NurbsCurve, NurbsSurface, Solid, Surface
 from formgraph.kernels.io import colors, gltf, rhino, step, threemf
 from formgraph.kernels.io.meshdata import mesh_report
 from formgraph.kernels.mesh import meshops
@@ -180,11 +180,18 @@ def export_step(
     curves: list[Curve] | None = None,
     surfaces: list[Surface] | None = None,
     meshes: list[Mesh] | None = None,
+    solids: list[Solid] | None = None,
+    names: list[str] | None = None,
+    colors: list[str] | None = None,
     *,
     ctx: Context,
 ) -> str:
-    """Write exact NURBS geometry (and meshes) as STEP, ISO 10303-21 AP214, for CAD.
+    """Write exact solids, NURBS geometry and meshes as STEP, ISO 10303-21 AP214, for CAD.
 
+    Solids (``brep.*``) become manifold solid B-reps of faces on their exact surfaces
+    (planes, cylinders, tori, B-splines), each its own product, named (``names``, default
+    ``solid 1``, ``solid 2``, ...) and coloured (``colors``), as OpenCASCADE's STEP
+    translator writes them: what CAD and CAM programs machine from.
     Surfaces become ``B_SPLINE_SURFACE_WITH_KNOTS`` (rational where weighted), each the face
     of its own shell in a shell-based surface model, bounded by its parameter domain's edges
     (a pole left out, a seam one edge used both ways): Fusion, SolidWorks and FreeCAD open
@@ -202,8 +209,23 @@ def export_step(
         NURBS surfaces.
     meshes : list[Mesh] | None
         Meshes, as faceted solids when closed.
+    solids : list[Solid] | None
+        Exact solids, as manifold solid B-reps.
+    names : list[str] | None
+        One name per solid (its product's name in CAD's tree).
+    colors : list[str] | None
+        One CSS colour per solid (``"#c0392b"``, ``"steelblue"``).
+
+    Example
+    -------
+    ``step: {type: export.step, path: bracket.step, solids: ["@bracket"], names: [bracket]}``
     """
-    _something(curves, surfaces, meshes, "STEP")
+    solids = solids or []
+    if not solids:
+        for port, given in (("names", names), ("colors", colors)):
+            if given:
+                raise InputError(port, f"{port} are given per solid, and there are no solids")
+        _something(curves, surfaces, meshes, "STEP")
     c = _nurbs_curves(curves or [], "curves")
     s = _nurbs_surfaces(surfaces or [], "surfaces")
     meshes = meshes or []
@@ -213,11 +235,46 @@ def export_step(
         + 8 * sum(m.n_faces for m in meshes),
         "STEP entities",
     )
+    attach = _solids_step(solids, names, colors, path) if solids else b""
+    if solids and not (c or s or meshes):
+        return str(ctx.write(path, attach))
     m = [
         (x.vertices, x.face_indices, x.face_offsets, mesh_report(*_arrays(x)).watertight)
         for x in meshes
     ]
-    return str(ctx.write(path, step.write_step(curves=c, surfaces=s, meshes=m)))
+    data = step.write_step(curves=c, surfaces=s, meshes=m, attach=attach)
+    return str(ctx.write(path, data))
+
+
+def _solids_step(
+    solids: list[Solid], names: list[str] | None, colours: list[str] | None, path: str
+) -> bytes:
+    """The STEP file of the solids, one named (coloured) product each."""
+    from formgraph.kernels.brep import BrepError, stepwrite
+
+    n = len(solids)
+    for port, given in (("names", names), ("colors", colours)):
+        if given is not None and len(given) != n:
+            raise InputError(port, f"{len(given)} {port} for {n} solids: give one each")
+    for k, x in enumerate(solids):
+        if x.is_empty:
+            raise InputError("solids", f"solid {k} is empty: there is nothing to write")
+    rgb = []
+    for value in colours or [None] * n:
+        if value is None:
+            rgb.append(None)
+            continue
+        try:
+            r, g, b = colors.rgb(value)
+        except ValueError as exc:
+            raise InputError("colors", str(exc)) from None
+        rgb.append((r / 255, g / 255, b / 255))
+    label = names or [f"solid {k + 1}" for k in range(n)]
+    title = path.rsplit("/", 1)[-1].rsplit(".", 1)[0] or "formgraph"
+    try:
+        return stepwrite.write([x.shape for x in solids], list(label), rgb, title)
+    except BrepError as exc:
+        raise InputError("solids", str(exc)) from None
 
 
 @node("export.rhino", version=1)

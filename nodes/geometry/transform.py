@@ -22,6 +22,7 @@ from formgraph.geometry import (
     ParametricCurve,
     ParametricSurface,
     Points,
+    Solid,
 )
 from formgraph.kernels.attributes import propagate as carry
 from formgraph.kernels.geometry import affine
@@ -116,6 +117,8 @@ def transform_one(g: Geometry, linear: np.ndarray, offset: np.ndarray) -> Geomet
             carry.turn(g.point_data, linear),
             carry.turn(g.face_data, linear),
         )
+    if isinstance(g, Solid):  # exact: a motion moves it, a scale maps its geometry
+        return g.transformed(linear, offset)
     raise ValueError(f"cannot transform a {type(g).__name__}")
 
 

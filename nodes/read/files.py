@@ -42,7 +42,9 @@ def parsed(path: str, what: str, fn, *args):
     except RecursionError:
         raise InputError("path", f"{path!r}: nested too deeply to read as {what}") from None
     except PARSE_ERRORS as exc:
-        raise InputError("path", f"{path!r}: cannot read it as {what}: {exc}") from None
+        raise InputError(
+            "path", f"{path!r}: cannot read it as {what}: {readers.in_words(exc)}"
+        ) from None
 
 
 @node("read.mesh", version=2)
@@ -75,7 +77,7 @@ def mesh(path: InputPath, weld: bool = False, *, ctx: Context) -> Mesh:
     ``part: {type: read.mesh, path: scan.stl, weld: true}``
     """
     _, data = ctx.read(path)
-    v, fi, fo, attributes = parsed(path, "a mesh", readers.mesh_data, path, data)
+    v, fi, fo, attributes = parsed(path, "a mesh", readers.mesh_data, path, data, ctx.budget)
     ctx.guard(len(fo) - 1, "faces")
     if weld:
         if attributes:

@@ -101,7 +101,7 @@ def test_a_ply_claiming_a_billion_faces_allocates_nothing(tmp_path):
 
 
 def test_a_3mf_member_lying_about_its_size_stops_at_the_cap(tmp_path):
-    from formgraph.kernels.io.threemf import read_3mf
+    from formgraph.kernels.io.threemf_read import read_3mf
 
     path = tmp_path / "bomb.3mf"
     with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as z:
@@ -113,7 +113,7 @@ def test_a_3mf_member_lying_about_its_size_stops_at_the_cap(tmp_path):
 def test_a_3mf_with_a_dtd_is_refused(tmp_path):
     import io
 
-    from formgraph.kernels.io.threemf import read_3mf
+    from formgraph.kernels.io.threemf_read import read_3mf
 
     buf = io.BytesIO()
     with zipfile.ZipFile(buf, "w") as z:

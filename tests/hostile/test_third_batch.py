@@ -97,8 +97,9 @@ def test_a_minsert_grid_over_the_budget_is_refused_before_expanding(tmp_path):
     # was: 10^10 copies expanded one virtual entity at a time (hung)
     with pytest.raises(
         fg.NodeError,
-        match=r"node 'c', input 'path'.*a MINSERT of "
-        r"10,000,000,000 copies expands to more than 1,000,000 entities",
+        match=r"node 'c', input 'path'.*blocks expand to 10,000,000,001 entities, over the "
+        r"budget of 1,000,000: INSERT \w+ of block 'B' \(10,000,000,000 copies, a MINSERT's "
+        r"rows x columns\) alone makes 10,000,000,000",
     ):
         _read(tmp_path, "a.dxf", (tmp_path / "a.dxf").read_bytes())
 

@@ -13,8 +13,9 @@ attributes follow exactly the same stencils as the points.
 
 A surface made anew from another (decimated, remeshed, offset) has no operation weights
 to follow: :func:`onto` finds for each new point the closest point of the old surface
-(an exact nearest-triangle query) and interpolates there by barycentric weights, and gives
-each new face the old face nearest its centroid.
+(the exact nearest-triangle query of :mod:`formgraph.kernels.geometry.meshdist`, the one
+``attr.transfer`` uses) and interpolates there by barycentric weights, and gives each new
+face the old face nearest its centroid.
 
 A ``normal`` attribute (three components) is a direction, not a position: :func:`turn`
 maps it by the inverse transpose of the linear part and renormalizes it.
@@ -263,102 +264,6 @@ def by_position(source: np.ndarray, target: np.ndarray) -> np.ndarray:
     return np.where(found, order[pos], -1)
 
 
-def _dot(x: np.ndarray, y: np.ndarray) -> np.ndarray:
-    return np.einsum("ij,ij->i", x, y)
-
-
-class _Closest:
-    """The closest point of a set of triangles ``corners`` (t, 3, 3) to many points: the
-    nearest triangle and the point's barycentric (v, w) there, exactly.
-
-    Each point looks at the triangles of its k nearest centres (scipy's cKDTree): the
-    ``FIRST`` nearest exactly, then only those whose centre distance less their own reach
-    (centre to farthest corner) could still beat the best so far. The best is certain when
-    the last candidate's centre is farther than the best distance plus the largest reach
-    of all (no other triangle can come nearer); a point left uncertain tries a larger k
-    (``CANDIDATES``), and the few left after that go through ``field.meshdist.Nearest``'s
-    exact tree.
-    """
-
-    CANDIDATES = (32, 128)  # per round
-    FIRST = 4
-    CHUNK = 1 << 14  # points per round: bounds the (point, candidate) pairs held at once
-
-    def __init__(self, corners: np.ndarray):
-        from scipy.spatial import cKDTree
-
-        self.corners = corners
-        self.a = corners[:, 0]
-        self.e1, self.e2 = corners[:, 1] - self.a, corners[:, 2] - self.a
-        self.aa, self.ab = _dot(self.e1, self.e1), _dot(self.e1, self.e2)
-        self.bb = _dot(self.e2, self.e2)
-        centre = corners.mean(axis=1)
-        self.reach = np.linalg.norm(corners - centre[:, None], axis=2).max(axis=1)
-        self.max_reach = float(self.reach.max())
-        self.centres = cKDTree(centre)
-        self.exact: Any = None  # the tree, built if a point needs it
-
-    def pairs(self, p: np.ndarray, tri: np.ndarray) -> tuple[np.ndarray, ...]:
-        """Distances and (v, w) from points ``p`` to triangles ``tri``, pair by pair."""
-        from ..field.meshdist import _triangle_coefficients
-
-        ap, e1, e2 = p - self.a[tri], self.e1[tri], self.e2[tri]
-        v, w = _triangle_coefficients(
-            _dot(e1, ap), _dot(e2, ap), self.aa[tri], self.ab[tri], self.bb[tri]
-        )
-        bad = ~(np.isfinite(v) & np.isfinite(w))
-        if bad.any():  # no area and no edge to follow: the nearest corner alone
-            far = np.linalg.norm(p[bad, None, :] - self.corners[tri[bad]], axis=2)
-            best = np.argmin(far, axis=1)
-            v[bad], w[bad] = best == 1, best == 2
-        dist = np.linalg.norm(ap - v[:, None] * e1 - w[:, None] * e2, axis=1)
-        return dist, v, w
-
-    def query(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(tri, v, w) of each point's closest point."""
-        n = len(points)
-        tri, v, w = np.empty(n, np.int64), np.empty(n), np.empty(n)
-        for s in range(0, n, self.CHUNK):
-            at = np.arange(s, min(s + self.CHUNK, n))
-            for k in self.CANDIDATES:  # more candidates for the points still uncertain
-                at = self._round(points, at, min(k, len(self.corners)), tri, v, w)
-                if not at.size:
-                    break
-            if at.size:
-                if self.exact is None:
-                    from ..field.meshdist import Nearest
-
-                    self.exact = Nearest(self.corners)
-                t = self.exact.nearest(points[at])[1]
-                tri[at] = t
-                _, v[at], w[at] = self.pairs(points[at], t)
-        return tri, v, w
-
-    def _round(self, points, at, k, tri, v, w) -> np.ndarray:
-        """The best of ``k`` candidates for the points ``at``; returns those uncertain."""
-        p = points[at]
-        first = min(self.FIRST, k)
-        dc, cand = self.centres.query(p, k)
-        dc, cand = dc.reshape(len(p), k), cand.reshape(len(p), k)
-        dist = np.full((len(p), k), np.inf)
-        cv, cw = np.zeros((len(p), k)), np.zeros((len(p), k))
-        head = (slice(None), slice(0, first))
-        pp = np.repeat(p, first, axis=0)
-        dist[head], cv[head], cw[head] = (
-            x.reshape(len(p), first) for x in self.pairs(pp, cand[head].ravel())
-        )
-        bound = dist[head].min(axis=1)
-        i, j = np.nonzero(dc[:, first:] - self.reach[cand[:, first:]] < bound[:, None])
-        j += first
-        dist[i, j], cv[i, j], cw[i, j] = self.pairs(p[i], cand[i, j])
-        best = np.argmin(dist, axis=1)
-        row = np.arange(len(p))
-        tri[at], v[at], w[at] = cand[row, best], cv[row, best], cw[row, best]
-        if k == len(self.corners):
-            return at[:0]
-        return at[dc[:, -1] < dist[row, best] + self.max_reach]
-
-
 def onto(
     source: Any,
     vertices: np.ndarray,
@@ -396,14 +301,16 @@ def onto(
     if triangles is None:
         _, tfi, _ = triangulate(sv, source.face_indices, source.face_offsets, max_tests)
         triangles = tfi.reshape(-1, 3)
+    from ..geometry.meshdist import Nearest
+
     face_of = np.repeat(np.arange(source.n_faces), np.diff(source.face_offsets) - 2)
-    closest = _Closest(sv[triangles])
+    closest = Nearest(sv[triangles])
     p = np.asarray(vertices, np.float64).reshape(-1, 3)
     if pd and len(p):
-        tri, v, w = closest.query(p)
+        _, tri, v, w = closest.locate(p)
         point = barycentric(triangles[tri], np.column_stack([v, w]))
     fi, fo = (np.asarray(x, np.int64) for x in faces)
     if fd and fo.size > 1:
         centre = np.add.reduceat(p[fi], fo[:-1]) / np.diff(fo)[:, None]
-        face = copy(face_of[closest.query(centre)[0]])
+        face = copy(face_of[closest.nearest(centre)[1]])
     return carried(source, point, face)

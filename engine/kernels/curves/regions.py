@@ -296,6 +296,8 @@ def rings_of(
         parts = np.array([region], dtype=object)
     else:
         parts = shapely.get_parts(region)
+        if (shapely.get_type_id(parts) == 6).any():  # a collection holding a MultiPolygon
+            parts = shapely.get_parts(parts)  # (as make_valid gives: polygons and lines)
         parts = parts[shapely.get_type_id(parts) == 3]  # polygons only
     parts = parts[~shapely.is_empty(parts)]
     if len(parts) == 0:

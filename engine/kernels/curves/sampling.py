@@ -13,17 +13,19 @@ once (vectorized over pieces and samples).
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable
 
 import numpy as np
 
-from ..nurbs import decompose_bezier
+from ..nurbs import decompose_bezier, decompose_bezier_batch, validate_curve
 
 __all__ = [
     "bezier_pieces",
     "chord_gap",
     "piece_jet",
+    "points_within",
     "polyline_at_lengths",
     "refine_chords",
     "sample_closed_batch",
@@ -35,12 +37,14 @@ _SAFETY = 1.5  # on the sampled maximum of |C''|
 _ROUNDS = 40  # midpoint refinement rounds (each halves the worst chord)
 
 
+@functools.lru_cache(maxsize=16)
 def _power_matrix(p: int) -> np.ndarray:
     """M with Bernstein B_{i,p}(t) = sum_j M[i, j] t**j."""
     m = np.zeros((p + 1, p + 1))
     for i in range(p + 1):  # degree + 1 rows: a tiny constant matrix
         for j in range(i, p + 1):
             m[i, j] = math.comb(p, i) * math.comb(p - i, j - i) * (-1) ** (j - i)
+    m.flags.writeable = False  # (kept: one per degree)
     return m
 
 
@@ -57,15 +61,22 @@ def _steps(curv: np.ndarray, tol: float) -> np.ndarray:
 
 
 def bezier_pieces(
-    control_points: np.ndarray, degree: int, knots: np.ndarray, weights: np.ndarray | None
+    control_points: np.ndarray,
+    degree: int,
+    knots: np.ndarray,
+    weights: np.ndarray | None,
+    validate: bool = True,
 ) -> np.ndarray:
     """Homogeneous power-form coefficients of each Bezier piece in XY: (k, p + 1, 3).
 
     Row j of piece k holds the t**j coefficients of (w x, w y, w) on t in [0, 1].
+    ``validate=False`` for a curve checked when it was made.
     """
-    seg, sw = decompose_bezier(control_points, degree, knots, weights)
-    w = np.ones(seg.shape[:2]) if sw is None else sw
-    hom = np.concatenate([seg[:, :, :2] * w[:, :, None], w[:, :, None]], axis=2)
+    seg, _ = decompose_bezier(control_points, degree, knots, weights, validate, projected=False)
+    if weights is None:  # (w x, w y, w) with w = 1
+        hom = np.concatenate([seg[:, :, :2], np.ones(seg.shape[:2] + (1,))], axis=2)
+    else:
+        hom = seg[:, :, [0, 1, 3]]
     return np.einsum("ij,kic->kjc", _power_matrix(degree), hom)
 
 
@@ -104,12 +115,13 @@ def piece_jet(coef: np.ndarray, piece: int, t: float) -> tuple[np.ndarray, np.nd
 
 
 def chord_gap(a: np.ndarray, b: np.ndarray, p: np.ndarray) -> np.ndarray:
-    """Distance from each point ``p`` to the chord ``a -> b`` (all (m, 2))."""
+    """Distance from each point ``p`` to the chord ``a -> b`` (all (m, 2) or (m, 3))."""
     ab = b - a
     den = np.einsum("ij,ij->i", ab, ab)
     num = np.einsum("ij,ij->i", p - a, ab)
     s = np.clip(np.divide(num, den, out=np.zeros_like(den), where=den > 0), 0.0, 1.0)
-    return np.hypot(*(p - a - s[:, None] * ab).T)
+    gap = p - a - s[:, None] * ab
+    return np.hypot(*gap.T) if gap.shape[1] == 2 else np.linalg.norm(gap, axis=1)
 
 
 def refine_chords(
@@ -123,9 +135,9 @@ def refine_chords(
 
     Parameters
     ----------
-    evaluate : callable (m,) parameters -> (m, 2) points
+    evaluate : callable (m,) parameters -> (m, 2) or (m, 3) points
     u : (n,) increasing parameters, the last the end of the curve
-    points : (n, 2) the curve at ``u``
+    points : (n, 2) or (n, 3) the curve at ``u``
     tol : float
     guard : callable of the sample count, called before each round grows the sampling
 
@@ -280,8 +292,10 @@ def sample_closed_batch(
     tol: float,
     guard: Callable[[int], None] | None = None,
     params: bool = False,
+    validate: bool = True,
 ) -> list[np.ndarray] | list[tuple[np.ndarray, np.ndarray]]:
-    """:func:`sample_nurbs` of many closed curves of one degree (>= 2) at once.
+    """:func:`sample_nurbs` of many closed curves of one degree (>= 2) at once
+    (``validate=False`` for curves checked when they were made).
 
     Every curve's Bezier pieces go into one array, so the curvature bound, the sampling and
     each round of midpoint refinement are one vectorized pass over all of them (a line of
@@ -301,9 +315,12 @@ def sample_closed_batch(
     degrees = {int(c[1]) for c in curves}
     if len(degrees) != 1 or min(degrees) < 2:
         raise ValueError(f"a batch is of one degree >= 2, got degrees {sorted(degrees)}")
-    coef = [bezier_pieces(np.asarray(cp, dtype=np.float64), p, kn, w) for cp, p, kn, w in curves]
-    k = np.array([c.shape[0] for c in coef])
-    coef_all = np.concatenate(coef)
+    if validate:
+        for cp, p, kn, w in curves:
+            validate_curve(np.asarray(cp, dtype=np.float64), p, kn, w)
+    # every curve's Bezier pieces in one pass of the blossoms, then (w x, w y, w) in power form
+    seg, k = decompose_bezier_batch(curves)
+    coef_all = np.einsum("ij,kic->kjc", _power_matrix(int(curves[0][1])), seg[:, :, [0, 1, 3]])
     first_piece = np.concatenate([[0], np.cumsum(k)[:-1]])
     base = first_piece + np.arange(len(k))  # the gap of 1 before each next curve
     # the curvature bound per piece, then equal steps
@@ -358,3 +375,46 @@ def sample_closed_batch(
 def _breaks(curve: tuple[np.ndarray, int, np.ndarray, np.ndarray | None]) -> np.ndarray:
     cp, p, kn, _ = curve
     return np.unique(np.asarray(kn, dtype=np.float64)[p : len(cp) + 1])
+
+
+def points_within(
+    evaluate: Callable[[np.ndarray], np.ndarray],
+    second: Callable[[np.ndarray], np.ndarray],
+    breaks: np.ndarray,
+    tol: float,
+    guard: Callable[[int], None] | None = None,
+) -> np.ndarray:
+    """(m, 3) points of a curve in space whose chords are all within ``tol`` of it.
+
+    Each span between ``breaks`` (knots, where a NURBS may bend sharply) gets
+    ``ceil(sqrt(1.5 max |C''| / (8 tol)))`` equal parameter steps, ``max |C''|`` looked at on
+    a grid of the span (the interpolation bound of the module docstring, in 3-D).
+
+    Parameters
+    ----------
+    evaluate : callable (m,) params -> (m, 3) points
+    second : callable (m,) params -> (m, 3) second derivatives
+    breaks : (s + 1,) float
+        The spans' ends, increasing.
+    tol : float
+        > 0.
+    guard : callable of the point count, optional
+        Called before the points are made.
+    """
+    if not tol > 0:
+        raise ValueError(f"the sampling tolerance must be positive, got {tol}")
+    b = np.asarray(breaks, dtype=np.float64)
+    spans = len(b) - 1
+    g = np.linspace(0.0, 1.0, _GRID + 1)
+    width = np.diff(b)
+    t = (b[:-1, None] + g[None, :] * width[:, None]).reshape(-1)
+    d2 = np.linalg.norm(np.asarray(second(t)), axis=-1).reshape(spans, _GRID + 1)
+    steps = _steps(d2.max(axis=1) * width**2, tol)  # |C''| in the span's unit parameter
+    total = int(steps.sum()) + 1
+    if guard is not None:
+        guard(total)
+    first = np.concatenate([[0], np.cumsum(steps)[:-1]])
+    span = np.repeat(np.arange(spans), steps)
+    f = (np.arange(total - 1) - first[span]) / steps[span]
+    u = np.append(b[span] + f * width[span], b[-1])
+    return np.asarray(evaluate(u))

@@ -4,10 +4,8 @@
   min/max (Lipschitz-preserving blends); TPMS sheets (gyroid, Schwarz P, diamond) of even
   wall thickness; the same on lattices of points (outer sums and products of tables along
   the axes) and on the lines of a lattice;
-- ``meshdist``: exact distance to a triangle mesh (candidates from k-d trees of triangle
-  centres and of clusters, pruned by disc and cylinder bounds), its sign by the
-  angle-weighted pseudonormal on a closed mesh or the generalized winding number (a
-  Barnes-Hut tree of dipoles, Barill et al. 2018), and the distance to polylines;
+- (the distance to a mesh that ``field.from_mesh`` evaluates is
+  :mod:`formgraph.kernels.geometry.meshdist`, shared with ``attr.distance``);
 - ``lattice``: the mesher's blocks: octree culling by the Lipschitz reach down to blocks
   of 8^3 cells, then dense per-block levels, corners owned by one block and signs
   inferred where the Lipschitz bound decides them (or every corner sampled on lattices);

@@ -56,16 +56,29 @@ def read_dxf(data: bytes, max_entities: int = MAX_ENTITIES) -> tuple[list[DxfCur
     try:
         doc, auditor = recover.read(io.BytesIO(data))
     except (ezdxf.DXFError, ValueError, TypeError, IndexError, KeyError, UnicodeError) as exc:
-        raise ValueError(f"not a DXF drawing ({type(exc).__name__}: {str(exc)[:100]})") from None
+        reason = str(exc).strip()[:100] or "it stops without saying why"
+        raise ValueError(f"not a DXF drawing ezdxf can read: {reason}") from None
     scale = UNITS_MM.get(int(doc.header.get("$INSUNITS", 0) or 0), 1.0)
     out: list[DxfCurve] = []
     skipped: Counter = Counter()
     # the recovery deletes an INSERT whose block the file does not define: counted, so the
     # reader says so rather than drawing less without a word
+    geometric = {AuditError.INVALID_MAJOR_AXIS, AuditError.INVALID_ELLIPSE_RATIO,
+                 AuditError.REMOVED_INVALID_GRAPHIC_ENTITY, AuditError.INVALID_VERTEX_COUNT,
+                 AuditError.INVALID_SPLINE_DEFINITION,
+                 AuditError.INVALID_SPLINE_CONTROL_POINT_COUNT,
+                 AuditError.INVALID_SPLINE_FIT_POINT_COUNT,
+                 AuditError.INVALID_SPLINE_KNOT_VALUE_COUNT,
+                 AuditError.INVALID_SPLINE_WEIGHT_COUNT}  # fmt: skip
     for fix in auditor.fixes:
         if fix.code == AuditError.UNDEFINED_BLOCK:
             skipped["INSERT of a block the file does not define"] += 1
+        elif fix.code in geometric and str(fix.message).startswith("Removed"):
+            # an entity the repair deleted as degenerate (an ELLIPSE of zero major axis)
+            skipped[f"{str(fix.message).removeprefix('Removed ').rstrip('.')}"] += 1
+    _counted(doc, max_entities)
     count = 0
+    dropped: dict[tuple[str, str], list[str]] = {}
     stack = [(iter(doc.modelspace()), None, 0)]
     while stack:
         entities, layer, depth = stack[-1]
@@ -93,18 +106,13 @@ def read_dxf(data: bytes, max_entities: int = MAX_ENTITIES) -> tuple[list[DxfCur
                     f"{', '.join(f'{f:g}' for f in scales)} (x, y, z) flattens or overflows it; "
                     "every scale must be a non-zero finite number"
                 )
-            copies = max(1, int(e.dxf.get("row_count", 1))) * max(
-                1, int(e.dxf.get("column_count", 1))
-            )
-            if count + copies > max_entities:  # a MINSERT's grid, refused before it expands
-                raise ValueError(
-                    f"a MINSERT of {copies:,} copies expands to more than {max_entities:,} "
-                    f"entities, over the budget"
-                )
             stack.append((_expand(e), here, depth + 1))
             continue
         try:
             curves = _curves(e, kind)
+        except _Nothing as why:  # degenerate: said in the warning, with its handle
+            dropped.setdefault((kind, str(why)), []).append(e.dxf.get("handle", "?"))
+            continue
         except (ValueError, ZeroDivisionError, IndexError) as exc:
             raise ValueError(f"{kind} {e.dxf.get('handle', '?')}: {exc}") from None
         if curves is None:
@@ -112,7 +120,72 @@ def read_dxf(data: bytes, max_entities: int = MAX_ENTITIES) -> tuple[list[DxfCur
             continue
         for cp, p, k, w in curves:
             out.append(DxfCurve((cp * scale, p, k, w), here))
+    for (kind, why), handles in dropped.items():
+        shown = ", ".join(handles[:3]) + (", ..." if len(handles) > 3 else "")
+        skipped[f"{kind} that draws nothing ({why}; handle {shown})"] += len(handles)
     return out, skipped
+
+
+class _Nothing(ValueError):
+    """An entity that draws nothing (a radius of zero or less, a zero axis): passed over
+    with a warning naming it, as an INSERT of a missing block is."""
+
+
+def _copies(e) -> int:
+    """How many times an INSERT places its block: rows x columns of a MINSERT, else 1."""
+    return max(1, int(e.dxf.get("row_count", 1))) * max(1, int(e.dxf.get("column_count", 1)))
+
+
+def _counted(doc, max_entities: int) -> None:
+    """Refuse, before anything is expanded, a drawing whose blocks expand past the budget:
+    the entities of each block definition are counted once, an INSERT counting its copies
+    times its block's count, multiplied down the block tree (an 11-level fan-out of 10
+    inserts a level is 10^11 entities, refused here in the time it takes to count the
+    file's own entities). A block that inserts itself is refused too."""
+    size: dict[str, int] = {}
+    on_path: set[str] = set()
+
+    def block_size(name: str) -> int:
+        # iterative post-order over the blocks a block inserts (no recursion: a chain of
+        # thousands of nested blocks is fine)
+        stack = [(name, None)]
+        while stack:
+            key, inserts = stack.pop()
+            if key in size:
+                continue
+            block = doc.blocks.get(key)
+            if block is None:
+                size[key] = 0
+                continue
+            if inserts is None:
+                if key in on_path:
+                    raise ValueError(f"block {key!r} inserts itself (through its inserts)")
+                on_path.add(key)
+                inserts = [(e.dxf.get("name", ""), _copies(e)) for e in block.query("INSERT")]
+                stack.append((key, inserts))
+                stack.extend((child, None) for child, _ in inserts if child not in size)
+                continue
+            on_path.discard(key)
+            size[key] = len(block) + sum(n * size.get(child, 0) for child, n in inserts)
+        return size[name]
+
+    total = 0
+    biggest = (0, None)
+    for e in doc.modelspace().query("INSERT"):
+        n = _copies(e) * block_size(e.dxf.get("name", ""))
+        total += n
+        biggest = max(biggest, (n, e), key=lambda x: x[0])
+    total += len(doc.modelspace())
+    if total > max_entities:
+        n, e = biggest
+        copies = _copies(e)
+        grid = f" ({copies:,} copies, a MINSERT's rows x columns)" if copies > 1 else ""
+        raise ValueError(
+            f"the drawing's blocks expand to {total:,} entities, over the budget of "
+            f"{max_entities:,}: INSERT {e.dxf.get('handle', '?')} of block "
+            f"{e.dxf.get('name', '')!r}{grid} alone makes {n:,} (blocks inside blocks); "
+            "refused before expanding"
+        )
 
 
 def _expand(insert):
@@ -137,7 +210,7 @@ def _curves(e, kind: str) -> list[CurveArrays] | None:
         c = Chain()
         a, b = _v(e.dxf.start), _v(e.dxf.end)
         if np.array_equal(a, b):
-            return []
+            raise _Nothing("its two ends are one point")
         c.add(line_piece(a, b))
         return [c.curve()]
     if kind == "LWPOLYLINE":
@@ -158,8 +231,8 @@ def _curves(e, kind: str) -> list[CurveArrays] | None:
         return None  # polyface and polygon meshes are not curves
     if kind in ("CIRCLE", "ARC"):
         c0, r = _v(e.dxf.center), float(e.dxf.radius)
-        if r <= 0:
-            return []
+        if not r > 0:
+            raise _Nothing(f"a radius of {r:g}")
         if kind == "CIRCLE":
             t0, t1 = 0.0, 2 * math.pi
         else:
@@ -169,6 +242,11 @@ def _curves(e, kind: str) -> list[CurveArrays] | None:
         chain.add(arc_pieces(c0, np.array([r, 0, 0]), np.array([0, r, 0]), t0, t1))
         return [_to_wcs(e, chain.curve())]
     if kind == "ELLIPSE":
+        major, ratio = _v(e.dxf.major_axis), float(e.dxf.get("ratio", 1.0))
+        if not np.linalg.norm(major) > 0:
+            raise _Nothing("a major axis of zero length")
+        if not ratio > 0:
+            raise _Nothing(f"an axis ratio of {ratio:g}")
         t0, t1 = float(e.dxf.start_param), float(e.dxf.end_param)
         t1 = t1 + 2 * math.pi if t1 <= t0 else t1
         chain = Chain()

@@ -159,7 +159,9 @@ def write_glb(
 # reading
 
 
-def read_gltf(data: bytes, *, scale: float = 1e3) -> list[tuple[str, np.ndarray, np.ndarray]]:
+def read_gltf(
+    data: bytes, *, scale: float = 1e3, max_elements: int = 50_000_000
+) -> list[tuple[str, np.ndarray, np.ndarray]]:
     """The triangle meshes a glTF 2.0 file (``.glb``, or ``.gltf`` JSON with embedded
     ``data:`` buffers) places: ``(name, vertices (n, 3), triangles (t, 3), colours (n, 3|4)
     or None)`` per mesh instance (``COLOR_0``, normalized integers read as 0..1), transforms
@@ -169,7 +171,9 @@ def read_gltf(data: bytes, *, scale: float = 1e3) -> list[tuple[str, np.ndarray,
     ------
     ValueError
         For a malformed container, external or compressed buffers, accessors that run past
-        their buffers, bad indices, or a node tree that is too deep or too large.
+        their buffers, bad or non-integer indices, a node tree that is too deep or too
+        large, or a scene placing more than ``max_elements`` vertices or triangles (counted
+        from the accessors before a copy is made).
     """
     doc, binary = _container(data)
     if doc.get("extensionsRequired"):
@@ -203,6 +207,7 @@ def read_gltf(data: bytes, *, scale: float = 1e3) -> list[tuple[str, np.ndarray,
                 stack.append((_int(c, len(nodes), "node"), m, depth + 1))
     else:
         placed = [(k, np.eye(4)) for k in range(len(meshes))]
+    _budgeted(doc, meshes, placed, max_elements)
     out = []
     for k, m in placed:
         mesh = meshes[k] if isinstance(meshes[k], dict) else {}
@@ -215,7 +220,13 @@ def read_gltf(data: bytes, *, scale: float = 1e3) -> list[tuple[str, np.ndarray,
                 continue
             p = _accessor(doc, buffers, attrs["POSITION"]).astype(np.float64).reshape(-1, 3)
             if "indices" in prim:
-                t = _accessor(doc, buffers, prim["indices"]).astype(np.int64).ravel()
+                t = _accessor(doc, buffers, prim["indices"])
+                if t.dtype.kind != "u":  # glTF 2.0, 3.7.2.1: UNSIGNED_BYTE, SHORT or INT
+                    raise ValueError(
+                        f"mesh {k}: its indices are {t.dtype.name} (accessor "
+                        f"{prim['indices']}); glTF indices are unsigned integers"
+                    )
+                t = t.astype(np.int64).ravel()
             else:
                 t = np.arange(len(p), dtype=np.int64)
             if t.size % 3:
@@ -236,6 +247,37 @@ def read_gltf(data: bytes, *, scale: float = 1e3) -> list[tuple[str, np.ndarray,
             c = np.concatenate(colors) if all(x is not None for x in colors) else None
             out.append((name, np.concatenate(verts) * scale, np.concatenate(tris), c))
     return out
+
+
+def _budgeted(doc: dict, meshes: list, placed: list, max_elements: int) -> None:
+    """Refuse a scene that places more than ``max_elements`` vertices or triangles, from the
+    accessors' counts, before any copy is made (a big mesh placed by many nodes)."""
+    accessors = doc.get("accessors", [])
+    size: dict[int, tuple[int, int]] = {}
+    vertices = triangles = 0
+    for k, _ in placed:
+        if k not in size:
+            nv = nt = 0
+            mesh = meshes[k] if isinstance(meshes[k], dict) else {}
+            for prim in mesh.get("primitives", []):
+                attrs = prim.get("attributes", {}) if isinstance(prim, dict) else {}
+                count = _count(accessors, attrs.get("POSITION"))
+                nv += count
+                nt += (_count(accessors, prim.get("indices")) if "indices" in prim else count) // 3
+            size[k] = (nv, nt)
+        vertices, triangles = vertices + size[k][0], triangles + size[k][1]
+    for count, what in ((vertices, "vertices"), (triangles, "triangles")):
+        if count > max_elements:
+            raise ValueError(
+                f"the scene places {count:,} {what} ({len(placed):,} mesh instances), over the "
+                f"budget of {max_elements:,}: refused before expanding"
+            )
+
+
+def _count(accessors: list, index) -> int:
+    a = accessors[index] if isinstance(index, int) and 0 <= index < len(accessors) else None
+    count = a.get("count", 0) if isinstance(a, dict) else 0
+    return count if isinstance(count, int) and count > 0 else 0
 
 
 def _container(data: bytes) -> tuple[dict, bytes | None]:

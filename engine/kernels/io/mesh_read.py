@@ -18,6 +18,8 @@ from .textscan import Lines, TokenError, ints_at, line_numbers, parse_floats, to
 
 __all__ = ["read_obj", "read_off", "read_stl", "triangles_flat"]
 
+_SPACE = np.zeros(256, dtype=bool)
+_SPACE[[9, 10, 11, 12, 13, 32]] = True
 _STL_RECORD = np.dtype(
     [("normal", "<f4", (3,)), ("v", "<f4", (9,)), ("attr", "<u2")], align=False
 )  # 50 bytes
@@ -61,6 +63,13 @@ def read_stl(data: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 def _stl_ascii(data: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    if b"\0" in data:  # text holds no NUL: binary bytes after a 'solid' header, not facets
+        at = data.index(b"\0")
+        raise ValueError(
+            f"it starts like an ASCII STL ('solid') but holds a NUL byte at byte {at:,}: "
+            "binary data, not text (a binary STL whose size does not match its triangle "
+            "count?)"
+        )
     buf = np.frombuffer(data, dtype=np.uint8)
     lines = Lines(buf)
     vertex = lines.keyword(b"vertex") | _indented(lines, b"vertex")
@@ -70,6 +79,16 @@ def _stl_ascii(data: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         raise ValueError(
             f"the ASCII STL has {n:,} vertex lines, not three per facet: truncated or garbled"
         )
+    if n == 0:  # an empty solid is 'solid' and 'endsolid' alone, not junk between them
+        first = _first_token(lines)
+        blank = first >= lines.ends
+        named = _indented(lines, b"solid") | _indented(lines, b"endsolid")
+        other = int((~blank & ~named).sum())
+        if other:
+            raise ValueError(
+                f"it starts like an ASCII STL ('solid') but none of its lines is a facet's "
+                f"vertex, and {other:,} are not STL at all: binary data or another format"
+            )
     text, _ = _stripped(lines, vertex, b"vertex")
     v = parse_floats(text, 3 * n).reshape(-1, 3)
     return triangles_flat(v, np.arange(n).reshape(-1, 3))
@@ -147,10 +166,20 @@ def read_obj(data: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         k = int(np.argmin(sizes))
         raise ValueError(f"line {f_lines[k] + 1}: a face needs at least 3 vertices")
     try:
-        idx, _ = ints_at(text, tokens)  # a token 'v/vt/vn' starts with its vertex index
+        idx, after = ints_at(text, tokens)  # a token 'v/vt/vn' starts with its vertex index
     except TokenError as exc:
         line = f_lines[line_numbers(starts, np.array([exc.offset]))[0]] + 1
         raise ValueError(f"line {line}: a face's vertex: {exc}") from None
+    # the index ends the token or meets its '/': '3.5' or '3x' is not index 3
+    end = text[np.minimum(after, text.size - 1)]
+    bad = (after < text.size) & ~(_SPACE[end] | (end == ord("/")))
+    if bad.any():
+        k = int(np.argmax(bad))
+        word = bytes(text[tokens[k] : tokens[k] + 20]).split()[0].decode("latin-1")
+        raise ValueError(
+            f"line {f_lines[line_of[k]] + 1}: a face's vertex {word!r} is not an index (a "
+            "whole number, then /texture/normal)"
+        )
     before = np.cumsum(is_v)[f_lines] if f_lines.size else np.zeros(0, np.int64)
     idx = np.where(idx < 0, idx + np.repeat(before, sizes), idx - 1)
     bad = (idx < 0) | (idx >= len(v))
@@ -200,7 +229,9 @@ def _rows(lines: Lines, which: np.ndarray, word: bytes, width: int, what: str) -
 
 def read_off(data: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """An OFF file: ``OFF``, then ``nv nf ne``, ``nv`` points and ``nf`` faces ``k i1 .. ik``
-    (any colour after a face's indices is ignored); ``#`` comments anywhere.
+    (any colour after a face's indices is ignored); ``#`` comments anywhere. A ``4OFF``'s
+    vertices are homogeneous, ``x y z w`` (Geomview's OFF format): the point is their
+    quotient by ``w``; an ``nOFF`` (N dimensions) is refused.
 
     Raises
     ------
@@ -217,6 +248,12 @@ def read_off(data: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     head = bytes(buf[lines.starts[content[0]] : lines.ends[content[0]]]).split()
     if not head or not head[0].endswith(b"OFF"):
         raise ValueError("an OFF file starts with the keyword OFF")
+    prefix = head[0][:-3]  # Geomview's [ST][C][N][4][n]OFF
+    if b"n" in prefix:
+        raise ValueError(
+            f"{head[0].decode('latin-1')!r}: an OFF of vertices in N dimensions is not read"
+        )
+    homogeneous = b"4" in prefix  # x y z w: the point is (x, y, z) / w
     counts = head[1:]
     rest = content[1:]
     if len(counts) < 2:  # the counts on their own line
@@ -235,7 +272,15 @@ def read_off(data: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         )
     pick = np.zeros(len(lines), dtype=bool)
     pick[rest[:nv]] = True
-    v = _rows(lines, pick, b"", 3, "vertex")
+    v = _rows(lines, pick, b"", 4 if homogeneous else 3, "vertex")
+    if homogeneous:
+        w = v[:, 3]
+        if not np.all(np.isfinite(w) & (w != 0)):
+            k = int(np.argmax(~(np.isfinite(w) & (w != 0))))
+            raise ValueError(
+                f"vertex {k}: its homogeneous w is {w[k]:g} (4OFF: the point is x/w, y/w, z/w)"
+            )
+        v = v[:, :3] / w[:, None]
     pick[:] = False
     pick[rest[nv : nv + nf]] = True
     ftext, starts = lines.text(pick)

@@ -15,7 +15,10 @@ import numpy as np
 from .ply_read import read_ply_vertices
 from .textscan import Lines, line_numbers, parse_floats, token_starts
 
-__all__ = ["read_ply_points", "read_text_points"]
+__all__ = ["MAX_COLUMNS", "MAX_LINE", "read_ply_points", "read_text_points"]
+
+MAX_LINE = 1 << 20  # characters on one line
+MAX_COLUMNS = 10_000  # values on one line
 
 
 def read_text_points(data: bytes, *, comma: bool) -> np.ndarray:
@@ -24,18 +27,40 @@ def read_text_points(data: bytes, *, comma: bool) -> np.ndarray:
     Raises
     ------
     ValueError
-        A line with fewer than two numbers, lines of different widths, or a non-number.
+        A line with fewer than two numbers, lines of different widths, a non-number, a NUL
+        byte (not text), or a line over :data:`MAX_LINE` characters or :data:`MAX_COLUMNS`
+        values.
     """
+    if b"\0" in data:
+        at = data.index(b"\0")
+        line = data.count(b"\n", 0, at) + 1
+        raise ValueError(
+            f"it holds a NUL byte (at byte {at:,}, line {line}): not a "
+            "text file of points (a binary file with a text extension?)"
+        )
     text = re.sub(rb"#[^\n]*", b"", data)
     if comma:
         text = text.replace(b";", b",").replace(b",", b" ")
     buf = np.frombuffer(text, dtype=np.uint8)
     lines = Lines(buf)
+    longest = int(np.max(lines.ends - lines.starts, initial=0))
+    if longest > MAX_LINE:  # refused before its tokens are counted (memory, and time)
+        k = int(np.argmax(lines.ends - lines.starts))
+        raise ValueError(
+            f"line {k + 1} is {longest:,} characters long, over {MAX_LINE:,}: a point file's "
+            "lines hold x, y, z and a few more values"
+        )
     tokens = token_starts(buf)
     per_line = np.bincount(line_numbers(lines.starts, tokens), minlength=len(lines))
     rows = np.flatnonzero(per_line > 0)
     if rows.size == 0:
         return np.zeros((0, 3))
+    if per_line.max() > MAX_COLUMNS:
+        k = int(np.argmax(per_line))
+        raise ValueError(
+            f"line {k + 1} has {int(per_line[k]):,} values, over {MAX_COLUMNS:,}: a point "
+            "file's lines hold x, y, z and a few more values"
+        )
     columns = (0, 1, 2)
     first = bytes(buf[lines.starts[rows[0]] : lines.ends[rows[0]]]).split()
     if not _numbers(first):  # a header

@@ -13,7 +13,10 @@ What goes in (ISO 10303-42 resources, as CAD programs exchange them):
   ``GEOMETRIC_CURVE_SET``;
 - each closed mesh a ``MANIFOLD_SOLID_BREP`` of a ``CLOSED_SHELL``, an open one an
   ``OPEN_SHELL`` of the surface model, each polygon a planar face bounded by a
-  ``POLY_LOOP`` (a faceted solid).
+  ``POLY_LOOP`` (a faceted solid);
+- exact solids come as the entities of another STEP file (OpenCASCADE's, written by
+  :mod:`formgraph.kernels.brep.stepwrite`: manifold solid B-reps with their own products,
+  names and colours), appended with their entity numbers moved past ours (``attach``).
 
 All hang off one product, in millimetres. Numbers are written as their shortest round-trip
 decimals, in bulk (:mod:`formgraph.kernels.io.numfmt`), so the file holds the geometry to the
@@ -22,9 +25,11 @@ last bit; control points and mesh vertices are ``CARTESIAN_POINT`` rows built as
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 
-from ..nurbs import homogeneous, is_clamped, project, respace
+from ..nurbs import clamp, clamp_surface, is_clamped
 from .numfmt import float_words, format_int, join_rows, squeeze
 
 __all__ = ["write_step"]
@@ -122,32 +127,12 @@ def _knot_lists(knots: np.ndarray) -> tuple[str, str]:
 
 def _clamp_surface(s: Surface) -> Surface:
     cp, du, dv, ku, kv, w = s
-    pw = homogeneous(cp, w)
-    for axis, (d, k) in enumerate(((du, ku), (dv, kv))):
-        if is_clamped(d, k):
-            continue
-        n = len(k) - d - 1
-        a, b = k[d], k[n]
-        tau = np.concatenate([[a] * (d + 1), k[(k > a) & (k < b)], [b] * (d + 1)])
-        moved = np.moveaxis(pw, axis, 0)
-        pw = np.moveaxis(respace(d, k, moved, tau), 0, axis)
-        if axis == 0:
-            ku = tau
-        else:
-            kv = tau
-    cp2, w2 = project(pw, w is not None)
-    return cp2, du, dv, ku, kv, w2
+    cp2, ku2, kv2, w2 = clamp_surface(cp, du, dv, ku, kv, w)
+    return cp2, du, dv, ku2, kv2, w2
 
 
 def _clamp_curve(c: Curve) -> Curve:
-    cp, p, k, w = c
-    if is_clamped(p, k):
-        return c
-    n = len(k) - p - 1
-    a, b = k[p], k[n]
-    tau = np.concatenate([[a] * (p + 1), k[(k > a) & (k < b)], [b] * (p + 1)])
-    cp2, w2 = project(respace(p, k, homogeneous(cp, w), tau), w is not None)
-    return cp2, p, tau, w2
+    return c if is_clamped(c[1], c[2]) else clamp(*c)
 
 
 def _curve_entity(f: _File, c: Curve, closed: bool = False) -> int:
@@ -336,6 +321,7 @@ def write_step(
     surfaces: list[Surface] = (),  # type: ignore[assignment]
     meshes: list[tuple[np.ndarray, np.ndarray, np.ndarray, bool]] = (),  # type: ignore[assignment]
     name: str = "formgraph",
+    attach: bytes = b"",
 ) -> bytes:
     """A STEP AP214 file (ISO 10303-21) of exact curves and surfaces and faceted meshes.
 
@@ -348,6 +334,8 @@ def write_step(
         A closed mesh becomes a faceted solid (closed shell), an open one an open shell.
     name : str
         The product's name.
+    attach : bytes
+        Another STEP file whose entities (its own products) join this one's.
 
     Returns
     -------
@@ -405,4 +393,21 @@ def write_step(
         f"FILE_NAME('{safe}.stp','1970-01-01T00:00:00',(''),(''),'formgraph','formgraph','');\n"
         "FILE_SCHEMA(('AUTOMOTIVE_DESIGN { 1 0 10303 214 1 1 1 1 }'));\nENDSEC;\nDATA;\n"
     ).encode()
-    return header + f.data() + b"ENDSEC;\nEND-ISO-10303-21;\n"
+    return header + f.data() + _renumbered(attach, f.next - 1) + b"ENDSEC;\nEND-ISO-10303-21;\n"
+
+
+_TOKEN = re.compile(rb"'(?:[^']|'')*'|#(\d+)")
+
+
+def _renumbered(data: bytes, offset: int) -> bytes:
+    """The entities of the DATA section of STEP file ``data``, every ``#n`` (outside
+    strings) made ``#(n + offset)``."""
+    if not data:
+        return b""
+    start = data.index(b"DATA;") + len(b"DATA;")
+    end = data.rindex(b"ENDSEC;")
+
+    def moved(m: re.Match[bytes]) -> bytes:
+        return m.group(0) if m.group(1) is None else b"#%d" % (int(m.group(1)) + offset)
+
+    return _TOKEN.sub(moved, data[start:end]).lstrip(b"\n")

@@ -31,6 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..geometry import MAX_COORDINATE
 from .chains import Chain, CurveArrays, arc_pieces, bezier_piece, line_piece
 
 __all__ = ["MAX_DEPTH", "MAX_ELEMENTS", "MAX_NUMBERS", "SvgCurve", "read_svg"]
@@ -40,7 +41,6 @@ MAX_DEPTH = 512
 MAX_NUMBERS = 2_000_000  # svgelements parses a path's numbers in Python: about 20 s of them
 _NUMBER = re.compile(rb"[0-9]+(?:\.[0-9]*)?|\.[0-9]+")
 PX_MM = 25.4 / 96.0
-_TAG = re.compile(rb"<(/?)([^>]*?)(/?)>")
 
 
 @dataclass(frozen=True)
@@ -53,16 +53,7 @@ def _bounded(data: bytes, max_elements: int) -> None:
     tags = data.count(b"<")
     if tags > max_elements:
         raise ValueError(f"the file has {tags:,} tags, over the budget of {max_elements:,}")
-    depth = deepest = 0
-    for m in _TAG.finditer(data):
-        body = m.group(2)
-        if body[:1] in (b"!", b"?"):
-            continue
-        if m.group(1):
-            depth -= 1
-        elif not m.group(3):
-            depth += 1
-            deepest = max(deepest, depth)
+    deepest = _depth(data)
     if deepest > MAX_DEPTH:
         raise ValueError(f"elements nest {deepest:,} deep, over the budget of {MAX_DEPTH}")
     numbers = len(_NUMBER.findall(data))
@@ -73,6 +64,35 @@ def _bounded(data: bytes, max_elements: int) -> None:
         )
     if b"<use" in data or b":use" in data:
         _bounded_uses(data, max_elements)
+
+
+def _depth(data: bytes) -> int:
+    """How deep the elements nest, in one linear pass over the positions of ``<`` and ``>``
+    (a regular expression per tag rescanned the rest of the file for every ``<`` left
+    without its ``>``: 58 KiB of them took 20 s).
+
+    A tag runs from a ``<`` to the next ``>``; a ``<`` inside it starts no tag. An end tag
+    (``</``) closes one level, an empty-element tag (``/>``) none, declarations, comments
+    and processing instructions (``<!``, ``<?``) none; a ``<`` with no ``>`` after it is not
+    a tag (the XML parser reports it).
+    """
+    buf = np.frombuffer(data, np.uint8)
+    lt, gt = np.flatnonzero(buf == 60), np.flatnonzero(buf == 62)
+    close = np.searchsorted(gt, lt)  # each '<''s next '>' (its index in gt)
+    ok = close < gt.size
+    lt, close = lt[ok], gt[close[ok]]
+    if lt.size == 0:
+        return 0
+    starts = np.ones(lt.size, dtype=bool)
+    starts[1:] = lt[1:] > close[:-1]  # not inside the tag a '<' before it opened
+    lt, close = lt[starts], close[starts]
+    after = buf[np.minimum(lt + 1, buf.size - 1)]
+    ending = after == 47  # '</'
+    empty = (buf[close - 1] == 47) & (close - 1 > lt)  # '/>'
+    name = np.where(ending, buf[np.minimum(lt + 2, buf.size - 1)], after)
+    other = ((name == 33) | (name == 63)) & (close > lt + 1 + ending)  # '<!', '<?'
+    step = np.where(other, 0, np.where(ending, -1, np.where(empty, 0, 1)))
+    return int(max(np.cumsum(step).max(initial=0), 0))
 
 
 def _bounded_uses(data: bytes, max_elements: int) -> None:
@@ -143,10 +163,11 @@ def read_svg(data: bytes, max_elements: int = MAX_ELEMENTS) -> tuple[list[SvgCur
 
     _bounded(data, max_elements)
     _finite_values(data)
+    _drawable_size(data)
     try:
         doc = se.SVG.parse(io.BytesIO(data), reify=False, ppi=96.0, on_error="raise")
     except Exception as exc:  # svgelements raises what its XML parser raises
-        raise ValueError(f"not an SVG document ({type(exc).__name__}: {str(exc)[:100]})") from None
+        raise ValueError(_why_not(data, exc, se)) from None
     _drawable_view_box(data)
     mm, declared = _mm_per_px(data, doc)
     height = _length(getattr(doc, "height", None)) if declared else 0.0
@@ -176,32 +197,129 @@ def read_svg(data: bytes, max_elements: int = MAX_ELEMENTS) -> tuple[list[SvgCur
         m = node.transform  # local to document pixels: applied to the control points (exact)
         lin = np.array([[m.a, m.c, 0.0], [m.b, m.d, 0.0], [0.0, 0.0, 1.0]], dtype=np.float64)
         move = np.array([m.e, m.f, 0.0], dtype=np.float64)
+        tag = type(node).__name__.lower()
+        name = f"a {tag}" + (f" id {node.id!r}" if getattr(node, "id", None) else "")
+        if (
+            not (np.isfinite(lin).all() and np.isfinite(move).all())
+            or lin[0, 0] * lin[1, 1] == lin[0, 1] * lin[1, 0]
+        ):
+            raise ValueError(
+                f"{name}: its transform {_shown_matrix(m)} flattens it to a line or a point, "
+                "or is not finite numbers"
+            )
         try:
             chains = _chains(se.Path(node), se)
         except ValueError as exc:
-            tag = type(node).__name__.lower()
-            name = f" id {node.id!r}" if getattr(node, "id", None) else ""
-            raise ValueError(f"a {tag}{name}: {exc}") from None
+            raise ValueError(f"{name}: {exc}") from None
+        if not chains:  # a zero size, which the SVG specification draws as nothing
+            passed[f"{tag} of zero size"] += 1
         for chain in chains:
             cp, p, k, w = chain.curve()
-            out.append(SvgCurve(((cp @ lin.T + move) * flip + shift, p, k, w), layer))
+            with np.errstate(all="ignore"):
+                cp = (cp @ lin.T + move) * flip + shift
+            _in_range(cp, name)
+            out.append(SvgCurve((cp, p, k, w), layer))
     return out, passed
+
+
+def _in_range(cp: np.ndarray, name: str) -> None:
+    """Refuse control points that are not finite or lie past :data:`MAX_COORDINATE`
+    (a ``skewX(90)``, a huge scale), naming the element."""
+    xyz = cp[:, :3] / cp[:, 3:] if cp.shape[1] == 4 else cp
+    with np.errstate(all="ignore"):
+        big = float(np.max(np.abs(xyz))) if xyz.size else 0.0
+    if not np.isfinite(xyz).all() or big > MAX_COORDINATE:
+        shown = "not a finite number" if not np.isfinite(xyz).all() else f"{big:.3g} mm"
+        raise ValueError(
+            f"{name}: a coordinate comes out {shown} after its transforms and units, past "
+            f"{MAX_COORDINATE:g} mm (where a double no longer holds a tenth of a millimetre): "
+            "a skew of 90 degrees, or a scale or number far too large?"
+        )
+
+
+def _shown_matrix(m: object) -> str:
+    values = [getattr(m, k) for k in "abcdef"]
+    return "matrix(" + " ".join(f"{float(v):g}" for v in values) + ")"
+
+
+def _why_not(data: bytes, exc: Exception, se: object) -> str:
+    """What is wrong with a file svgelements failed on, in a reader's words: the XML
+    parser's own sentence, else the first path data or transform that fails alone."""
+    import xml.etree.ElementTree as ET
+
+    if isinstance(exc, ET.ParseError):
+        return f"not an SVG document: the XML is not well formed ({exc})"
+    for m in re.finditer(rb"\s(d|transform)\s*=\s*(\"[^\"<]*\"|'[^'<]*')", data):
+        text = m.group(2)[1:-1].decode("utf-8", "replace")
+        try:
+            if m.group(1) == b"d":
+                list(se.Path(text))  # type: ignore[attr-defined]
+            else:
+                se.Matrix(text)  # type: ignore[attr-defined]
+        except Exception as bad:  # noqa: BLE001  (which one fails is what we want)
+            line = data.count(b"\n", 0, m.start()) + 1
+            what = "path data" if m.group(1) == b"d" else "transform"
+            if isinstance(bad, ZeroDivisionError | OverflowError) or "domain" in str(bad):
+                reason = "holds a number too small or too large to compute with"
+            else:
+                reason = "is not valid SVG syntax (a command without its numbers, or a stray "
+                reason += "character?)"
+            return f"line {line}: the {what} {_clip(text)!r} {reason}"
+    reason = str(exc).strip() or "it stops without saying why"
+    return f"not an SVG drawing svgelements can read: {reason[:100]}"
+
+
+def _clip(text: str, n: int = 40) -> str:
+    return text if len(text) <= n else text[: n - 3] + "..."
+
+
+_ROOT_LENGTH = re.compile(
+    rb"\s*([+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?)\s*([a-z%]*)\s*"
+)
+
+
+def _drawable_size(data: bytes) -> None:
+    """Refuse a root ``width`` or ``height`` that is zero, negative, not finite or not a
+    length at all (``nanmm``, ``1e400mm``): the SVG specification draws nothing for zero,
+    and svgelements then gave no curves without a word."""
+    root = re.search(rb"<(?:\w+:)?svg\b([^<>]*)>", data[: 1 << 16])
+    if root is None:
+        return
+    for m in re.finditer(rb"\s(width|height)\s*=\s*[\"']([^\"'<>]*)[\"']", root.group(1)):
+        text = m.group(2)
+        length = _ROOT_LENGTH.fullmatch(text)
+        value = float(length.group(1)) if length else float("nan")
+        if not (math.isfinite(value) and value > 0):
+            raise ValueError(
+                f"the root's {m.group(1).decode()} {text.decode('latin-1')[:30]!r} is not a "
+                "positive finite length: an SVG viewer draws nothing of it"
+            )
 
 
 # the attributes that hold coordinates and lengths, and a NaN or infinity written in one
 _GEOMETRIC = rb"d|points|x|y|x1|y1|x2|y2|cx|cy|r|rx|ry|width|height|viewBox|transform"
 _ATTRIBUTE = re.compile(rb"\s(" + _GEOMETRIC + rb")\s*=\s*(\"[^\"]*\"|'[^']*')")
-_NOT_FINITE = re.compile(rb"(?<![A-Za-z0-9_#.-])[+-]?(nan|inf(inity)?)(?![A-Za-z0-9_-])", re.I)
+_NOT_FINITE = re.compile(
+    rb"(?<![A-Za-z0-9_#.-])[+-]?(nan|inf(inity)?)(mm|cm|in|pt|pc|px|em|ex|%)?(?![A-Za-z0-9_-])",
+    re.I,
+)
+
+
+_HUGE = re.compile(rb"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)[eE]\+?[0-9]{3,}")
 
 
 def _finite_values(data: bytes) -> None:
-    """Refuse a NaN or an infinity in a coordinate, length or transform, naming its line
-    and attribute (svgelements parses them as numbers and then draws nothing, or fails
-    without a word)."""
-    if not re.search(rb"(?i)nan|inf", data):
+    """Refuse a NaN or an infinity (or a number past the largest double) in a coordinate,
+    length or transform, naming its line and attribute (svgelements parses them as numbers
+    and then draws nothing, or fails without a word)."""
+    if not re.search(rb"(?i)nan|inf|e\+?[0-9]{3}", data):
         return
     for m in _ATTRIBUTE.finditer(data):  # the rare file that spells one: attribute by attribute
         bad = _NOT_FINITE.search(m.group(2))
+        if bad is None:  # a number past the largest double (1e400) reads as an infinity
+            bad = next(
+                (h for h in _HUGE.finditer(m.group(2)) if math.isinf(float(h.group()))), None
+            )
         if bad:
             line = data.count(b"\n", 0, m.start()) + 1
             raise ValueError(
@@ -214,7 +332,7 @@ def _finite_values(data: bytes) -> None:
 def _drawable_view_box(data: bytes) -> None:
     """Refuse a root ``viewBox`` of zero (or negative) width or height: the SVG
     specification draws nothing for it (zero disables rendering; negative is an error)."""
-    root = re.search(rb"<(?:\w+:)?svg\b([^>]*)>", data[: 1 << 16])
+    root = re.search(rb"<(?:\w+:)?svg\b([^<>]*)>", data[: 1 << 16])
     box = root and re.search(rb"\sviewBox\s*=\s*[\"']([^\"']*)[\"']", root.group(1))
     if not box:
         return
@@ -252,7 +370,7 @@ def _mm_per_px(data: bytes, doc: object) -> tuple[float, bool]:
     off); a document ``width="100mm"`` must measure 100 mm, so the root's length is read
     here and divided by the pixels svgelements made of it.
     """
-    root = re.search(rb"<(?:\w+:)?svg\b([^>]*)>", data[: 1 << 16])
+    root = re.search(rb"<(?:\w+:)?svg\b([^<>]*)>", data[: 1 << 16])
     if root is None:
         return PX_MM, False
     attrs = dict(re.findall(rb'([\w:-]+)\s*=\s*["\']([^"\']*)["\']', root.group(1)))

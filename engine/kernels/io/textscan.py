@@ -13,7 +13,15 @@ import warnings
 
 import numpy as np
 
-__all__ = ["Lines", "TokenError", "ints_at", "line_numbers", "parse_floats", "token_starts"]
+__all__ = [
+    "Lines",
+    "TokenError",
+    "ints_at",
+    "line_numbers",
+    "parse_floats",
+    "parse_ints",
+    "token_starts",
+]
 
 # what C's strtod (np.fromstring) reads as one number: Python's float() also takes "1_000"
 _C_NUMBER = re.compile(
@@ -116,6 +124,32 @@ def parse_floats(buf: np.ndarray, expected: int) -> np.ndarray:
     if values.size != expected:
         message, offset = _first_bad(buf, expected)
         raise TokenError(message, offset)
+    return values
+
+
+def parse_ints(buf: np.ndarray, expected: int) -> np.ndarray:
+    """Exactly ``expected`` whitespace-separated decimal integers from ``buf`` (int64; one
+    past the int64 range saturates, which a caller's range check then refuses).
+
+    Raises
+    ------
+    TokenError
+        When a token is not a whole number (``3.5``, ``1e3``) or the count differs.
+    """
+    if expected == 0:
+        return np.zeros(0, np.int64)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", DeprecationWarning)
+            values = np.fromstring(buf.tobytes(), dtype=np.int64, sep=" ")
+    except ValueError:
+        values = np.zeros(0, np.int64)
+    if values.size != expected:
+        for m in re.finditer(rb"\S+", bytes(buf)):
+            if re.fullmatch(rb"[+-]?[0-9]+", m.group()) is None:
+                word = m.group()[:20].decode("latin-1")
+                raise TokenError(f"{word!r} is not a whole number", m.start())
+        raise TokenError(f"expected {expected:,} whole numbers, found {values.size:,}", 0)
     return values
 
 

@@ -23,7 +23,7 @@ set through every operation: they are split but never flipped, a vertex on one f
 line (two feature edges) moves only along it (collapsed into a neighbour on the line,
 projected onto the input's feature edges), and a feature corner (any other count) stays
 where it is. So creases stay sharp and boundaries stay where they were. The vertex
-positions are projected with :class:`formgraph.kernels.field.meshdist.Nearest` (exact
+positions are projected with :class:`formgraph.kernels.geometry.meshdist.Nearest` (exact
 closest points).
 """
 
@@ -396,7 +396,7 @@ def isotropic_remesh(
     OpenedError
         If a closed input came out open (a defect of this kernel, reported, not hidden).
     """
-    from ..field.meshdist import Nearest
+    from ..geometry.meshdist import Nearest
 
     v = np.asarray(vertices, dtype=np.float64)
     t = np.asarray(triangles, dtype=np.int64)

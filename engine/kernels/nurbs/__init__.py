@@ -53,6 +53,8 @@ from .fit import fit_columns, interpolate, interpolation_parameters
 from .knots import (
     clamp,
     decompose_bezier,
+    decompose_bezier_batch,
+    decompose_bezier_surface,
     elevate_degree,
     insert_knot,
     insert_knot_surface,
@@ -64,6 +66,7 @@ from .knots import (
 )
 from .surface import (
     basis_matrix,
+    clamp_surface,
     surface_derivatives,
     surface_evaluate,
     surface_evaluate_grid,
@@ -79,10 +82,13 @@ __all__ = [
     "blossom_basis",
     "circle",
     "clamp",
+    "clamp_surface",
     "clamped_uniform_knots",
     "curve_derivatives",
     "curve_evaluate",
     "decompose_bezier",
+    "decompose_bezier_batch",
+    "decompose_bezier_surface",
     "domain_spans",
     "elevate_degree",
     "evaluate_homogeneous",

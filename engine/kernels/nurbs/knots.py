@@ -28,6 +28,8 @@ from .curve import homogeneous, project
 __all__ = [
     "clamp",
     "decompose_bezier",
+    "decompose_bezier_batch",
+    "decompose_bezier_surface",
     "elevate_degree",
     "insert_knot",
     "insert_knot_surface",
@@ -418,6 +420,11 @@ def _bezier_pieces(p: int, U: np.ndarray, pw: np.ndarray) -> tuple[np.ndarray, n
     first, last = domain_spans(p, U)
     spans = np.arange(first, last + 1)
     spans = spans[U[spans + 1] > U[spans]]
+    return _pieces_at(p, U, pw, spans), spans
+
+
+def _pieces_at(p: int, U: np.ndarray, pw: np.ndarray, spans: np.ndarray) -> np.ndarray:
+    """The Bezier control points (S, p + 1, d) of the pieces on knot spans ``spans``."""
     a, b = U[spans], U[spans + 1]
     kk = np.arange(p + 1)
     # argument j of Bezier point k is b when j < k, else a
@@ -427,30 +434,115 @@ def _bezier_pieces(p: int, U: np.ndarray, pw: np.ndarray) -> tuple[np.ndarray, n
     mu = np.repeat(spans, p + 1)
     alpha = blossom_basis(p, U, mu, args.reshape(-1, p))
     idx = mu[:, None] - p + kk
-    seg = np.einsum("ir,ird->id", alpha, pw[idx]).reshape(len(spans), p + 1, -1)
-    return seg, spans
+    return np.einsum("ir,ird->id", alpha, pw[idx]).reshape(len(spans), p + 1, -1)
 
 
 def decompose_bezier(
-    control_points: np.ndarray, degree: int, knots: np.ndarray, weights: np.ndarray | None
+    control_points: np.ndarray,
+    degree: int,
+    knots: np.ndarray,
+    weights: np.ndarray | None,
+    validate: bool = True,
+    projected: bool = True,
 ) -> tuple[np.ndarray, np.ndarray | None]:
     """Split the curve into its Bezier pieces, one per non-empty knot span (A5.6).
 
     Bezier point k of the piece on ``[a, b]`` is the blossom of that piece at
     ``(a, .., a, b, .., b)`` (p - k times a, k times b): the result of inserting every
     knot up to multiplicity p, computed for all pieces at once. Works for unclamped
-    curves too (only the domain's pieces).
+    curves too (only the domain's pieces). ``validate=False`` skips the check of the
+    arrays, for callers that hand over a curve checked when it was made (a NurbsCurve's);
+    ``projected=False`` gives the pieces in homogeneous coordinates ``(w x, w y, w z, w)``
+    (a rational curve's; a non-rational one's are its points) and None.
 
     Returns
     -------
     segments : (k, p + 1, 3) float
     segment_weights : (k, p + 1) float, or None for a non-rational curve
     """
-    validate_curve(control_points, degree, knots, weights)
+    if validate:
+        validate_curve(control_points, degree, knots, weights)
     U = np.asarray(knots, dtype=np.float64)
     seg, _ = _bezier_pieces(degree, U, homogeneous(control_points, weights))
+    if not projected:
+        return seg, None
     cp, w = project(seg, weights is not None)
     return cp, w
+
+
+def decompose_bezier_batch(curves: Sequence[Curve]) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`decompose_bezier` of many curves of one degree at once, in homogeneous
+    coordinates ``(w x, w y, w z, w)`` (w = 1 for a non-rational curve).
+
+    The blossoms of a span use only the knots and control points around it, so the curves'
+    knot vectors are laid end to end as they are (not shifted: each piece comes out bit for
+    bit as it would alone) and each curve's control points padded with ``p + 1`` rows, so
+    that control point j of every curve sits at the index its knots do; one pass of the
+    blossoms then makes every piece of every curve. The curves are not checked (callers
+    hand over curves checked when they were made).
+
+    Returns
+    -------
+    pieces : (k, p + 1, 4) float
+        The pieces of every curve, curve after curve.
+    counts : (c,) int64
+        How many pieces each curve has.
+    """
+    if not curves:
+        return np.zeros((0, 1, 4)), np.zeros(0, np.int64)
+    p = int(curves[0][1])
+    pws, knots, spans = [], [], []
+    at = 0
+    for cp, degree, kn, w in curves:  # one step per curve: its arrays are laid end to end
+        if int(degree) != p:
+            raise ValueError(f"a batch is of one degree, got {degree} and {p}")
+        cp = np.asarray(cp, dtype=np.float64)
+        n = len(cp)
+        hom = homogeneous(cp, np.ones(n) if w is None else w)
+        pws += [hom, np.zeros((p + 1, 4))]
+        U = np.asarray(kn, dtype=np.float64)
+        knots.append(U)
+        local = np.arange(p, n)
+        spans.append(local[U[local + 1] > U[local]] + at)
+        at += n + p + 1
+    seg = _pieces_at(p, np.concatenate(knots), np.concatenate(pws), np.concatenate(spans))
+    counts = np.array([len(x) for x in spans], dtype=np.int64)
+    plain = np.repeat([c[3] is None for c in curves], counts)
+    seg[plain, :, 3] = 1.0  # a non-rational curve's weights stay exactly 1 (not a sum)
+    return seg, counts
+
+
+def decompose_bezier_surface(
+    control_points: np.ndarray,
+    degree_u: int,
+    degree_v: int,
+    knots_u: np.ndarray,
+    knots_v: np.ndarray,
+    weights: np.ndarray | None,
+) -> tuple[np.ndarray, np.ndarray | None]:
+    """Split a surface into its Bezier patches, one per pair of non-empty knot spans.
+
+    A tensor product decomposes one direction at a time: :func:`decompose_bezier`'s
+    blossoms along u with every column of control points carried along (each column a
+    curve in u), then along v on the result (A5.7 done as two passes of A5.6).
+
+    Returns
+    -------
+    patches : (k, p + 1, q + 1, 3) float
+        Patch (i, j) of the spans is ``k = i * (spans in v) + j``.
+    patch_weights : (k, p + 1, q + 1) float, or None for a non-rational surface
+    """
+    validate_surface(control_points, degree_u, degree_v, knots_u, knots_v, weights)
+    p, q = int(degree_u), int(degree_v)
+    pw = homogeneous(control_points, weights)  # (nu, nv, d)
+    nu, nv, d = pw.shape
+    a, _ = _bezier_pieces(p, np.asarray(knots_u, np.float64), pw.reshape(nu, nv * d))
+    su = a.shape[0]  # (su, p + 1, nv * d): every column's u pieces
+    cols = a.reshape(su * (p + 1), nv, d).transpose(1, 0, 2).reshape(nv, -1)
+    b, _ = _bezier_pieces(q, np.asarray(knots_v, np.float64), cols)
+    sv = b.shape[0]  # (sv, q + 1, su * (p + 1) * d)
+    patches = b.reshape(sv, q + 1, su, p + 1, d).transpose(2, 0, 3, 1, 4)
+    return project(patches.reshape(su * sv, p + 1, q + 1, d), weights is not None)
 
 
 def reparametrize(knots: np.ndarray, t0: float, t1: float, degree: int | None = None) -> np.ndarray:

@@ -19,10 +19,12 @@ from .basis import (
     domain_spans,
     find_spans,
 )
-from .curve import homogeneous
+from .curve import homogeneous, project
+from .knots import is_clamped, respace
 
 __all__ = [
     "basis_matrix",
+    "clamp_surface",
     "surface_derivatives",
     "surface_evaluate",
     "surface_evaluate_grid",
@@ -331,3 +333,34 @@ def surface_normals(
         length[bad] = np.linalg.norm(n[bad], axis=-1)
     safe = np.where(length > 0, length, 1.0)
     return n / safe[..., None]
+
+
+def clamp_surface(
+    control_points: np.ndarray,
+    degree_u: int,
+    degree_v: int,
+    knots_u: np.ndarray,
+    knots_v: np.ndarray,
+    weights: np.ndarray | None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
+    """The same surface on knot vectors clamped in u and v (:func:`clamp` along each axis
+    that is not).
+
+    Returns
+    -------
+    (control_points (nu, nv, 3), knots_u, knots_v, weights (nu, nv) or None)
+    """
+    pw = homogeneous(np.asarray(control_points, dtype=np.float64), weights)
+    ku = np.asarray(knots_u, dtype=np.float64)
+    kv = np.asarray(knots_v, dtype=np.float64)
+    out = [ku, kv]
+    for axis, d in enumerate((degree_u, degree_v)):
+        k = out[axis]
+        if is_clamped(d, k):
+            continue
+        a, b = k[d], k[len(k) - d - 1]
+        tau = np.concatenate([[a] * (d + 1), k[(k > a) & (k < b)], [b] * (d + 1)])
+        pw = np.moveaxis(respace(d, k, np.moveaxis(pw, axis, 0), tau), 0, axis)
+        out[axis] = tau
+    cp, w = project(pw, weights is not None)
+    return cp, out[0], out[1], w
