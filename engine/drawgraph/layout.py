@@ -28,6 +28,7 @@ from ..core.errors import FormgraphError
 from ..core.registry import node_types
 from ..language.model import Expr, Items, Literal, exprs_of, parse_input, wires_of
 from .drawing import Drawing
+from .placed import anchors, pin
 from .shapes import Circle, Rect, Text, Wire, text_width
 
 __all__ = ["MARKS", "draw_graph", "failed_nodes", "node_marks"]
@@ -493,7 +494,7 @@ def _place_and_draw(
     page_h = TOP + tallest + MARGIN + 4
     pinned = {k for k in boxes if k[2:] in positions}
     if pinned:
-        page_w, page_h = _pin(boxes, positions, pinned, page_w)
+        page_w, page_h = pin(boxes, positions, pinned, page_w, TOP, V_GAP, MARGIN)
     d = Drawing(page_w, page_h, title=_title(graph))
     _header(d, graph, ran, list(boxes.values()))
     layer_of = {k: i for i, lay in enumerate(order) for k in lay}
@@ -528,45 +529,10 @@ def _place_and_draw(
                 halo=True,
             )
         )
-    d.meta["boxes"] = {
-        box.key[2:]: {
-            "x": box.x,
-            "y": box.y,
-            "w": box.width,
-            "h": box.height,
-            "param": box.is_param,
-            "ports": {p: box.port_y(p) for p in box.ports},
-            "outputs": {o: box.output_y(o) for o, _ in box.outputs},
-        }
-        for box in boxes.values()
-    }
+    d.meta["boxes"] = anchors(boxes.values())
     if path is not None:
         d.save(path)
     return d
-
-
-def _pin(
-    boxes: dict[str, Box],
-    positions: Mapping[str, tuple[float, float]],
-    pinned: set[str],
-    page_w: float,
-) -> tuple[float, float]:
-    """Boxes with a position put there; the others keep their laid-out places, moved down
-    below the placed ones (a node added in the text lands where nothing is); the page's
-    size to hold them all."""
-    bottom = TOP
-    for k in pinned:
-        b = boxes[k]
-        b.x, b.y = (max(0.0, float(c)) for c in positions[k[2:]])
-        bottom = max(bottom, b.y + b.height)
-    free = [boxes[k] for k in boxes if k not in pinned]
-    if free:
-        shift = bottom + 3 * V_GAP - min(b.y for b in free)
-        for b in free:
-            b.y += shift
-    right = max((b.x + b.width + 40 for b in boxes.values()), default=page_w)
-    low = max((b.y + b.height for b in boxes.values()), default=TOP)
-    return max(page_w, right + MARGIN), low + MARGIN + 4
 
 
 def _summary(graph: Any) -> str:
