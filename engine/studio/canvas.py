@@ -144,10 +144,10 @@ class Canvas:
     # ------------------------------------------------------------------ requests
 
     def _asker(self, op: str) -> Any:
-        def ask(rid: Any, *args: Any) -> None:
+        def ask(rid: Any = None, *args: Any) -> None:
+            if not args or not isinstance(args[-1], str):
+                return  # not our page's request: nothing to answer
             *rest, text = args
-            if not isinstance(text, str):
-                return
             kind = f"canvas-{next(self._kinds)}"  # each its own: none supersedes another
             self.page.worker.submit(kind, self.answer, rid, op, rest, text)
 
