@@ -282,3 +282,26 @@ def test_a_node_added_with_placeholders_is_reported_by_the_checker():
 def test_only_changed_reports_a_stray_byte():
     with pytest.raises(AssertionError):
         _only_changed("abc", "abX", [te.Edit(0, 1, "a")])
+
+
+def test_a_subgraph_node_opens_its_file_and_nothing_else(tmp_path):
+    import types
+
+    from formgraph.studio.canvas import Canvas
+    from formgraph.studio.session import StudioSession
+
+    part = (
+        'formgraph: 1\nnodes:\n  c:\n    type: points.circle\n    count: 6\noutputs:\n  pts: "@c"\n'
+    )
+    (tmp_path / "part.yaml").write_text(part)
+    top = tmp_path / "top.yaml"
+    top.write_text("formgraph: 1\nnodes:\n  p:\n    type: part.yaml\n")
+    session = StudioSession(top, out_dir=tmp_path / "out")
+    assert session.open().ok
+    c = Canvas.__new__(Canvas)
+    c.page = types.SimpleNamespace(session=session)
+    shown = c.read_subgraph("p")
+    assert shown["text"] == part and shown["path"].endswith("part.yaml")
+    assert c.read_subgraph("ghost") is None
+    svg = canvas_svg(draw_graph(session.graph), frozenset({"p"}))
+    assert 'data-node="p" data-subgraph="1"' in svg
