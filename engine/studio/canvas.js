@@ -20,13 +20,14 @@
   const trigger = (name, args) => window.trame.trigger(name, args);
 
   // ------------------------------------------------------------------ view transform
-  // (on the two elements themselves: a property inherited from the canvas would restyle
-  // every shape of the drawing at each step of a pan)
+  // (on the HTML box that holds the drawing, not on its <svg>: a transform set on an SVG
+  // root restyles every shape under it, 14,000 of them in a 500-node graph, ~300 ms a step
+  // in headless chromium; on the box around it, no shape is restyled)
   const paint = () => {
     const h = host();
     if (!h) return;
     const t = `translate(${fg.tx}px, ${fg.ty}px) scale(${fg.k})`;
-    h.querySelectorAll('.fg-drawing > svg, #fg-overlay').forEach((e) => {
+    h.querySelectorAll('.fg-drawing, #fg-overlay').forEach((e) => {
       e.style.transform = t;
     });
   };

@@ -30,8 +30,10 @@ html, body { overflow: hidden; }
   padding: 2px 8px; color: #555; }
 .fg-canvas { position: relative; flex: 1 1 auto; overflow: hidden; outline: none;
   touch-action: none; background: #fbfbfb; }
-.fg-canvas .fg-drawing svg, #fg-overlay { position: absolute; left: 0; top: 0;
-  transform-origin: 0 0; will-change: transform; }
+.fg-canvas .fg-drawing, #fg-overlay { position: absolute; left: 0; top: 0;
+  transform-origin: 0 0; }
+.fg-canvas .fg-drawing { width: max-content; line-height: 0; }
+.fg-canvas .fg-drawing svg { display: block; }
 #fg-overlay { overflow: visible; pointer-events: none; }
 .fg-hit { fill: transparent; cursor: move; }
 .fg-hit.fg-selected { stroke: #1976d2; stroke-width: 2.5; }
