@@ -298,10 +298,45 @@ def test_a_subgraph_node_opens_its_file_and_nothing_else(tmp_path):
     top.write_text("formgraph: 1\nnodes:\n  p:\n    type: part.yaml\n")
     session = StudioSession(top, out_dir=tmp_path / "out")
     assert session.open().ok
-    c = Canvas.__new__(Canvas)
-    c.page = types.SimpleNamespace(session=session)
+    c = Canvas(types.SimpleNamespace(session=session), bind=False)
     shown = c.read_subgraph("p")
     assert shown["text"] == part and shown["path"].endswith("part.yaml")
     assert c.read_subgraph("ghost") is None
     svg = canvas_svg(draw_graph(session.graph), frozenset({"p"}))
     assert 'data-node="p" data-subgraph="1"' in svg
+
+
+def test_an_accepted_wire_is_cooked_from_the_graph_its_check_read(tmp_path, monkeypatch):
+    import types
+
+    from formgraph.evaluation.graph import Graph
+    from formgraph.studio.canvas import Canvas
+    from formgraph.studio.session import StudioSession
+
+    path = tmp_path / "tube.yaml"
+    path.write_text(TUBE)
+    session = StudioSession(path, out_dir=tmp_path / "out")
+    assert session.open().ok
+    c = Canvas(types.SimpleNamespace(session=session), bind=False)
+    reads = []
+    real = Graph.from_text.__func__
+    monkeypatch.setattr(
+        Graph, "from_text", classmethod(lambda cls, *a, **k: reads.append(1) or real(cls, *a, **k))
+    )
+    text = session.text
+    # the session's own version is not read again; the wired one is read once, for the
+    # gesture's check, and then cooked as read
+    reply = c.answer(1, "wire", ["spiral", "", "tube", "profile"], text)
+    assert '    profile: "@spiral"\n' in reply["text"] and len(reads) == 1
+    graph = c.take_checked(reply["text"])
+    assert isinstance(graph, Graph) and c.take_checked(reply["text"]) is None  # once
+    cooked = session.open(reply["text"], graph)
+    assert len(reads) == 1 and session.graph is graph
+    assert cooked.ok and session.graph.nodes["tube"] == "nurbs.sweep"
+    # the next gesture's "before" is this one's "after": not read again either
+    again = c.answer(2, "wire", ["section", "", "tube", "profile"], reply["text"])
+    assert '    profile: "@section"\n' in again["text"] and len(reads) == 2
+    # a refused wire hands nothing over: the accepted one before it still goes to the session
+    bad = c.answer(3, "wire", ["section", "", "closed", "mesh"], again["text"])
+    assert "expected Mesh" in bad["refused"] and "text" not in bad
+    assert isinstance(c.take_checked(again["text"]), Graph)

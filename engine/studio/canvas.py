@@ -110,12 +110,25 @@ class Canvas:
     ----------
     page : Page
         The studio page (its session, worker, state and loop).
+    bind : bool
+        Register the requests with the page's trame controller and state (False: only the
+        session is used, as the tests drive it).
     """
 
-    def __init__(self, page: Any):
+    def __init__(self, page: Any, *, bind: bool = True):
         self.page = page
         self.placed: dict[str, tuple[float, float]] = {}  # the last drawing's boxes
+        # texts checked lately -> (their graph, its problems): a gesture checks the text
+        # before and after it, and the next gesture's "before" is this one's "after"
+        self._checked: dict[str, tuple[Any, list[Any]]] = {}
+        # an accepted edit's text and its graph, checked: the session cooks it as it is
+        # rather than reading and checking the text again
+        self._handover: tuple[str, Any] | None = None
         self._kinds = itertools.count()
+        if bind:  # (``bind=False``: the requests' half alone, for a page without trame)
+            self._bind(page)
+
+    def _bind(self, page: Any) -> None:
         ctrl = page.ctrl
         for op in ("wire", "unwire", "add", "delete", "rename", "move"):
             ctrl.trigger(f"canvas_{op}")(self._asker(op))
@@ -168,6 +181,9 @@ class Canvas:
             ]
             if fresh:
                 return {"id": rid, "refused": fresh[0], "port": list(port)}
+            graph, problems = self._check(new)
+            ok = not problems and graph is not self.page.session.graph
+            self._handover = (new, graph) if ok else None
         return {
             "id": rid,
             "edits": [e.where(text) for e in textedit.merged(edits)],
@@ -179,19 +195,24 @@ class Canvas:
     ) -> tuple[list[textedit.Edit], tuple[str, str] | None]:
         from formgraph.language.yamlio import parse
 
-        doc = parse(text, str(self.page.session.path))
+        if op == "wire":  # (read once for the edit and the checks around it)
+            read = self._check(text)[0]
+            params, nodes = read._params, read._nodes
+        else:
+            doc = parse(text, str(self.page.session.path))
+            params, nodes = doc.params, doc.nodes
         types = self._types()
         if op == "wire":
             src, output, dst, port = (str(a) for a in args)
             if src == dst:
                 raise textedit.EditError("a node cannot take its own output")
-            ref = f"={src}" if src in doc.params else None
+            ref = f"={src}" if src in params else None
             listed = False
-            nd = doc.nodes.get(dst)
+            nd = nodes.get(dst)
             spec = types.get(nd.type) if nd is not None else None
             if ref is None and spec is not None and port in spec.inputs:
                 kinds = spec.inputs[port].type.kinds
-                src_nd = doc.nodes.get(src)
+                src_nd = nodes.get(src)
                 src_spec = types.get(src_nd.type) if src_nd is not None else None
                 out_type = None
                 if src_spec is not None:
@@ -209,7 +230,7 @@ class Canvas:
         if op == "unwire":
             src, to = (str(a) for a in args)
             dst, _, port = to.partition(".")
-            if src in doc.params:
+            if src in params:
                 raise textedit.EditError(
                     f"'{dst}.{port}' reads the param '{src}' in its expression: edit it in the text"
                 )
@@ -221,7 +242,7 @@ class Canvas:
                 raise textedit.EditError(f"there is no node type '{type_name}'")
             base = re.sub(r"\W", "_", type_name.rsplit(".", 1)[-1]).strip("_") or "node"
             base = base if not base[0].isdigit() else f"n{base}"
-            taken = set(doc.nodes) | set(doc.params)
+            taken = set(nodes) | set(params)
             name = next(
                 f"{base}{i or ''}" for i in itertools.count() if f"{base}{i or ''}" not in taken
             )
@@ -237,7 +258,7 @@ class Canvas:
             return edits, None
         if op == "move":
             name, (x, y) = str(args[0]), _xy(args[1], args[2])
-            if name not in doc.nodes and name not in doc.params:
+            if name not in nodes and name not in params:
                 raise textedit.EditError(f"there is no node '{name}'")
             self.placed[name] = (x, y)
             return textedit.move_nodes(text, {name: (x, y)}), None
@@ -254,21 +275,52 @@ class Canvas:
                 pass
         return node_types()
 
-    def _problems_at(self, text: str, node: str, port: str) -> list[str]:
+    def _check(self, text: str) -> tuple[Any, list[Any]]:
+        """``text`` as the session would open it (read, then checked) and its problems.
+
+        The graph read is returned even when it does not check (its ``params`` and ``nodes``
+        are what the gestures edit); the version the session shows is not read again.
+        """
         from formgraph.evaluation.graph import Graph
 
         s = self.page.session
+        if text == s.text and s.graph is not None and s.draft is s.graph:
+            return s.graph, []
+        if text in self._checked:
+            return self._checked[text]
+        graph = Graph.from_text(
+            text,
+            file=str(s.path),
+            out_dir=s.out_dir,
+            budget=s.budget,
+            inputs_dir=s.inputs_dir,
+            check=False,
+        )
         try:
-            Graph.from_text(
-                text, file=str(s.path), out_dir=s.out_dir, budget=s.budget, inputs_dir=s.inputs_dir
-            )
+            graph.check()
+            problems: list[Any] = []
         except GraphError as exc:
-            return [
-                p.message
-                for p in exc.problems
-                if p.where.node == node and p.where.input in (port, None)
-            ]
-        return []
+            problems = list(exc.problems)
+        while len(self._checked) >= 4:  # (this gesture's two texts, and the last one's)
+            del self._checked[next(iter(self._checked))]
+        self._checked[text] = (graph, problems)
+        return graph, problems
+
+    def _problems_at(self, text: str, node: str, port: str) -> list[str]:
+        return [
+            p.message
+            for p in self._check(text)[1]
+            if p.where.node == node and p.where.input in (port, None)
+        ]
+
+    def take_checked(self, text: str) -> Any:
+        """The graph of an accepted edit's ``text``, checked and not yet cooked (else None):
+        handed over once, to the session's next opening of that text."""
+        handover, self._handover = self._handover, None
+        if handover is None or handover[0] != text:
+            return None
+        self._checked.pop(text, None)  # (the session owns it now: it gains a cache)
+        return handover[1]
 
     def reply(self, result: dict[str, Any]) -> None:
         """On the page's loop: the reply to the page; an accepted edit is cooked at once
@@ -276,7 +328,8 @@ class Canvas:
         page = self.page
         if "text" in result:
             page._editor_text = result["text"]
-            page.worker.submit("text", page.session.open, result["text"])
+            new = result["text"]
+            page.worker.submit("text", lambda: page.session.open(new, self.take_checked(new)))
         with page.state:
             page.state.canvas_reply = result
             if "refused" in result:

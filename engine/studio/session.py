@@ -214,11 +214,12 @@ class StudioSession:
             )
         return data.decode("utf-8", errors="replace")
 
-    def open(self, text: str | None = None) -> Cooked:
+    def open(self, text: str | None = None, checked: Graph | None = None) -> Cooked:
         """Take a new version of the graph (the editor's text, or the file's) and cook it.
 
         The params the controls hold are kept where the new version still has them and
-        still accepts their values.
+        still accepts their values. ``checked`` is ``text`` already read and checked, with
+        this session's file, folders and budget (the canvas's accepted edit), cooked as is.
         """
         if text is None:
             try:
@@ -230,7 +231,7 @@ class StudioSession:
             self.disk_text = text
         self.text = text
         try:
-            graph = Graph.from_text(
+            graph = checked or Graph.from_text(
                 text,
                 file=str(self.path),
                 out_dir=self.out_dir,

@@ -24,9 +24,7 @@ def canvas(tmp_path):
     path = tmp_path / "tube.yaml"
     shutil.copy(TUBE, path)
     session = StudioSession(path, out_dir=tmp_path / "out")
-    c = Canvas.__new__(Canvas)  # the requests' half alone (no trame page)
-    c.page = types.SimpleNamespace(session=session)
-    c.placed = {}
+    c = Canvas(types.SimpleNamespace(session=session), bind=False)  # (no trame page)
     return c
 
 
