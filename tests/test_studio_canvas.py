@@ -253,6 +253,9 @@ def test_the_palette_lists_every_type_with_its_ports():
     cap = next(e for e in entries if e["name"] == "mesh.cap")
     assert cap["summary"] == node_types()["mesh.cap"].summary
     assert {"name": "mesh", "type": "Mesh", "required": True} in cap["inputs"]
+    offset = next(e for e in entries if e["name"] == "mesh.offset")
+    assert "``" in node_types()["mesh.offset"].summary
+    assert offset["summary"] == node_types()["mesh.offset"].summary.replace("``", "")
 
 
 def test_the_sheet_pages_points_and_attributes():

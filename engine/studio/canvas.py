@@ -50,7 +50,8 @@ def palette(types: Mapping[str, Any]) -> list[dict[str, Any]]:
             {"name": o if spec.multi_output else "", "type": t.name}
             for o, t in spec.outputs.items()
         ]
-        out.append({"name": name, "summary": spec.summary, "inputs": inputs, "outputs": outputs})
+        summary = spec.summary.replace("``", "")  # (numpydoc's literals, read as plain text)
+        out.append({"name": name, "summary": summary, "inputs": inputs, "outputs": outputs})
     return out
 
 
