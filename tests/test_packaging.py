@@ -66,6 +66,7 @@ def test_wheel_holds_every_module(tmp_path):
         if path not in names:
             missing.append(path)
     assert not missing, f"the wheel lacks {missing}"
+    assert "formgraph/studio/canvas.js" in names  # the studio's canvas, served with the page
     entry = [n for n in names if n.endswith("entry_points.txt")]
     assert entry, "no console script"
     text = zipfile.ZipFile(wheel).read(entry[0]).decode()

@@ -24,6 +24,9 @@ class Drawing:
     height: float
     shapes: list[Shape] = field(default_factory=list)
     title: str = ""
+    #: what a program drawing on top needs: for a graph, each box's place and its ports'
+    #: (see :func:`formgraph.drawgraph.layout.draw_graph`)
+    meta: dict = field(default_factory=dict)
 
     def add(self, shape: Shape) -> None:
         self.shapes.append(shape)

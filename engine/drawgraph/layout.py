@@ -28,6 +28,7 @@ from ..core.errors import FormgraphError
 from ..core.registry import node_types
 from ..language.model import Expr, Items, Literal, exprs_of, parse_input, wires_of
 from .drawing import Drawing
+from .placed import anchors, pin
 from .shapes import Circle, Rect, Text, Wire, text_width
 
 __all__ = ["MARKS", "draw_graph", "failed_nodes", "node_marks"]
@@ -227,7 +228,9 @@ def _param_names(value: Any, port_type: Any, params: set[str]) -> list[str]:
     return [n for n in sorted(names) if n in params]
 
 
-def _model(graph: Any, marks: Iterable[Mark] | None) -> tuple[dict[str, Box], list[Edge]]:
+def _model(
+    graph: Any, marks: Iterable[Mark] | None, all_ports: bool = False
+) -> tuple[dict[str, Box], list[Edge]]:
     registry = _registry(graph)
     params = graph.param_defs
     values = graph.params
@@ -283,6 +286,9 @@ def _model(graph: Any, marks: Iterable[Mark] | None) -> tuple[dict[str, Box], li
                 used = True
             if used:
                 box.ports.append(port)
+        if all_ports and spec is not None:  # every input, to wire on a canvas
+            wired = list(box.ports)
+            box.ports = [*spec.inputs, *(p for p in wired if p not in spec.inputs)]
         boxes[box.key] = box
     # label each wire with the type that leaves its source
     labelled = []
@@ -366,6 +372,8 @@ def draw_graph(
     stats: Mapping[str, Any] | None = None,
     marks: Iterable[Mark] | None = None,
     failed: Iterable[str] = (),
+    positions: Mapping[str, tuple[float, float]] | None = None,
+    all_ports: bool = False,
 ) -> Drawing:
     """Draw ``graph``'s nodes, params and wires as a layered diagram.
 
@@ -382,6 +390,13 @@ def draw_graph(
         Mark functions ``(graph, node) -> list[str]``; default :data:`MARKS`.
     failed : iterable of str
         Nodes whose run failed (drawn red): see :func:`failed_nodes`.
+    positions : mapping, optional
+        Node or param name -> (x, y) of its box's top left corner, kept as given; default
+        the graph file's ``layout:`` section (the studio's canvas writes it). The others
+        are laid out as usual, below the placed ones; with any box placed, wires go
+        straight from port to port.
+    all_ports : bool
+        Draw every input port of each node, not only the wired ones (the canvas wires them).
 
     Returns
     -------
@@ -400,7 +415,7 @@ def draw_graph(
     """
     stats = graph.stats if stats is None else stats
     failed = set(failed)
-    boxes, edges = _model(graph, marks)
+    boxes, edges = _model(graph, marks, all_ports)
     ran = bool(stats) or bool(failed)
     for key, box in boxes.items():
         if box.is_param:
@@ -439,7 +454,9 @@ def draw_graph(
             links.append((a, b, at_a, at_b))
         chains.append(chain)
     order = _order(members, links)
-    return _place_and_draw(graph, boxes, edges, chains, order, ran, path)
+    if positions is None:
+        positions = getattr(graph, "layout", None) or {}
+    return _place_and_draw(graph, boxes, edges, chains, order, ran, path, positions)
 
 
 def failed_nodes(error: BaseException) -> list[str]:
@@ -463,6 +480,7 @@ def _place_and_draw(
     order: list[list[str]],
     ran: bool,
     path: str | os.PathLike[str] | None,
+    positions: Mapping[str, tuple[float, float]] = {},  # noqa: B006 (read only)
 ) -> Drawing:
     def height(key: str) -> float:
         return boxes[key].height if key in boxes else 10.0
@@ -491,14 +509,18 @@ def _place_and_draw(
             else:
                 point[k] = y + 5.0
             y += height(k) + V_GAP
-    d = Drawing(page_w, TOP + tallest + MARGIN + 4, title=_title(graph))
+    page_h = TOP + tallest + MARGIN + 4
+    pinned = {k for k in boxes if k[2:] in positions}
+    if pinned:
+        page_w, page_h = pin(boxes, positions, pinned, page_w, TOP, V_GAP, MARGIN)
+    d = Drawing(page_w, page_h, title=_title(graph))
     _header(d, graph, ran, list(boxes.values()))
     layer_of = {k: i for i, lay in enumerate(order) for k in lay}
     labels: dict[tuple[str, str], set[str]] = {}
     for e, chain in zip(edges, chains, strict=True):
         src, dst = boxes[e.src], boxes[e.dst]
         pts = [(src.x + src.width, src.output_y(e.output))]
-        for k in chain[1:-1]:  # straight across each crossed layer, in its own slot
+        for k in chain[1:-1] if not pinned else ():  # across each crossed layer, in its slot
             i = layer_of[k]
             pts += [(xs[i], point[k]), (xs[i] + widths[i], point[k])]
         pts.append((dst.x, dst.port_y(e.port)))
@@ -525,6 +547,7 @@ def _place_and_draw(
                 halo=True,
             )
         )
+    d.meta["boxes"] = anchors(boxes.values())
     if path is not None:
         d.save(path)
     return d

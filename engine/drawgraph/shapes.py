@@ -8,6 +8,7 @@ widths (the font the PNG uses, and the first the SVG asks for), so boxes fit the
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 from xml.sax.saxutils import escape, quoteattr
 
@@ -33,6 +34,7 @@ _BOLD = (
 _WIDTHS = {False: [int(w) for w in _REGULAR.split()], True: [int(w) for w in _BOLD.split()]}
 
 
+@functools.lru_cache(maxsize=8192)  # the same port and type names, box after box
 def text_width(text: str, size: float, bold: bool = False) -> float:
     """The width of ``text`` set in DejaVu Sans at ``size`` pixels (others as an 'M')."""
     table = _WIDTHS[bold]

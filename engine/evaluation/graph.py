@@ -122,6 +122,8 @@ class Graph(Plans):
         self._input_digests: dict[str, tuple[tuple[int, ...], str]] = {}  # input -> (stamp, hash)
         self._parse_problems: list[Problem] = []
         self.outputs: dict[str, Any] = {}  # the `outputs:` mapping, for use as a subgraph
+        # where the canvas drew each node (the file's `layout:`): the drawing's, no key's
+        self.layout: dict[str, tuple[float, float]] = {}
         self._output_lines: dict[str, int] = {}
         self._subgraphs: dict[str, SubgraphSpec] = {}  # graph-file node types -> specs
         self._includes: Includes | None = None
@@ -165,6 +167,7 @@ class Graph(Plans):
         g._parse_problems = doc.problems
         g.outputs = doc.outputs
         g._output_lines = doc.output_lines
+        g.layout = doc.layout
         g._source = (text, g.description, dict(g.outputs))
         if check:
             try:

@@ -205,7 +205,7 @@ class Includes:
         registry = {**node_types(), **subs}
         # the file, the files it uses, and the versions of the node types it runs: a new
         # implementation of a node inside invalidates the subgraph's cached outputs too
-        h = hashlib.blake2b(data, digest_size=20)
+        h = hashlib.blake2b(_without_layout(data, doc), digest_size=20)
         for t in sorted(subs):
             h.update(f"\0{t}\0{subs[t].digest}".encode())
         for t in sorted({nd.type for nd in doc.nodes.values()} - set(subs)):
@@ -240,3 +240,26 @@ class Includes:
             subgraphs=subs,
             output_wires=wires,
         )
+
+
+def _without_layout(data: bytes, doc: Document) -> bytes:
+    """A graph file's bytes without its ``layout:`` section (the canvas's positions, which
+    must not change the key of what the file computes)."""
+    if doc.top_keys is None or "layout" not in doc.top_keys:
+        return data
+    import re
+
+    import yaml
+
+    from . import yamlread
+
+    text = data.decode("utf-8")
+    root = yaml.compose(text, Loader=yamlread.Loader)  # (parsed already: it composes)
+    starts = [0, *(m.end() for m in re.finditer("\n", text))]
+    for k, v in root.value:
+        if isinstance(k, yaml.ScalarNode) and k.value == "layout":
+            a = starts[k.start_mark.line] + k.start_mark.column
+            end = v.end_mark
+            b = starts[end.line] + end.column if end.line < len(starts) else len(text)
+            return (text[:a] + text[b:]).encode("utf-8")
+    return data

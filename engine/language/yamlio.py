@@ -24,7 +24,7 @@ FORMAT_VERSION = 1
 MAX_BYTES = 16 * 1024 * 1024
 MAX_VALUES = 400_000  # scalars and collections, with aliases expanded: a few seconds to read
 MAX_DEPTH = 64
-TOP_KEYS = ("formgraph", "description", "params", "nodes", "outputs")
+TOP_KEYS = ("formgraph", "description", "params", "nodes", "outputs", "layout")
 
 
 @dataclass
@@ -38,6 +38,9 @@ class Document:
     #: the top-level keys written, or None when the file could not be read as a mapping
     #: (not YAML, too large, ...): then its problems say all there is to say
     top_keys: tuple[str, ...] | None = None
+    #: where the studio's canvas drew each node (``layout:``): read, never checked, and in
+    #: no cache key (see :func:`layout_of`)
+    layout: dict[str, tuple[float, float]] = field(default_factory=dict)
 
 
 def _line(node: yaml.Node) -> int:
@@ -142,6 +145,10 @@ def parse(text: str, file: str = "<graph>") -> Document:
         else:
             problem("'outputs' must be a mapping of output name to a wire ('@node')", _line(k))
 
+    if "layout" in top:
+        _value(top["layout"][1], problem, None, None)  # (tags refused, as anywhere)
+        doc.layout = layout_of(top["layout"][1])
+
     if "nodes" not in top:
         problem("missing 'nodes:' (a mapping of node name to its type and inputs)", 1)
         return doc
@@ -208,6 +215,32 @@ def _merged(node: yaml.MappingNode, problem: Any) -> bool:
         problem(f"cannot merge: {getattr(exc, 'problem', None) or exc}", _line(node))
         return False
     return True
+
+
+def layout_of(node: yaml.Node) -> dict[str, tuple[float, float]]:
+    """The node positions a ``layout:`` section holds (``name: [x, y]``).
+
+    The section is the canvas's memory, not part of the graph: an entry that is not a name
+    and two finite numbers is passed over without a problem (the canvas writes it again when
+    the node is moved), and nothing here reaches a cache key.
+    """
+    out: dict[str, tuple[float, float]] = {}
+    if not isinstance(node, yaml.MappingNode):
+        return out
+    for k, v in node.value:
+        if not isinstance(k, yaml.ScalarNode) or not isinstance(v, yaml.SequenceNode):
+            continue
+        if v.tag != "tag:yaml.org,2002:seq":
+            continue
+        if len(v.value) != 2 or not all(isinstance(c, yaml.ScalarNode) for c in v.value):
+            continue
+        try:
+            x, y = (float(c.value) for c in v.value)
+        except ValueError:
+            continue
+        if math.isfinite(x) and math.isfinite(y):
+            out[str(k.value)] = (x, y)
+    return out
 
 
 def _scalar_key(node: yaml.Node) -> str:

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from typing import Any
 
-__all__ = ["ARRAYS", "CSS", "EDITOR_LOADER", "build", "clickable_svg"]
+__all__ = ["ARRAYS", "CSS", "EDITOR_LOADER", "build"]
 
 CSS = """
 html, body { overflow: hidden; }
@@ -24,8 +24,52 @@ html, body { overflow: hidden; }
   padding: 4px 8px; border-top: 1px solid #ddd; white-space: pre-wrap; }
 .fg-center { flex: 1 1 auto; display: flex; flex-direction: column; min-width: 0; }
 .fg-view { flex: 1 1 62%; position: relative; min-height: 0; }
-.fg-graph { flex: 0 0 38%; overflow: auto; border-top: 1px solid #ddd; background: white; }
-.fg-graph svg { cursor: pointer; max-width: 100%; height: auto; }
+.fg-graph { flex: 0 0 38%; display: flex; flex-direction: column; min-height: 0;
+  border-top: 1px solid #ddd; background: white; }
+.fg-graph-bar { display: flex; align-items: center; gap: 6px; font: 12px sans-serif;
+  padding: 2px 8px; color: #555; }
+.fg-canvas { position: relative; flex: 1 1 auto; overflow: hidden; outline: none;
+  touch-action: none; background: #fbfbfb; }
+.fg-canvas .fg-drawing, #fg-overlay { position: absolute; left: 0; top: 0;
+  transform-origin: 0 0; }
+.fg-canvas .fg-drawing { width: max-content; line-height: 0; }
+.fg-canvas .fg-drawing svg { display: block; }
+#fg-overlay { overflow: visible; pointer-events: none; }
+.fg-hit { fill: transparent; cursor: move; }
+.fg-hit.fg-selected { stroke: #1976d2; stroke-width: 2.5; }
+.fg-port { fill: transparent; cursor: crosshair; }
+.fg-port:hover { fill: rgba(25, 118, 210, 0.35); }
+.fg-wire-hit { fill: none; stroke: transparent; stroke-width: 9; cursor: pointer; }
+path.fg-selected:not(.fg-wire-hit) { stroke: #1976d2; stroke-width: 3; }
+.fg-ghost-wire { fill: none; stroke: #1976d2; stroke-width: 2; stroke-dasharray: 5 3; }
+.fg-ghost-box { fill: rgba(25, 118, 210, 0.08); stroke: #1976d2; stroke-dasharray: 4 3; }
+.fg-refusal { position: absolute; max-width: 420px; background: #fff4f4; z-index: 5;
+  border: 1px solid #b00020; color: #b00020; font: 12px sans-serif; padding: 4px 6px;
+  border-radius: 4px; }
+.fg-rename { position: absolute; z-index: 5; font: bold 13px sans-serif; width: 150px;
+  background: white; border: 1px solid #1976d2; padding: 1px 4px; }
+.fg-palette { position: absolute; left: 10px; top: 10px; width: 600px; background: white;
+  border: 1px solid #999; box-shadow: 0 4px 16px rgba(0, 0, 0, 0.2); z-index: 6;
+  display: flex; flex-direction: column; font: 12px sans-serif; }
+.fg-palette input { padding: 6px 8px; border-bottom: 1px solid #ddd; outline: none;
+  font-size: 13px; }
+.fg-palette-body { display: flex; min-height: 0; height: 240px; }
+.fg-palette-list { flex: 1 1 58%; overflow-y: auto; }
+.fg-palette-item { padding: 2px 8px; white-space: nowrap; overflow: hidden;
+  text-overflow: ellipsis; cursor: pointer; }
+.fg-palette-item.hi { background: #e3f0fc; }
+.fg-palette-item span, .fg-palette-doc i { color: #666; }
+.fg-palette-doc { flex: 1 1 42%; overflow-y: auto; border-left: 1px solid #ddd;
+  padding: 4px 8px; }
+.fg-palette-doc ul { margin: 0 0 4px 16px; padding: 0; }
+.fg-sheet { flex: 1 1 auto; overflow: auto; font: 12px monospace; }
+.fg-sheet table { border-collapse: collapse; }
+.fg-sheet td, .fg-sheet th { border: 1px solid #e3e3e3; padding: 1px 6px; text-align: right; }
+.fg-sheet th { background: #f3f3f3; position: sticky; top: 0; }
+.fg-subgraph { position: absolute; inset: 8px; z-index: 7; background: white; display: flex;
+  flex-direction: column; border: 1px solid #999; box-shadow: 0 4px 16px rgba(0, 0, 0, 0.2); }
+.fg-subgraph pre { flex: 1 1 auto; overflow: auto; margin: 0; padding: 6px 10px;
+  font: 12px monospace; }
 .fg-right { flex: 0 0 250px; overflow-y: auto; border-left: 1px solid #ddd; padding: 6px 10px; }
 .fg-control { margin-bottom: 6px; }
 .fg-control-name { font-size: 12px; color: #333; display: flex; align-items: center;
@@ -188,32 +232,6 @@ ARRAYS = """
 """
 
 
-def clickable_svg(drawing: Any) -> str:
-    """The drawing's SVG with an invisible rectangle over each node box, ``data-node`` set
-    to the node's name (the page's click handler reads it)."""
-    from xml.sax.saxutils import quoteattr
-
-    boxes = []
-    rect = None
-    for shape in drawing.shapes:
-        cls = getattr(shape, "cls", "")
-        if cls == "node":
-            rect = shape
-        elif cls == "param":
-            rect = None
-        elif cls == "name" and rect is not None:
-            boxes.append((shape.text, rect))
-            rect = None
-    hits = "".join(
-        f'<rect data-node={quoteattr(name)} x="{r.x:.1f}" y="{r.y:.1f}" width="{r.w:.1f}" '
-        f'height="{r.h:.1f}" fill="transparent" stroke="none"/>'
-        for name, r in boxes
-    )
-    svg = drawing.svg
-    svg = svg[svg.index("<svg") :]  # no XML declaration inside a page
-    return svg.replace("</svg>", hits + "</svg>")
-
-
 def build(page: Any) -> tuple[Any, Any]:
     """The page's widgets, bound to ``page``'s state and controller: (layout, 3-D view)."""
     from trame.ui.vuetify3 import VAppLayout
@@ -221,6 +239,7 @@ def build(page: Any) -> tuple[Any, Any]:
     from trame.widgets import vuetify3 as v
     from trame_pyvista.widgets import PyVistaLocalView
 
+    from .canvas import JS as CANVAS_JS
     from .scene import ARRAYS_TOPIC
 
     page.state.editor_ready = False
@@ -228,6 +247,13 @@ def build(page: Any) -> tuple[Any, Any]:
         client.Style(CSS)
         client.Script(EDITOR_LOADER)
         client.Script(ARRAYS % {"topic": ARRAYS_TOPIC})
+        client.Script(CANVAS_JS.read_text(encoding="utf-8"))
+        client.ClientStateChange(value="canvas_reply", change="window.fgCanvas.reply(canvas_reply)")
+        client.ClientStateChange(
+            value="graph_svg",
+            change="window.fgCanvas && window.fgCanvas.later()",
+            trigger_on_create=True,
+        )
         ready = "() => trame.state.set('editor_ready', true)"
         load = f"window.fgLoadEditor(editor_files, {ready})"
         after_draw = f"window.fgAfterDraw(() => {load}, 8000)"
@@ -281,6 +307,7 @@ def build(page: Any) -> tuple[Any, Any]:
                             theme="vs",
                             markers=("markers",),
                             options=("editor_options",),
+                            ref="editor",
                         )
                         # resolved by name when it renders: it is registered after the
                         # page's template was compiled
@@ -299,18 +326,7 @@ def build(page: Any) -> tuple[Any, Any]:
                             after_scene_loaded=f"cook_id > 0 && {after_draw}",
                         )
                     with html.Div(classes="fg-graph", id="graph"):
-                        html.Div(
-                            "showing {{ shown }}",
-                            style="font: 12px sans-serif; padding: 4px 8px; color: #555;",
-                        )
-                        html.Div(
-                            v_html=("graph_svg",),
-                            click=(
-                                "$event.target.closest('[data-node]') && "
-                                "trigger('show_node', [$event.target.closest('[data-node]')"
-                                ".getAttribute('data-node')])"
-                            ),
-                        )
+                        _graph_panel(v, html)
                 with html.Div(classes="fg-right", id="controls"):
                     with html.Div(
                         style="display: flex; justify-content: space-between; "
@@ -363,6 +379,75 @@ def build(page: Any) -> tuple[Any, Any]:
                     _control_widgets(v, html)
     _defer_editor(page.server)
     return layout, view
+
+
+def _graph_panel(v: Any, html: Any) -> None:
+    """The graph's drawing as a canvas (``canvas.js``), or the spreadsheet of what is shown."""
+    with html.Div(classes="fg-graph-bar"):
+        html.Span("showing {{ shown }}", style="flex: 1 1 auto;")
+        html.Span(
+            "Tab: add a node, drag port to port: wire, Del: delete, F2: rename",
+            v_show="!sheet_open",
+            style="color: #888;",
+        )
+        v.VBtn(
+            "graph",
+            size="x-small",
+            variant=("sheet_open ? 'text' : 'tonal'",),
+            click="sheet_open = false",
+            id="show-graph",
+        )
+        v.VBtn(
+            "spreadsheet",
+            size="x-small",
+            variant=("sheet_open ? 'tonal' : 'text'",),
+            click="trigger('sheet', ['points', 0])",
+            id="show-sheet",
+        )
+    with html.Div(id="graph-canvas", classes="fg-canvas", v_show="!sheet_open"):
+        html.Div(v_html=("graph_svg",), classes="fg-drawing")
+        with html.Div(v_if="subgraph_view", classes="fg-subgraph", id="subgraph"):
+            with html.Div(classes="fg-graph-bar"):
+                html.B("{{ subgraph_view.path }}", style="flex: 1 1 auto;")
+                html.Span("read only here: formgraph serve it to edit it")
+                v.VBtn("close", size="x-small", variant="text", click="subgraph_view = null")
+            html.Pre("{{ subgraph_view.text }}")
+    with html.Div(v_if="sheet_open", classes="fg-sheet", id="sheet"):
+        with html.Div(v_if="sheet", classes="fg-graph-bar"):
+            html.Span(
+                "{{ sheet.node }}: {{ sheet.total }} {{ sheet.domain }}"
+                "{{ sheet.items > 1 ? ' (the first of ' + sheet.items + ' items)' : '' }}, "
+                "page {{ sheet.page + 1 }} of {{ sheet.pages }}",
+                style="flex: 1 1 auto;",
+            )
+            for label, domain in (("points", "points"), ("faces", "faces")):
+                v.VBtn(
+                    label,
+                    size="x-small",
+                    variant=(f"sheet.domain === '{domain}' ? 'tonal' : 'text'",),
+                    click=f"trigger('sheet', ['{domain}', 0])",
+                )
+            v.VBtn(
+                "<",
+                size="x-small",
+                variant="text",
+                disabled=("sheet.page === 0",),
+                click="trigger('sheet', [sheet.domain, sheet.page - 1])",
+            )
+            v.VBtn(
+                ">",
+                size="x-small",
+                variant="text",
+                disabled=("sheet.page + 1 >= sheet.pages",),
+                click="trigger('sheet', [sheet.domain, sheet.page + 1])",
+                id="sheet-next",
+            )
+        html.Div("nothing shown has elements to list", v_if="!sheet")
+        with html.Table(v_if="sheet"):
+            with html.Tr():
+                html.Th("{{ c }}", v_for="c in sheet.columns", key="c")
+            with html.Tr(v_for="(r, i) in sheet.rows", key="i"):
+                html.Td("{{ x }}", v_for="(x, j) in r", key="j")
 
 
 def _defer_editor(server: Any) -> None:

@@ -177,6 +177,12 @@ class Page:
         ctrl.add("reload")(lambda: self.worker.submit("disk", self._open_disk))
         ctrl.add("reset_all")(self._reset_all)
         ctrl.add("show_results")(lambda: self.worker.submit("show", self.session.show, None))
+        from formgraph.core.registry import node_types
+
+        from .canvas import Canvas, palette
+
+        self.canvas = Canvas(self)
+        s.palette = palette(node_types())
 
     # --------------------------------------------------------------------- server life
 
@@ -277,6 +283,10 @@ class Page:
             if result is not None and self.loop is not None:
                 self.loop.call_soon_threadsafe(self._show_drawing, *result)
             return
+        if kind.startswith("canvas-") or kind in ("sheet", "subgraph"):
+            if self.loop is not None:
+                self.loop.call_soon_threadsafe(self._canvas_result, kind, result)
+            return
         t0 = time.perf_counter()
         prepared = None
         # a slider step's drawing of the graph is made and sent once the steps settle
@@ -298,6 +308,13 @@ class Page:
                 self._early.append((kind, result, seconds, prepared))
                 return
         self.loop.call_soon_threadsafe(self._apply, kind, result, seconds, prepared)
+
+    def _canvas_result(self, kind: str, result: Any) -> None:
+        if kind.startswith("canvas-"):
+            self.canvas.reply(result)
+            return
+        with self.state:
+            self.state[kind if kind == "sheet" else "subgraph_view"] = result
 
     def _snapshot(self) -> dict[str, Any]:
         """What the page shows of the session, read in the worker thread, between two of
@@ -424,6 +441,8 @@ class Page:
                 s.status_bad = True
             s.busy = not self.worker.idle(ignore=BACKGROUND)
             s.cook_id = s.cook_id + 1
+            if s.sheet_open and cooked.ok:
+                self.worker.submit("sheet", self.canvas.make_sheet)
             s.timing = {
                 "cook_ms": round(cooked.seconds * 1000, 2),
                 # in the worker: queue, recook, datasets and drawing prepared
@@ -492,19 +511,27 @@ class Page:
 
     def _drawing(self, cooked: Cooked) -> str | None:
         """The graph's drawing, coloured by the last evaluation (None: nothing to draw)."""
-        from formgraph.core.errors import FormgraphError
         from formgraph.drawgraph.layout import draw_graph
 
-        from .layout import clickable_svg
+        from .canvas import canvas_svg
 
-        graph = self.session.graph
+        graph = self.session.draft or self.session.graph  # as written, checked or not
         if graph is None:
             return None
+        failed = cooked.failed or [p.where.node for p in cooked.problems if p.where.node]
         try:
-            drawing = draw_graph(graph, stats=cooked.stats, failed=cooked.failed)
-        except FormgraphError:
+            drawing = draw_graph(
+                graph,
+                stats=cooked.stats,
+                failed=failed,
+                positions=self.canvas.positions(graph),
+                all_ports=True,
+            )
+        except Exception:  # noqa: BLE001 (a version the checker refused may not draw: a cycle)
             return None
-        return clickable_svg(drawing)
+        self.canvas.drawn(drawing)
+        subgraphs = frozenset(n for n, t in graph.nodes.items() if t.endswith((".yaml", ".yml")))
+        return canvas_svg(drawing, subgraphs)
 
     def _picture(self, datasets: Any) -> None:
         from formgraph.viewer.app import _camera_lost

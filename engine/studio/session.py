@@ -198,6 +198,9 @@ class StudioSession:
         self.text = ""  # the text of the version opened last (the editor's or the file's)
         self.disk_text: str | None = None  # the file's text as last read or saved
         self.graph: Graph | None = None  # the last version that checked
+        # the last version opened, checked or not: what the canvas draws (a node just added
+        # with its inputs to fill in is drawn, its problems marked)
+        self.draft: Graph | None = None
         self.values: dict[str, Any] = {}  # params set by the controls (and --set)
         self.shown_names: list[str] | None = None  # None: the graph's results
         self.last: Cooked = Cooked(False, [])
@@ -218,11 +221,12 @@ class StudioSession:
             )
         return data.decode("utf-8", errors="replace")
 
-    def open(self, text: str | None = None) -> Cooked:
+    def open(self, text: str | None = None, checked: Graph | None = None) -> Cooked:
         """Take a new version of the graph (the editor's text, or the file's) and cook it.
 
         The params the controls hold are kept where the new version still has them and
-        still accepts their values.
+        still accepts their values. ``checked`` is ``text`` already read and checked, with
+        this session's file, folders and budget (the canvas's accepted edit), cooked as is.
         """
         if text is None:
             try:
@@ -234,7 +238,7 @@ class StudioSession:
             self.disk_text = text
         self.text = text
         try:
-            graph = Graph.from_text(
+            graph = checked or Graph.from_text(
                 text,
                 file=str(self.path),
                 out_dir=self.out_dir,
@@ -243,8 +247,10 @@ class StudioSession:
             )
         except GraphError as exc:
             self._files = list(getattr(exc, "files", None) or [self.path])
+            self.draft = self._unchecked(text)
             return self._failed(exc.problems, str(exc))
         self._files = [*(graph.files or [self.path]), *graph.input_files]
+        self.draft = graph
         if self.memory is not None:
             graph.memory = self.memory  # a new version recomputes only what it reaches
         first = self.graph is None
@@ -257,6 +263,16 @@ class StudioSession:
         cooked = self.cook()
         cooked.new_graph = True
         return cooked
+
+    def _unchecked(self, text: str) -> Graph | None:
+        """``text`` as a graph not checked (None: not even its nodes could be read)."""
+        try:
+            graph = Graph.from_text(
+                text, file=str(self.path), check=False, out_dir=self.out_dir, budget=self.budget
+            )
+        except FormgraphError:
+            return None
+        return graph if graph._nodes else None
 
     def _start_values(self, graph: Graph) -> dict[str, Any] | Cooked:
         from formgraph.core.errors import UsageError
