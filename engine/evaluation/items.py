@@ -16,7 +16,6 @@ a wired input enters the subgraph's keys as the wire's identity.
 from __future__ import annotations
 
 import os
-import stat
 from typing import Any
 
 import numpy as np
@@ -42,7 +41,6 @@ __all__ = [
     "LanguageRun",
     "file_stamp",
     "input_names",
-    "input_stamp",
     "reads_loop",
 ]
 
@@ -71,17 +69,6 @@ def input_names(value: Input, pt: Any) -> set[str]:
 def reads_loop(value: Input, loop: str, pt: Any) -> bool:
     """Whether an input reads the loop name (and so differs item by item)."""
     return loop in input_names(value, pt)
-
-
-def input_stamp(path: Any) -> tuple[int, ...] | None:
-    """What changes when an input file's bytes do (None for anything but a regular file)."""
-    try:
-        st = os.stat(path)
-    except OSError:
-        return None
-    if not stat.S_ISREG(st.st_mode):
-        return None
-    return (st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns)
 
 
 def file_stamp(path: Any) -> tuple[int, int] | None:

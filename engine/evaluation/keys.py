@@ -13,6 +13,8 @@ from __future__ import annotations
 import enum
 import hashlib
 import json
+import os
+import stat
 import uuid
 import weakref
 from collections.abc import Callable
@@ -24,7 +26,6 @@ import numpy as np
 from ..core import safety
 from ..core.errors import PathError, Problem, Where
 from ..geometry import Geometry
-from .items import input_stamp
 
 __all__ = [
     "KEYED_INLINE",
@@ -229,3 +230,14 @@ class InputKeys:
                 self.g._input_digests.clear()
             self.g._input_digests[str(path)] = (stamp, digest)
         return {"path": relpath, "bytes": digest}
+
+
+def input_stamp(path: Path) -> tuple[int, ...] | None:
+    """What changes when an input file's bytes do (None for anything but a regular file)."""
+    try:
+        st = os.stat(path)
+    except OSError:
+        return None
+    if not stat.S_ISREG(st.st_mode):
+        return None
+    return (st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns)
