@@ -14,9 +14,10 @@ from the seed and the number of trials so far, so the same seed gives the same t
 whatever the number of workers, and a study interrupted and continued gives the trials an
 uninterrupted one would have.
 
-With ``out``, the study lives in ``out/study.journal`` (optuna's journal file storage: an
-append-only log, each record one write), so running the same study again continues it to
-the new budget; trials an interrupted run had asked but not told are run again. Every
+With ``out``, the study lives in ``out/study.journal`` (:mod:`formgraph.sweeps.journal`:
+each batch's told trials appended in one write), so running the same study again replays
+it into optuna and continues to the new budget; a batch an interrupted run had asked but
+not told is asked again, identically, and run. Every
 batch rewrites ``trials.csv`` and ``pareto.csv`` whole (atomically); ``progress.png`` is
 drawn at the end.
 """
@@ -40,6 +41,7 @@ from ..evaluation.graph import Graph
 from .api import _GRAPH_CACHE, EACH_WORKER, _cell, _label, _table_text, _tabular, _targets
 from .api import _write_atomic as write_atomic
 from .cluster import RowResult, Targets, Totals
+from .journal import Journal, replay
 from .objectives import (
     Constraint,
     Objective,
@@ -53,7 +55,6 @@ from .sampling import domain, param_kind
 __all__ = ["METHODS", "Study", "optimize", "require_optuna"]
 
 METHODS = ("tpe", "nsga2", "cmaes", "random")
-STUDY = "formgraph"
 MAX_BUDGET = 1_000_000
 
 
@@ -148,15 +149,6 @@ def _sampler(optuna: Any, method: str, seed: int, population: int) -> Any:
     if method == "cmaes":
         return s.CmaEsSampler(seed=seed, warn_independent_sampling=False)
     return s.RandomSampler(seed=seed)
-
-
-def _storage(optuna: Any, out: Path | None) -> Any:
-    if out is None:
-        return optuna.storages.InMemoryStorage()
-    from optuna.storages.journal import JournalFileBackend
-
-    out.mkdir(parents=True, exist_ok=True)
-    return optuna.storages.JournalStorage(JournalFileBackend(str(out / "study.journal")))
 
 
 def optimize(
@@ -280,30 +272,22 @@ def optimize(
         },
         sort_keys=True,
     )
-    storage = _storage(optuna, out_dir)
-    study = optuna.create_study(
-        study_name=STUDY,
-        storage=storage,
-        directions=[o.direction for o in objectives],
-        load_if_exists=True,
-    )
-    asked_before = study.user_attrs.get("question")
-    if asked_before is None:
-        study.set_user_attr("question", question)
-    elif asked_before != question:
+    journal = None if out_dir is None else Journal(out_dir / "study.journal")
+    asked_before, records = (None, []) if journal is None else journal.read()
+    if asked_before is not None and asked_before != question:
         raise ValueError(
             f"{out_dir} holds a study of another question (other params, objectives, "
             f"constraints, method, seed or batch); give another out folder, or delete "
             f"{out_dir / 'study.journal'} to start again"
         )
+    if journal is not None and asked_before is None:
+        journal.start(question)
+    study = optuna.create_study(directions=[o.direction for o in objectives])
+    replay(optuna, study, records)
     population = max(batch, 16)
-    rows: dict[int, dict[str, Any]] = {}
-    pending = []  # asked by an interrupted run and never told: run again, as they were
-    for t in study.get_trials(deepcopy=False):
-        if t.state.name in ("COMPLETE", "FAIL") and "row" in t.user_attrs:
-            rows[t.number] = t.user_attrs["row"]
-        elif t.state.name == "RUNNING":
-            pending.append(optuna.trial.Trial(study, t._trial_id))
+    rows: dict[int, dict[str, Any]] = {
+        t.number: t.user_attrs["row"] for t in study.get_trials(deepcopy=False)
+    }
     resumed = len(rows)
     totals = Totals()
     t0 = time.perf_counter()
@@ -368,18 +352,15 @@ def optimize(
         with run_dask.connect(client, workers) as c:
             embedded = client is None
             while True:
-                n = len(rows) + len(pending)
-                asked = list(pending)
-                pending = []
-                if len(asked) < batch and n < budget:
-                    seed_n = (seed * 1_000_003 + n) % (2**32)
-                    study.sampler = _sampler(optuna, method, seed_n, population)
-                    with warnings.catch_warnings():
-                        warnings.simplefilter("ignore")  # optuna's experimental notes
-                        more = min(batch - len(asked), budget - n)
-                        asked += [study.ask(space) for _ in range(more)]
-                if not asked:
+                n = len(rows)
+                if n >= budget:
                     break
+                # a sampler seeded by the seed and the trials so far: the same history
+                # gives the same batch, in one run or across an interruption
+                study.sampler = _sampler(optuna, method, (seed * 1_000_003 + n) % 2**32, population)
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore")  # optuna's experimental notes
+                    asked = [study.ask(space) for _ in range(min(batch, budget - n))]
                 params_of = {t.number: {**base, **t.params} for t in asked}
                 got: dict[int, RowResult] = {}
                 part = run_dask.run(
@@ -395,6 +376,9 @@ def optimize(
                 )
                 for t in sorted(asked, key=lambda t: t.number):  # told in order: deterministic
                     tell(t, params_of[t.number], got[t.number])
+                if journal is not None:
+                    held = study.get_trials(deepcopy=False)
+                    journal.append(held[t.number] for t in asked)
                 for name in ("variants", "naive", "needed", "computed", "cached"):
                     setattr(totals, name, getattr(totals, name) + getattr(part, name))
                 write_tables()
