@@ -103,9 +103,7 @@ def replay(optuna: Any, study: Any, records: list[dict[str, Any]]) -> None:
             optuna.trial.create_trial(
                 state=state,
                 params=rec["params"],
-                distributions={
-                    k: json_to_distribution(d) for k, d in rec["distributions"].items()
-                },
+                distributions={k: json_to_distribution(d) for k, d in rec["distributions"].items()},
                 values=rec["values"] if state == optuna.trial.TrialState.COMPLETE else None,
                 user_attrs=rec["user_attrs"],
                 system_attrs=rec["system_attrs"],
