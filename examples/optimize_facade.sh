@@ -6,6 +6,6 @@
 set -e
 formgraph optimize graphs/facade_daylight.yaml \
   --vary columns=2:10 floors=1:4 w=0.4:1.6 h=0.5:2.4 depth=0.05:0.8 \
-  --maximize daylight.area --minimize material.volume \
+  --maximize daylight.volume --minimize material.volume \
   --constraint "depth - 0.3 * h >= 0" --constraint "w * columns <= 10" \
   --method nsga2 --budget 200 --batch 20 --seed 1 --render facade --out out/facade_front "$@"
