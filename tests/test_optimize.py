@@ -328,3 +328,21 @@ def test_the_command_line_refuses_a_mesh_objective_and_names_a_missing_optuna(
     monkeypatch.setitem(sys.modules, "optuna", None)
     assert cli_main([*args, "--out", str(tmp_path / "o")]) == 2
     assert "pip install 'formgraph[optimize]'" in capsys.readouterr().err
+
+
+def test_the_progress_line_says_trials_the_best_and_the_time_left():
+    import io
+
+    from formgraph.cli.optimize import _Progress, progress_text
+
+    text = progress_text(40, 100, "best size.area = 571.2", 2.0)
+    assert text == "optimize 40/100 trials, best size.area = 571.2, 2.0/s, ETA 0:30"
+
+    class Tty(io.StringIO):
+        def isatty(self):
+            return True
+
+    tty, pipe = Tty(), io.StringIO()
+    _Progress(tty)(100, 100, "best x = 1", 5.0)
+    _Progress(pipe)(100, 100, "best x = 1", 5.0)
+    assert "optimize 100/100 trials, best x = 1" in tty.getvalue() and pipe.getvalue() == ""
