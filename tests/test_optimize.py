@@ -151,11 +151,19 @@ def test_a_two_objective_front_is_non_dominated_both_ways(client, tmp_path):
         _ = s.best
 
 
-@settings(max_examples=40, deadline=None)
-@given(st.lists(st.tuples(st.integers(0, 5), st.integers(0, 5), st.integers(0, 5)), max_size=40))
-def test_non_dominated_matches_the_definition(points):
-    v = np.array(points, dtype=float).reshape(len(points), 3)
-    keep = non_dominated(v)
+@settings(max_examples=60, deadline=None)
+@given(
+    st.integers(1, 3).flatmap(
+        lambda k: st.lists(st.tuples(*[st.integers(0, 5)] * k), max_size=40).map(
+            lambda pts: (k, pts)
+        )
+    )
+)
+def test_non_dominated_matches_the_definition(case):
+    # one objective (the least), two (the sorted sweep) and three (pairwise), ties included
+    k, points = case
+    keep = non_dominated(np.array(points, dtype=float).reshape(len(points), k))
+    assert keep.shape == (len(points),) and keep.dtype == bool
     for i, p in enumerate(points):
         assert keep[i] == (not any(dominates(q, p) for q in points))
 

@@ -17,9 +17,9 @@ uninterrupted one would have.
 With ``out``, the study lives in ``out/study.journal`` (:mod:`formgraph.sweeps.journal`:
 each batch's told trials appended in one write), so running the same study again replays
 it into optuna and continues to the new budget; a batch an interrupted run had asked but
-not told is asked again, identically, and run. Every
-batch rewrites ``trials.csv`` and ``pareto.csv`` whole (atomically); ``progress.png`` is
-drawn at the end.
+not told is asked again, identically, and run. ``trials.csv`` and
+``pareto.csv`` are rewritten whole (atomically) after a batch at most once a second, and at
+the end; ``progress.png`` is drawn at the end.
 """
 
 from __future__ import annotations
@@ -56,6 +56,7 @@ __all__ = ["METHODS", "Study", "optimize", "require_optuna"]
 
 METHODS = ("tpe", "nsga2", "cmaes", "random")
 MAX_BUDGET = 1_000_000
+TABLE_INTERVAL = 1.0  # seconds between rewrites of trials.csv and pareto.csv mid-study
 
 
 def require_optuna() -> Any:
@@ -77,6 +78,9 @@ class Study:
 
     ``trials`` are dicts: ``trial``, the params, ``status`` ('ok' or 'failed'), ``error``,
     ``seconds``, each measured column (objectives first), ``feasible`` and ``pareto``.
+    ``overhead`` is the CPU time (of the calling thread) the study spent on its own work
+    beside the sweep runs: asking and telling optuna, the journal, the tables, the progress
+    callback and ``progress.png``.
     """
 
     trials: list[dict[str, Any]]
@@ -87,6 +91,7 @@ class Study:
     seconds: float = 0.0
     resumed: int = 0
     files: list[Path] = field(default_factory=list)
+    overhead: float = 0.0  # CPU seconds of the study's own work (see optimize)
 
     @property
     def pareto(self) -> list[dict[str, Any]]:
@@ -291,6 +296,8 @@ def optimize(
     resumed = len(rows)
     totals = Totals()
     t0 = time.perf_counter()
+    own = 0.0  # thread CPU seconds outside the sweep runs (Study.overhead)
+    written = [-math.inf]  # when the tables were last written
     files: list[Path] = []
     if cache_dir is _GRAPH_CACHE:
         cache_dir = g.disk.root if g.disk is not None else None
@@ -320,7 +327,7 @@ def optimize(
         front = [r for r in ordered if r["pareto"]]
         write_atomic(out_dir / "pareto.csv", _table_text(columns, front))
 
-    def tell(trial: Any, params: Mapping[str, Any], result: RowResult) -> None:
+    def tell(trial: Any, params: Mapping[str, Any], result: RowResult) -> dict[str, Any]:
         row: dict[str, Any] = {"trial": trial.number}
         row.update({c: params[c] for c in columns if c in params})
         row.update(status="ok", error="", seconds=round(result.seconds, 6))
@@ -346,7 +353,7 @@ def optimize(
             study.tell(trial, values)
         else:
             study.tell(trial, state=optuna.trial.TrialState.FAIL)
-        rows[trial.number] = row
+        return row
 
     try:
         with run_dask.connect(client, workers) as c:
@@ -355,6 +362,7 @@ def optimize(
                 n = len(rows)
                 if n >= budget:
                     break
+                mark = time.thread_time()
                 # a sampler seeded by the seed and the trials so far: the same history
                 # gives the same batch, in one run or across an interruption
                 study.sampler = _sampler(optuna, method, (seed * 1_000_003 + n) % 2**32, population)
@@ -363,6 +371,7 @@ def optimize(
                     asked = [study.ask(space) for _ in range(min(batch, budget - n))]
                 params_of = {t.number: {**base, **t.params} for t in asked}
                 got: dict[int, RowResult] = {}
+                own += time.thread_time() - mark
                 part = run_dask.run(
                     g,
                     [(t.number, params_of[t.number]) for t in asked],
@@ -374,20 +383,30 @@ def optimize(
                     shared_disk=(embedded or shared_cache) and not worker_cache,
                     bp=bp,
                 )
-                for t in sorted(asked, key=lambda t: t.number):  # told in order: deterministic
-                    tell(t, params_of[t.number], got[t.number])
+                mark = time.thread_time()
+                told = {  # told in trial order: deterministic
+                    t.number: tell(t, params_of[t.number], got[t.number])
+                    for t in sorted(asked, key=lambda t: t.number)
+                }
                 if journal is not None:
                     held = study.get_trials(deepcopy=False)
                     journal.append(held[t.number] for t in asked)
+                # the rows count once the journal holds them: a Ctrl-C before that leaves
+                # the tables and the journal agreeing, and the rerun asks the batch again
+                rows.update(told)
                 for name in ("variants", "naive", "needed", "computed", "cached"):
                     setattr(totals, name, getattr(totals, name) + getattr(part, name))
-                write_tables()
+                if time.perf_counter() - written[0] >= TABLE_INTERVAL:
+                    # whole tables at most once a second: a long study of quick trials
+                    # does not spend its time rewriting them after every small batch
+                    write_tables()
+                    written[0] = time.perf_counter()
                 if progress is not None:
                     rate = (len(rows) - resumed) / max(time.perf_counter() - t0, 1e-9)
                     progress(len(rows), budget, best_text(), rate)
+                own += time.thread_time() - mark
                 if on_batch is not None:
                     on_batch(len(rows))
-            write_tables()
             flags = _front(list(rows.values()), objectives, signs)
             if out_dir is not None and (export or render):
                 files += _front_files(
@@ -395,6 +414,7 @@ def optimize(
                     cache_path, worker_cache, size, export, render,
                 )  # fmt: skip
     finally:
+        mark = time.thread_time()
         write_tables()  # an interrupted study leaves its tables and picture as they stand
         ordered = [rows[i] for i in sorted(rows)]
         if out_dir is not None and rows:
@@ -402,7 +422,10 @@ def optimize(
 
             shown = draw_progress(ordered, objectives, out_dir / "progress.png")
             files[:0] = [out_dir / "trials.csv", out_dir / "pareto.csv", shown]
-    result = Study(ordered, columns, objectives, cons, totals, resumed=resumed, files=files)
+        own += time.thread_time() - mark
+    result = Study(
+        ordered, columns, objectives, cons, totals, resumed=resumed, files=files, overhead=own
+    )
     result.seconds = time.perf_counter() - t0
     return result
 
