@@ -107,7 +107,7 @@ def run(table) -> None:
             case = f"optimize: the study's own CPU a trial, {n} trials, {method}"
             table.add(
                 case,
-                "formgraph study",
+                "formgraph",
                 own[len(own) // 2],
                 f"median of {len(own)}: ask, tell, journal, tables, progress.png "
                 "(Study.overhead, client thread CPU time)",
