@@ -46,12 +46,16 @@ def test_profile_runs_a_tool_radius_from_the_outline(side, sign):
         d = shapely.distance(shapely.points(p[:, :2]), region.boundary)
         inside = shapely.contains_xy(region, p[:, 0], p[:, 1])
         assert np.all(inside == (sign < 0))
-        # round corners are chords of the arc, within the tolerance (1e-4 of the size: 0.008)
-        assert d.min() >= 3 - 0.008
-        assert np.median(d) == pytest.approx(3, abs=1e-3)
-    # the circle's and the rounded rectangle's paths are exact arcs
+        # every path is exact: at the tool's radius up to the outline's own sampling
+        assert d.min() >= 3 - 1e-4
+        assert np.median(d) == pytest.approx(3, abs=1e-4)
+    # the circle's, the rounded rectangle's and the star's paths are exact: the star (a
+    # polygon, a hole) grows with arcs of the tool's radius about its corners when the
+    # region shrinks, and shrinks to a pentagon of five sharp corners when it grows
     exact = [c for c in paths if c.degree == 2 and c.rational]
-    assert len(exact) == 2 * 3
+    assert len(exact) == (3 if sign < 0 else 2) * 3
+    pentagons = [c for c in paths if c.degree == 1 and len(c.control_points) == 6]
+    assert len(pentagons) == (0 if sign < 0 else 3)
 
 
 def test_profile_cuts_holes_before_the_outer_loop_and_on_stays_on_the_curves():
@@ -122,3 +126,18 @@ def test_bad_tools_and_depths_are_located_errors(kwargs, message):
     g.add("p", "cam.profile", curves=["@plate"], **kwargs)
     with pytest.raises(fg.FormgraphError, match=message):
         g.evaluate("p")
+
+
+def test_tabs_hold_the_part_and_leave_the_holes_exact():
+    g = _graph()
+    g.add(
+        "p", "cam.profile", curves=["@plate", "@hole"], tool_diameter=6, depth=6, step_down=2,
+        tabs=3, tab_height=1,
+    )  # fmt: skip
+    paths = g.evaluate("p")
+    hole, plate = paths[:3], paths[3:]  # holes first, each loop through its depths
+    assert all(c.degree == 2 and c.rational for c in hole)
+    assert all(c.degree == 2 and c.rational for c in plate[:2])  # -2, -4: above -5
+    z = np.asarray(plate[2].control_points)[:, 2]
+    assert set(np.round(z, 9)) == {-6.0, -5.0}  # the last pass, lifted to the tabs' top
+    assert np.sum(np.diff(z) > 0) == 3  # three tabs, each climbed once

@@ -101,6 +101,57 @@ def test_nodes_catalogue_and_one_node():
     assert r.returncode == 1 and "did you mean 'points.grid'" in r.stderr
 
 
+def test_nodes_of_a_graph_file_lists_the_types_it_uses(graph_file, tmp_path):
+    # a graph without outputs: its node types, and a sentence for what it is not
+    r = cli("nodes", graph_file.name, cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.splitlines()[:2] == [
+        "g.yaml uses 1 node type in 1 node:",
+        "  points.circle  pts",
+    ]
+    assert "It has no 'outputs:', so it is not a node type" in r.stdout
+    assert "formgraph params g.yaml" in r.stdout
+    # a part: its interface as a node, then what it uses
+    r = cli("nodes", "graphs/parts/ring.yaml", cwd=ROOT)
+    assert r.returncode == 0, r.stderr
+    assert "inputs:\n  radius" in r.stdout and "outputs:\n  mesh         Mesh" in r.stdout
+    assert "  nurbs.circle      path, section" in r.stdout
+    r = cli("nodes", "graphs/vase_repeat.yaml", cwd=ROOT)
+    assert r.returncode == 0 and "(repeat " in r.stdout
+    r = cli("nodes", "missing.yaml", cwd=tmp_path)
+    assert r.returncode == 1 and "missing.yaml" in r.stderr and "Traceback" not in r.stderr
+
+
+def test_params_lists_types_defaults_ranges_steps_and_docs():
+    import yaml
+
+    path = ROOT / "graphs" / "lattice_part.yaml"
+    r = cli("params", str(path), "--json")
+    assert r.returncode == 0, r.stderr
+    rows = json.loads(r.stdout)
+    declared = yaml.safe_load(path.read_text())["params"]
+    assert [row["name"] for row in rows] == list(declared)
+    for row in rows:
+        p = declared[row["name"]]
+        assert (row["default"], row["doc"]) == (p["default"], p["doc"])
+        assert (row["min"], row["max"], row["choices"]) == (
+            p.get("min"),
+            p.get("max"),
+            p.get("choices"),
+        )
+    steps = {row["name"]: row["step"] for row in rows}
+    # a hundredth of the range, rounded up to 1, 2 or 5 x 10^k: 3.6 / 100 -> 0.05
+    assert steps == {"wall": 0.05, "lattice": None, "period": 0.5, "sheet": 0.05, "cell": 0.02}
+    assert {row["name"]: row["type"] for row in rows}["lattice"] == "choice"
+    text = cli("params", str(path)).stdout.splitlines()
+    assert text[1].split() == ["name", "type", "default", "range", "step", "doc"]
+    assert text[2].split()[:7] == ["wall", "float", "1.2", "0.4", "..", "4", "0.05"]
+    assert "gyroid | schwarz_p | diamond" in text[3]
+    r = cli("params", "--help")
+    assert r.returncode == 0 and "--json" in r.stdout
+    assert "params" in cli("--help").stdout
+
+
 def test_schema_validates_the_example_graphs():
     jsonschema = pytest.importorskip("jsonschema")
     import yaml

@@ -108,6 +108,27 @@ def test_boxes_show_type_ports_and_output_types_and_wires_their_types():
     assert sorted(p.get("data-from") for p in both) == ["outline", "wave"]
 
 
+def test_a_repeated_transform_is_drawn_with_the_type_it_carries():
+    g = fg.Graph()
+    g.add("box", "mesh.box", size=[1, 1, 1])
+    g.add("turned", "geometry.transform", geometry="@box", rotate=[0, 0, "=i * 10"])
+    g.set_input("turned", "repeat", {"i": 4})
+    g.add("pts", "points.grid", nx=2, ny=2)
+    g.add("placed", "geometry.transform", geometry="@box", translate="=p")
+    g.set_input("placed", "repeat", {"p": "@pts"})
+    g.add("circles", "nurbs.circle", radius="=k + 1")
+    g.set_input("circles", "repeat", {"k": 3})
+    g.add("scaled", "geometry.transform", geometry="=c", scale=2)
+    g.set_input("scaled", "repeat", {"c": "@circles"})
+    g.add("all", "mesh.merge", meshes="@turned")
+    root = parse(draw_graph(g).svg)
+    texts = [t.text for t in by_class(root, "text", "output-type")]
+    assert not any("Geometry" in t for t in texts), texts  # not the port's declared type
+    assert texts.count("-> list[Mesh]") == 2 and "-> list[NurbsCurve]" in texts
+    wire_labels = [t.text for t in by_class(root, "text", "wire-label")]
+    assert "list[Mesh]" in wire_labels and not any("Geometry" in t for t in wire_labels)
+
+
 def _box_rects(root: ET.Element) -> list[tuple[float, float, float, float]]:
     rects = by_class(root, "rect", "node") + by_class(root, "rect", "param")
     return [tuple(float(r.get(k)) for k in ("x", "y", "width", "height")) for r in rects]

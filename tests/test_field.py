@@ -276,3 +276,96 @@ def test_separable_fields_are_the_ones_sampled_on_tables():
     assert Field.transform(g, np.eye(3), [1, 0, 0], [1, 2, 3]).separable
     assert not Field.transform(g, [[0, 1, 0], [-1, 0, 0], [0, 0, 1]], [0, 0, 0], 1).separable
     assert not Field.union([g, Field.torus(2.0, 0.5)]).separable  # a torus is point-wise
+
+
+def four_blocks(smooth, **extra):
+    """Four 10 x 10 x 5 blocks standing on z = 0 in a 2 x 2 square, unioned."""
+    nodes = {
+        name: ("field.box", {"size": [10, 10, 5], "center": [5 + 10 * i, 5 + 10 * j, 2.5]})
+        for name, (i, j) in zip("abcd", [(0, 0), (1, 0), (0, 1), (1, 1)], strict=True)
+    }
+    nodes["u"] = ("field.union", {"fields": ["@a", "@b", "@c", "@d"], "smooth": smooth})
+    nodes.update(extra)
+    nodes.setdefault("m", ("field.mesh", {"field": "@u", "cell": 0.5}))
+    return build(**nodes)
+
+
+def test_a_smooth_union_that_pushes_a_flat_bottom_below_the_bed_is_warned_of():
+    g = four_blocks(1.0)
+    v = g.evaluate("m").vertices
+    (warning,) = g.stats["m"].warnings
+    below, above = -v[:, 2].min(), v[:, 2].max() - 5
+    assert below > 0.4 and above > 0.4  # the ridges under and over the seams, up to k/4 and more
+    assert "the smooth union (its input smooth: 1)" in warning
+    assert f"the face at z = 5 (facing +z) by {above:.3g}, at (" in warning
+    assert f"the face at z = 0 (facing -z) by {below:.3g}, at (" in warning
+    assert "; and 2 more" in warning  # the four sides, by about k / 4
+    assert "intersect the blend with a box" in warning
+    # the advice works: cut back to the blocks' box, the blend stays inside, no warning
+    cut = four_blocks(
+        1.0,
+        box=("field.box", {"size": [20, 20, 5], "center": [10, 10, 2.5]}),
+        cut=("field.intersection", {"fields": ["@u", "@box"]}),
+        m=("field.mesh", {"field": "@cut", "cell": 0.5}),
+    )
+    v = cut.evaluate("m").vertices
+    assert cut.stats["m"].warnings == []
+    assert v[:, 2].min() > -0.05 and v[:, 2].max() < 5.05  # within a tenth of the cell
+    sharp = four_blocks(0.0)
+    sharp.evaluate("m")
+    assert sharp.stats["m"].warnings == []
+
+
+def test_fillets_and_shapes_that_cross_the_plane_are_not_warned_of():
+    g = build(
+        plate=("field.box", {"size": [20, 20, 2], "center": [0, 0, 1]}),
+        post=("field.cylinder", {"radius": 2, "height": 10, "center": [0, 0, 7]}),
+        ball=("field.sphere", {"radius": 2, "center": [6, 0, 0.5]}),  # through the bed
+        u=("field.union", {"fields": ["@plate", "@post", "@ball"], "smooth": 1.5}),
+        m=("field.mesh", {"field": "@u", "cell": 0.4}),
+        s=("field.union", {"fields": ["@plate", "@post", "@ball"]}),
+        ms=("field.mesh", {"field": "@s", "cell": 0.4}),
+    )
+    blended, sharp = g.evaluate(["m", "ms"]).values()
+    assert tm(blended).volume > tm(sharp).volume + 1  # the fillets are there
+    assert g.stats["m"].warnings == []
+
+
+def test_a_slanted_flat_face_and_a_mesh_s_faces_are_checked_too():
+    g = four_blocks(
+        1.0,
+        t=("field.transform", {"field": "@u", "rotate": [30, 0, 0]}),
+        m=("field.mesh", {"field": "@t", "cell": 0.5}),
+    )
+    g.evaluate("m")
+    (warning,) = g.stats["m"].warnings
+    assert "n = [0, -0.5, 0.866]" in warning  # the top face's normal, turned 30 deg about x
+    h = build(
+        a=("mesh.box", {"size": [2, 2, 2], "center": [1, 1, 1]}),
+        b=("mesh.box", {"size": [2, 2, 2], "center": [3, 1, 1]}),
+        fa=("field.from_mesh", {"mesh": "@a"}),
+        fb=("field.from_mesh", {"mesh": "@b"}),
+        u=("field.union", {"fields": ["@fa", "@fb"], "smooth": 0.8}),
+        m=("field.mesh", {"field": "@u", "cell": 0.1}),
+    )
+    v = h.evaluate("m").vertices
+    (warning,) = h.stats["m"].warnings
+    assert f"the face at z = 0 (facing -z) by {-v[:, 2].min():.3g}, at (" in warning
+
+
+@settings(max_examples=8, deadline=None)
+@given(
+    gap=st.floats(0.0, 1.5),
+    smooth=st.floats(0.2, 2.0),
+    height=st.floats(1.0, 4.0),
+)
+def test_a_blend_is_warned_of_exactly_when_its_mesh_passes_the_bed(gap, smooth, height):
+    g = build(
+        a=("field.box", {"size": [3, 3, 2], "center": [0, 0, 1]}),
+        b=("field.box", {"size": [3, 3, height], "center": [3 + gap, 0, height / 2]}),
+        u=("field.union", {"fields": ["@a", "@b"], "smooth": smooth}),
+        m=("field.mesh", {"field": "@u", "cell": 0.25}),
+    )
+    v = g.evaluate("m").vertices
+    warned = any("z = 0 (facing -z)" in w for w in g.stats["m"].warnings)
+    assert warned == (v[:, 2].min() < -0.025)

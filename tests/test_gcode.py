@@ -108,10 +108,78 @@ def test_linuxcnc_interprets_the_program_without_an_error(tmp_path):
     [
         ({"feed": 0}, r"feed.*must be positive"),
         ({"plunge": -5}, r"plunge.*must be positive"),
-        ({"safe_z": -10}, r"safe_z.*not below the safe height"),
+        ({"safe_z": -10}, r"safe_z.*safe height must be above the work \(z > 0"),
     ],
 )
 def test_bad_feeds_and_heights_are_located_errors(tmp_path, kwargs, message):
     with pytest.raises(fg.FormgraphError, match=message):
         _part(tmp_path, **kwargs)
     assert not (tmp_path / "part.nc").exists()
+
+
+@pytest.mark.parametrize(("side", "radius"), [("outside", 3.0), ("inside", None)])
+def test_a_sharp_rectangle_profile_has_its_round_corners_as_arcs(tmp_path, side, radius):
+    g = fg.Graph(out_dir=tmp_path)
+    g.add("plate", "curves.rectangle", size=[40, 30])
+    g.add(
+        "ell",
+        "curves.polyline",
+        points=[[0, 0, 0], [40, 0, 0], [40, 10, 0], [10, 10, 0], [10, 30, 0], [0, 30, 0]],
+        closed=True,
+    )
+    g.add("p", "cam.profile", curves=["@plate" if radius else "@ell"], tool_diameter=6, side=side)
+    g.add("nc", "export.gcode", paths="@p", path="p.nc")
+    text = open(g.evaluate("nc")).read()
+    moves, _ = _run(text)
+    arcs = [m for m in moves if "Arc" in m[0]]
+    lines = [m for m in moves if m[0] == "GCodeLinearMove" and m[1][2] == m[2][2]]
+    centres = np.array([a[:2] + [p["I"], p["J"]] for _, a, _, p in arcs])
+    if radius:  # outside a rectangle: four quarter arcs about its corners, four sides
+        assert len(arcs) == 4 and len(lines) == 4
+        assert all(m[0] == "GCodeArcMoveCCW" for m in arcs)  # the outer loop runs CCW
+        corners = {(-20.0, -15.0), (20.0, -15.0), (20.0, 15.0), (-20.0, 15.0)}
+        assert {tuple(np.round(c, 4)) for c in centres} == corners
+    else:  # inside an L: one arc, about its inside corner, radius 3
+        assert len(arcs) == 1 and len(lines) == 6
+        assert centres[0] == pytest.approx([10, 10], abs=1e-4)
+        radius = 3.0
+    for _, a, b, _ in arcs:  # both ends on the circle of the tool's radius
+        c = centres[[m[1] is a for m in arcs].index(True)]
+        assert np.linalg.norm(a[:2] - c) == pytest.approx(radius, abs=1e-4)
+        assert np.linalg.norm(b[:2] - c) == pytest.approx(radius, abs=1e-4)
+
+
+def test_holding_tabs_lift_only_the_passes_below_their_top(tmp_path):
+    g = fg.Graph(out_dir=tmp_path)
+    g.add("plate", "curves.rectangle", size=[60, 40])
+    g.add(
+        "p",
+        "cam.profile",
+        curves=["@plate"],
+        tool_diameter=6,
+        depth=6,
+        step_down=2,
+        tabs=4,
+        tab_width=5,
+        tab_height=1.5,
+    )
+    g.add("nc", "export.gcode", paths="@p", path="tabs.nc")
+    moves, _ = _run(open(g.evaluate("nc")).read())
+    cuts = [m for m in moves if m[0] != "GCodeRapidMove" and not np.allclose(m[1], m[2])]
+    assert min(m[2][2] for m in cuts) == -6  # never below the depth
+    # the passes at -2 and -4 are above the tabs' top (-4.5): whole, exact arcs
+    assert sum("Arc" in m[0] for m in cuts) == 2 * 4
+    last = [m for m in cuts if m[1][2] in (-6, -4.5) and m[2][2] in (-6, -4.5)]
+    flat = [m for m in last if m[1][2] == m[2][2]]
+    ups = [m for m in last if m[2][2] > m[1][2]]
+    downs = [m for m in last if m[2][2] < m[1][2]]
+    # four tabs: straight up and straight down, in place
+    assert len(ups) == len(downs) == 4
+    assert all(np.allclose(m[1][:2], m[2][:2]) for m in ups + downs)
+    length = {z: sum(np.linalg.norm(m[2][:2] - m[1][:2]) for m in flat if m[1][2] == z)
+              for z in (-6, -4.5)}  # fmt: skip
+    # over each tab for its width plus the tool's diameter; the whole loop as long as the
+    # offset rectangle (chords of its corner arcs within the tolerance)
+    assert length[-4.5] == pytest.approx(4 * (5 + 6), abs=1e-6)
+    perimeter = 2 * (60 + 40) + 2 * np.pi * 3
+    assert length[-6] + length[-4.5] == pytest.approx(perimeter, abs=1e-2)

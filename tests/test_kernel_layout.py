@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import shapely
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from formgraph.kernels.curves.regions import even_odd_region
@@ -39,6 +39,7 @@ def _star(rng: np.random.Generator, n: int, centre: tuple[float, float]) -> np.n
 
 @settings(max_examples=25, deadline=None)
 @given(st.integers(0, 2**32 - 1), st.integers(3, 16), st.integers(3, 16))
+@example(0, 7, 3)  # a crossing of the cycle rounded onto a corner
 def test_minkowski_sum_of_star_polygons_matches_the_union_of_convex_pieces(seed, n, m):
     rng = np.random.default_rng(seed)
     a, b = _star(rng, n, (0, 0)), _star(rng, m, (2, 1))
@@ -47,7 +48,11 @@ def test_minkowski_sum_of_star_polygons_matches_the_union_of_convex_pieces(seed,
     ours, ref = _ours(nfp.minkowski_outer(a, b)), _reference_sum(a, b)
     # Clipper rounds the crossings of the cycle to the grid: within a unit
     assert shapely.hausdorff_distance(ours.boundary, ref.boundary) < 1.5
-    assert ours.area == pytest.approx(ref.area, rel=1e-4)
+    # a corner moved by at most half a grid diagonal changes the area by at most that much
+    # times the length of its two edges: over all corners, the perimeter times 0.71 (seed 0,
+    # n 7, m 3 has a corner where the cycle crosses itself rounded by one unit: 375 of 3.17e6)
+    sliver = shapely.symmetric_difference(ours, ref).area
+    assert sliver <= np.sqrt(0.5) * ref.boundary.length
 
 
 @pytest.mark.parametrize(

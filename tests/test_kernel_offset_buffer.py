@@ -110,10 +110,10 @@ def agree(polylines, closed, d) -> list[np.ndarray]:
     the level set (every point of it at ``|d|`` from the input, to the tolerance); the GEOS
     loops.
 
-    Where the two differ by more, the GEOS path must be the one within the tolerance of the
-    offset built from its definition (`reference`) and the marching path the one off it: a
-    known defect of the marching path, on collinear runs that double back (its corner
-    recovery misses where a doubled segment's band meets the next edge's offset)."""
+    Where the two differ by more, the GEOS path must be within the tolerance of the offset
+    built from its definition (`reference`); the marching path may be off it (a known defect
+    on collinear runs that double back: its corner recovery misses where a doubled segment's
+    band meets the next edge's offset)."""
     size = extent(polylines)
     scale = size if size > 0 else 2 * abs(d)
     tol = 1e-3 * scale
@@ -123,8 +123,10 @@ def agree(polylines, closed, d) -> list[np.ndarray]:
     assert level_error(fast, polylines, closed, d, tol) <= tol
     if hausdorff(fast, slow, tol) > tol:
         exact = reference(polylines, closed, d)
+        # Both may be within the tolerance of it and still 2 tolerances apart (nested stars
+        # shrunk 0.3, d 0.05: 1.2e-3 and 1.6e-4 from it, tolerance 1.3e-3): only the GEOS
+        # path is held to it here; the marching path's own accuracy is tested elsewhere.
         assert hausdorff(fast, exact, tol) <= tol
-        assert hausdorff(slow, exact, tol) > tol, "the paths differ, the marching path's fine"
         return fast
     # The same islands and holes: orientation by orientation, the same total area.
     for sign in (1, -1):
@@ -355,6 +357,44 @@ def test_self_intersecting_loops_agree(points, d):
     if np.abs(u[0] * v[:, 1] - u[1] * v[:, 0]).max() == 0:
         return  # all on one line: no region, nothing to compare but a band
     agree([pts], [True], d)
+
+
+def test_a_join_meeting_an_edge_at_a_shallow_angle_keeps_its_corner():
+    # A hole shrunk to a sliver by d = 0.05: its corner where the round join about the
+    # star's reflex corner meets another edge's offset at about 20 degrees was 1.13
+    # tolerances off with joins chorded to 0.4 of the tolerance (hypothesis found it).
+    outer = np.array(
+        [
+            [0.106224592, 0.326925677],
+            [-0.351940964, 0.169485836],
+            [-0.497987147, 0.0448196545],
+            [-0.48198143, -0.133018423],
+            [0.134233266, -0.990949762],
+            [0.936234871, -0.351374824],
+            [1.0, 0.0],
+        ]
+    )
+    inner = np.array(
+        [
+            [0.723734038, 0.690079011],
+            [0.0148693487, 0.312146043],
+            [-0.327067963, 0.945000819],
+            [-0.654860734, 0.755749574],
+            [-0.888835449, 0.458226522],
+            [-0.959492974, -0.281732557],
+            [-0.786053095, -0.618158986],
+            [-0.142314838, -0.989821442],
+            [0.235758936, -0.971811568],
+            [0.723734038, -0.690079011],
+            [1.0, 0.0],
+        ]
+    )
+    free = shapely.Polygon(outer).exterior.distance(shapely.Point(0.0, 0.0))
+    polylines = [outer, inner * 0.3 * free]
+    tol = 1e-3 * extent(polylines)
+    fast = buffer_polylines(polylines, [True, True], 0.05)
+    assert hausdorff(fast, reference(polylines, [True, True], 0.05), tol) <= tol
+    agree(polylines, [True, True], 0.05)
 
 
 @_SETTINGS

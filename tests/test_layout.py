@@ -4,6 +4,7 @@ rigidly, exact curves kept exact, parts in holes; checked with shapely and ezdxf
 from __future__ import annotations
 
 import re
+from pathlib import Path
 
 import ezdxf
 import numpy as np
@@ -134,3 +135,58 @@ def test_errors_name_the_part_and_the_port():
         _nest([open_curve], sheet=[50, 50])
     with pytest.raises(fg.NodeError, match=r"sheet.*\[width, height\]"):
         _nest(part("disc", 0), sheet=[50, -1])
+
+
+def test_marks_ride_rigidly_on_the_parts_they_lie_on():
+    g = fg.Graph()
+    g.add("a", "curves.rectangle", size=[60, 30])
+    g.add("b", "curves.rectangle", size=[40, 40], radius=5, center=[100, 0, 0])
+    g.add("ta", "curves.text", text="A", size=10, align="center", position=[0, -3, 0])
+    g.add("tb", "curves.text", text="B", size=10, align="center", position=[100, -3, 0])
+    g.add("n", "layout.nest", curves=["@a", "@b"], marks=["@tb", "@ta"], sheet=[100, 50])
+    nested = g.evaluate("n")
+    parts = {
+        round(shapely.Polygon(np.asarray(c.sample(400))[:-1, :2]).area): c for c in nested.curves
+    }
+    before = {"A": (g.evaluate("a"), g.evaluate("ta")), "B": (g.evaluate("b"), g.evaluate("tb"))}
+    marks = iter(nested.marks)
+    for name in ("B", "A"):  # in the order given: B's two loops, then A's two
+        outline, glyphs = before[name]
+        placed = parts[round(shapely.Polygon(np.asarray(outline.sample(400))[:-1, :2]).area)]
+        ring = shapely.Polygon(np.asarray(placed.sample(400))[:-1, :2])
+        ref = shapely.Polygon(np.asarray(outline.sample(400))[:-1, :2])
+        for glyph in glyphs:
+            moved = next(marks)
+            p0 = np.asarray(glyph.sample(200))[:, :2]
+            p1 = np.asarray(moved.sample(200))[:, :2]
+            # on the placed part, each point as far from its outline as before: rigid
+            assert shapely.contains_xy(ring, p1[:, 0], p1[:, 1]).all()
+            d0 = shapely.distance(shapely.points(p0), ref.exterior)
+            d1 = shapely.distance(shapely.points(p1), ring.exterior)
+            assert d1 == pytest.approx(d0, abs=1e-6)
+            # and the glyph's own shape is kept (pairwise distances)
+            assert np.linalg.norm(p1[0] - p1[100]) == pytest.approx(np.linalg.norm(p0[0] - p0[100]))
+    assert next(marks, None) is None
+
+
+def test_contour_sheets_numbers_each_layer_on_its_engrave_layer(tmp_path):
+    g = fg.load(
+        Path(__file__).resolve().parents[1] / "graphs/contour_sheets.yaml", out_dir=tmp_path
+    )
+    doc = ezdxf.readfile(g.evaluate("dxf"))
+    by_layer: dict[str, list] = {}
+    for e in doc.modelspace():
+        by_layer.setdefault(e.dxf.layer, []).append(e)
+    assert len(by_layer["cut"]) == 6  # six layers, one outline each
+    assert len(by_layer["engrave"]) == 8  # the digits 1-6, the 4 and the 6 with a counter
+    nested = g.evaluate("nested")
+    layers = [shapely.Polygon(np.asarray(c.sample(800))[:-1, :2]) for c in nested.curves]
+    for mark in nested.marks:  # every number lies on exactly one layer
+        p = np.asarray(mark.sample(100))[:, :2]
+        on = [shapely.contains_xy(poly, p[:, 0], p[:, 1]).all() for poly in layers]
+        assert sum(on) == 1
+    svg = open(g.evaluate("svg")).read()
+    for layer in ("sheet", "cut", "engrave"):  # Inkscape's layers, one per kind of line
+        assert f'id="{layer}" inkscape:groupmode="layer"' in svg
+    engrave = svg.split('id="engrave"')[1].split("</g>")[0]
+    assert engrave.count("<path") == 8

@@ -51,6 +51,55 @@ def test_taubin_matches_trimesh_and_keeps_the_volume(noisy_sphere):
     assert out.is_watertight
 
 
+def test_taubin_alone_grows_a_sphere_and_keep_volume_holds_it_over_100_steps():
+    s = trimesh.creation.icosphere(4)  # 2,562 vertices, clean
+    m = as_mesh(s)
+    # the filter alone is trimesh's (its passes: lambda, mu, ...), which grows the sphere
+    alone = run("mesh.smooth", mesh=m, iterations=100, keep_volume=False)
+    ref = tm(m)
+    trimesh.smoothing.filter_taubin(ref, lamb=0.5, nu=0.53, iterations=200)
+    np.testing.assert_allclose(alone.vertices, ref.vertices, atol=1e-12)
+    ten = run("mesh.smooth", mesh=m, iterations=10, keep_volume=False)
+    assert ten.volume / m.volume - 1 == pytest.approx(0.0025, abs=0.0005)
+    assert alone.volume / m.volume - 1 == pytest.approx(0.025, abs=0.003)
+    # kept: the volume after every number of steps up to 100, to rounding; the shape the
+    # filter's, only scaled (the umbrella operator commutes with a scale about the centre)
+    for steps in (1, 10, 37, 100):
+        kept = run("mesh.smooth", mesh=m, iterations=steps)
+        assert tm(kept).volume == pytest.approx(s.volume, rel=1e-12)  # trimesh measures
+    scale = np.cbrt(m.volume / alone.volume)
+    np.testing.assert_allclose(kept.vertices, alone.vertices * scale, atol=1e-9)
+
+
+def test_keep_volume_holds_each_closed_part_and_leaves_open_ones(noisy_sphere):
+    small = trimesh.creation.icosphere(3, radius=0.3)
+    small.vertices += [3.0, 0, 0]
+    rng = np.random.default_rng(2)
+    small.vertices += rng.normal(0, 0.005, small.vertices.shape)
+    plane = run("mesh.plane", size=[2, 2], divisions=[8, 8])
+    sheet = trimesh.Trimesh(
+        plane.vertices
+        + [0, 0, 5]
+        + np.c_[np.zeros((plane.n_vertices, 2)), rng.normal(0, 0.05, plane.n_vertices)],
+        plane.face_indices.reshape(-1, 4)[:, [0, 1, 2, 0, 2, 3]].reshape(-1, 3),
+    )
+    parts = [tm(noisy_sphere), small, sheet]
+    both = as_mesh(trimesh.util.concatenate(parts))
+    out = run("mesh.smooth", mesh=both, iterations=30)
+    alone = run("mesh.smooth", mesh=both, iterations=30, keep_volume=False)
+    n0, n1 = len(parts[0].vertices), len(parts[0].vertices) + len(small.vertices)
+    for lo, hi, part in ((0, n0, parts[0]), (n0, n1, small)):
+        faces = tm(out).faces
+        mine = faces[(faces >= lo).all(axis=1) & (faces < hi).all(axis=1)] - lo
+        got = trimesh.Trimesh(out.vertices[lo:hi], mine, process=False)
+        assert got.volume == pytest.approx(part.volume, rel=1e-12)
+    assert radial_noise(run("mesh.smooth", mesh=noisy_sphere, iterations=10)) < 0.5 * radial_noise(
+        noisy_sphere
+    )
+    # the open sheet is the filter's alone: nothing to keep
+    np.testing.assert_array_equal(out.vertices[n1:], alone.vertices[n1:])
+
+
 def test_laplacian_shrinks_and_taubin_does_not(noisy_sphere):
     lap = run("mesh.smooth", mesh=noisy_sphere, iterations=30, method="laplacian")
     tau = run("mesh.smooth", mesh=noisy_sphere, iterations=30, method="taubin")

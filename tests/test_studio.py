@@ -667,6 +667,98 @@ def test_slider_recooks_and_redraws(page):
     assert _turns(page) == (turns + 1 if turns < 12 else turns - 1)
 
 
+def _z_extent(stl: Path) -> float:
+    import trimesh
+
+    return float(np.ptp(trimesh.load(stl, file_type="stl").vertices[:, 2]))
+
+
+def test_every_key_press_counts_while_a_step_recooks(page, studio):
+    """Four presses, each while the step of the one before still cooks, move the slider four
+    steps, and the session cooks the last value (the run's tube is that many turns tall):
+    a step's result sent back the value it cooked, over a press still on its way."""
+    turns = _turns(page)
+    key, sign = ("ArrowRight", 1) if turns <= 8 else ("ArrowLeft", -1)
+    page.locator(".fg-slider-turns .v-slider-thumb").focus()
+    for _ in range(4):
+        page.keyboard.press(key)
+        page.wait_for_timeout(60)  # a step of the tube cooks for some 80-300 ms
+    page.wait_for_function("window.trame.state.get('busy') === false")
+    page.wait_for_timeout(1000)  # any step still on its way lands
+    assert _turns(page) == turns + 4 * sign
+    stl = studio.out / "tube.stl"
+    before = stl.stat().st_mtime_ns if stl.exists() else None
+    page.click("#run")
+    end = time.monotonic() + 60
+    while (not stl.exists() or stl.stat().st_mtime_ns == before) and time.monotonic() < end:
+        time.sleep(0.1)
+    time.sleep(0.2)  # written atomically: whole once it is there
+    thickness = float(re.search(r"thickness = ([\d.]+)", page.inner_text("#controls"))[1])
+    # z = t / 2 pi over `turns` turns, and the tube's radius above and below
+    assert _z_extent(stl) == pytest.approx(turns + 4 * sign + 2 * thickness, abs=0.02)
+    page.locator(".fg-control", has_text="turns").get_by_text("reset").click()  # back to 3
+    page.wait_for_function("document.querySelector('#controls').innerText.includes('turns = 3')")
+
+
+def test_values_are_shown_to_the_step(page):
+    """A value is labelled to its slider step's decimals: radius (step 0.1) as 9.4, not the
+    9.399999999999999 a float sum of steps can give; thickness (step 0.01) as 0.30."""
+    page.evaluate(
+        "window.trame.state.set('params', "
+        "{...window.trame.state.get('params'), radius: 9.399999999999999})"
+    )
+    page.wait_for_function("document.querySelector('#controls').innerText.includes('radius = 9.')")
+    text = page.inner_text("#controls")
+    assert "radius = 9.4\n" in text + "\n" and "9.39999" not in text
+    assert re.search(r"thickness = \d\.\d\d\b", text)
+    assert re.search(r"turns = \d+\b(?!\.)", text)
+    page.locator(".fg-control", has_text="radius").get_by_text("reset").click()
+    page.wait_for_function("document.querySelector('#controls').innerText.includes('radius = 2.0')")
+
+
+def _open_until_drawn(page, url: str) -> None:
+    """Load the studio in ``page`` and wait until its first run is shown and drawn."""
+    page.set_default_timeout(WAIT_MS)
+    page.goto(url)
+    page.wait_for_function("document.querySelector('#status')?.innerText.includes('cached')")
+    end = time.monotonic() + 20
+    while _shows_model(_canvas(page)) < 0.02 and time.monotonic() < end:
+        time.sleep(0.2)
+
+
+def test_the_page_loads_without_a_console_error_or_a_failed_request(page, studio):
+    """Nothing on the console but information, no request refused or failed: the client's
+    first POST to paraview/ (a launcher it asks for the websocket's address) was answered
+    405 on every load."""
+    context = page.context.browser.new_context(viewport=page.viewport_size)
+    problems: list[str] = []
+    try:
+        other = context.new_page()
+        other.on(
+            "console",
+            lambda m: (
+                problems.append(f"console {m.type}: {m.text}")
+                if m.type in ("error", "warning")
+                else None
+            ),
+        )
+        other.on("pageerror", lambda e: problems.append(f"page error: {e}"))
+        other.on("requestfailed", lambda r: problems.append(f"failed: {r.url} {r.failure}"))
+        other.on(
+            "response",
+            lambda r: (
+                problems.append(f"{r.status} {r.request.method} {r.url}")
+                if r.status >= 400
+                else None
+            ),
+        )
+        _open_until_drawn(other, studio.url)
+        other.wait_for_timeout(2000)  # what loads after the picture (the editor) too
+    finally:
+        context.close()
+    assert problems == []
+
+
 def test_a_step_sends_its_arrays_ahead_of_its_scene(page):
     """vtk.js gets a step's new arrays with its scene and asks for none; the websocket
     delivers ArrayBuffers, not Blobs (which the browser reads back asynchronously); the
@@ -704,12 +796,7 @@ def test_a_page_loaded_after_steps_shows_them(page, studio):
     context = page.context.browser.new_context(viewport=page.viewport_size)
     try:
         other = context.new_page()  # a second tab, or the page reloaded
-        other.set_default_timeout(WAIT_MS)
-        other.goto(studio.url)
-        other.wait_for_function("document.querySelector('#status')?.innerText.includes('cached')")
-        end = time.monotonic() + 20
-        while _shows_model(_canvas(other)) < 0.02 and time.monotonic() < end:
-            time.sleep(0.2)
+        _open_until_drawn(other, studio.url)
         # the same tube (the cameras may differ: the first page was framed again as the
         # tube grew), told by its proportions: each turn makes it taller, not wider
         assert _aspect(_canvas(other)) == pytest.approx(_aspect(_canvas(page)), rel=0.12)
@@ -968,6 +1055,24 @@ def test_normals_go_as_int8_within_half_a_degree():
     assert angle.max() < 0.5 and (q[0] == 0).all()
     # the same directions give the same bytes: a step that only scales them sends nothing
     assert np.array_equal(quantized_normals(unit * 3.0), quantized_normals(unit))
+
+
+def test_a_slider_value_is_put_on_its_step():
+    from formgraph.studio.page import _as_param
+    from formgraph.studio.session import Control
+
+    radius = Control("radius", "slider", 2.0, 2.0, 0.5, 10.0, 0.1)
+    assert radius.digits == 1 and radius.as_dict()["digits"] == 1
+    assert _as_param(radius, 9.399999999999999) == 9.4
+    assert _as_param(radius, 0.5 + 89 * 0.1) == 9.4
+    assert _as_param(radius, 10.04) == 10.0 and _as_param(radius, 11) == 10.0
+    fine = Control("t", "slider", 0.3, 0.3, 0.05, 1.0, 0.01)
+    assert (fine.digits, _as_param(fine, 0.30000000000000004)) == (2, 0.3)
+    whole = Control("n", "slider", 3, 3, 1, 12, 1.0)
+    assert (whole.digits, _as_param(whole, 7.0), type(_as_param(whole, 7.0))) == (0, 7, int)
+    assert Control("x", "slider", 0, 0, 0, 1000, 5.0).digits == 0
+    assert Control("x", "number", 0.5, 0.5).digits is None
+    assert _as_param(Control("x", "number", 0.5, 0.5), 0.123456) == 0.123456
 
 
 def test_choice_control_for_an_enum_param():

@@ -107,10 +107,28 @@ def _parser() -> argparse.ArgumentParser:
     draw.add_argument("--no-cache", action="store_true", help="do not use the on-disk cache")
     draw.add_argument("--cache-dir", default=None, help=argparse.SUPPRESS)
 
-    nodes = sub.add_parser("nodes", help="the node catalogue, or one node type's ports")
-    nodes.add_argument("type", nargs="?")
+    nodes = sub.add_parser(
+        "nodes",
+        help="the node catalogue, one node type's ports, or the node types a graph file uses",
+        description="Without TYPE: every node type. With a node type (mesh.box): its ports "
+        "and outputs. With a graph file (GRAPH.yaml): the node types it uses, each with its "
+        "nodes, and its ports and outputs as a node type where it has 'outputs:'.",
+    )
+    nodes.add_argument("type", nargs="?", metavar="TYPE|GRAPH.yaml")
     nodes.add_argument("--markdown", action="store_true", help="the catalogue as Markdown")
     nodes.add_argument(
+        "--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS
+    )
+
+    params = sub.add_parser(
+        "params",
+        help="a graph's params: type, default, range or choices, slider step, doc",
+        description="List the params of GRAPH in the file's order: type, default, range "
+        "(min .. max, or the choices), the step the studio's slider moves by, and the doc.",
+    )
+    params.add_argument("graph")
+    params.add_argument("--json", action="store_true", help="one JSON object per param, a list")
+    params.add_argument(
         "--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS
     )
 
@@ -366,11 +384,11 @@ def cmd_nodes(args: argparse.Namespace) -> int:
     if args.markdown:
         sys.stdout.write(markdown())
         return 0
-    if args.type and args.type.endswith((".yaml", ".yml")):  # a graph file's interface
+    if args.type and args.type.endswith((".yaml", ".yml")):  # a graph file
         from ..evaluation.graph import load
+        from .listing import nodes_text
 
-        g = load(args.type)
-        print(node_text(g.as_node_spec()))
+        print(nodes_text(load(args.type)))
         return 0
     if args.type:
         registry = node_types()
@@ -379,6 +397,19 @@ def cmd_nodes(args: argparse.Namespace) -> int:
         print(node_text(registry[args.type]))
         return 0
     print(catalogue_text())
+    return 0
+
+
+def cmd_params(args: argparse.Namespace) -> int:
+    from ..evaluation.graph import load
+    from .listing import params_rows, params_text
+
+    g = load(args.graph)
+    if args.json:
+        json.dump(params_rows(g), sys.stdout, indent=2, default=str)
+        sys.stdout.write("\n")
+    else:
+        print(params_text(g))
     return 0
 
 
@@ -397,6 +428,7 @@ COMMANDS = {
     "watch": cmd_watch,
     "graph": cmd_graph,
     "nodes": cmd_nodes,
+    "params": cmd_params,
     "schema": cmd_schema,
     "sweep": lambda args: _sweep_command("cmd_sweep", args),
     "cache": lambda args: _sweep_command("cmd_cache", args),

@@ -186,6 +186,21 @@ class Edge:
     param: bool = False
 
 
+def _output_types(graph: Any, registry: dict[str, Any]) -> dict[tuple[str, str | None], Any]:
+    """The checker's type of each node output (a repeated transform of a mesh carries
+    ``list[Mesh]``, not its port's ``Geometry | list[Geometry]``); empty for a graph that
+    has no outline to ask."""
+    from ..language.check import output_types
+
+    outline = getattr(graph, "_outline", None)
+    if not callable(outline):
+        return {}
+    try:
+        return output_types(outline(), registry)
+    except FormgraphError:  # a subgraph file that does not load: the ports' own types
+        return {}
+
+
 def _type_name(pt: Any) -> str:
     return getattr(pt, "name", str(pt))
 
@@ -229,6 +244,7 @@ def _model(graph: Any, marks: Iterable[Mark] | None) -> tuple[dict[str, Box], li
         boxes[f"p:{name}"] = Box(f"p:{name}", name, sub, family="param")
     edges: list[Edge] = []
     types = graph.nodes
+    known = _output_types(graph, registry)
     for name, type_name in types.items():
         spec = registry.get(type_name)
         nd = graph._nodes[name]
@@ -237,8 +253,10 @@ def _model(graph: Any, marks: Iterable[Mark] | None) -> tuple[dict[str, Box], li
         repeated = any(m.startswith("repeat") for m in box.marks)
         if spec is not None:
             for out, pt in spec.outputs.items():
+                found = known.get((name, out if spec.multi_output else None))
                 label = _type_name(pt)
                 label = f"list[{label}]" if repeated else label
+                label = found.name if found is not None else label
                 box.outputs.append(("" if not spec.multi_output else out, label))
         else:
             box.outputs.append(("", "outputs"))

@@ -100,11 +100,7 @@ def check_graph(g: Outline, extra: list[Problem] | None = None) -> list[Problem]
             except TypeMismatch as exc:
                 problems.append(Problem(Where(file, p.line), f"param '{p.name}': choice {exc}"))
 
-    for name in kahn_order(g.nodes):  # output types upstream first (see output_type)
-        spec = registry.get(g.nodes[name].type)
-        if spec is not None:
-            for out in spec.outputs if spec.multi_output else [None]:
-                output_type(g, Wire(name, out), registry)
+    output_types(g, registry)
 
     for nd in g.nodes.values():
         spec = registry.get(nd.type)
@@ -161,6 +157,23 @@ def _check_outputs(g: Outline, registry: dict[str, NodeSpec]) -> list[Problem]:
                 )
             )
     return out
+
+
+def output_types(
+    g: Outline, registry: Mapping[str, NodeSpec] | None = None
+) -> dict[tuple[str, str | None], PortType | None]:
+    """The type each node output carries, ``(node, output) -> type`` (``output`` None for a
+    node of one output; the type None where unknown), as :func:`output_type` finds it: a
+    repeated node's a list, a ``SameAs`` output the type it follows (a repeated
+    ``geometry.transform`` of a mesh gives ``list[Mesh]``). Asked upstream first, so each
+    is one step."""
+    registry = {**node_types(), **g.subgraphs} if registry is None else registry
+    for name in kahn_order(g.nodes):
+        spec = registry.get(g.nodes[name].type)
+        if spec is not None:
+            for out in spec.outputs if spec.multi_output else [None]:
+                output_type(g, Wire(name, out), registry)
+    return dict(g.types)
 
 
 def output_type(

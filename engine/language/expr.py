@@ -84,7 +84,7 @@ FUNCTIONS: dict[str, tuple[Callable[..., Any], int | tuple[int, int | None]]] = 
     "max": (_reduce(np.maximum), (1, None)),
     "clip": (np.clip, 3),
     "where": (np.where, 3),
-    # per-element variation: a pure hash to [0, 1) and Perlin noise in [-1, 1]
+    # per-element variation: a pure hash to [0, 1) and 0.96 x Perlin's noise, in [-1, 1]
     "rand": (_rand, (1, 2)),
     "noise": (_noise, (1, 3)),
 }

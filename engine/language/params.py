@@ -4,6 +4,7 @@ range, the warnings about guessed types, and "did you mean" for names."""
 from __future__ import annotations
 
 import difflib
+import math
 import struct
 import zlib
 from collections.abc import Mapping, Sequence
@@ -16,7 +17,14 @@ from ..core.registry import DEFAULT_BUDGET
 from ..core.types import Kind, PortType, TypeMismatch, number_text
 from .model import ParamDef
 
-__all__ = ["check_param_value", "param_kind", "param_warnings", "parse_sets", "suggest"]
+__all__ = [
+    "check_param_value",
+    "param_kind",
+    "param_step",
+    "param_warnings",
+    "parse_sets",
+    "suggest",
+]
 
 
 def suggest(name: str, options: Any) -> str:
@@ -47,6 +55,26 @@ def param_kind(p: ParamDef) -> type | None:
     if isinstance(d, float):
         return float
     return None
+
+
+def param_step(p: ParamDef) -> float | None:
+    """The step of a number param with a min and a max (the studio's slider moves by it,
+    and shows values rounded to it): 1 for a whole number, else about a hundredth of the
+    range rounded to 1, 2 or 5 times a power of ten; None for any other param."""
+    if p.choices is not None or p.min is None or p.max is None:
+        return None
+    d = p.default
+    if isinstance(d, bool) or not isinstance(d, (int, float)):
+        if p.type is None or p.type.name not in ("int", "float"):
+            return None
+    if param_kind(p) is int or (p.type is not None and p.type.name == "int"):
+        return 1.0
+    span = float(p.max) - float(p.min)
+    if not span > 0:
+        return 1.0
+    raw = span / 100.0
+    power = 10.0 ** math.floor(math.log10(raw))
+    return next(m * power for m in (1.0, 2.0, 5.0, 10.0) if raw <= m * power)
 
 
 def check_param_value(p: ParamDef, value: Any) -> Any:

@@ -389,11 +389,16 @@ def _defer_editor(server: Any) -> None:
 
 def _control_widgets(v: Any, html: Any) -> None:
     """A control per param (``controls`` in the state), with its reset."""
-    set_value = "params[c.name] = $event; trigger('set_param', [c.name, $event])"
+    # the page's value goes to the server's state too (no echo back to this page), so a
+    # page loaded later starts from it; the step itself comes with the trigger
+    set_value = (
+        "params[c.name] = $event; flushState('params'); trigger('set_param', [c.name, $event])"
+    )
     with html.Div(v_for="c in controls", key="c.name", classes="fg-control"):
         with html.Div(classes="fg-control-name"):
-            html.Span(
-                "{{ c.name }} = {{ params[c.name] }}",
+            html.Span(  # a slider's value to its step's decimals, not 9.399999999999999
+                "{{ c.name }} = {{ c.digits == null || typeof params[c.name] !== 'number' "
+                "? params[c.name] : params[c.name].toFixed(c.digits) }}",
                 title=("c.doc",),
             )
             v.VBtn(
@@ -422,8 +427,9 @@ def _control_widgets(v: Any, html: Any) -> None:
             hide_details=True,
             variant="outlined",
             change=(
-                "trigger('set_param', [c.name, c.kind === 'number' ? "
-                "Number($event.target.value) : $event.target.value])"
+                "(v => { params[c.name] = v; flushState('params'); "
+                "trigger('set_param', [c.name, v]) })(c.kind === 'number' ? "
+                "Number($event.target.value) : $event.target.value)"
             ),
         )
         v.VSwitch(

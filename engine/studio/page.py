@@ -16,6 +16,7 @@ from __future__ import annotations
 import asyncio
 import gc
 import itertools
+import math
 import sys
 import threading
 import time
@@ -80,6 +81,7 @@ class Page:
         session.progress = self.worker.check
         self.controls: list[Control] = []
         self._wanted: dict[str, Any] = {}  # the controls' values, as the page last set them
+        self._resets = 0  # resets asked since the page was last sent the values
         self._editor_text = ""  # the editor's text as the loop last knew it
         self._disk_text: str | None = None  # the file's text as last read or saved
         self._color_by: str | None = None  # the attribute the page colours by
@@ -173,13 +175,14 @@ class Page:
         ctrl.trigger("save")(self._save)
         ctrl.add("run")(self._run)
         ctrl.add("reload")(lambda: self.worker.submit("disk", self._open_disk))
-        ctrl.add("reset_all")(lambda: self.worker.submit("params", self.session.reset_params))
+        ctrl.add("reset_all")(self._reset_all)
         ctrl.add("show_results")(lambda: self.worker.submit("show", self.session.show, None))
 
     # --------------------------------------------------------------------- server life
 
     def _bind(self, wslink_server: Any) -> None:
         wslink_server.app.middlewares.append(self.guard.middleware)
+        wslink_server.app.router.add_post("/paraview/", _session_config)
 
     def _ready(self, **_: Any) -> None:
         with self._handoff:
@@ -218,8 +221,14 @@ class Page:
         return self.session.set_params(**values)
 
     def _reset_param(self, name: str) -> None:
+        self._resets += 1  # the value goes back on the page with the step
         self._wanted.pop(name, None)
         self.worker.submit("params", self._reset, name)
+
+    def _reset_all(self) -> None:
+        self._resets += 1
+        self._wanted.clear()
+        self.worker.submit("params", self.session.reset_params)
 
     def _reset(self, name: str) -> Cooked:
         return self.session.reset_params(name)
@@ -378,11 +387,17 @@ class Page:
                 and (cooked.new_graph or kind == "params")
                 and not newer
             ):
-                # (with a newer step waiting, the sliders keep the values the user set)
                 self.controls = snap["controls"]
-                self._wanted = dict(snap["values"])
                 s.controls = [c.as_dict() for c in self.controls]
-                s.params = {c.name: plain(c.value) for c in self.controls}
+                # a slider step leaves the page's values alone: the page set them, and may
+                # have moved on while this step cooked (sent back now, an older value would
+                # overwrite a key press still on its way here, and the slider would step
+                # on from it); a reset, a refused value or a new graph send the session's
+                if kind != "params" or self._resets or not cooked.ok:
+                    self._resets = 0
+                    self._wanted = dict(snap["values"])
+                    s.params = {c.name: plain(c.value) for c in self.controls}
+                    s.dirty("params")  # the page's may differ from what was last sent
             if svg is not None and kind == "params":
                 self._settled_svg = svg  # a slider step: the drawing once the steps settle
             elif kind == "params":
@@ -558,6 +573,22 @@ class Page:
         self.state[view._VtkLocalView__scene_id] = full
 
 
+async def _session_config(request: Any) -> Any:
+    """Where the page's websocket is, for the page's first request.
+
+    trame's client, given no ``sessionURL``, first asks a ParaView-style launcher for one:
+    a POST to ``paraview/`` beside the page, answered by this server with 405, which the
+    browser logs as an error on every load before the client falls back to ``/ws``. This
+    answers it as a launcher does (wslink's launcher protocol: a JSON object with
+    ``sessionURL``), so the page connects at once and its console stays clean. The guard
+    has checked the request (token, Host, Origin) before it gets here.
+    """
+    from aiohttp import web
+
+    scheme = "wss" if request.secure else "ws"
+    return web.json_response({"sessionURL": f"{scheme}://{request.host}/ws"})
+
+
 def _as_param(c: Control, value: Any) -> Any:
     """A control's value as the param's type reads it."""
     if c.kind == "toggle":
@@ -567,6 +598,9 @@ def _as_param(c: Control, value: Any) -> Any:
             number = float(value)
         except (TypeError, ValueError):
             return value  # the param's check says what was expected
+        if not math.isfinite(number):
+            return number  # the param's check says what was expected
+        number = c.snap(number)
         if c.step == 1.0 and number.is_integer():
             return int(number)
         return number

@@ -47,6 +47,27 @@ class Control:
     choices: tuple[Any, ...] = ()  # a choice's options: texts, numbers or booleans
     doc: str = ""
 
+    @property
+    def digits(self) -> int | None:
+        """Decimals that show a value on the step's grid (0.05: 2; 1 or 5: 0); None
+        without a step."""
+        import math
+
+        if not self.step or not math.isfinite(self.step):
+            return None
+        return max(0, -math.floor(math.log10(self.step) + 1e-9))
+
+    def snap(self, number: float) -> float:
+        """A slider's ``number`` on its grid (min + k step), rounded to the step's decimals:
+        the browser's float steps add up to 9.399999999999999, the param gets 9.4."""
+        if self.kind != "slider" or not self.step or self.min is None:
+            return number
+        k = round((number - self.min) / self.step)
+        on_grid = self.min + k * self.step
+        if self.max is not None:
+            on_grid = min(max(on_grid, self.min), self.max)
+        return round(on_grid, self.digits or 0)
+
     def as_dict(self) -> dict[str, Any]:
         """The control as the page's state holds it (JSON: an Enum as its value)."""
         return {
@@ -56,6 +77,7 @@ class Control:
             "min": self.min,
             "max": self.max,
             "step": self.step,
+            "digits": self.digits,
             "choices": [plain(c) for c in self.choices],
             "doc": self.doc,
         }
@@ -83,7 +105,7 @@ def controls_of(graph: Graph, values: dict[str, Any]) -> list[Control]:
     int), any other number a number field, a bool a toggle, and anything else (a vector, a
     list, a string) a text field holding its YAML.
     """
-    from formgraph.language.params import param_kind
+    from formgraph.language.params import param_kind, param_step
 
     out = []
     current = {**graph.params, **values}
@@ -103,7 +125,7 @@ def controls_of(graph: Graph, values: dict[str, Any]) -> list[Control]:
             out.append(Control(name, "toggle", bool(value), default, doc=p.doc))
         elif isinstance(value, (int, float)) and p.min is not None and p.max is not None:
             lo, hi = float(p.min), float(p.max)
-            step = 1.0 if integer else _nice_step(lo, hi)
+            step = param_step(p) or 1.0
             out.append(Control(name, "slider", value, default, lo, hi, step, doc=p.doc))
         elif isinstance(value, (int, float)):
             step = 1.0 if integer else None
@@ -111,21 +133,6 @@ def controls_of(graph: Graph, values: dict[str, Any]) -> list[Control]:
         else:
             out.append(Control(name, "text", value, default, doc=p.doc))
     return out
-
-
-def _nice_step(lo: float, hi: float) -> float:
-    """About a hundredth of the range, rounded to 1, 2 or 5 times a power of ten."""
-    import math
-
-    span = hi - lo
-    if not span > 0:
-        return 1.0
-    raw = span / 100.0
-    power = 10.0 ** math.floor(math.log10(raw))
-    for m in (1.0, 2.0, 5.0, 10.0):
-        if raw <= m * power:
-            return m * power
-    return 10.0 * power
 
 
 @dataclass

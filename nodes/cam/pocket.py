@@ -35,7 +35,8 @@ def pocket(
     left standing between passes: with a stepover up to 0.5 the passes are close enough
     everywhere; above it the ridges between passes are found (GEOS) and the passes halfway
     between are added where they cut them. The wall pass of an outline made of arcs and
-    straight pieces is its exact offset (G2/G3 in G-code).
+    straight pieces, or of a polygon, is its exact offset (G2/G3 in G-code; its inside
+    corners arcs of the tool's radius).
 
     Inside corners keep a fillet of radius r. Material the tool cannot reach beyond that
     (a gap narrower than the tool: a piece wider than two thirds of r) is named in a

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 from enum import Enum
+from pathlib import PurePosixPath
 from typing import Annotated
 
 import numpy as np
@@ -16,6 +17,8 @@ from formgraph.geometry import Curve, NurbsCurve
 from formgraph.kernels.curves import sampling as ksampling
 from formgraph.kernels.io.gcode import ToolPath, arc_moves, gcode_bytes
 from formgraph.nodes.export.drawing import curve_path
+
+EXTENSIONS = (".nc", ".ngc", ".gcode", ".gc", ".tap", ".cnc")  # what senders open as G-code
 
 
 class Mode(str, Enum):
@@ -49,18 +52,23 @@ def gcode(
     ``mode: laser`` there is no Z: the beam goes on (M4, grbl's dynamic power, S =
     ``spindle``, default 1000) at each path's start and off (M5) at its end.
 
+    Refused: a file name without a G-code extension, a safe height at or below the work's
+    top (z = 0). Warned: no paths (the program does nothing), a router's path above the
+    work (z > 0: it cuts air).
+
     Parameters
     ----------
     paths : list[Curve]
         The tool-centre paths, in the order to run them (``cam.profile``, ``cam.pocket``).
     path : OutputPath
-        File path relative to the output directory, e.g. ``part.nc``.
+        File path relative to the output directory, e.g. ``part.nc``; its extension one
+        of .nc, .ngc, .gcode, .gc, .tap, .cnc.
     feed : float
         Cutting feed, mm/min.
     plunge : float
         Plunging feed, mm/min.
     safe_z : float
-        Height of rapid moves: above the work and its clamps.
+        Height of rapid moves: above the work (z > 0; its top is z = 0) and its clamps.
     spindle : float
         Router: spindle speed, rpm (M3 S...); without it no spindle command is written.
         Laser: the beam's power S.
@@ -75,14 +83,35 @@ def gcode(
     """
     if isinstance(paths, Curve):
         paths = [paths]
+    suffix = PurePosixPath(str(path)).suffix.lower()
+    if suffix not in EXTENSIONS:
+        raise InputError(
+            "path",
+            f"{str(path)!r} is not a G-code file name: end it with one of "
+            f"{', '.join(EXTENSIONS)} (controllers and senders go by the extension)",
+        )
     for port, value in (("feed", feed), ("plunge", plunge)):
         if not (math.isfinite(value) and value > 0):
             raise InputError(port, f"the {port} must be positive (mm/min), got {value}")
-    if not math.isfinite(safe_z):
-        raise InputError("safe_z", f"the safe height must be finite, got {safe_z}")
     laser = mode == Mode.laser
+    if not laser and not (math.isfinite(safe_z) and safe_z > 0):
+        raise InputError(
+            "safe_z",
+            f"the safe height must be above the work (z > 0: the work's top is z = 0), "
+            f"got {safe_z}",
+        )
     moves = [_moves(c, i, tolerance, ctx) for i, c in enumerate(paths)]
     ctx.guard(sum(len(m.points) for m in moves), "G-code moves")
+    if not any(len(m.points) for m in moves):
+        ctx.warn("no paths to cut: the program only sets the machine up and ends")
+    above = [i for i, m in enumerate(moves) if len(m.points) and m.points[:, 2].max() > 0]
+    if above and not laser:
+        top = max(float(moves[i].points[:, 2].max()) for i in above)
+        listed = ", ".join(map(str, above[:5])) + (" ..." if len(above) > 5 else "")
+        ctx.warn(
+            f"{len(above)} path(s) ({listed}) run above the work, up to z = {top:g} (tool "
+            "paths go down from its top at z = 0): they cut nothing there"
+        )
     try:
         data = gcode_bytes(moves, feed, plunge, safe_z, spindle, laser)
     except ValueError as exc:

@@ -11,7 +11,8 @@ import numpy as np
 from formgraph.core.errors import InputError
 from formgraph.core.registry import Context, Range, node
 from formgraph.geometry import Field, Mesh
-from formgraph.kernels.field import mesher
+from formgraph.kernels.field import mesher, planar
+from formgraph.nodes.field import _blend
 from formgraph.nodes.field._common import bounds_box
 
 
@@ -108,7 +109,52 @@ def mesh_of(
     if not len(t):
         ctx.warn("the field has no surface inside its bounds: the mesh is empty")
         return Mesh(np.zeros((0, 3)), np.zeros(0, np.int64), np.zeros(1, np.int64))
+    _warn_moved_faces(field, v, cell, ctx)
     return Mesh(v, t.reshape(-1), np.arange(0, 3 * len(t) + 1, 3))
+
+
+def _face_words(normal: np.ndarray, offset: float) -> str:
+    """'the face at z = 0 (facing -z)' for an axis-aligned plane, else by its normal."""
+    k = int(np.argmax(np.abs(normal)))
+    if abs(abs(normal[k]) - 1) < 1e-9:
+        side = "+" if normal[k] > 0 else "-"
+        return f"the face at {'xyz'[k]} = {offset * normal[k] + 0.0:.4g} (facing {side}{'xyz'[k]})"
+    n = ", ".join(f"{x:.3g}" for x in normal)
+    return f"the face on the plane n . p = {offset:.4g}, n = [{n}]"
+
+
+def _warn_moved_faces(field: Field, vertices: np.ndarray, cell: float, ctx: Context) -> None:
+    """Warn when a smooth union pushed a flat face of its inputs past its plane, where the
+    sharp union stayed behind it (a flat bottom no longer on the bed): see
+    :mod:`formgraph.kernels.field.planar`. Tolerance: a tenth of the cell."""
+    radii = _blend.smooth_unions(field)
+    if not radii:
+        return
+    normals, offsets = _blend.flat_faces(field)
+    if not len(normals):
+        return
+    moved = planar.overshoots(
+        vertices,
+        _blend.sharpened(field).evaluate,
+        normals,
+        offsets,
+        tol=cell / 10,
+    )
+    if not moved:
+        return
+    faces = "; ".join(
+        f"{_face_words(m.normal, m.offset)} by {m.excess:.3g}, at "
+        f"({', '.join(f'{x:.4g}' for x in m.where)}) ({m.count} vertices)"
+        for m in moved[:4]
+    )
+    more = f"; and {len(moved) - 4} more" if len(moved) > 4 else ""
+    ctx.warn(
+        f"the smooth union (its input smooth: {', '.join(f'{r:g}' for r in radii)}) pushes "
+        f"flat faces of its inputs past their planes (by more than a tenth of the cell "
+        f"{cell:g}) where the sharp union stays behind them: {faces}{more}. A part meant to "
+        "stand on such a face no longer does: use a smaller smooth, or intersect the blend "
+        "with a box (field.intersection) to cut it back to the plane"
+    )
 
 
 @node("field.mesh", version=2)

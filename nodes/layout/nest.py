@@ -32,9 +32,10 @@ class Nested(NamedTuple):
     sheets: int
     utilisation: float
     outlines: list[Curve]
+    marks: list[Curve]
 
 
-@node("layout.nest", version=1)
+@node("layout.nest", version=2)
 def nest(
     curves: list[Curve],
     sheet: list[float],
@@ -43,6 +44,7 @@ def nest(
     seed: int = 0,
     effort: Annotated[int, Range(min=1, max=MAX_EFFORT)] = 10,
     tolerance: Annotated[float | None, Range(min=0)] = None,
+    marks: list[Curve] | None = None,
     *,
     ctx: Context,
 ) -> Nested:
@@ -58,7 +60,7 @@ def nest(
     Outputs: ``curves`` (the parts placed; sheet k shifted k times the sheet's width plus
     10 % along x), ``sheets``, ``utilisation`` (the parts' area over the sheet area used:
     every sheet but the last whole, the last up to its rightmost part) and ``outlines``
-    (the sheets' rectangles).
+    (the sheets' rectangles) and ``marks`` (the ``marks`` moved with their parts).
 
     Parameters
     ----------
@@ -78,6 +80,11 @@ def nest(
     tolerance : float
         Outlines are simplified within this for the nesting (the spacing grows by it, so
         parts never come closer). Default: 1e-4 of the sheet's diagonal.
+    marks : list[Curve]
+        Curves that ride on the parts without being cut (labels from ``curves.text``,
+        engraving, bend lines): each goes with the part that holds most of its points,
+        moved and turned as that part is; they do not take part in the nesting. A mark on
+        no part is an error naming it.
 
     Example
     -------
@@ -92,12 +99,19 @@ def nest(
     w, h = float(sheet[0]), float(sheet[1])
     if not math.isfinite(spacing):
         raise InputError("spacing", f"the spacing must be finite, got {spacing}")
+    if spacing > math.hypot(w, h):
+        ctx.warn(
+            f"the spacing {spacing:g} is more than the sheet's diagonal "
+            f"({math.hypot(w, h):.6g}): every part gets a sheet of its own"
+        )
     loops, outline, hole = _o.region_loops(curves, ctx)
     starts = np.flatnonzero(~hole)
     bounds = np.r_[starts, len(loops)]
     parts = [loops[a:b] for a, b in zip(bounds[:-1], bounds[1:], strict=True)]
     groups = [outline[a:b] for a, b in zip(bounds[:-1], bounds[1:], strict=True)]
     ctx.guard(len(parts) * rotations * effort, "part placements")
+    marks = [marks] if isinstance(marks, Curve) else list(marks or [])
+    owner = _owners(marks, parts)
     try:
         result = knest.nest(parts, (w, h), spacing, rotations, seed, effort, tolerance)
     except knest.PartTooLarge as exc:
@@ -111,15 +125,50 @@ def nest(
         port = "tolerance" if str(exc).startswith("the tolerance") else "sheet"
         raise InputError(port, str(exc)) from None
     placed: list[Curve] = []
+    moves = []
     for i, group in enumerate(groups):  # one step per part: its curves moved as a whole
         c, s = math.cos(result.angle[i]), math.sin(result.angle[i])
         linear = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
         shift = result.offset[i] + (result.sheet[i] * w * (1 + SHEET_GAP), 0.0)
         offset = np.array([shift[0], shift[1], 0.0])
+        moves.append((linear, offset))
         placed += [transform_one(g, linear, offset) for g in group]
+    moved = [transform_one(m, *moves[k]) for m, k in zip(marks, owner, strict=True)]
     corners = np.array([[0, 0, 0], [w, 0, 0], [w, h, 0], [0, h, 0]], dtype=np.float64)
     outlines: list[Curve] = [
         NurbsCurve.polyline(corners + [k * w * (1 + SHEET_GAP), 0, 0], closed=True)
         for k in range(result.sheets)
     ]
-    return Nested(placed, result.sheets, result.utilisation, outlines)
+    return Nested(placed, result.sheets, result.utilisation, outlines, moved)
+
+
+def _owners(marks: list[Curve], parts: list[list[np.ndarray]]) -> list[int]:
+    """The part each mark rides on: the one that holds most of its points (33 along it,
+    ends and holes counted as the region does), found for all points at once through
+    GEOS's STR tree."""
+    if not marks:
+        return []
+    samples = []
+    for j, m in enumerate(marks):  # one step per mark: its points
+        if not isinstance(m, Curve):
+            raise InputError("marks", f"mark {j} is a {type(m).__name__}, not a curve")
+        pts = np.asarray(m.sample(33), dtype=np.float64)[:, :2]
+        if not np.isfinite(pts).all():
+            raise InputError("marks", f"mark {j} has points that are not finite")
+        samples.append(pts)
+    pts = np.concatenate(samples)
+    which = np.repeat(np.arange(len(marks)), [len(p) for p in samples])
+    polys = np.array([shapely.Polygon(r[0], list(r[1:])) for r in parts], dtype=object)
+    hit_pt, hit_part = shapely.STRtree(polys).query(shapely.points(pts), predicate="intersects")
+    counts = np.zeros((len(marks), len(parts)), dtype=np.int64)
+    np.add.at(counts, (which[hit_pt], hit_part), 1)
+    lost = np.flatnonzero(counts.max(axis=1) == 0)
+    if len(lost):
+        j = int(lost[0])
+        x, y = samples[j][0]
+        raise InputError(
+            "marks",
+            f"mark {j} (from ({x:.6g}, {y:.6g})) lies on no part: a mark rides on the part "
+            f"it is drawn on ({len(lost)} mark(s) on none)",
+        )
+    return counts.argmax(axis=1).tolist()

@@ -63,7 +63,7 @@ def mesh_offset(
     return Mesh(out.vertices, *faces, **carry.onto(mesh, out.vertices, faces, max_tests=ctx.budget))
 
 
-@node("mesh.solidify", version=2)
+@node("mesh.solidify", version=3)
 def solidify(
     mesh: Mesh,
     thickness: Annotated[float, Range(min=0)],
@@ -94,8 +94,12 @@ def solidify(
     planar_rims : bool
         Keep every planar boundary loop in its own plane: its vertices move along their
         normals projected into the plane (the wall's thickness kept), so a shade whose
-        bottom rim lies on z = 0 still stands on z = 0. Loops that are not planar, or
-        whose surface lies nearly in the loop's plane, move along their normals.
+        bottom rim lies on z = 0 still stands on z = 0. Where the whole surface lies on
+        one side of such a plane (a bed, or a top), no vertex of the wall passes it: the
+        rings next to the rim, whose normals point through the plane on a flaring wall,
+        slide along the wall away from it, so the wall ends in the plane without folding
+        back. Loops that are not planar, or whose surface lies nearly in the loop's plane
+        (within 30 degrees), move along their normals.
     """
     if thickness <= 0:
         raise InputError("thickness", f"thickness must be > 0, got {thickness:g}")

@@ -8,6 +8,7 @@ import pytest
 
 import formgraph as fg
 from formgraph.core.errors import BudgetError
+from formgraph.geometry import Field
 
 
 def graph(**nodes):
@@ -176,3 +177,30 @@ def test_the_mesher_refuses_a_box_too_many_cells_across_to_number():
     v, t = mesher.mesh_field(sphere, np.full(3, -1.5), np.full(3, 1.5), 0.05, 1.0)
     edges = np.sort(np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]]), axis=1)
     assert len(v) and (np.unique(edges, axis=0, return_counts=True)[1] == 2).all()
+
+
+def test_the_flat_face_check_walks_a_deep_recipe_without_recursion():
+    from formgraph.nodes.field import _blend
+
+    f = Field.union([Field.box([1, 1, 1]), Field.box([1, 1, 1], [1, 0, 0])], smooth=0.5)
+    for _ in range(5000):  # deeper than Python's recursion limit
+        f = Field.offset(f, 0.0)
+    assert _blend.smooth_unions(f) == [0.5]
+    normals, offsets = _blend.flat_faces(f)
+    assert len(normals) == 8  # the faces of both boxes, the four shared planes once
+    sharp = _blend.sharpened(f)
+    while sharp.op == "offset":
+        sharp = sharp.children[0]
+    assert sharp.op == "union" and sharp.args["smooth"] == 0
+
+
+def test_a_hundred_blended_boxes_are_checked_in_blocks_and_warned_of_once():
+    nodes = {
+        f"b{i}": ("field.box", {"size": [1, 1, 1], "center": [0.9 * i, 0, 0.5]}) for i in range(100)
+    }
+    nodes["u"] = ("field.union", {"fields": [f"@b{i}" for i in range(100)], "smooth": 0.4})
+    nodes["m"] = ("field.mesh", {"field": "@u", "cell": 0.25})
+    g = graph(**nodes)
+    v = g.evaluate("m").vertices
+    (warning,) = g.stats["m"].warnings
+    assert f"the face at z = 0 (facing -z) by {-v[:, 2].min():.3g}" in warning

@@ -32,7 +32,7 @@ import shapely
 from ..curves.regions import even_odd_region
 from ..offset import offset_loops
 
-__all__ = ["depths", "leftovers", "pocket_levels"]
+__all__ = ["depths", "leftovers", "over_tabs", "pocket_levels", "tab_spans"]
 
 _RIDGE = 1e-6  # of the reachable area: ridges below this are rounding, not material
 _FILLET = 1 / 3  # inscribed radius, as a share of r, above which a leftover is reported
@@ -162,3 +162,63 @@ def leftovers(
         if width / 2 > _FILLET * radius or not levels:
             out.append((float(centre[0]), float(centre[1]), float(piece.area), float(width)))
     return sorted(out, key=lambda t: -t[2])
+
+
+def tab_spans(length: float, count: int, span: float) -> np.ndarray:
+    """Where a closed path of ``length`` is lifted over ``count`` holding tabs, evenly
+    spaced along it (the first centred half a spacing from the start, so no tab sits on
+    the path's start, where the tool plunges): (count, 2) arc lengths [start, end).
+
+    Raises
+    ------
+    ValueError
+        Tabs that would meet (count times ``span`` not less than the length).
+    """
+    if count * span >= length:
+        raise ValueError(
+            f"{count} tabs of {span:g} along the tool path (the tab's width plus the tool's "
+            f"diameter) do not fit on a loop of length {length:.6g}: give fewer or narrower "
+            "tabs"
+        )
+    centre = (np.arange(count) + 0.5) * (length / count)
+    return np.c_[centre - span / 2, centre + span / 2]
+
+
+def over_tabs(points: np.ndarray, spans: np.ndarray, z: float, z_tab: float) -> np.ndarray:
+    """A closed path at depth ``z`` lifted to ``z_tab`` over the tabs: straight up at each
+    tab's start, along it at ``z_tab``, straight down at its end.
+
+    Parameters
+    ----------
+    points : (n, 2) float
+        The path (within its tolerance), closed: the last point is the first.
+    spans : (k, 2) float
+        Arc lengths [start, end) of the tabs along it, sorted, apart (:func:`tab_spans`).
+    z, z_tab : float
+        The pass's depth and the tabs' top (z < z_tab).
+
+    Returns
+    -------
+    (m, 3) float
+        The lifted path: the points and the tabs' ends (each twice, at z and at z_tab),
+        in order.
+    """
+    pts = np.asarray(points, dtype=np.float64)
+    s = np.r_[0.0, np.cumsum(np.hypot(*np.diff(pts, axis=0).T))]
+    ends = spans.ravel()  # a0 b0 a1 b1 ...
+    # the path's own points, less any that falls on a tab's end (the end stands for it)
+    j = np.clip(np.searchsorted(ends, s), 1, len(ends) - 1)
+    gap = np.minimum(np.abs(s - ends[j - 1]), np.abs(s - ends[j]))
+    own = s[gap > 1e-12 * s[-1]]
+    k = np.searchsorted(spans[:, 0], own, side="right") - 1
+    inside = (k >= 0) & (own < spans[np.maximum(k, 0), 1])
+    # each tab end twice: up at a start (low, then high), down at an end (high, then low)
+    second = np.tile([False, True], len(ends))
+    starts = np.repeat(np.tile([True, False], len(spans)), 2)
+    high = np.where(starts, second, ~second)
+    at = np.r_[own, np.repeat(ends, 2)]
+    zs = np.r_[np.where(inside, z_tab, z), np.where(high, z_tab, z)]
+    order = np.lexsort((np.r_[np.zeros(len(own)), second], at))
+    at, zs = at[order], zs[order]
+    xy = np.c_[np.interp(at, s, pts[:, 0]), np.interp(at, s, pts[:, 1])]
+    return np.c_[xy, zs]

@@ -42,6 +42,7 @@ _MUTATION = 0.1  # chance that a part swaps places with the next in a child's or
 _FINEST = 8  # grid steps the tolerance spans at least
 _SLACK = 0.01  # of the sheet's width: used lengths this close count as equal
 _GROW_MITRE = 2.0  # mitre limit of the growth by half the spacing (>= 1: contains the round)
+_FIT = 1e-9  # relative: a part this close to the sheet's size fits it
 
 
 class PartTooLarge(ValueError):
@@ -49,7 +50,7 @@ class PartTooLarge(ValueError):
 
     def __init__(self, part: int, size: tuple[float, float], sheet: tuple[float, float]):
         super().__init__(
-            f"part {part} ({size[0]:.6g} x {size[1]:.6g} with the spacing) does not fit on "
+            f"part {part} ({size[0]:.6g} x {size[1]:.6g}) does not fit on "
             f"the {sheet[0]:.6g} x {sheet[1]:.6g} sheet at any allowed turn"
         )
         self.part = part
@@ -162,11 +163,17 @@ class _Problem:
         outer = grid(shapely.get_coordinates(grown.exterior)[:-1])
         holes = [grid(shapely.get_coordinates(h)[:-1]) for h in grown.interiors]
         turned = ring @ rot.T
-        lo, hi = turned.min(axis=0) - tol, turned.max(axis=0) + tol
-        w, h = self.sheet
+        bare_lo, bare_hi = turned.min(axis=0), turned.max(axis=0)
+        lo, hi = bare_lo - tol, bare_hi + tol  # the margin covers the outline's sampling
+        size = np.array(self.sheet)
         low = np.ceil(-lo * self.scale).astype(np.int64)
-        high = np.floor((np.array([w, h]) - hi) * self.scale).astype(np.int64)
-        right = int(math.ceil(hi[0] * self.scale))
+        high = np.floor((size - hi) * self.scale).astype(np.int64)
+        # a part as large as the sheet (within a relative _FIT) fits without the margin: it
+        # goes to the middle of what is left, on the grid
+        tight = (low > high) & (bare_hi - bare_lo <= size * (1 + _FIT))
+        middle = np.round(0.5 * (size - bare_hi - bare_lo) * self.scale).astype(np.int64)
+        low, high = np.where(tight, middle, low), np.where(tight, middle, high)
+        right = int(math.ceil(bare_hi[0] * self.scale))
         return _Shape(outer, holes, low, high, right, self.area[i], bool(np.all(low <= high)))
 
     def nfp(self, a: int, ka: int, b: int, kb: int) -> tuple[list[np.ndarray], np.ndarray]:
@@ -339,6 +346,9 @@ def nest(
         raise ValueError(f"rotations must be 1 or more, got {rotations}")
     if effort < 1:
         raise ValueError(f"effort must be 1 or more evaluations, got {effort}")
+    # two parts on one sheet are never farther apart than its diagonal: any spacing beyond
+    # it gives each part a sheet of its own, as twice the diagonal does, on a finer grid
+    spacing = min(spacing, 2 * math.hypot(w, h))
     polygons = [shapely.Polygon(r[0], list(r[1:])) for r in parts]
     if not polygons:
         z = np.zeros(0)
@@ -362,7 +372,7 @@ def nest(
         if not any(s.fits for s in turns):
             i = int(np.flatnonzero(problem.kind == t)[0])
             lo, hi = shapely.bounds(polygons[i]).reshape(2, 2)
-            size = hi - lo + spacing
+            size = hi - lo
             raise PartTooLarge(i, (float(size[0]), float(size[1])), (w, h))
     best_score, best, evaluations = _search(problem, seed, effort)
     sheet_of = best[:, 0]
@@ -375,7 +385,8 @@ def nest(
     sheets = int(sheet_of.max()) + 1
     length = (best_score - (sheets - 1)) * w
     used = (sheets - 1) * w * h + length * h
-    util = float(problem.area.sum() / used) if used > 0 else 0.0
+    # the grid's rounding may make a sheet-sized part's used length a hair short
+    util = min(1.0, float(problem.area.sum() / used)) if used > 0 else 0.0
     return Nesting(sheet_of, angle, offset, sheets, float(length), util, evaluations)
 
 

@@ -8,7 +8,13 @@ from .halfedge import build_halfedges
 from .measure import next_corner
 from .meshops import face_normals, reverse_faces
 
-__all__ = ["planar_rim_directions", "solidify", "vertex_normals"]
+__all__ = [
+    "behind_beds",
+    "planar_rim_directions",
+    "planar_rim_moves",
+    "solidify",
+    "vertex_normals",
+]
 
 MeshArrays = tuple[np.ndarray, np.ndarray, np.ndarray]
 
@@ -97,11 +103,14 @@ def solidify(
     if fo.size < 2:
         raise ValueError("the surface has no faces to thicken")
     he = build_halfedges(fi, fo, len(v))
-    n = vertex_normals(v, fi, fo)
+    n = normals = vertex_normals(v, fi, fo)
+    planes = np.zeros((0, 4))
     if planar_rims and he.boundary_halfedges.size:
-        n = planar_rim_directions(v, he.boundary_edges, n)
+        n, planes = planar_rim_moves(v, he.boundary_edges, normals)
     front = v + n * (t * (1.0 + offset) / 2.0)[:, None]
     back = v - n * (t * (1.0 - offset) / 2.0)[:, None]
+    if len(planes):
+        front, back = (behind_beds(v, normals, copy, planes) for copy in (front, back))
     nv = len(v)
     b = he.boundary_halfedges
     a_, b_ = he.origin[b], he.vertex[b]
@@ -114,7 +123,16 @@ def solidify(
 def planar_rim_directions(
     vertices: np.ndarray, boundary_edges: np.ndarray, normals: np.ndarray, tol: float = 1e-6
 ) -> np.ndarray:
-    """Offset directions with the vertices of planar boundary loops kept in their plane.
+    """Offset directions with the vertices of planar boundary loops kept in their plane
+    (:func:`planar_rim_moves`, its directions alone)."""
+    return planar_rim_moves(vertices, boundary_edges, normals, tol)[0]
+
+
+def planar_rim_moves(
+    vertices: np.ndarray, boundary_edges: np.ndarray, normals: np.ndarray, tol: float = 1e-6
+) -> tuple[np.ndarray, np.ndarray]:
+    """Offset directions with the vertices of planar boundary loops kept in their plane,
+    and those planes.
 
     Each loop (a connected component of the boundary edges) gets its best-fit plane from
     the eigenvectors of its covariance (all loops at once, a batched ``eigh``); a loop whose
@@ -134,7 +152,10 @@ def planar_rim_directions(
 
     Returns
     -------
-    (n, 3) float: ``normals`` with the rim vertices' rows replaced.
+    directions : (n, 3) float
+        ``normals`` with the rim vertices' rows replaced.
+    planes : (p, 4) float
+        The planes of the loops kept in them: unit normal, offset (``n . x = c``).
     """
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
@@ -171,4 +192,77 @@ def planar_rim_directions(
     use = planar[loop] & ok_loop[loop]
     out = np.array(normals, dtype=np.float64)
     out[rim[use]] = proj[use] / length2[use, None]
+    kept = np.unique(loop[use])
+    planes = np.column_stack([plane[kept], np.einsum("ij,ij->i", plane[kept], centre[kept])])
+    return out, planes
+
+
+def behind_beds(
+    vertices: np.ndarray,
+    normals: np.ndarray,
+    moved: np.ndarray,
+    planes: np.ndarray,
+    rise: float = 0.5,
+    tol: float = 1e-9,
+) -> np.ndarray:
+    """An offset copy kept behind every rim plane that bounds the surface (a bed), without
+    folds.
+
+    A planar rim keeps its vertices in its plane, but the next rings of an offset wall move
+    along their normals, which near the rim of a flaring wall point through the plane: a
+    shade stood on a ring of vertices below the bed, and the section showed the wall folding
+    back. A plane counts as a bed when the whole surface lies on one side of it (to ``tol``
+    of its size). The wall cut by the plane starts where the offset surface meets it (the
+    rim's moved vertex); the vertices of the offset copy that fell behind the bed, or too
+    near it, slide within their tangent plane (which is the offset surface's, to first
+    order: the wall keeps its thickness) away from the bed, to ``rise`` times their
+    vertex's own height above it. Heights along the wall then grow with the surface's
+    (``max`` of two growing functions), so the copy neither crosses the bed nor folds back;
+    vertices far from it keep their place. Where the surface is nearly parallel to the bed
+    (within 15 degrees) a vertex that crossed it stops where its move meets it.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+        The surface.
+    normals : (n, 3) float
+        Its unit vertex normals (the offset surface's tangent planes).
+    moved : (n, 3) float
+        Each vertex moved (an offset copy).
+    planes : (p, 4) float
+        Unit normals and offsets of the rim planes (:func:`planar_rim_moves`).
+    rise : float
+        The height above the bed, as a share of the vertex's own, that a moved vertex at
+        least keeps (0 < rise < 1).
+
+    Returns
+    -------
+    (n, 3) float: ``moved``, with the vertices near a bed slid away from it.
+    """
+    v = np.asarray(vertices, dtype=np.float64)
+    nrm = np.asarray(normals, dtype=np.float64)
+    out = np.array(moved, dtype=np.float64)
+    eps = tol * max(float(np.ptp(v, axis=0).max()), 1e-300)
+    for plane in np.asarray(planes, dtype=np.float64).reshape(-1, 4):
+        up, level = -plane[:3], -plane[3]  # height: up . x - level, >= 0 on the surface
+        height = v @ up - level
+        if height.min() < -eps:  # the surface is on the other side, or on both
+            if height.max() > eps:
+                continue  # the plane bounds nothing
+            up, level, height = -up, -level, -height
+        raise_by = np.maximum(rise * height, 0.0) - (out @ up - level)
+        low = np.flatnonzero(raise_by > eps)
+        if not low.size:
+            continue
+        # the steepest way up within each vertex's tangent plane, and its climb per length
+        slope = up - np.einsum("ij,j->i", nrm[low], up)[:, None] * nrm[low]
+        climb2 = np.einsum("ij,ij->i", slope, slope)
+        steep = climb2 >= np.sin(np.radians(15.0)) ** 2
+        i = low[steep]
+        out[i] += slope[steep] * (raise_by[i] / climb2[steep])[:, None]
+        # nearly parallel to the bed: a vertex that crossed it stops where its move meets it
+        j = low[~steep]
+        below = (out[j] @ up - level) < 0
+        j, step = j[below], out[j[below]] - v[j[below]]
+        out[j] = v[j] + step * (height[j] / -(step @ up))[:, None]
     return out
