@@ -40,6 +40,7 @@ from .geometry import (
     Surface,
 )
 from .sweeps.api import Sweep, sweep
+from .sweeps.optimize import Study, optimize
 
 
 def show(source: Any, node: str | Iterable[str] | None = None, **kwargs: Any) -> Any:
@@ -84,4 +85,6 @@ __all__ = [
     "node_types",
     "show",
     "sweep",
+    "optimize",
+    "Study",
 ]

@@ -137,10 +137,12 @@ def _parser() -> argparse.ArgumentParser:
         "--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS
     )
 
+    from .optimize import add_parser as add_optimize
     from .serve import add_parser as add_serve
     from .sweep import add_parsers
 
     add_parsers(sub)
+    add_optimize(sub)
     add_serve(sub)
     return ap
 
@@ -430,6 +432,7 @@ COMMANDS = {
     "schema": cmd_schema,
     "sweep": lambda args: _sweep_command("cmd_sweep", args),
     "cache": lambda args: _sweep_command("cmd_cache", args),
+    "optimize": lambda args: _optimize_command(args),
     "serve": lambda args: _serve_command(args),
 }
 
@@ -438,6 +441,12 @@ def _serve_command(args: argparse.Namespace) -> int:
     from .serve import cmd_serve
 
     return cmd_serve(args)
+
+
+def _optimize_command(args: argparse.Namespace) -> int:
+    from .optimize import cmd_optimize
+
+    return cmd_optimize(args)
 
 
 def _sweep_command(name: str, args: argparse.Namespace) -> int:

@@ -23,7 +23,7 @@ def _budget(text: str) -> int:
     return value
 
 
-def graph_options(p: argparse.ArgumentParser) -> None:
+def graph_options(p: argparse.ArgumentParser, budget_flag: str = "--budget") -> None:
     p.add_argument(
         "--set",
         action="extend",
@@ -39,7 +39,8 @@ def graph_options(p: argparse.ArgumentParser) -> None:
         help="the folder read nodes read from (default: the graph file's folder)",
     )
     p.add_argument(
-        "--budget",
+        budget_flag,
+        dest="budget",
         type=_budget,
         default=DEFAULT_BUDGET,
         help=f"element budget per node (default {DEFAULT_BUDGET:,})",

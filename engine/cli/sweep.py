@@ -54,8 +54,7 @@ def add_parsers(sub: Any) -> None:
     )
     sw.add_argument("--workers", type=int, metavar="N", help="embedded workers (one per core)")
     sw.add_argument("--out", default="out", metavar="DIR", help="output directory (./out)")
-    sw.add_argument("--no-cache", action="store_true", help="do not use the on-disk cache")
-    sw.add_argument("--cache-dir", default=None, help=argparse.SUPPRESS)
+    cache_options(sw)
     graph_options(sw)
 
     cache = sub.add_parser(
@@ -72,18 +71,42 @@ def add_parsers(sub: Any) -> None:
     )
 
 
+def cache_options(p: argparse.ArgumentParser) -> None:
+    """``--cache DIR`` (a folder every worker may share) and ``--no-cache``."""
+    p.add_argument("--no-cache", action="store_true", help="do not use the on-disk cache")
+    p.add_argument(
+        "--cache",
+        "--cache-dir",
+        dest="cache_dir",
+        default=None,
+        metavar="DIR",
+        help="the disk cache folder (default ~/.cache/formgraph); with --scheduler, a folder "
+        "on a filesystem every worker mounts at the same path, shared by all of them",
+    )
+
+
+def cache_choice(args: argparse.Namespace) -> tuple[Any, bool]:
+    """The cache folder the workers use, and whether the client sees it too."""
+    from ..evaluation.cache import default_cache_dir
+    from ..sweeps.api import EACH_WORKER
+
+    if args.no_cache:
+        return None, False
+    if args.cache_dir:
+        return args.cache_dir, True  # named: the same folder for the client and each worker
+    if args.scheduler:
+        return EACH_WORKER, False  # the client's folder means nothing on other machines
+    return default_cache_dir(), False
+
+
 def _camera(args: argparse.Namespace) -> tuple[Any, Any, Any] | None:
     """The sheet's camera as the plain (view, azimuth, elevation) the workers are sent."""
     camera = camera_arg(args)
     return None if camera is None else (camera.view, camera.azimuth, camera.elevation)
 
 
-def cmd_sweep(args: argparse.Namespace) -> int:
-    """``formgraph sweep``."""
-    from ..evaluation.cache import default_cache_dir
-    from ..evaluation.graph import load
-    from ..sweeps.api import EACH_WORKER, TerminalProgress, sweep
-
+def vary_and_workers(args: argparse.Namespace) -> dict[str, str]:
+    """``--vary`` as {name: spec}, after checking it and ``--workers`` (UsageError)."""
     if args.workers is not None and args.workers < 1:
         raise UsageError(f"--workers takes a positive count, got {args.workers}")
     if args.workers is not None and args.scheduler:
@@ -96,19 +119,25 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         if name.strip() in vary:
             raise UsageError(f"--vary {name.strip()} is given twice")
         vary[name.strip()] = spec.strip()
-    cache_dir: Any = None
-    if not args.no_cache:
-        cache_dir = args.cache_dir or default_cache_dir()
+    return vary
+
+
+def cmd_sweep(args: argparse.Namespace) -> int:
+    """``formgraph sweep``."""
+    from ..evaluation.cache import default_cache_dir
+    from ..evaluation.graph import load
+    from ..sweeps.api import EACH_WORKER, TerminalProgress, sweep
+
+    vary = vary_and_workers(args)
+    cache_dir, shared = cache_choice(args)
     g = load(
         args.graph,
         out_dir=args.out,
-        cache_dir=cache_dir,
+        cache_dir=default_cache_dir() if cache_dir is EACH_WORKER else cache_dir,
         budget=args.budget,
         inputs_dir=getattr(args, "inputs", None),
     )
     g.set(**parse_sets(g, args.set))
-    if args.scheduler and not args.no_cache and not args.cache_dir:
-        cache_dir = EACH_WORKER  # the client's folder means nothing on other machines
     progress = TerminalProgress(sys.stderr)
     t0 = time.perf_counter()
     try:
@@ -125,6 +154,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
             client=args.scheduler,
             workers=args.workers,
             cache_dir=cache_dir,
+            shared_cache=shared,
             per_sheet=args.per_sheet,
             camera=_camera(args),
             progress=progress,

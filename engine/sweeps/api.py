@@ -329,6 +329,7 @@ def sweep(
     client: Any = None,
     workers: int | None = None,
     cache_dir: Any = _GRAPH_CACHE,
+    shared_cache: bool = False,
     size: tuple[int, int] = (256, 192),
     camera: tuple[Any, Any, Any] | None = None,
     per_sheet: int = 100,
@@ -366,6 +367,9 @@ def sweep(
         LocalCluster of ``workers`` single-threaded processes (one per core), closed after.
     cache_dir : path, None or EACH_WORKER
         The disk cache workers use; default the graph's own (``cache_dir=`` of load).
+    shared_cache : bool
+        ``cache_dir`` is one folder that the client and every worker see (a shared
+        filesystem): nodes found there are loaded, not scheduled, on a remote cluster too.
     on_row, progress : callables, optional
         Called on the client with each finished row dict, and with
         (done, total, failed, variants per second).
@@ -470,6 +474,7 @@ def sweep(
             workers=workers,
             cache_dir=None if cache_dir is EACH_WORKER else cache_dir,
             worker_cache=cache_dir is EACH_WORKER,
+            shared_disk=shared_cache and cache_dir is not EACH_WORKER,
         )
     finally:
         if table is not None:

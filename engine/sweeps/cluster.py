@@ -418,15 +418,24 @@ def run(
     workers: int | None = None,
     cache_dir: str | os.PathLike[str] | None = None,
     worker_cache: bool = False,
+    shared_disk: bool = False,
+    bp: Blueprint | None = None,
 ) -> Totals:
-    """Run ``variants`` (index, params) and call ``on_row`` on the client as each finishes."""
+    """Run ``variants`` (index, params) and call ``on_row`` on the client as each finishes.
+
+    ``shared_disk``: the client sees the workers' ``cache_dir`` (a folder on a shared
+    filesystem), so nodes found there are loaded, not scheduled, as on an embedded cluster.
+    ``bp``: the blueprint of an earlier call, so workers rebuild the graph only once for a
+    series of runs (an optimisation study's batches).
+    """
     from distributed import as_completed, wait
 
     if not variants:  # all done already (a resumed sweep): no cluster needed
         return Totals()
-    bp = blueprint(g, None if cache_dir is None else str(cache_dir), worker_cache)
+    if bp is None:
+        bp = blueprint(g, None if cache_dir is None else str(cache_dir), worker_cache)
     bp_key = f"graph-{bp.token}"
-    embedded = client is None
+    embedded = client is None or shared_disk
     visible = None
     if embedded and (cache_dir is not None or worker_cache):  # the workers' disk is ours
         visible = DiskCache(default_cache_dir() if worker_cache else cache_dir)

@@ -1,0 +1,139 @@
+"""Optimisation studies: what the study loop adds to a sweep, how much work trials share,
+and what a second worker buys.
+
+- Per-trial overhead: a 200-trial study of a light graph (a 16-point circle and its
+  polyline, microseconds of work) against a sweep of the same number of variants on the
+  same running 2-worker cluster (interleaved rounds, wall clock): the difference is what
+  asking, telling, the batches' extra Dask round trips, the tables (trials.csv, pareto.csv,
+  the journal) and the progress picture cost. Beside it, the study's own work alone
+  (``Study.overhead``: CPU time of the client thread outside the sweep runs), which a busy
+  machine does not inflate. Random sampling (optuna's cheapest sampler) and TPE.
+- The lamp shade (graphs/lamp_shade.yaml, 15 nodes), a 200-trial TPE study of wall,
+  window and height: node evaluations computed against 200 x its node count (the shared
+  fraction: the revolved band no varied param reaches, each window size's bores, ...).
+- A 100-trial study of the lamp shade (booleans: a heavy graph) on 1 worker and on 2,
+  wall clock, with the machine's load average beside it.
+
+The embedded cluster is started before timing and its workers warmed (they import the node
+families), as in bench_sweep. No disk cache: every node is computed or shared in-study.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+import time
+from pathlib import Path
+
+import formgraph as fg
+
+ROOT = Path(__file__).resolve().parents[1]
+LAMP = ROOT / "graphs" / "lamp_shade.yaml"
+LAMP_VARY = {"wall": "0.02:0.3", "window": "0.05:0.5", "height": "0.6:2.2"}
+
+
+def _light() -> fg.Graph:
+    light = fg.Graph()
+    light.add_param("r", 1.0, min=0.1, max=100)
+    light.add("pts", "points.circle", count=16, radius="=r")
+    light.add("ring", "curves.polyline", points="@pts", closed=True)
+    light.add("size", "curves.measure", curve="@ring")
+    return light
+
+
+def _study(graph, vary, client, budget, method="tpe", **kw):
+    with tempfile.TemporaryDirectory() as tmp:
+        t0 = time.perf_counter()
+        s = fg.optimize(
+            graph, vary, minimize=[kw.pop("objective", "size.length")], budget=budget,
+            method=method, client=client, cache_dir=None, out=tmp, **kw,
+        )  # fmt: skip
+        return time.perf_counter() - t0, s
+
+
+def _optuna_alone(method: str, n: int) -> float:
+    """CPU seconds a trial of optuna's own ask and tell, in batches of 8 as a study runs."""
+    import math
+
+    import optuna
+    from optuna.distributions import FloatDistribution
+
+    from formgraph.sweeps.optimize import _sampler
+
+    optuna.logging.set_verbosity(optuna.logging.WARNING)
+    space = {"r": FloatDistribution(1.0, 50.0)}
+    study = optuna.create_study()
+    t0 = time.thread_time()
+    while len(study.trials) < n:
+        study.sampler = _sampler(optuna, method, len(study.trials), 16)
+        for t in [study.ask(space) for _ in range(8)]:
+            study.tell(t, [2 * math.pi * t.params["r"]])
+    return (time.thread_time() - t0) / n
+
+
+def run(table) -> None:
+    import matplotlib.figure  # noqa: F401  (imported once a process: not a trial's cost)
+
+    from formgraph.sweeps.cluster import connect
+
+    embedded = connect(None, workers=2)
+    client = embedded.__enter__()
+    try:
+        fg.sweep(_light(), {"r": "1:2:64"}, ["size"], client=client, cache_dir=None)  # warm
+        fg.sweep(fg.load(LAMP), {"wall": "0.05:0.1:4"}, ["size"], client=client, cache_dir=None)
+        n = 200
+        for method in ("random", "tpe"):
+            own: list[float] = []
+
+            def study(method=method, own=own):
+                s = _study(_light(), {"r": "1:50"}, client, n, method)[1]
+                own.append(s.overhead / n)
+
+            def sweep():
+                fg.sweep(_light(), {"r": "1:50"}, ["size"], method="random", samples=n,
+                         client=client, cache_dir=None)  # fmt: skip
+
+            case = f"optimize: light graph x {n} trials, {method}, batches of 8, 2 workers"
+            table.compare(
+                case,
+                api=study,
+                references={"sweep of as many variants, same cluster": sweep},
+                rounds=3,
+                min_seconds=0.0,
+                note="the whole study (asks and tells between batches of 8)",
+            )
+            own.sort()
+            alone = sorted(_optuna_alone(method, n) for _ in range(3))
+            case = f"optimize: the study's own CPU a trial, {n} trials, {method}"
+            table.add(
+                case,
+                "formgraph",
+                own[len(own) // 2],
+                f"median of {len(own)}: ask, tell, journal, tables, progress.png "
+                "(Study.overhead, client thread CPU time)",
+            )
+            table.add(case, "optuna ask and tell alone", alone[1], "same batches and space")
+
+        seconds, s = _study(fg.load(LAMP), LAMP_VARY, client, 200, objective="size.volume")
+        t = s.totals
+        table.add(
+            "optimize: lamp shade, 200 TPE trials, 2 workers",
+            "formgraph study",
+            seconds,
+            f"{t.computed:,} nodes computed for 200 x {t.naive // max(t.variants, 1)} = "
+            f"{t.naive:,} ({1 - t.computed / t.naive:.0%} shared)",
+        )
+    finally:
+        embedded.__exit__(None, None, None)
+    load = os.getloadavg()[0]
+    walls = {}
+    for workers in (1, 2):
+        with connect(None, workers=workers) as c:
+            fg.sweep(fg.load(LAMP), {"wall": "0.05:0.1:4"}, ["size"], client=c, cache_dir=None)
+            walls[workers] = _study(
+                fg.load(LAMP), LAMP_VARY, c, 100, objective="size.volume", seed=4
+            )[0]
+    case = "optimize: lamp shade, 100 TPE trials, wall clock"
+    note = f"1 worker / 2 workers = {walls[1] / walls[2]:.2f}x; load average {load:.1f} at start"
+    table.add(case, "2 workers", walls[2], note)
+    table.add(case, "1 worker", walls[1], f"load average {os.getloadavg()[0]:.1f} at end")
