@@ -482,9 +482,12 @@ def run(
                         futures.append(again)
                         pending.add(again)
                         continue
+                    # its data lost with a worker since as_completed said it was done:
+                    # Dask recomputes it, or deadlocks (#3196); ours again, on new keys
+                    gone = stuck or fut.status in ("pending", "lost")
                     if fut.key in results:
                         finished = results[fut.key].rows
-                    elif len(chunks[fut.key]) > 1 and (stuck or _killed(fut)):
+                    elif len(chunks[fut.key]) > 1 and (gone or _killed(fut)):
                         # one variant of the task kills its worker (out of memory, a crash
                         # in compiled code): each of its rows again on its own, so only that
                         # one fails and the others are not blamed for it
@@ -495,7 +498,7 @@ def run(
                         pending.update(again)
                         fut.release()
                         continue
-                    elif stuck or _killed(fut):  # it, or a task beside it on the dying worker
+                    elif gone or _killed(fut):  # it, or a task beside it on the dying worker
                         suspects.append(fut.key)
                         fut.release()
                         continue
@@ -543,7 +546,9 @@ def _split(dsk: dict[str, Any], chunks: dict[str, list[str]], task_key: str) -> 
 
 def _chunk_result(fut: Any, row_keys: list[str]) -> list[tuple[str, RowResult]]:
     try:
-        return fut.result().rows
+        return fut.result(timeout=GATHER_SECONDS).rows
+    except TimeoutError:
+        return [(k, RowResult(LOST, 0.0, {}, {}, None, {})) for k in row_keys]
     except Exception as exc:  # KilledWorker after too many deaths, or a bug of ours
         if type(exc).__name__ == "KilledWorker":
             msg = "the Dask workers running this variant kept dying (out of memory?)"
