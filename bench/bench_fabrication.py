@@ -149,7 +149,7 @@ def _strip_utilisation(table) -> None:  # noqa: ANN001
     table.add(
         "utilisation, 48 parts on a strip 400 high",
         "formgraph",
-        took,
+        [took],
         f"utilisation {area / (height * ours.length):.3f} "
         f"(length {ours.length:.1f}, effort {EFFORT})",
     )
@@ -181,7 +181,7 @@ def _strip_utilisation(table) -> None:  # noqa: ANN001
     table.add(
         "utilisation, 48 parts on a strip 400 high",
         "spyrrow",
-        took,
+        [took],
         f"utilisation {area / (height * sol.width):.3f} "
         f"(length {sol.width:.1f}, {seconds} s budget)",
     )
@@ -199,7 +199,7 @@ def _sheet_utilisation(table) -> None:  # noqa: ANN001
         table.add(
             case,
             label,
-            time.perf_counter() - t0,
+            [time.perf_counter() - t0],
             f"utilisation {ours.utilisation:.3f}, {ours.sheets} sheets, effort {effort}",
         )
     # plain bottom-left fill of the bounding rectangles: the same evaluations, as restarts
@@ -217,7 +217,7 @@ def _sheet_utilisation(table) -> None:  # noqa: ANN001
     table.add(
         case,
         "bottom-left fill of boxes",
-        time.perf_counter() - t0,
+        [time.perf_counter() - t0],
         f"utilisation {area / used:.3f}, {int(sheets)} sheets, {EFFORT} restarts",
     )
 

@@ -108,18 +108,18 @@ def run(table) -> None:
             table.add(
                 case,
                 "formgraph",
-                own[len(own) // 2],
+                own,
                 f"median of {len(own)}: ask, tell, journal, tables, progress.png "
                 "(Study.overhead, client thread CPU time)",
             )
-            table.add(case, "optuna ask and tell alone", alone[1], "same batches and space")
+            table.add(case, "optuna ask and tell alone", alone, "same batches and space")
 
         seconds, s = _study(fg.load(LAMP), LAMP_VARY, client, 200, objective="size.volume")
         t = s.totals
         table.add(
             "optimize: lamp shade, 200 TPE trials, 2 workers",
             "formgraph study",
-            seconds,
+            [seconds],
             f"{t.computed:,} nodes computed for 200 x {t.naive // max(t.variants, 1)} = "
             f"{t.naive:,} ({1 - t.computed / t.naive:.0%} shared)",
         )
@@ -135,5 +135,5 @@ def run(table) -> None:
             )[0]
     case = "optimize: lamp shade, 100 TPE trials, wall clock"
     note = f"1 worker / 2 workers = {walls[1] / walls[2]:.2f}x; load average {load:.1f} at start"
-    table.add(case, "2 workers", walls[2], note)
-    table.add(case, "1 worker", walls[1], f"load average {os.getloadavg()[0]:.1f} at end")
+    table.add(case, "2 workers", [walls[2]], note)
+    table.add(case, "1 worker", [walls[1]], f"load average {os.getloadavg()[0]:.1f} at end")
