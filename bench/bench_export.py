@@ -63,9 +63,11 @@ def _exporter(folder: str, node: str, mesh, **inputs):
 
 
 def _named(folder: str, stem: str, write):
-    """``write(path)`` to a new file name each call."""
+    """``write(path)`` to a new file name each call (the number before the extension, which
+    trimesh and pyvista read the format from)."""
+    base, ext = os.path.splitext(stem)
     names = itertools.count()
-    return lambda: write(os.path.join(folder, f"{stem}{next(names)}"))
+    return lambda: write(os.path.join(folder, f"{base}{next(names)}{ext}"))
 
 
 def run(table) -> None:
