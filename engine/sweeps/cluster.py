@@ -428,7 +428,7 @@ def run(
     ``bp``: the blueprint of an earlier call, so workers rebuild the graph only once for a
     series of runs (an optimisation study's batches).
     """
-    from distributed import as_completed, wait
+    from distributed import as_completed
 
     if not variants:  # all done already (a resumed sweep): no cluster needed
         return Totals()
@@ -511,13 +511,7 @@ def run(
             for key in suspects:
                 (alone,) = c.get(dsk, [key], sync=False, optimize_graph=False)
                 futures.append(alone)
-                try:
-                    wait([alone], timeout=GATHER_SECONDS)
-                    finished = alone.result(timeout=GATHER_SECONDS).rows
-                except TimeoutError:
-                    finished = [(k, RowResult(LOST, 0.0, {}, {}, None, {})) for k in chunks[key]]
-                except Exception:
-                    finished = _chunk_result(alone, chunks[key])
+                finished = _chunk_result(alone, chunks[key])  # waits GATHER_SECONDS at most
                 alone.release()
                 deliver(finished)
         finally:
@@ -548,10 +542,10 @@ def _chunk_result(fut: Any, row_keys: list[str]) -> list[tuple[str, RowResult]]:
     try:
         return fut.result(timeout=GATHER_SECONDS).rows
     except TimeoutError:
-        return [(k, RowResult(LOST, 0.0, {}, {}, None, {})) for k in row_keys]
+        msg = LOST
     except Exception as exc:  # KilledWorker after too many deaths, or a bug of ours
         if type(exc).__name__ == "KilledWorker":
             msg = "the Dask workers running this variant kept dying (out of memory?)"
         else:
             msg = one_line(exc)
-        return [(k, RowResult(msg, 0.0, {}, {}, None, {})) for k in row_keys]
+    return [(k, RowResult(msg, 0.0, {}, {}, None, {})) for k in row_keys]
