@@ -7,19 +7,22 @@
 
 optuna (Akiba et al., "Optuna: a next-generation hyperparameter optimization framework",
 KDD 2019) proposes the trials by ask-and-tell from this module's own loop: ask ``batch``
-trials, run them as one sweep (:func:`formgraph.sweeps.cluster.run`: keys planned on the
+trials, run them as one sweep (:func:`formgraph.sweeps.cluster.start`: keys planned on the
 client, shared nodes computed once, the disk cache reused, failures recorded as rows),
-tell their results in trial order, repeat. The sampler is seeded afresh before each batch
-from the seed and the number of trials so far, so the same seed gives the same trials
-whatever the number of workers, and a study interrupted and continued gives the trials an
-uninterrupted one would have.
+tell their results in trial order. Batch b is asked once batch b - 2 is told, while
+b - 1 runs (its trials running in optuna: TPE's constant liar counts them), so the workers
+go from one batch to the next without waiting for the client to tell, ask and plan. That
+schedule is fixed and the sampler is seeded afresh before each batch from the seed and
+the number of trials asked, so the same seed gives the same trials whatever the number of
+workers, and a study interrupted and continued gives the trials an uninterrupted one would
+have.
 
 With ``out``, the study lives in ``out/study.journal`` (:mod:`formgraph.sweeps.journal`:
 each batch's told trials appended in one write), so running the same study again replays
 it into optuna and continues to the new budget; a batch an interrupted run had asked but
 not told is asked again, identically, and run. ``trials.csv`` and
-``pareto.csv`` are rewritten whole (atomically) after a batch at most once a second, and at
-the end; ``progress.png`` is drawn at the end.
+``pareto.csv`` are rewritten whole (atomically) after a batch at most once a second (and
+in at most 5% of the time), and at the end; ``progress.png`` is drawn at the end.
 """
 
 from __future__ import annotations
@@ -315,7 +318,7 @@ def optimize(
     totals = Totals()
     t0 = time.perf_counter()
     own = 0.0  # thread CPU seconds outside the sweep runs (Study.overhead)
-    written = [-math.inf]  # when the tables were last written
+    written = [-math.inf]  # when the tables may next be written
     files: list[Path] = []
     if cache_dir is _GRAPH_CACHE:
         cache_dir = g.disk.root if g.disk is not None else None
@@ -434,11 +437,14 @@ def optimize(
                     rows.update(told)
                     for name in ("variants", "naive", "needed", "computed", "cached"):
                         setattr(totals, name, getattr(totals, name) + getattr(part, name))
-                    if time.perf_counter() - written[0] >= TABLE_INTERVAL:
-                        # whole tables at most once a second: a long study of quick trials
-                        # does not spend its time rewriting them after every small batch
+                    if time.perf_counter() >= written[0]:
+                        # whole tables at most once a second, and at most a twentieth of
+                        # the time: a long study of quick trials does not spend its time
+                        # rewriting ever longer tables after every small batch
+                        began = time.perf_counter()
                         write_tables()
-                        written[0] = time.perf_counter()
+                        ended = time.perf_counter()
+                        written[0] = ended + max(TABLE_INTERVAL, 19 * (ended - began))
                     if progress is not None:
                         rate = (len(rows) - resumed) / max(time.perf_counter() - t0, 1e-9)
                         progress(len(rows), budget, best_text(), rate)
