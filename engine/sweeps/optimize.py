@@ -400,6 +400,7 @@ def optimize(
                             warnings.simplefilter("ignore")  # optuna's experimental notes
                             asked = [study.ask(space) for _ in range(min(batch, budget - n))]
                         b = _Batch(n, asked, {t.number: {**base, **t.params} for t in asked})
+                        own += time.thread_time() - mark  # the sweep's own work is not ours
                         b.running = run_dask.start(
                             g,
                             [(t.number, b.params_of[t.number]) for t in asked],
@@ -413,7 +414,6 @@ def optimize(
                             bp=bp,
                         )
                         inflight.append(b)
-                        own += time.thread_time() - mark
                     if not inflight:
                         break
                     b = inflight[0]
