@@ -7,6 +7,11 @@ headed by how it was made (commit, clock, machine, load, each module's duration)
 
 A module that fails does not stop the others: its failure is a row of the table and the exit
 status is 1, so a long run always ends with every row that could be measured.
+
+``--jobs N`` runs modules in N processes at once (``BENCH_CLOCK=cpu`` only: each process
+times its own CPU seconds, and a row's ratios come from rounds interleaved within one
+process). The modules that time parallel work or wall clock (:data:`ALONE`) still run one
+at a time, after the others, with nothing beside them.
 """
 
 from __future__ import annotations
@@ -27,7 +32,11 @@ from pathlib import Path  # noqa: E402
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
-from harness import CLOCK, Table  # noqa: E402
+from harness import CLOCK, Row, Table  # noqa: E402
+
+# Modules whose rows are wall-clock times of parallel work (workers, a browser, a server)
+# or of whole commands: never run beside another module.
+ALONE = {"fabrication", "optimize", "studio", "sweep"}
 
 
 def _commit() -> str:
@@ -67,36 +76,75 @@ def _cpu() -> str:
     return platform.processor() or platform.machine()
 
 
+def _run_module(name: str) -> tuple[list[Row], str | None, float]:
+    """Run ``bench_<name>`` into a table of its own: (its rows, its failure, seconds)."""
+    table = Table()
+    t0 = time.perf_counter()
+    print(f"running bench_{name} ...", file=sys.stderr, flush=True)
+    error = None
+    try:
+        importlib.import_module(f"bench_{name}").run(table)
+    except Exception as exc:  # noqa: BLE001  (report it as a row; the other modules go on)
+        traceback.print_exc()
+        error = f"{type(exc).__name__}: {exc}"
+        table.add(f"bench_{name}", "failed", None, error)
+    seconds = time.perf_counter() - t0
+    print(f"  bench_{name}: {seconds:.0f} s", file=sys.stderr, flush=True)
+    return table.rows, error, seconds
+
+
+def _option(argv: list[str], flag: str) -> tuple[list[str], str | None]:
+    if flag not in argv:
+        return argv, None
+    i = argv.index(flag)
+    if i + 1 >= len(argv):
+        raise SystemExit(f"{flag} needs a value")
+    return argv[:i] + argv[i + 2 :], argv[i + 1]
+
+
 def main(argv: list[str]) -> int:
     markdown = "--markdown" in argv
     argv = [a for a in argv if a != "--markdown"]
+    argv, jobs_text = _option(argv, "--jobs")
+    jobs = int(jobs_text) if jobs_text else 1
+    if jobs > 1 and CLOCK != "cpu":
+        raise SystemExit("--jobs times modules side by side: give BENCH_CLOCK=cpu with it")
     names = argv or sorted(p.stem[len("bench_") :] for p in HERE.glob("bench_*.py"))
-    table = Table()
     load_before, started = _load(), time.time()
-    durations: list[str] = []
-    failed: list[str] = []
+    results: dict[str, tuple[list[Row], str | None, float]] = {}
+    side_by_side = [n for n in names if n not in ALONE] if jobs > 1 else []
+    if side_by_side:
+        import multiprocessing
+        from concurrent.futures import ProcessPoolExecutor
+
+        spawn = multiprocessing.get_context("spawn")  # each module in a fresh interpreter
+        with ProcessPoolExecutor(jobs, mp_context=spawn, max_tasks_per_child=1) as pool:
+            futures = {name: pool.submit(_run_module, name) for name in side_by_side}
+            for name, fut in futures.items():
+                try:
+                    results[name] = fut.result()
+                except Exception as exc:  # noqa: BLE001  (its process died: a crash, a kill)
+                    row = Row(f"bench_{name}", "failed", None, f"{type(exc).__name__}: {exc}")
+                    results[name] = ([row], f"{type(exc).__name__}: {exc}", 0.0)
     for name in names:
-        print(f"running bench_{name} ...", file=sys.stderr, flush=True)
-        t0 = time.perf_counter()
-        try:
-            importlib.import_module(f"bench_{name}").run(table)
-        except Exception as exc:  # noqa: BLE001  (report it as a row; the other modules go on)
-            traceback.print_exc()
-            failed.append(name)
-            table.add(f"bench_{name}", "failed", None, f"{type(exc).__name__}: {exc}")
-        seconds = time.perf_counter() - t0
-        durations.append(f"{name} {seconds:.0f} s")
-        print(f"  bench_{name}: {seconds:.0f} s", file=sys.stderr, flush=True)
+        if name not in results:
+            results[name] = _run_module(name)
+    table = Table()
+    for name in names:  # in the order asked, however they ran
+        table.rows.extend(results[name][0])
+    failed = [n for n in names if results[n][1] is not None]
+    durations = ", ".join(f"{n} {results[n][2]:.0f} s" for n in names)
     if markdown:
         total = (time.time() - started) / 60
+        how = f" --jobs {jobs}" if jobs > 1 else ""
         print(
             f"Made by `{'BENCH_CLOCK=cpu ' if CLOCK == 'cpu' else ''}python bench/run.py "
-            f"--markdown` at commit {_commit()} on "
+            f"--markdown{how}` at commit {_commit()} on "
             f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime(started))}: "
             f"{os.cpu_count()} cores ({_cpu()}), Python {platform.python_version()}, "
             f"{'CPU' if CLOCK == 'cpu' else 'wall'} time unless a row says otherwise; load "
             f"average {load_before} at the start and {_load()} at the end; {total:.0f} min in "
-            f"all ({', '.join(durations)})."
+            f"all ({durations})."
             + (f" Failed: {', '.join(failed)} (their rows say why)." if failed else "")
             + "\n"
         )
