@@ -396,7 +396,7 @@ class Graph(Plans):
 
     def set_input(self, node: str, port: str, value: Any) -> None:
         """Change one input of a node as authored (a literal, wire or expression)."""
-        nd = self._nodes[node]
+        nd = self._nodes[node] = self._nodes[node].moved()  # (its own: see NodeDef.moved)
         value = plain(value, f"input '{port}' of '{node}'")
         if port == "repeat":  # not an input: the node's loop
             nd.set_repeat(value)

@@ -25,9 +25,9 @@ on edits of every graph in ``graphs/``, including edits that break them.
 from __future__ import annotations
 
 import copy
+import functools
 import re
 from collections.abc import Mapping
-from dataclasses import replace
 from typing import Any
 
 import yaml
@@ -49,6 +49,7 @@ __all__ = ["node_span", "recheck", "reparse"]
 _CONTEXTUAL = re.compile(r"[&*!%]|<<|^(?:---|\.\.\.)", re.MULTILINE)
 
 
+@functools.lru_cache(maxsize=4)  # (a gesture asks for the lines of one text twice)
 def _line_starts(text: str) -> list[int]:
     return [0] + [m.end() for m in re.finditer("\n", text)]
 
@@ -118,26 +119,15 @@ def _same_node(a: NodeDef, b: NodeDef) -> bool:
     ) and (a.repeat_raw, a.simulate_raw) == (b.repeat_raw, b.simulate_raw)  # fmt: skip
 
 
-def _shifted(nd: NodeDef, lines: int) -> NodeDef:
-    """A copy of ``nd`` written ``lines`` lines further down (its dicts its own)."""
-    return replace(
-        nd,
-        raw=dict(nd.raw),
-        inputs=dict(nd.inputs),
-        line=None if nd.line is None else nd.line + lines,
-        input_lines={p: n + lines for p, n in nd.input_lines.items()},
-        parse_errors=dict(nd.parse_errors),
-    )
-
-
 def reparse(before: Document, old: str, new: str, name: str, file: str) -> Document | None:
     """``new`` read as :func:`~.yamlio.parse` reads it, knowing that ``before`` is ``old``
     read and that ``new`` differs from ``old`` within node ``name``'s lines only; None when
     that is not so, or when reading those lines alone could differ from reading the whole
     text (then read the whole text).
 
-    ``before`` must have no problems and no aliases. Every node and param of the result is
-    a copy: the two documents share no mutable state.
+    ``before`` must have no problems and no aliases. The nodes the edit did not change or
+    move are shared with ``before`` (a graph never changes a node in place:
+    :meth:`~.model.NodeDef.moved`); its params are copies (the check sets their kinds).
     """
     if before.problems or before.top_keys is None or before.sizes[0] != before.sizes[1]:
         return None
@@ -171,7 +161,7 @@ def reparse(before: Document, old: str, new: str, name: str, file: str) -> Docum
         if n == name:
             nodes[n], after = read_now[0], True
         else:
-            nodes[n] = _shifted(nd, lines if after else 0)
+            nodes[n] = nd.moved(lines) if after and lines else nd  # (not changed in place)
     params = {}
     for n, p in before.params.items():
         p = copy.copy(p)

@@ -106,9 +106,11 @@ class _Doc:
         self.window: yaml.MappingNode | None = None
         if within is not None:
             self.window = self._window(*within)
-            if self.window is not None:
-                self.root = self.window
-                self.starts = [0] + [m.end() for m in re.finditer("\n", text)]
+            if self.window is not None:  # (offsets are asked within its lines only)
+                self.root, self._at = self.window, within
+                self._local = [0] + [
+                    m.end() for m in re.finditer("\n", text[within[0] : within[1]])
+                ]
                 return
         try:
             root = yaml.compose(text, Loader=yamlread.Loader)
@@ -139,6 +141,9 @@ class _Doc:
 
     def offset(self, mark: yaml.Mark) -> int:
         """A mark's character offset, from its line and column."""
+        if self.window is not None:
+            start, _, line = self._at
+            return min(start + self._local[mark.line - line] + mark.column, len(self.text))
         return (
             min(self.starts[mark.line] + mark.column, len(self.text))
             if mark.line < len(self.starts)
