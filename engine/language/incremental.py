@@ -49,7 +49,7 @@ __all__ = ["node_span", "recheck", "reparse"]
 _CONTEXTUAL = re.compile(r"[&*!%]|<<|^(?:---|\.\.\.)", re.MULTILINE)
 
 
-@functools.lru_cache(maxsize=4)  # (a gesture asks for the lines of one text twice)
+@functools.lru_cache(maxsize=2)  # (a gesture asks for the lines of one text twice)
 def _line_starts(text: str) -> list[int]:
     return [0] + [m.end() for m in re.finditer("\n", text)]
 
