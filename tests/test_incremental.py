@@ -168,6 +168,9 @@ HAND_EDITS = [
     ("c", "0.01]", "0.01"),  # not YAML
     ("c", "translate", "geometry"),  # an input twice
     ("c", '"@b"', '&g "@b"'),  # an anchor
+    ("c", "[0, 0, 0.01]", "&v [0, 0, 0.01]\n    center: *v"),  # and its alias
+    ("c", "[0, 0, 0.01]", "*nowhere"),  # an alias of nothing
+    ("c", "[0, 0, 0.01]", "{<<: {x: 1}}"),  # a merge key
     ("c", '"@b"', "!!python/name:os.system"),
     ("c", '"@b"', '"=k"'),
     ("c", "[0, 0, 0.01]", '"=k * 2"'),  # '*' in an expression: read whole, same result

@@ -43,10 +43,12 @@ from .yamlread import compose, estimate_values, expansion
 
 __all__ = ["node_span", "recheck", "reparse"]
 
-# what makes a node's lines mean something outside them, or read differently in context:
-# anchors, aliases, tags, merge keys, directives and document markers (a false alarm, such
-# as '*' in an expression, only costs the whole read)
-_CONTEXTUAL = re.compile(r"[&*!%]|<<|^(?:---|\.\.\.)", re.MULTILINE)
+# what could make a node's lines mean something outside them, or read differently in
+# context: anchors, aliases and tags (as tokens: '=a*b' and '=a * b' are not), merge keys,
+# directives and document markers. (The sizes and the composing alone catch these too: an
+# alias of the text before, or one the lines alone cannot resolve, is already refused; a
+# false alarm only costs the whole read.)
+_CONTEXTUAL = re.compile(r"(?:^|[\s\[{,])[&*!]\S|<<|^(?:%|---|\.\.\.)", re.MULTILINE)
 
 
 @functools.lru_cache(maxsize=2)  # (a gesture asks for the lines of one text twice)
