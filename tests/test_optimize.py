@@ -314,10 +314,14 @@ def test_a_worker_killed_during_a_study_is_survived(tmp_path):
 
 def test_ctrl_c_and_a_rerun_continue_the_study(tmp_path):
     graph = tmp_path / "slow.yaml"
-    log = tmp_path / "calls.log"
+    log, hold = tmp_path / "calls.log", tmp_path / "hold"
+    # two batches run, the third waits while `hold` exists: the interrupt always comes
+    # mid-study (a loaded machine could finish all sixteen trials before it)
+    hold.touch()
     graph.write_text(
         "formgraph: 1\nparams:\n  a: {default: 1.0, min: 0, max: 10}\nnodes:\n"
-        f'  per: {{type: stub.logged, x: "=a", log: "{log}", label: per, seconds: 0.05}}\n'
+        f'  per: {{type: stub.logged, x: "=a", log: "{log}", label: per, seconds: 0.05, '
+        f'hold: "{hold}", after: 8}}\n'
     )
     out = tmp_path / "out"
     code = (
@@ -327,7 +331,14 @@ def test_ctrl_c_and_a_rerun_continue_the_study(tmp_path):
     args = [sys.executable, "-c", code, str(ROOT / "tests"), "optimize", str(graph)]
     args += ["--vary", "a=0:10", "--minimize", "per", "--budget", "16", "--batch", "4"]
     args += ["--workers", "1", "--out", str(out), "--no-cache"]
-    proc = subprocess.Popen(args, stderr=subprocess.PIPE, text=True)
+    # Ctrl-C heard even when the suite itself runs with SIGINT ignored (started with `&`
+    # from a script: the shell ignores it for background jobs, and Python keeps that)
+    proc = subprocess.Popen(
+        args,
+        stderr=subprocess.PIPE,
+        text=True,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )
     try:
         deadline = time.monotonic() + 120
         while time.monotonic() < deadline:  # until a few batches are told
@@ -335,6 +346,8 @@ def test_ctrl_c_and_a_rerun_continue_the_study(tmp_path):
                 break
             time.sleep(0.05)
         proc.send_signal(signal.SIGINT)
+        time.sleep(0.5)
+        hold.unlink()  # the waiting trials end, so the cluster closes without a kill
         _, err = proc.communicate(timeout=60)
     finally:
         proc.kill()

@@ -295,6 +295,9 @@ def optimize(
         },
         sort_keys=True,
     )
+    if isinstance(client, str):
+        # before the out folder is touched: an unreachable scheduler leaves no file behind
+        run_dask.probe_scheduler(client)
     journal = None if out_dir is None else Journal(out_dir / "study.journal")
     asked_before, records = (None, []) if journal is None else journal.read()
     if asked_before is not None and asked_before != question:
