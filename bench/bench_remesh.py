@@ -148,12 +148,12 @@ def run(table) -> None:
         mesh = Mesh(v0, t0.reshape(-1), np.arange(0, t0.size + 1, 3))
         g = fg.Graph()
         g.add_param("m", type="Mesh")
-        g.add_param("e", edge)
-        g.add("r", "mesh.remesh", mesh="=m", edge_length="=e")
+        g.add_param("edge", edge)
+        g.add("r", "mesh.remesh", mesh="=m", edge_length="=edge")
         steps = itertools.count(1)
 
         def ours(g=g, mesh=mesh, edge=edge, steps=steps):
-            return g.evaluate("r", m=mesh, e=edge * (1 + next(steps) * 1e-12))
+            return g.evaluate("r", m=mesh, edge=edge * (1 + next(steps) * 1e-12))
 
         out = ours()
         notes = {
