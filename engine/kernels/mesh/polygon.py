@@ -29,6 +29,8 @@ here decide.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from .measure import next_corner
@@ -79,14 +81,14 @@ def polygon_plane(points: np.ndarray) -> np.ndarray:
     if p.shape[1] == 2:
         return q * np.array([-1.0, 1.0]) if s[0, 1] - s[1, 0] < 0 else q
     n = (s[1, 2] - s[2, 1], s[2, 0] - s[0, 2], s[0, 1] - s[1, 0])
-    length = float(np.sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]))
+    length = math.sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2])
     if length == 0:
         return q[:, :2]  # no area at all: any projection (the fan fallback handles it)
     n = (n[0] / length, n[1] / length, n[2] / length)
     # u: n x (x or y axis, whichever is further from n), w = n x u (3-vectors: written
     # out, np.cross costs 20 us a call)
     u = (0.0, n[2], -n[1]) if abs(n[0]) < 0.9 else (-n[2], 0.0, n[0])
-    lu = float(np.sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]))
+    lu = math.sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2])
     u = (u[0] / lu, u[1] / lu, u[2] / lu)
     w = (n[1] * u[2] - n[2] * u[1], n[2] * u[0] - n[0] * u[2], n[0] * u[1] - n[1] * u[0])
     return q @ np.array([u, w]).T
