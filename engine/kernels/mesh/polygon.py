@@ -200,7 +200,7 @@ def tiling(xy: np.ndarray, ends: np.ndarray, triangles: np.ndarray) -> np.ndarra
     """
     n = len(xy)
     tri = np.asarray(triangles).reshape(-1, 3).astype(np.int64)
-    if len(tri) != n + 2 * (len(ends) - 1) - 2 or n < 3:
+    if len(tri) != n + 2 * (len(ends) - 1) - 2 or n < 3 or tri.min() < 0 or tri.max() >= n:
         return None
     x, y = xy[:, 0], xy[:, 1]
     xa, ya = x[tri[:, 0]], y[tri[:, 0]]
