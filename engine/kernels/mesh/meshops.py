@@ -366,7 +366,8 @@ def triangulate(
             # a few large faces (a polygon made a face): each tested and clipped in its
             # own plane, made once (the batched test below costs a face's clipping again)
             for f, start in zip(corners, tri_off[faces].tolist(), strict=True):
-                out[start : start + k - 2] = f[large_face(v[f], max_tests)]
+                # (np.take: a fancy index of rows is 4x slower on (k, 3))
+                out[start : start + k - 2] = f[large_face(np.take(v, f, axis=0), max_tests)]
             continue
         local = np.broadcast_to(
             np.stack([np.zeros(k - 2, dtype=np.int64), np.arange(1, k - 1), np.arange(2, k)], 1),

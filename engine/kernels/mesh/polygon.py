@@ -21,10 +21,12 @@ done, so a hostile polygon cannot take minutes.
 Simple polygons go to mapbox_earcut first (the C++ port of Mapbox's earcut: ear clipping
 with a z-order index of the corners, the well-kept library for exactly this; 10-20x faster
 than the rounds here, measured in ``bench/bench_mesh.py``) when its worst case, ``k^2 / 2``
-tests, is within ``max_tests``. Its answer is checked (``k - 2`` triangles of the loop's
-corners, none flipped, their areas adding up to the polygon's); where it is not a tiling
--- a loop that touches or crosses itself, for which earcut drops triangles -- the rounds
-here decide.
+tests, is within ``max_tests``. Its answer is checked by :func:`tiling` (``k - 2``
+triangles, none flipped, whose edges pair up with the loop's: a proof that they cover it
+once, in one sort); where it is not a tiling -- a loop that touches or crosses itself, for
+which earcut drops or overlaps triangles -- the rounds here decide. The check is needed:
+earcut does not promise a tiling (its README: "acceptable results for practical data"),
+and whether a loop is simple is not known before.
 """
 
 from __future__ import annotations
@@ -32,8 +34,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-
-from .measure import next_corner
 
 __all__ = [
     "WorkLimitError",
@@ -209,33 +209,34 @@ def tiling(xy: np.ndarray, ends: np.ndarray, triangles: np.ndarray) -> np.ndarra
         tri, area = tri[:, ::-1], -area
     if area.min() < -1e-9 * float(area.sum()):
         return None
-    off = np.zeros(len(ends) + 1, dtype=np.int64)
-    off[1:] = ends
-    if off[-1] != n:
+    last = np.asarray(ends, dtype=np.int64) - 1  # each ring's last corner
+    if last[-1] != n - 1:
         return None
-    t = len(tri)  # 3 t + n = 4 n + 6 h - 6 edges: even
-    # each triangle's edges a -> b, then each ring's edges reversed; as 32-bit integers
-    # where the keys fit (half the time to sort)
-    kind = np.int32 if 2 * n * n < 2**31 else np.int64
-    tail = np.empty(3 * t + n, dtype=kind)
-    head = np.empty(3 * t + n, dtype=kind)
-    tail[: 3 * t] = tri.reshape(-1)
-    rows = head[: 3 * t].reshape(t, 3)
-    rows[:, :2] = tri[:, 1:]
-    rows[:, 2] = tri[:, 0]
-    head[3 * t :] = np.arange(n)
-    tail[3 * t :] = next_corner(off)
-    # an edge's key: its pair {a, b} twice over, plus 1 for the way b -> a (b > a)
-    way = tail > head
-    lo = np.where(way, head, tail)
-    lo *= n
-    lo += np.where(way, tail, head)
-    lo *= 2
-    lo += way
-    key = np.sort(lo).reshape(-1, 2)
+    first = np.zeros_like(last)
+    first[1:] = last[:-1] + 1
+    # an edge a -> b's key: its pair {a, b} twice over, plus 1 for the way b > a ... a
+    # triangle's three (the next corner of each: its columns turned by one) ...
+    nxt = np.empty_like(tri)
+    nxt[:, :2] = tri[:, 1:]
+    nxt[:, 2] = tri[:, 0]
+    way = tri > nxt
+    edge = np.minimum(tri, nxt)
+    edge *= n
+    edge += np.maximum(tri, nxt)
+    edge *= 2
+    edge += way
+    # ... and each ring edge reversed, i + 1 -> i (last -> first at its end): in closed form
+    kind = np.int32 if 2 * n * n < 2**31 else np.int64  # (half the time to sort)
+    key = np.empty(edge.size + n, dtype=kind)
+    key[: edge.size] = edge.reshape(-1)
+    ring = key[edge.size :]
+    ring[:] = np.arange(3, 2 * n * (n + 1), 2 * (n + 1), dtype=kind)[:n]
+    ring[last] = 2 * (first * n + last)
+    key.sort()
     # paired exactly: the sorted keys go (2 e, 2 e + 1), (2 e', 2 e' + 1), ... (sorted,
     # so no pair can repeat: the next pair starts past 2 e + 1)
-    if np.any(key[:, 0] & 1) or np.any(key[:, 1] - key[:, 0] != 1):
+    pairs = key.reshape(-1, 2)  # (3 t + n = 4 n + 6 h - 6: even)
+    if np.any(pairs[:, 0] & 1) or np.any(pairs[:, 1] - pairs[:, 0] != 1):
         return None
     return tri
 
