@@ -117,9 +117,9 @@ class Table:
         Each implementation is called once to warm up (imports, caches a user would also have
         warm, JIT compilation); the number of calls per timing is fixed from a second call
         (the first of a graph can take 400 ms of imports: sized on it, a 1 ms call was
-        timed once a round, just after ``gc.collect()`` had emptied the CPU's caches, and
-        read 30-70% slow) so a timing lasts about ``min_seconds``. ``warmup=False`` skips that call (a reference of
-        a minute: one call a round, its imports in its first). A reference that fails to
+        timed once a round, just after ``gc.collect()``, and read about 30% slow) so a
+        timing lasts about ``min_seconds``. ``warmup=False`` skips both calls (a reference
+        of a minute: one call a round, its imports in its first). A reference that fails to
         import is noted as not installed, never silently dropped. Returns the
         per-implementation :class:`Stat`.
         """
