@@ -117,7 +117,7 @@ class Table:
         Each implementation is called once to warm up (imports, caches a user would also have
         warm, JIT compilation); the number of calls per timing is fixed from a second call
         (the first of a graph can take 400 ms of imports: sized on it, a 1 ms call was
-        timed once a round, just after ``gc.collect()``, and read about 30% slow) so a
+        timed once a round, just after ``gc.collect()``, and read 60% slow) so a
         timing lasts about ``min_seconds``. ``warmup=False`` skips both calls (a reference
         of a minute: one call a round, its imports in its first). A reference that fails to
         import is noted as not installed, never silently dropped. Returns the
@@ -139,10 +139,9 @@ class Table:
                 t0 = now()
                 fn()
                 first = now() - t0
-                if first < min_seconds:  # the first call paid for imports: size on a second
-                    t0 = now()
-                    fn()
-                    first = now() - t0
+                t0 = now()  # the first call paid for imports: sized on a second
+                fn()
+                first = now() - t0
             except ImportError as exc:
                 missing[name] = f"not installed ({exc.name})"
                 impls = [i for i in impls if i[0] != name]

@@ -85,9 +85,14 @@ def polygon_plane(points: np.ndarray) -> np.ndarray:
     if length == 0:
         return q[:, :2]  # no area at all: any projection (the fan fallback handles it)
     n = (n[0] / length, n[1] / length, n[2] / length)
-    # u: n x (x or y axis, whichever is further from n), w = n x u (3-vectors: written
-    # out, np.cross costs 20 us a call)
-    u = (0.0, n[2], -n[1]) if abs(n[0]) < 0.9 else (-n[2], 0.0, n[0])
+    # u: the x axis (the y axis if n is near x) made square to n, w = n x u: a loop in a
+    # plane z = c keeps its own x and y (mirrored in y if it faces -z): mapbox_earcut took
+    # 13% longer on the bench's 10,000-corner star turned a quarter, as the old choice of
+    # u turned it. 3-vectors written out: np.cross costs 20 us a call.
+    if abs(n[0]) < 0.9:
+        u = (1.0 - n[0] * n[0], -n[0] * n[1], -n[0] * n[2])
+    else:
+        u = (-n[1] * n[0], 1.0 - n[1] * n[1], -n[1] * n[2])
     lu = math.sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2])
     u = (u[0] / lu, u[1] / lu, u[2] / lu)
     w = (n[1] * u[2] - n[2] * u[1], n[2] * u[0] - n[0] * u[2], n[0] * u[1] - n[1] * u[0])
