@@ -11,8 +11,10 @@ and what a second worker buys.
 - The lamp shade (graphs/lamp_shade.yaml, 15 nodes), a 200-trial TPE study of wall,
   window and height: node evaluations computed against 200 x its node count (the shared
   fraction: the revolved band no varied param reaches, each window size's bores, ...).
-- A 100-trial study of the lamp shade (booleans: a heavy graph) on 1 worker and on 2,
-  wall clock, with the machine's load average beside it.
+- A 100-trial study on 1 worker and on 2, wall clock, with the machine's load average
+  beside it: of the lamp shade (~100 ms a trial, mostly its booleans), and of the heavy
+  graph, the lamp shade at 4x the faces (~330 ms a trial), where a trial's compute
+  dominates the study's own work on the client (~20 ms a trial).
 
 The embedded cluster is started before timing and its workers warmed (they import the node
 families), as in bench_sweep. No disk cache: every node is computed or shared in-study.
@@ -125,15 +127,70 @@ def run(table) -> None:
         )
     finally:
         embedded.__exit__(None, None, None)
-    load = os.getloadavg()[0]
-    walls = {}
-    for workers in (1, 2):
-        with connect(None, workers=workers) as c:
-            fg.sweep(fg.load(LAMP), {"wall": "0.05:0.1:4"}, ["size"], client=c, cache_dir=None)
-            walls[workers] = _study(
-                fg.load(LAMP), LAMP_VARY, c, 100, objective="size.volume", seed=4
-            )[0]
-    case = "optimize: lamp shade, 100 TPE trials, wall clock"
-    note = f"1 worker / 2 workers = {walls[1] / walls[2]:.2f}x; load average {load:.1f} at start"
-    table.add(case, "2 workers", [walls[2]], note)
-    table.add(case, "1 worker", [walls[1]], f"load average {os.getloadavg()[0]:.1f} at end")
+    _workers(table)
+
+
+# The heavy graph: the lamp shade with its band tessellated 64 x 192 (4x the faces of
+# graphs/lamp_shade.yaml) and 64-segment bores, so its booleans take ~330 ms a trial and a
+# trial's compute dominates the study's own work (~20 ms a trial on the client: optuna's
+# TPE ask, planning, Dask's round trips)
+FINE = {("band_mesh", "u"): 64, ("band_mesh", "v"): 192, ("bore", "segments"): 64}
+
+
+def _lamp(fine: bool) -> fg.Graph:
+    g = fg.load(LAMP)
+    if fine:
+        for (node, port), value in FINE.items():
+            g.set_input(node, port, value)
+    return g
+
+
+def _trial_ms(g: fg.Graph) -> float:
+    """CPU milliseconds of one trial evaluated alone (median of 5 random designs)."""
+    import random
+    import statistics
+
+    rnd = random.Random(7)
+    times = []
+    for _ in range(5):
+        params = {"wall": rnd.uniform(0.02, 0.3), "window": rnd.uniform(0.05, 0.5)}
+        t0 = time.thread_time()
+        g.evaluate("size", height=rnd.uniform(0.6, 2.2), **params)
+        times.append(time.thread_time() - t0)
+    return 1000 * statistics.median(times)
+
+
+def _workers(table, rounds: int = 2) -> None:
+    """100 TPE trials on 1 worker and on 2, wall clock, in interleaved rounds (1 2, 2 1,
+    ...), each cluster started and warmed once; the ratio is taken round by round."""
+    from formgraph.sweeps.cluster import connect
+
+    for fine in (False, True):
+        name = "lamp shade, 4x the faces" if fine else "lamp shade"
+        ms = _trial_ms(_lamp(fine))
+        walls: dict[int, list[float]] = {1: [], 2: []}
+        loads: list[float] = []
+        with connect(None, workers=1) as one, connect(None, workers=2) as two:
+            clients = {1: one, 2: two}
+            for c in clients.values():  # warm: node families imported, graph built
+                fg.sweep(_lamp(fine), {"wall": "0.05:0.1:4"}, ["size"], client=c, cache_dir=None)
+            for r in range(rounds):
+                for workers in (1, 2) if r % 2 == 0 else (2, 1):
+                    loads.append(os.getloadavg()[0])
+                    walls[workers].append(
+                        _study(
+                            _lamp(fine), LAMP_VARY, clients[workers], 100,
+                            objective="size.volume", seed=4,
+                        )[0]
+                    )  # fmt: skip
+        ratios = sorted(a / b for a, b in zip(walls[1], walls[2], strict=True))
+        case = f"optimize: {name} (~{ms:.0f} ms a trial), 100 TPE trials, wall clock"
+        table.add(
+            case,
+            "2 workers",
+            walls[2],
+            f"1 worker / 2 workers = {ratios[len(ratios) // 2]:.2f}x (per round "
+            f"{ratios[0]:.2f}-{ratios[-1]:.2f}); load average {min(loads):.1f}-"
+            f"{max(loads):.1f} at the studies' starts",
+        )
+        table.add(case, "1 worker", walls[1], "same seed, so the same 100 trials")

@@ -31,6 +31,9 @@ CLOCK = os.environ.get("BENCH_CLOCK", "wall")
 if CLOCK not in ("wall", "cpu"):
     raise SystemExit(f"BENCH_CLOCK must be wall or cpu, got {CLOCK!r}")
 _CLOCKS = {"wall": time.perf_counter, "cpu": time.process_time}
+# ``BENCH_SMOKE=1``: every implementation called once, in one round, no warm-up: checks that
+# each module runs through (its numbers mean nothing) in a fraction of a real run's time.
+SMOKE = os.environ.get("BENCH_SMOKE", "") not in ("", "0")
 _now = _CLOCKS[CLOCK]
 
 
@@ -124,6 +127,8 @@ class Table:
         per-implementation :class:`Stat`.
         """
         now = _CLOCKS[clock] if clock else _now
+        if SMOKE:
+            rounds, min_seconds, warmup = 1, 0.0, False
         impls: list[tuple[str, str, Callable[[], object]]] = [("formgraph", "api", api)]
         if kernel is not None:
             impls.append(("formgraph kernel", "kernel", kernel))

@@ -214,6 +214,68 @@ def test_a_study_resumed_to_a_larger_budget_keeps_its_trials(client, tmp_path):
         fg.optimize(can_graph(tmp_path), budget=40, out=out, **{**kw, "seed": 9})
 
 
+@pytest.mark.parametrize("method", ["nsga2", "cmaes"])
+def test_a_resumed_study_asks_what_a_straight_one_asks_whatever_the_sampler(
+    client, tmp_path, method
+):
+    """The rerun replays the journal's last batch as running trials and tells it after
+    asking the next batch, as the first run did (batch b asked while b - 1 runs): NSGA-II's
+    generations and CMA-ES's populations count running trials their own way."""
+    if method == "cmaes":
+        pytest.importorskip("cmaes")  # optuna's CMA-ES sampler needs it (not a dependency)
+    kw = dict(
+        vary={"r": "1:15", "h": "1:30"},
+        minimize=["size.area"],
+        maximize=["size.volume"] if method == "nsga2" else [],
+        method=method,
+        batch=4,
+        seed=3,
+        client=client,
+        cache_dir=None,
+    )
+    out = tmp_path / "out"
+    fg.optimize(can_graph(tmp_path), budget=20, out=out, **kw)  # past NSGA-II's first 16
+    more = fg.optimize(can_graph(tmp_path), budget=28, out=out, **kw)
+    straight = fg.optimize(can_graph(tmp_path), budget=28, **kw)
+    assert more.resumed == 20 and trial_params(more) == trial_params(straight)
+
+
+def test_the_journal_holds_back_its_last_batch_until_the_next_is_asked(tmp_path):
+    import optuna
+    from optuna.distributions import FloatDistribution
+
+    from formgraph.sweeps.journal import Journal, replay, tell_recorded
+
+    optuna.logging.set_verbosity(optuna.logging.WARNING)
+    space = {"x": FloatDistribution(0.0, 1.0)}
+    study = optuna.create_study()
+    journal = Journal(tmp_path / "study.journal")
+    journal.start("q")
+    for first in (0, 3):  # batches of 3, then of 2 (a budget of 5)
+        asked = [study.ask(space) for _ in range(3 if first == 0 else 2)]
+        for t in asked:
+            t.set_user_attr("row", {"trial": t.number})
+            t.set_constraint("c0", t.params["x"] - 0.5)
+            study.tell(t, t.params["x"] ** 2)
+        journal.append((study.trials[t.number] for t in asked), first)
+    question, records = journal.read()
+    assert question == "q" and [r["batch"] for r in records] == [0, 0, 0, 3, 3]
+    for rec in records[3:]:
+        del rec["batch"]  # a journal that does not say its batches: counted from the size
+    again = optuna.create_study()
+    held = replay(optuna, again, records, 3)
+    running = optuna.trial.TrialState.RUNNING
+    assert [rec["number"] for _, rec in held] == [3, 4]
+    assert [t.state == running for t in again.trials] == [False, False, False, True, True]
+    assert all("constraints:c0" not in again.trials[n].system_attrs for n in (3, 4))
+    assert again.ask(space).number == 5  # the next batch is asked first
+    for trial_id, rec in held:
+        tell_recorded(optuna, again, trial_id, rec)
+    for old, new in zip(study.trials, again.trials, strict=False):
+        assert (new.state, new.params, new.values) == (old.state, old.params, old.values)
+        assert (new.user_attrs, new.system_attrs) == (old.user_attrs, old.system_attrs)
+
+
 def logged(tmp_path: Path, seconds: float) -> fg.Graph:
     g = fg.Graph()
     g.add_param("a", 1.0, min=0, max=10)
@@ -252,10 +314,14 @@ def test_a_worker_killed_during_a_study_is_survived(tmp_path):
 
 def test_ctrl_c_and_a_rerun_continue_the_study(tmp_path):
     graph = tmp_path / "slow.yaml"
-    log = tmp_path / "calls.log"
+    log, hold = tmp_path / "calls.log", tmp_path / "hold"
+    # two batches run, the third waits while `hold` exists: the interrupt always comes
+    # mid-study (a loaded machine could finish all sixteen trials before it)
+    hold.touch()
     graph.write_text(
         "formgraph: 1\nparams:\n  a: {default: 1.0, min: 0, max: 10}\nnodes:\n"
-        f'  per: {{type: stub.logged, x: "=a", log: "{log}", label: per, seconds: 0.05}}\n'
+        f'  per: {{type: stub.logged, x: "=a", log: "{log}", label: per, seconds: 0.05, '
+        f'hold: "{hold}", after: 8}}\n'
     )
     out = tmp_path / "out"
     code = (
@@ -265,7 +331,14 @@ def test_ctrl_c_and_a_rerun_continue_the_study(tmp_path):
     args = [sys.executable, "-c", code, str(ROOT / "tests"), "optimize", str(graph)]
     args += ["--vary", "a=0:10", "--minimize", "per", "--budget", "16", "--batch", "4"]
     args += ["--workers", "1", "--out", str(out), "--no-cache"]
-    proc = subprocess.Popen(args, stderr=subprocess.PIPE, text=True)
+    # Ctrl-C heard even when the suite itself runs with SIGINT ignored (started with `&`
+    # from a script: the shell ignores it for background jobs, and Python keeps that)
+    proc = subprocess.Popen(
+        args,
+        stderr=subprocess.PIPE,
+        text=True,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )
     try:
         deadline = time.monotonic() + 120
         while time.monotonic() < deadline:  # until a few batches are told
@@ -273,6 +346,8 @@ def test_ctrl_c_and_a_rerun_continue_the_study(tmp_path):
                 break
             time.sleep(0.05)
         proc.send_signal(signal.SIGINT)
+        time.sleep(0.5)
+        hold.unlink()  # the waiting trials end, so the cluster closes without a kill
         _, err = proc.communicate(timeout=60)
     finally:
         proc.kill()

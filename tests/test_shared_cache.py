@@ -76,6 +76,27 @@ def test_a_half_written_entry_in_the_folder_is_a_miss(tmp_path):
     assert cache.get(key) == (False, None)
 
 
+def test_releases_of_two_entry_formats_sharing_a_folder_keep_each_others_entries(
+    tmp_path, monkeypatch
+):
+    # a colleague on a release with a newer entry format shares the team's cache: each
+    # release reads its own entries and leaves the other's (they were deleted as foreign)
+    from formgraph.evaluation import cache as _cache
+
+    key = "cd" * 20
+    cache = DiskCache(tmp_path)
+    assert cache.put(key, [1.0, 2.0])
+    monkeypatch.setattr(_cache, "FORMAT", _cache.FORMAT + 1)
+    assert cache.get(key) == (False, None)  # not its format: a miss ...
+    assert cache.put(key, [3.0])
+    assert cache.get(key) == (True, [3.0])
+    monkeypatch.undo()
+    assert cache.get(key) == (True, [1.0, 2.0])  # ... that deleted nothing
+    names = sorted(p.name for p, _, _ in cache.entries())
+    assert names == [f"{key}.f{_cache.FORMAT + 1}.npz", f"{key}.npz"]  # both bounded, pruned
+    assert cache.clear()[0] == 2
+
+
 CAN = """\
 formgraph: 1
 params:

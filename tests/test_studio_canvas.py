@@ -321,16 +321,19 @@ def test_an_accepted_wire_is_cooked_from_the_graph_its_check_read(tmp_path, monk
     session = StudioSession(path, out_dir=tmp_path / "out")
     assert session.open().ok
     c = Canvas(types.SimpleNamespace(session=session), bind=False)
-    reads = []
-    real = Graph.from_text.__func__
+    reads, whole = [], []
+    real, edit = Graph.from_text.__func__, Graph.from_edit.__func__
     monkeypatch.setattr(
-        Graph, "from_text", classmethod(lambda cls, *a, **k: reads.append(1) or real(cls, *a, **k))
+        Graph, "from_text", classmethod(lambda cls, *a, **k: whole.append(1) or real(cls, *a, **k))
+    )
+    monkeypatch.setattr(
+        Graph, "from_edit", classmethod(lambda cls, *a, **k: reads.append(1) or edit(cls, *a, **k))
     )
     text = session.text
     # the session's own version is not read again; the wired one is read once, for the
-    # gesture's check, and then cooked as read
+    # gesture's check (its edited node's lines only), and then cooked as read
     reply = c.answer(1, "wire", ["spiral", "", "tube", "profile"], text)
-    assert '    profile: "@spiral"\n' in reply["text"] and len(reads) == 1
+    assert '    profile: "@spiral"\n' in reply["text"] and len(reads) == 1 and not whole
     graph = c.take_checked(reply["text"])
     assert isinstance(graph, Graph) and c.take_checked(reply["text"]) is None  # once
     cooked = session.open(reply["text"], graph)

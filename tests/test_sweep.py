@@ -473,7 +473,14 @@ def test_ctrl_c_leaves_a_valid_table_and_the_rerun_completes_it(tmp_path):
     args = [sys.executable, "-c", code, str(ROOT / "tests"), "sweep", str(graph)]
     args += ["--vary", "a=1:12:12", "--measure", "per", "--workers", "1", "--out", str(out)]
     args += ["--cache-dir", str(tmp_path / "cache")]
-    proc = subprocess.Popen(args, stderr=subprocess.PIPE, text=True)
+    # Ctrl-C heard even when the suite itself runs with SIGINT ignored (started with `&`
+    # from a script: the shell ignores it for background jobs, and Python keeps that)
+    proc = subprocess.Popen(
+        args,
+        stderr=subprocess.PIPE,
+        text=True,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )
     try:
         deadline = time.monotonic() + 300  # a bound against a hang
         while time.monotonic() < deadline and proc.poll() is None:  # until three rows are in

@@ -26,6 +26,27 @@ __all__ = ["Context", "NodeSpec", "Port", "Range", "Variables", "node", "node_ty
 
 DEFAULT_BUDGET = 50_000_000
 
+# The least bytes one element of each unit a guard counts takes in the node's output
+# (float64 coordinates, indices at 4 bytes at the least). A guard that does not state its
+# ``nbytes`` is checked against memory with this lower bound, so it refuses only an output
+# that surely cannot fit; units that count work rather than output (tests, updates,
+# passes) have none.
+LEAST_BYTES = {
+    "points": 24,
+    "vertices": 24,
+    "control points": 24,
+    "glyph control points": 16,
+    "curve samples": 24,
+    "surface samples": 24,
+    "sample points": 24,
+    "tool-path points": 24,
+    "coordinates": 8,
+    "samples": 8,
+    "faces": 12,
+    "triangles": 12,
+    "face corners": 4,
+}
+
 
 class _Required:
     def __repr__(self) -> str:
@@ -336,11 +357,15 @@ class Context:
                 )
             if nbytes is not None:
                 self._fits(elements, what, nbytes)
+            elif what in LEAST_BYTES:
+                self._fits(elements, what, LEAST_BYTES[what] * elements, least=True)
         except BudgetError as exc:
             exc.port = port
             raise
 
-    def _fits(self, elements: int | float, what: str, nbytes: int | float) -> None:
+    def _fits(
+        self, elements: int | float, what: str, nbytes: int | float, least: bool = False
+    ) -> None:
         need = memory.PEAK_FACTOR * nbytes
         if need < memory.UNCHECKED:
             return
@@ -350,8 +375,9 @@ class Context:
         held = self.tally.held if self.tally is not None else 0
         also = f"; this run holds {memory.fmt_bytes(held)} of earlier outputs" if held else ""
         raise BudgetError(
-            f"would make {_count(elements)} {what}, {memory.fmt_bytes(nbytes)} (about "
-            f"{memory.fmt_bytes(need)} while it is made), but the process has "
+            f"would make {_count(elements)} {what}, {'at least ' if least else ''}"
+            f"{memory.fmt_bytes(nbytes)} (about {memory.fmt_bytes(need)} while it is made), "
+            f"but the process has "
             f"{room.describe()}{also}: refused before allocating"
         )
 

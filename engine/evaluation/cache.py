@@ -44,6 +44,11 @@ from .keys import (  # noqa: F401  (the keys' home before keys.py; imported from
 )
 
 FORMAT = 2  # 2: the checksum covers the description too (entry_checksum)
+# Entries of format 2 are named <key>.npz (as they were when it was introduced); a later
+# format names its own <key>.f<N>.npz, so releases of two formats sharing one folder (a team
+# cache) each keep their entries instead of deleting the other's as foreign. The folder's
+# size bound and pruning cover every format's entries, so an old format's fade by last use.
+_FIRST_NAMED_FORMAT = 2
 MAX_INFLATE = 16  # ours are stored uncompressed (1x); anything far beyond is hostile
 MAX_META_DEPTH = 64  # ours nest a few levels per list of geometry
 
@@ -179,7 +184,8 @@ class DiskCache:
         self._written = 0  # bytes written since this object last pruned
 
     def _path(self, key: str) -> Path:
-        return self.root / key[:2] / f"{key}.npz"
+        suffix = "" if FORMAT == _FIRST_NAMED_FORMAT else f".f{FORMAT}"
+        return self.root / key[:2] / f"{key}{suffix}.npz"
 
     def _shard(self, key: str) -> Path | None:
         """The folder of ``key``'s entry, None when it is a symlink or not a folder."""
@@ -346,7 +352,7 @@ class CacheInfo:
 
 
 DEFAULT_MAX_BYTES = 2 << 30
-_ENTRY = re.compile(r"[0-9a-f]{40}\.npz")
+_ENTRY = re.compile(r"[0-9a-f]{40}(?:\.f[0-9]{1,4})?\.npz")  # a key, its format (see FORMAT)
 
 
 def default_max_bytes() -> int:

@@ -31,7 +31,7 @@ from ..language.check import Outline, check_graph
 from ..language.model import NodeDef, ParamDef, parse_input
 from ..language.params import check_param_value
 from ..language.subgraph import Includes, SubgraphSpec, is_graph_type
-from ..language.yamlio import MAX_BYTES, MAX_DEPTH, dump, parse, read_choices
+from ..language.yamlio import MAX_BYTES, MAX_DEPTH, Document, dump, parse, read_choices
 from . import cache as _cache
 from .arguments import check_budgets, nesting, node_names, plain
 from .plans import Plans
@@ -135,6 +135,10 @@ class Graph(Plans):
         self._checked = False
         # from_text: (the text read, its description and outputs); forgotten on any change
         self._source: tuple[str, str, dict[str, Any]] | None = None
+        self._read: Document | None = None  # the document read from it (from_text)
+        self._clean: Outline | None = None  # the outline of a check that found nothing
+        # from_edit: (the graph before's clean outline, the node edited), for check()
+        self._edited: tuple[Outline, str] | None = None
         self.stats: dict[str, NodeStat] = {}
         self.progress: Progress | None = None
 
@@ -151,7 +155,7 @@ class Graph(Plans):
             self._replay.clear()
             self._step_params = None
             self._sinks = None
-            self._source = None
+            self._source = self._read = self._clean = self._edited = None
 
     # ----------------------------------------------------------------------- building
 
@@ -159,7 +163,35 @@ class Graph(Plans):
     def from_text(
         cls, text: str, *, file: str | None = None, check: bool = True, **kwargs: Any
     ) -> Graph:
-        doc = parse(text, file or "<graph>")
+        return cls._from_document(parse(text, file or "<graph>"), text, file, check, **kwargs)
+
+    @classmethod
+    def from_edit(
+        cls, before: Graph, text: str, node: str, *, file: str | None = None, check: bool = True,
+        **kwargs: Any,
+    ) -> Graph:  # fmt: skip
+        """:meth:`from_text` of ``text``, which is the text ``before`` was read from (and
+        checked clean) with node ``node``'s lines edited: that node is read again, and the
+        check looks at what it reaches (:mod:`formgraph.language.incremental`). Where that
+        cannot be proved the same as reading and checking the whole text, the whole text is
+        read and checked; either way the graph and its problems are the same."""
+        from ..language.incremental import reparse
+
+        src, doc = before._source, None
+        if before._read is not None and before._clean is not None and src is not None:
+            doc = reparse(before._read, src[0], text, node, file or "<graph>")
+        if doc is None:
+            return cls.from_text(text, file=file, check=check, **kwargs)
+        g = cls._from_document(doc, text, file, False, **kwargs)
+        g._edited = (before._clean, node)
+        if check:
+            g._check_read()
+        return g
+
+    @classmethod
+    def _from_document(
+        cls, doc: Document, text: str, file: str | None, check: bool, **kwargs: Any
+    ) -> Graph:
         g = cls(file=file, description=doc.description, **kwargs)
         g._params = doc.params
         g._values = {n: p.default for n, p in doc.params.items()}
@@ -169,13 +201,17 @@ class Graph(Plans):
         g._output_lines = doc.output_lines
         g.layout = doc.layout
         g._source = (text, g.description, dict(g.outputs))
+        g._read = doc
         if check:
-            try:
-                g.check()
-            except GraphError as exc:
-                exc.files = g.files  # type: ignore[attr-defined]  (what watch must watch)
-                raise
+            g._check_read()
         return g
+
+    def _check_read(self) -> None:
+        try:
+            self.check()
+        except GraphError as exc:
+            exc.files = self.files  # type: ignore[attr-defined]  (what watch must watch)
+            raise
 
     @property
     def file_label(self) -> str:
@@ -360,7 +396,7 @@ class Graph(Plans):
 
     def set_input(self, node: str, port: str, value: Any) -> None:
         """Change one input of a node as authored (a literal, wire or expression)."""
-        nd = self._nodes[node]
+        nd = self._nodes[node] = self._nodes[node].moved()  # (its own: see NodeDef.moved)
         value = plain(value, f"input '{port}' of '{node}'")
         if port == "repeat":  # not an input: the node's loop
             nd.set_repeat(value)
@@ -431,12 +467,23 @@ class Graph(Plans):
 
     def check(self) -> None:
         """Check the whole graph; raise one GraphError listing every problem."""
+        from ..language.incremental import recheck
+
+        edited, self._edited = self._edited, None
+        if edited is not None and not self._parse_problems:
+            outline = Outline(
+                self.file_label, self._params, self._nodes, {}, self.outputs, self._output_lines
+            )
+            if recheck(edited[0], outline, edited[1]):  # (no subgraph: nothing to include)
+                self._subgraphs, self._include_problems = {}, []
+                self._checked, self._clean = True, outline
+                return
         outline = self._outline()
         problems = check_graph(outline, self._parse_problems + self._include_problems)
         if problems:
             cycles = all(p.message.startswith("cycle: ") for p in problems)
             raise (CycleError if cycles else GraphError)(problems)
-        self._checked = True
+        self._checked, self._clean = True, outline
 
     def problems(self) -> list[Problem]:
         outline = self._outline()

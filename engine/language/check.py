@@ -69,9 +69,42 @@ def check_graph(g: Outline, extra: list[Problem] | None = None) -> list[Problem]
     file = g.file_label
     registry = {**node_types(), **g.subgraphs}
 
+    infer_fed(g, registry)
+    problems.extend(param_problems(g))
+    output_types(g, registry)
+
+    for nd in g.nodes.values():
+        spec = registry.get(nd.type)
+        if spec is not None:
+            expression_ports_take_text(g, nd, spec)
+        if spec is None:
+            if nd.type.endswith((".yaml", ".yml")):
+                continue  # a graph file: its problems come from reading it
+            if nd.type:
+                # the SPEC's form: file:line, then the type (the node is named after it)
+                problems.append(
+                    Problem(
+                        Where(file, nd.input_lines.get("type", nd.line)),
+                        f"unknown node type '{nd.type}'{suggest(nd.type, registry)}"
+                        f" in node '{nd.name}'",
+                    )
+                )
+            continue
+        problems.extend(_check_node(g, nd, spec, registry))
+
+    problems.extend(_check_outputs(g, registry))
+    problems.extend(cycle_problems(g.nodes, g.file_label))
+    return problems
+
+
+def param_problems(g: Outline) -> list[Problem]:
+    """The problems of ``g``'s params: their names, and their defaults and choices against
+    their types (after :func:`~.inference.infer_fed`, which a whole-number param's kind
+    follows)."""
     from .expr import CONSTANTS, FUNCTIONS
 
-    infer_fed(g, registry)
+    problems: list[Problem] = []
+    file = g.file_label
     for p in g.params.values():
         if not p.name.isidentifier() or p.name.startswith("_"):
             problems.append(
@@ -99,30 +132,6 @@ def check_graph(g: Outline, extra: list[Problem] | None = None) -> list[Problem]
                 check_param_value(p, c)
             except TypeMismatch as exc:
                 problems.append(Problem(Where(file, p.line), f"param '{p.name}': choice {exc}"))
-
-    output_types(g, registry)
-
-    for nd in g.nodes.values():
-        spec = registry.get(nd.type)
-        if spec is not None:
-            expression_ports_take_text(g, nd, spec)
-        if spec is None:
-            if nd.type.endswith((".yaml", ".yml")):
-                continue  # a graph file: its problems come from reading it
-            if nd.type:
-                # the SPEC's form: file:line, then the type (the node is named after it)
-                problems.append(
-                    Problem(
-                        Where(file, nd.input_lines.get("type", nd.line)),
-                        f"unknown node type '{nd.type}'{suggest(nd.type, registry)}"
-                        f" in node '{nd.name}'",
-                    )
-                )
-            continue
-        problems.extend(_check_node(g, nd, spec, registry))
-
-    problems.extend(_check_outputs(g, registry))
-    problems.extend(cycle_problems(g.nodes, g.file_label))
     return problems
 
 

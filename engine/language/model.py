@@ -288,6 +288,16 @@ class NodeDef:
                 nd.parse_errors[port] = str(exc.problems[0].message)
         return nd
 
+    def moved(self, lines: int = 0) -> NodeDef:
+        """A copy with dicts of its own, written ``lines`` lines further down: a node in a
+        graph is not changed in place (graphs read from one text share their nodes)."""
+        return NodeDef(
+            self.name, self.type, dict(self.raw), dict(self.inputs),
+            None if self.line is None else self.line + lines,
+            {p: n + lines for p, n in self.input_lines.items()}, dict(self.parse_errors),
+            self.repeat, self.repeat_raw, self.simulate, self.simulate_raw,
+        )  # fmt: skip
+
     def set_repeat(self, raw: Any) -> None:
         """Set (or with None, remove) the node's ``repeat:``."""
         self.parse_errors.pop("repeat", None)

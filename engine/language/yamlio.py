@@ -41,6 +41,9 @@ class Document:
     #: where the studio's canvas drew each node (``layout:``): read, never checked, and in
     #: no cache key (see :func:`layout_of`)
     layout: dict[str, tuple[float, float]] = field(default_factory=dict)
+    #: the values the text holds, with aliases expanded and as written (see
+    #: :func:`.yamlread.expansion`): what an edit of one node adds to is known
+    sizes: tuple[int, int] = (0, 0)
 
 
 def _line(node: yaml.Node) -> int:
@@ -70,10 +73,10 @@ def parse(text: str, file: str = "<graph>") -> Document:
     try:
         try:
             root, bulk = yamlread.compose(text)
-            too_big = yamlread.expansion_problem(root, bulk, MAX_VALUES, MAX_DEPTH)
+            too_big, *sizes = yamlread.expansion(root, bulk, MAX_VALUES, MAX_DEPTH)
         except (yaml.YAMLError, ValueError):  # a lifted array was not a plain value: as written
             root, bulk = yaml.compose(text, Loader=yamlread.Loader), yamlread.Bulk()
-            too_big = yamlread.expansion_problem(root, bulk, MAX_VALUES, MAX_DEPTH)
+            too_big, *sizes = yamlread.expansion(root, bulk, MAX_VALUES, MAX_DEPTH)
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         problem(
@@ -87,6 +90,7 @@ def parse(text: str, file: str = "<graph>") -> Document:
     if too_big:
         problem(too_big)
         return doc
+    doc.sizes = (sizes[0], sizes[1])
     if root is None or not isinstance(root, yaml.MappingNode):
         problem("a graph file is a mapping with 'formgraph: 1' and 'nodes:'", 1)
         return doc
@@ -168,43 +172,53 @@ def parse(text: str, file: str = "<graph>") -> Document:
             )
         if name in doc.params:
             problem(f"the name '{name}' is both a param and a node", line, name)
-        if not isinstance(nv, yaml.MappingNode):
-            problem("a node is a mapping with 'type:' and its inputs", line, name)
-            continue
-        raw: dict[str, Any] = {}
-        lines: dict[str, int] = {}
-        unreadable: dict[str, str] = {}
-        node_type = None
-        for ik, iv in nv.value if _merged(nv, problem) else ():
-            port = _scalar_key(ik)
-            if port in raw or (port == "type" and node_type is not None):
-                problem("input appears twice", _line(ik), name, port)
-                continue
-            bad: list[str] = []
-            value = _value(iv, lambda msg, *a, bad=bad: bad.append(msg), name, port, bulk)
-            if port == "type":
-                node_type = value
-                lines["type"] = _line(ik)  # an unknown type is reported at its own line
-                bad and problem(bad[0], _line(ik), name)
-                continue
-            raw[port] = value
-            lines[port] = _line(ik)
-            if bad:
-                unreadable[port] = bad[0]
-        if node_type is not None and not isinstance(node_type, str):
-            problem(
-                f"'type' must be a node type name such as points.circle, got {describe(node_type)}",
-                lines["type"],
-                name,
-            )
-            node_type = ""
-        elif not isinstance(node_type, str):
-            problem("missing 'type:' (e.g. type: points.circle)", line, name)
-            node_type = ""
-        nd = NodeDef.make(name, node_type, raw, line, lines)
-        nd.parse_errors.update(unreadable)
-        doc.nodes[name] = nd
+        nd = node_def(name, line, nv, problem, bulk)
+        if nd is not None:
+            doc.nodes[name] = nd
     return doc
+
+
+def node_def(
+    name: str, line: int, nv: yaml.Node, problem: Any, bulk: yamlread.Bulk | None = None
+) -> NodeDef | None:
+    """The node ``name`` (its key on ``line``) from its composed body ``nv``; its problems
+    go to ``problem(message, line, node, input)`` (None: the body is not a mapping)."""
+    if not isinstance(nv, yaml.MappingNode):
+        problem("a node is a mapping with 'type:' and its inputs", line, name)
+        return None
+    raw: dict[str, Any] = {}
+    lines: dict[str, int] = {}
+    unreadable: dict[str, str] = {}
+    node_type = None
+    for ik, iv in nv.value if _merged(nv, problem) else ():
+        port = _scalar_key(ik)
+        if port in raw or (port == "type" and node_type is not None):
+            problem("input appears twice", _line(ik), name, port)
+            continue
+        bad: list[str] = []
+        value = _value(iv, lambda msg, *a, bad=bad: bad.append(msg), name, port, bulk)
+        if port == "type":
+            node_type = value
+            lines["type"] = _line(ik)  # an unknown type is reported at its own line
+            bad and problem(bad[0], _line(ik), name)
+            continue
+        raw[port] = value
+        lines[port] = _line(ik)
+        if bad:
+            unreadable[port] = bad[0]
+    if node_type is not None and not isinstance(node_type, str):
+        problem(
+            f"'type' must be a node type name such as points.circle, got {describe(node_type)}",
+            lines["type"],
+            name,
+        )
+        node_type = ""
+    elif not isinstance(node_type, str):
+        problem("missing 'type:' (e.g. type: points.circle)", line, name)
+        node_type = ""
+    nd = NodeDef.make(name, node_type, raw, line, lines)
+    nd.parse_errors.update(unreadable)
+    return nd
 
 
 def _merged(node: yaml.MappingNode, problem: Any) -> bool:

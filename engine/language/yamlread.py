@@ -234,6 +234,14 @@ def expansion_problem(
         When a placeholder of ``bulk`` is not exactly one whole plain scalar: the text must
         be composed again without lifting.
     """
+    return expansion(root, bulk, max_values, max_depth)[0]
+
+
+def expansion(
+    root: yaml.Node | None, bulk: Bulk, max_values: int, max_depth: int
+) -> tuple[str | None, int, int]:
+    """:func:`expansion_problem`, and the values counted: with aliases expanded, and as
+    written (equal when the text has no alias; both partial after a problem)."""
     count = 0  # values, aliases expanded
     own = 0  # values written in the text
     distinct: set[int] = set()
@@ -255,16 +263,20 @@ def expansion_problem(
         if count > max_values and own > max_values:
             return (
                 f"the file holds more than {max_values:,} values (numbers, strings, lists and "
-                f"mappings); a graph this large is better built in Python"
+                f"mappings); a graph this large is better built in Python",
+                count,
+                own,
             )
         # only aliases make the tree larger than the text
         if count > max_values or (count > 100_000 and count > 4 * own):
             return (
                 f"the YAML's aliases expand to more than {min(count, max_values):,} values "
-                f"(aliases of aliases?); refusing to read it"
+                f"(aliases of aliases?); refusing to read it",
+                count,
+                own,
             )
         if depth + inner > max_depth:  # a lifted array's own levels count too
-            return f"the YAML is nested too deeply (more than {max_depth} levels)"
+            return f"the YAML is nested too deeply (more than {max_depth} levels)", count, own
         if isinstance(node, yaml.SequenceNode):
             stack.extend((v, depth + 1, False) for v in node.value)
         elif isinstance(node, yaml.MappingNode):
@@ -273,7 +285,7 @@ def expansion_problem(
                 stack.append((v, depth + 1, False))
     if found != set(bulk):
         raise ValueError("a placeholder outside the values (in a comment?)")
-    return None
+    return None, count, own
 
 
 # ------------------------------------------------------------------------- construction

@@ -27,6 +27,7 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 
 from formgraph.core.errors import GraphError
+from formgraph.language.incremental import node_span
 
 from . import textedit
 
@@ -177,6 +178,7 @@ class Canvas:
             return {"id": rid, "refused": f"not understood: {exc}"}
         new = textedit.apply(text, edits)
         if port is not None:
+            self._check(new, edited=(text, port[0]))  # (one node's lines changed)
             fresh = [
                 m for m in self._problems_at(new, *port) if m not in self._problems_at(text, *port)
             ]
@@ -224,10 +226,11 @@ class Canvas:
                 listed = any(k.is_list for k in kinds) and not src_list
                 if src_spec is not None and not src_spec.multi_output:
                     output = ""
-            return textedit.wire(text, src, output, dst, port, listed=listed, ref=ref), (
-                dst,
-                port,
+            within = node_span(text, nodes, dst)  # (dst's lines: all the edit composes)
+            edits = textedit.wire(
+                text, src, output, dst, port, listed=listed, ref=ref, within=within
             )
+            return edits, (dst, port)
         if op == "unwire":
             src, to = (str(a) for a in args)
             dst, _, port = to.partition(".")
@@ -276,11 +279,14 @@ class Canvas:
                 pass
         return node_types()
 
-    def _check(self, text: str) -> tuple[Any, list[Any]]:
+    def _check(self, text: str, edited: tuple[str, str] | None = None) -> tuple[Any, list[Any]]:
         """``text`` as the session would open it (read, then checked) and its problems.
 
         The graph read is returned even when it does not check (its ``params`` and ``nodes``
         are what the gestures edit); the version the session shows is not read again.
+        ``edited`` is (the text before, the node whose lines alone the edit changed): the
+        graph of the text before, when it checked, is then read and checked again only
+        where the edit reaches (:meth:`Graph.from_edit`, the same graph and problems).
         """
         from formgraph.evaluation.graph import Graph
 
@@ -289,14 +295,12 @@ class Canvas:
             return s.graph, []
         if text in self._checked:
             return self._checked[text]
-        graph = Graph.from_text(
-            text,
-            file=str(s.path),
-            out_dir=s.out_dir,
-            budget=s.budget,
-            inputs_dir=s.inputs_dir,
-            check=False,
-        )
+        how = dict(file=str(s.path), out_dir=s.out_dir, budget=s.budget, inputs_dir=s.inputs_dir)
+        before = self._check(edited[0])[0] if edited is not None else None
+        if before is not None:
+            graph = Graph.from_edit(before, text, edited[1], check=False, **how)
+        else:
+            graph = Graph.from_text(text, check=False, **how)
         try:
             graph.check()
             problems: list[Any] = []

@@ -101,8 +101,17 @@ def apply(text: str, edits: Iterable[Edit]) -> str:
 class _Doc:
     """The text composed (no number arrays lifted: the marks are the text's own)."""
 
-    def __init__(self, text: str):
+    def __init__(self, text: str, within: tuple[int, int, int] | None = None):
         self.text = text
+        self.window: yaml.MappingNode | None = None
+        if within is not None:
+            self.window = self._window(*within)
+            if self.window is not None:  # (offsets are asked within its lines only)
+                self.root, self._at = self.window, within
+                self._local = [0] + [
+                    m.end() for m in re.finditer("\n", text[within[0] : within[1]])
+                ]
+                return
         try:
             root = yaml.compose(text, Loader=yamlread.Loader)
         except yaml.YAMLError as exc:
@@ -115,8 +124,26 @@ class _Doc:
         self.root = root
         self.starts = [0] + [m.end() for m in re.finditer("\n", text)]
 
+    def _window(self, start: int, end: int, line: int) -> yaml.MappingNode | None:
+        """The lines ``text[start:end]`` (one node's, its key on 0-based ``line``) composed
+        at their own line numbers: the node's entry, when they hold exactly one block entry
+        (else None: the whole text is composed)."""
+        try:
+            root = yaml.compose("\n" * line + self.text[start:end], Loader=yamlread.Loader)
+        except yaml.YAMLError:
+            return None
+        if not isinstance(root, yaml.MappingNode) or root.flow_style or len(root.value) != 1:
+            return None
+        key = root.value[0][0]
+        if not isinstance(key, yaml.ScalarNode) or key.start_mark.line != line:
+            return None
+        return root
+
     def offset(self, mark: yaml.Mark) -> int:
         """A mark's character offset, from its line and column."""
+        if self.window is not None:
+            start, _, line = self._at
+            return min(start + self._local[mark.line - line] + mark.column, len(self.text))
         return (
             min(self.starts[mark.line] + mark.column, len(self.text))
             if mark.line < len(self.starts)
@@ -130,6 +157,8 @@ class _Doc:
         return None
 
     def nodes(self) -> yaml.MappingNode:
+        if self.window is not None:  # one node's lines: the nodes mapping's entry for it
+            return self.window
         found = self.section("nodes")
         if found is None or not isinstance(found[1], yaml.MappingNode):
             raise EditError("the graph has no 'nodes:' mapping to edit")
@@ -220,16 +249,20 @@ def wire(
     *,
     listed: bool = False,
     ref: str | None = None,
+    within: tuple[int, int, int] | None = None,
 ) -> list[Edit]:
     """Wire ``src`` (its ``output``, or its only one for "") into ``dst``'s ``port``.
 
     An absent port gains an entry; a port holding a value has it replaced, unless the port
     takes a list (``listed``): then the list gains an element (a single wire there becomes a
     list of both). ``ref`` is the value to write instead of the wire (a param's
-    ``"=name"``).
+    ``"=name"``). ``within`` is where ``dst`` is written (see
+    :func:`formgraph.language.incremental.node_span`): only those lines are composed.
     """
     _name(port, "port name")
-    doc = _Doc(text)
+    doc = _Doc(text, within)
+    if doc.window is not None and doc.window.value[0][0].value != dst:
+        doc = _Doc(text)  # (not dst's lines: the whole text says where dst is)
     ref = _quoted(ref if ref is not None else f"@{src}.{output}" if output else f"@{src}")
     _, body = doc.node(dst)
     for k, v in body.value:

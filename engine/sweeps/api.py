@@ -426,6 +426,9 @@ def sweep(
         folder = f"variants/{i:0{width}d}"
         return [f"{folder}/{render}.png"] if render else []
 
+    if isinstance(client, str):
+        # before sweep.csv is touched: an unreachable scheduler leaves no file behind
+        run_dask.probe_scheduler(client)
     if table is not None:
         for i, cells in table.previous().items():
             row = _kept(cells, i, params_of, columns, kinds, targets.exports)

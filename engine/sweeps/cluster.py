@@ -53,7 +53,7 @@ from .tasks import (
     run_step,
 )
 
-__all__ = ["RowResult", "SweepError", "Targets", "Totals", "connect", "run"]
+__all__ = ["RowResult", "Running", "SweepError", "Targets", "Totals", "connect", "run", "start"]
 
 BLAS_ENV = {
     "OMP_NUM_THREADS": "1",
@@ -379,10 +379,17 @@ def connect(client: Any, workers: int | None) -> Iterator[Any]:
     # numpy kernels whose temporaries are megabytes that costs a page-fault storm (the spiral
     # tube builds 1.4x slower), and a sweep's workers end with the sweep anyway. Dask's own
     # profiler (a thread reading each worker's stacks every 10 ms, for a dashboard that is
-    # off here) is off too.
+    # off here) is off too. So are most of the timers an idle cluster runs (the event
+    # loops' 20 ms tick, kept only to warn of a blocked loop; the 500 ms system monitor,
+    # for the dashboard; the nannies' 100 ms memory check, here every 500 ms): 8% of a
+    # core between the client and two workers, measured idle, down to 2%, which on two
+    # cores is taken from the workers' trials
     settings = {
         "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
         "distributed.worker.profile.enabled": False,
+        "distributed.admin.tick.interval": "1s",
+        "distributed.admin.system-monitor.interval": "2s",
+        "distributed.worker.memory.monitor-interval": "500ms",
     }
     with (
         dask.config.set(settings),
@@ -428,29 +435,90 @@ def run(
     ``bp``: the blueprint of an earlier call, so workers rebuild the graph only once for a
     series of runs (an optimisation study's batches).
     """
-    from distributed import as_completed
-
     if not variants:  # all done already (a resumed sweep): no cluster needed
         return Totals()
+    with connect(client, workers) as c:
+        return start(
+            g, variants, targets, on_row, c,
+            cache_dir=cache_dir, worker_cache=worker_cache, shared_disk=shared_disk,
+            embedded=client is None, bp=bp,
+        ).wait()  # fmt: skip
+
+
+def start(
+    g: Graph,
+    variants: Sequence[tuple[int, dict[str, Any]]],
+    targets: Targets,
+    on_row: Callable[[int, RowResult], None],
+    c: Any,
+    *,
+    cache_dir: str | os.PathLike[str] | None = None,
+    worker_cache: bool = False,
+    shared_disk: bool = False,
+    embedded: bool = False,
+    bp: Blueprint | None = None,
+) -> Running:
+    """Plan ``variants`` and hand their tasks to the cluster of the client ``c``; the rows
+    are delivered by :meth:`Running.wait`.
+
+    ``embedded``: ``c`` is the client of a cluster on this machine (its disk is ours).
+    Several runs may be in flight at once (an optimisation study asks its next batch while
+    one runs): the scheduler starts a later run's tasks when workers have nothing earlier
+    to do, so the workers never wait for the client between batches.
+    """
     if bp is None:
         bp = blueprint(g, None if cache_dir is None else str(cache_dir), worker_cache)
     bp_key = f"graph-{bp.token}"
-    embedded = client is None or shared_disk
+    embedded = embedded or shared_disk
     visible = None
     if embedded and (cache_dir is not None or worker_cache):  # the workers' disk is ours
         visible = DiskCache(default_cache_dir() if worker_cache else cache_dir)
-    seen: dict[str, tuple[float, str]] = {}
-    with connect(client, workers) as c:
-        threads = sum(w.get("nthreads", 1) for w in c.scheduler_info()["workers"].values())
-        # a few variants to a task when there are many per thread: Dask's overhead per task
-        # is paid once per few light variants, and the table still grows steadily
-        cap = FILES_CHUNK_CAP if targets.exports or targets.render else CHUNK_CAP
-        chunk = max(1, min(cap, len(variants) // (8 * max(threads, 1))))
-        dsk, rows, chunks, totals = build(g, bp_key, variants, targets, visible, chunk)
+    threads = sum(w.get("nthreads", 1) for w in c.scheduler_info()["workers"].values())
+    # a few variants to a task when there are many per thread: Dask's overhead per task
+    # is paid once per few light variants, and the table still grows steadily
+    cap = FILES_CHUNK_CAP if targets.exports or targets.render else CHUNK_CAP
+    chunk = max(1, min(cap, len(variants) // (8 * max(threads, 1))))
+    dsk, rows, chunks, totals = build(g, bp_key, variants, targets, visible, chunk)
+    dsk[bp_key] = bp
+    return Running(c, dsk, rows, chunks, totals, on_row)
+
+
+class Running:
+    """A run whose tasks the cluster holds; :meth:`wait` delivers its rows as they finish."""
+
+    def __init__(
+        self,
+        c: Any,
+        dsk: dict[str, Any],
+        rows: dict[str, list[int]],
+        chunks: dict[str, list[str]],
+        totals: Totals,
+        on_row: Callable[[int, RowResult], None],
+    ):
+        self.c, self.dsk, self.rows, self.chunks = c, dsk, rows, chunks
+        self.totals, self.on_row = totals, on_row
+        self.futures: list[Any] = []
+        if rows:
+            self.futures = c.get(dsk, list(chunks), sync=False, optimize_graph=False)
+
+    def cancel(self) -> None:
+        """Withdraw every task still held (an interrupted study's batch in flight)."""
+        if self.futures:
+            self.c.cancel(self.futures)
+
+    def wait(self) -> Totals:
+        """Call ``on_row`` for every variant as its row task finishes; the totals.
+
+        A row task that dies with its worker is run again (its rows one by one, so only a
+        variant that kills its worker fails); a result lost with a worker is asked again.
+        """
+        from distributed import as_completed
+
+        c, dsk, rows, chunks, futures = self.c, self.dsk, self.rows, self.chunks, self.futures
+        totals = self.totals
         if not rows:
             return totals
-        dsk[bp_key] = bp
-        futures = c.get(dsk, list(chunks), sync=False, optimize_graph=False)
+        seen: dict[str, tuple[float, str]] = {}
         pending = as_completed(futures)
         resubmitted: dict[str, int] = {}
         suspects: list[str] = []  # one-row tasks killed with others: each again, alone
@@ -459,8 +527,9 @@ def run(
             for row_key, result in finished:
                 seen.update(result.costs)
                 for index in rows[row_key]:
-                    on_row(index, result)
+                    self.on_row(index, result)
 
+        ended = False
         try:
             for batch in pending.batches():  # one gather per batch: no round trip per task
                 done = [f for f in batch if f.status == "finished"]
@@ -514,11 +583,16 @@ def run(
                 finished = _chunk_result(alone, chunks[key])  # waits GATHER_SECONDS at most
                 alone.release()
                 deliver(finished)
+            ended = True
         finally:
-            c.cancel(futures)
-    totals.computed = sum(1 for _, st in seen.values() if st == "computed")
-    totals.cached = sum(1 for _, st in seen.values() if st == "cached")
-    return totals
+            # every future is released once delivered; cancelling them all again would
+            # withdraw a row key that a run still in flight shares (the same variant asked
+            # twice by an optimiser)
+            if not ended:
+                c.cancel(futures)
+        totals.computed = sum(1 for _, st in seen.values() if st == "computed")
+        totals.cached = sum(1 for _, st in seen.values() if st == "cached")
+        return totals
 
 
 def _killed(fut: Any) -> bool:

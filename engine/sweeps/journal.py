@@ -19,7 +19,9 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
-__all__ = ["Journal"]
+__all__ = ["Journal", "replay", "tell_recorded"]
+
+CONSTRAINTS = "constraints:"  # optuna's system attribute of a trial's constraint values
 
 
 class Journal:
@@ -58,8 +60,10 @@ class Journal:
         self.path.parent.mkdir(parents=True, exist_ok=True)
         self._append([json.dumps({"question": question})])
 
-    def append(self, trials: Iterable[Any]) -> None:
-        """Record optuna FrozenTrials (told) in one write."""
+    def append(self, trials: Iterable[Any], batch: int) -> None:
+        """Record optuna FrozenTrials (told) in one write; ``batch`` is the number of the
+        first trial of their batch (a resumed study tells the last batch after asking the
+        next, as the uninterrupted study did)."""
         from optuna.distributions import distribution_to_json
 
         lines = []
@@ -72,6 +76,7 @@ class Journal:
                 "values": t.values,
                 "user_attrs": t.user_attrs,
                 "system_attrs": t.system_attrs,
+                "batch": batch,
             }
             lines.append(json.dumps(rec))
         if lines:
@@ -86,9 +91,17 @@ class Journal:
             os.close(fd)
 
 
-def replay(optuna: Any, study: Any, records: list[dict[str, Any]]) -> None:
+def replay(
+    optuna: Any, study: Any, records: list[dict[str, Any]], batch: int
+) -> list[tuple[int, dict[str, Any]]]:
     """Add recorded trials to an in-memory ``study``: trials 0, 1, 2, ... as long as they
-    run on (a number recorded twice counts once; nothing after a gap is trusted)."""
+    run on (a number recorded twice counts once; nothing after a gap is trusted).
+
+    The last batch is added as running trials (their params, none of what their tell set):
+    the study asked its next batch before telling it, so the caller asks that batch first
+    and then tells these, with :func:`tell_recorded`. Returns (trial id, record) for them.
+    ``batch`` is the study's batch size, for a journal whose records do not say their batch.
+    """
     from optuna.distributions import json_to_distribution
 
     by_number: dict[int, dict[str, Any]] = {}
@@ -97,15 +110,46 @@ def replay(optuna: Any, study: Any, records: list[dict[str, Any]]) -> None:
     ordered = []
     while len(ordered) in by_number:
         ordered.append(by_number[len(ordered)])
+    if not ordered:
+        return []
+    last = ordered[-1].get("batch")
+    if not isinstance(last, int) or not 0 <= last < len(ordered):
+        last = (len(ordered) - 1) // batch * batch
+    held = []
     for rec in ordered:
         state = optuna.trial.TrialState[rec["state"]]
+        running = rec["number"] >= last
         study.add_trial(
             optuna.trial.create_trial(
-                state=state,
+                state=optuna.trial.TrialState.RUNNING if running else state,
                 params=rec["params"],
                 distributions={k: json_to_distribution(d) for k, d in rec["distributions"].items()},
-                values=rec["values"] if state == optuna.trial.TrialState.COMPLETE else None,
-                user_attrs=rec["user_attrs"],
-                system_attrs=rec["system_attrs"],
+                values=rec["values"]
+                if state == optuna.trial.TrialState.COMPLETE and not running
+                else None,
+                user_attrs={} if running else rec["user_attrs"],
+                system_attrs={
+                    k: v
+                    for k, v in rec["system_attrs"].items()
+                    if not (running and k.startswith(CONSTRAINTS))
+                },
             )
         )
+        if running:
+            held.append((study.get_trials(deepcopy=False)[-1]._trial_id, rec))
+    return held
+
+
+def tell_recorded(optuna: Any, study: Any, trial_id: int, rec: dict[str, Any]) -> None:
+    """Tell a trial :func:`replay` added as running what its record says."""
+    trial = optuna.trial.Trial(study, trial_id)
+    for k, v in rec["user_attrs"].items():
+        trial.set_user_attr(k, v)
+    for k, v in rec["system_attrs"].items():
+        if k.startswith(CONSTRAINTS):  # set at the tell, as the study set them
+            trial.set_constraint(k[len(CONSTRAINTS) :], v)
+    state = optuna.trial.TrialState[rec["state"]]
+    if state == optuna.trial.TrialState.COMPLETE:
+        study.tell(trial, rec["values"])
+    else:
+        study.tell(trial, state=state)

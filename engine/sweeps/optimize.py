@@ -7,19 +7,22 @@
 
 optuna (Akiba et al., "Optuna: a next-generation hyperparameter optimization framework",
 KDD 2019) proposes the trials by ask-and-tell from this module's own loop: ask ``batch``
-trials, run them as one sweep (:func:`formgraph.sweeps.cluster.run`: keys planned on the
+trials, run them as one sweep (:func:`formgraph.sweeps.cluster.start`: keys planned on the
 client, shared nodes computed once, the disk cache reused, failures recorded as rows),
-tell their results in trial order, repeat. The sampler is seeded afresh before each batch
-from the seed and the number of trials so far, so the same seed gives the same trials
-whatever the number of workers, and a study interrupted and continued gives the trials an
-uninterrupted one would have.
+tell their results in trial order. Batch b is asked once batch b - 2 is told, while
+b - 1 runs (its trials running in optuna: TPE's constant liar counts them), so the workers
+go from one batch to the next without waiting for the client to tell, ask and plan. That
+schedule is fixed and the sampler is seeded afresh before each batch from the seed and
+the number of trials asked, so the same seed gives the same trials whatever the number of
+workers, and a study interrupted and continued gives the trials an uninterrupted one would
+have.
 
 With ``out``, the study lives in ``out/study.journal`` (:mod:`formgraph.sweeps.journal`:
 each batch's told trials appended in one write), so running the same study again replays
 it into optuna and continues to the new budget; a batch an interrupted run had asked but
 not told is asked again, identically, and run. ``trials.csv`` and
-``pareto.csv`` are rewritten whole (atomically) after a batch at most once a second, and at
-the end; ``progress.png`` is drawn at the end.
+``pareto.csv`` are rewritten whole (atomically) after a batch at most once a second (and
+in at most 5% of the time), and at the end; ``progress.png`` is drawn at the end.
 """
 
 from __future__ import annotations
@@ -29,6 +32,7 @@ import math
 import os
 import time
 import warnings
+from collections import deque
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -41,7 +45,7 @@ from ..evaluation.graph import Graph
 from .api import _GRAPH_CACHE, EACH_WORKER, _cell, _label, _table_text, _tabular, _targets
 from .api import _write_atomic as write_atomic
 from .cluster import RowResult, Targets, Totals
-from .journal import Journal, replay
+from .journal import Journal, replay, tell_recorded
 from .objectives import (
     Constraint,
     Objective,
@@ -57,6 +61,7 @@ __all__ = ["METHODS", "Study", "optimize", "require_optuna"]
 METHODS = ("tpe", "nsga2", "cmaes", "random")
 MAX_BUDGET = 1_000_000
 TABLE_INTERVAL = 1.0  # seconds between rewrites of trials.csv and pareto.csv mid-study
+AHEAD = 1  # batches asked beyond the one being waited for (see the loop in optimize)
 
 
 def require_optuna() -> Any:
@@ -138,6 +143,19 @@ class Study:
             )
         lines += [f"wrote {p}" for p in self.files]
         return "\n".join(lines)
+
+
+@dataclass
+class _Batch:
+    """Trials asked together and run as one sweep (or, ``held``, a journal's last batch,
+    replayed as running trials and told from its records)."""
+
+    first: int  # the number of its first trial
+    asked: list[Any] = field(default_factory=list)  # optuna Trials
+    params_of: dict[int, dict[str, Any]] = field(default_factory=dict)
+    got: dict[int, RowResult] = field(default_factory=dict)
+    running: Any = None  # cluster.Running while its tasks are on the cluster
+    held: list[tuple[int, dict[str, Any]]] = field(default_factory=list)
 
 
 def _violations(constraints: Sequence[Constraint], row: Mapping[str, Any]) -> list[float]:
@@ -277,6 +295,9 @@ def optimize(
         },
         sort_keys=True,
     )
+    if isinstance(client, str):
+        # before the out folder is touched: an unreachable scheduler leaves no file behind
+        run_dask.probe_scheduler(client)
     journal = None if out_dir is None else Journal(out_dir / "study.journal")
     asked_before, records = (None, []) if journal is None else journal.read()
     if asked_before is not None and asked_before != question:
@@ -288,16 +309,19 @@ def optimize(
     if journal is not None and asked_before is None:
         journal.start(question)
     study = optuna.create_study(directions=[o.direction for o in objectives])
-    replay(optuna, study, records)
+    held = replay(optuna, study, records, batch)
     population = max(batch, 16)
     rows: dict[int, dict[str, Any]] = {
-        t.number: t.user_attrs["row"] for t in study.get_trials(deepcopy=False)
+        t.number: t.user_attrs["row"]
+        for t in study.get_trials(deepcopy=False)
+        if t.state != optuna.trial.TrialState.RUNNING
     }
+    rows.update((rec["number"], rec["user_attrs"]["row"]) for _, rec in held)
     resumed = len(rows)
     totals = Totals()
     t0 = time.perf_counter()
     own = 0.0  # thread CPU seconds outside the sweep runs (Study.overhead)
-    written = [-math.inf]  # when the tables were last written
+    written = [-math.inf]  # when the tables may next be written
     files: list[Path] = []
     if cache_dir is _GRAPH_CACHE:
         cache_dir = g.disk.root if g.disk is not None else None
@@ -355,58 +379,85 @@ def optimize(
             study.tell(trial, state=optuna.trial.TrialState.FAIL)
         return row
 
+    inflight: deque[_Batch] = deque()
+    if held:  # the journal's last batch: told after the next is asked, as it was
+        inflight.append(_Batch(held[0][1]["number"], held=held))
     try:
         with run_dask.connect(client, workers) as c:
             embedded = client is None
-            while True:
-                n = len(rows)
-                if n >= budget:
-                    break
-                mark = time.thread_time()
-                # a sampler seeded by the seed and the trials so far: the same history
-                # gives the same batch, in one run or across an interruption
-                study.sampler = _sampler(optuna, method, (seed * 1_000_003 + n) % 2**32, population)
-                with warnings.catch_warnings():
-                    warnings.simplefilter("ignore")  # optuna's experimental notes
-                    asked = [study.ask(space) for _ in range(min(batch, budget - n))]
-                params_of = {t.number: {**base, **t.params} for t in asked}
-                got: dict[int, RowResult] = {}
-                own += time.thread_time() - mark
-                part = run_dask.run(
-                    g,
-                    [(t.number, params_of[t.number]) for t in asked],
-                    Targets(targets.measures, (), None, size),
-                    got.__setitem__,
-                    client=c,
-                    cache_dir=cache_path,
-                    worker_cache=worker_cache,
-                    shared_disk=(embedded or shared_cache) and not worker_cache,
-                    bp=bp,
-                )
-                mark = time.thread_time()
-                told = {  # told in trial order: deterministic
-                    t.number: tell(t, params_of[t.number], got[t.number])
-                    for t in sorted(asked, key=lambda t: t.number)
-                }
-                if journal is not None:
-                    held = study.get_trials(deepcopy=False)
-                    journal.append(held[t.number] for t in asked)
-                # the rows count once the journal holds them: a Ctrl-C before that leaves
-                # the tables and the journal agreeing, and the rerun asks the batch again
-                rows.update(told)
-                for name in ("variants", "naive", "needed", "computed", "cached"):
-                    setattr(totals, name, getattr(totals, name) + getattr(part, name))
-                if time.perf_counter() - written[0] >= TABLE_INTERVAL:
-                    # whole tables at most once a second: a long study of quick trials
-                    # does not spend its time rewriting them after every small batch
-                    write_tables()
-                    written[0] = time.perf_counter()
-                if progress is not None:
-                    rate = (len(rows) - resumed) / max(time.perf_counter() - t0, 1e-9)
-                    progress(len(rows), budget, best_text(), rate)
-                own += time.thread_time() - mark
-                if on_batch is not None:
-                    on_batch(len(rows))
+            try:
+                while True:
+                    # the schedule: batch b is asked once batch b - 2 is told, while b - 1
+                    # runs, so the workers go from one batch to the next without waiting for
+                    # the client's tell, ask and planning; fixed, whatever the workers, so a
+                    # seed gives the same trials on one worker or many
+                    while len(inflight) <= AHEAD and len(study.trials) < budget:
+                        mark = time.thread_time()
+                        n = len(study.trials)
+                        # a sampler seeded by the seed and the trials asked so far: the same
+                        # history gives the same batch, in one run or across an interruption
+                        study.sampler = _sampler(
+                            optuna, method, (seed * 1_000_003 + n) % 2**32, population
+                        )
+                        with warnings.catch_warnings():
+                            warnings.simplefilter("ignore")  # optuna's experimental notes
+                            asked = [study.ask(space) for _ in range(min(batch, budget - n))]
+                        b = _Batch(n, asked, {t.number: {**base, **t.params} for t in asked})
+                        own += time.thread_time() - mark  # the sweep's own work is not ours
+                        b.running = run_dask.start(
+                            g,
+                            [(t.number, b.params_of[t.number]) for t in asked],
+                            Targets(targets.measures, (), None, size),
+                            b.got.__setitem__,
+                            c,
+                            cache_dir=cache_path,
+                            worker_cache=worker_cache,
+                            shared_disk=(embedded or shared_cache) and not worker_cache,
+                            embedded=embedded,
+                            bp=bp,
+                        )
+                        inflight.append(b)
+                    if not inflight:
+                        break
+                    b = inflight[0]
+                    part = b.running.wait() if b.running is not None else Totals()
+                    mark = time.thread_time()
+                    inflight.popleft()
+                    if b.held:
+                        for trial_id, rec in b.held:
+                            tell_recorded(optuna, study, trial_id, rec)
+                        told = {rec["number"]: rows[rec["number"]] for _, rec in b.held}
+                    else:
+                        told = {  # told in trial order: deterministic
+                            t.number: tell(t, b.params_of[t.number], b.got[t.number])
+                            for t in sorted(b.asked, key=lambda t: t.number)
+                        }
+                        if journal is not None:
+                            trials = study.get_trials(deepcopy=False)
+                            journal.append((trials[t.number] for t in b.asked), b.first)
+                    # the rows count once the journal holds them: a Ctrl-C before that leaves
+                    # the tables and the journal agreeing, and the rerun asks the batch again
+                    rows.update(told)
+                    for name in ("variants", "naive", "needed", "computed", "cached"):
+                        setattr(totals, name, getattr(totals, name) + getattr(part, name))
+                    if time.perf_counter() >= written[0]:
+                        # whole tables at most once a second, and at most a twentieth of
+                        # the time: a long study of quick trials does not spend its time
+                        # rewriting ever longer tables after every small batch
+                        began = time.perf_counter()
+                        write_tables()
+                        ended = time.perf_counter()
+                        written[0] = ended + max(TABLE_INTERVAL, 19 * (ended - began))
+                    if progress is not None:
+                        rate = (len(rows) - resumed) / max(time.perf_counter() - t0, 1e-9)
+                        progress(len(rows), budget, best_text(), rate)
+                    own += time.thread_time() - mark
+                    if on_batch is not None:
+                        on_batch(len(rows))
+            finally:
+                for b in inflight:  # an interrupted study's batches in flight: withdrawn
+                    if b.running is not None:
+                        b.running.cancel()
             flags = _front(list(rows.values()), objectives, signs)
             if out_dir is not None and (export or render):
                 files += _front_files(

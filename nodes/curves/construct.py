@@ -130,7 +130,7 @@ def subdivide(
         Rounds of subdivision; the point count roughly doubles each round.
     """
     p, closed = control_polygon(curve)
-    ctx.guard(kc.subdivided_count(len(p), closed, iterations), "points")
+    ctx.guard(kc.subdivided_count(len(p), closed, iterations), "points", port="iterations")
     out = InputError.call("curve", kc.subdivide_polygon, p, closed=closed, iterations=iterations)
     return polyline_curve(out, closed=closed)
 

@@ -115,9 +115,31 @@ def test_a_run_is_refused_for_memory_before_it_runs_out():
     assert int(m.group(1)) == 3 + int(m.group(2)[1:]) and float(m.group(3)) < 480
 
 
+def test_a_node_that_states_no_bytes_is_refused_by_the_least_its_output_takes():
+    # curves.subdivide counts its points and states no bytes: 33,554,432 points take at
+    # least 24 bytes each, 805 MB (1.6 GB while made), more than the limit leaves. It was
+    # let run and failed inside the kernel; it is refused before allocating, located.
+    extra = (
+        "  small: {type: points.grid, nx: 2, ny: 2}\n"
+        "  sq: {type: curves.polyline, closed: true, points: [[0,0,0],[1,0,0],[1,1,0],[0,1,0]]}\n"
+        "  fine: {type: curves.subdivide, curve: '@sq', iterations: 23}\n"
+    )
+    got = _run(RLIMIT.replace("EXTRA", repr(extra)).replace("TARGETS", repr("fine")))
+    assert got["error"] == "BudgetError", got
+    assert re.fullmatch(
+        r"h\.yaml:11: node 'fine', input 'iterations': would make 33,554,432 points, at least "
+        r"805 MB \(about 1\.61 GB while it is made\), but the process has [\d.]+ [MG]B left under "
+        r"the address-space limit \(RLIMIT_AS\) of [\d.]+ GB \([\d.]+ [MG]B in use\); this run "
+        r"holds [\d.]+ \w+ of earlier outputs: refused before allocating",
+        got["message"],
+    ), got["message"]
+    assert got["done"] == ["sq"]  # its input made, the subdivision refused
+
+
 def test_a_node_that_runs_out_of_memory_unannounced_says_so_located():
-    # mesh.cylinder does not say what its output will take: nothing refuses it before it
-    # runs, so an allocation past the limit fails inside it; the error still says so, located
+    # mesh.cylinder states only the least its output takes (4 bytes a face corner), far
+    # below what it makes: the guard lets it run, an allocation past the limit fails inside
+    # it, and the error still says so, located
     extra = (
         "  small: {type: points.grid, nx: 2, ny: 2}\n"
         "  tube: {type: mesh.cylinder, radius: 1, height: 1, segments: 8000000}\n"

@@ -108,3 +108,23 @@ def test_nobody_listening_is_a_sentence():
         port = s.getsockname()[1]
         with pytest.raises(cluster.SweepError, match="cannot reach the Dask scheduler"):
             cluster.probe_scheduler(f"tcp://127.0.0.1:{port}", timeout=1)
+
+
+@pytest.mark.parametrize("command", ["sweep", "optimize"])
+def test_an_unreachable_scheduler_leaves_no_file(tmp_path, capsys, command):
+    # the scheduler is checked before sweep.csv, trials.csv or the journal is written: a
+    # failed start leaves no table of no rows behind (it was a header-only sweep.csv)
+    (tmp_path / "g.yaml").write_text(GRAPH + "  m: {type: curves.measure, curve: '@c'}\n")
+    out = tmp_path / "out"
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
+        s.bind(("127.0.0.1", 0))
+        address = f"tcp://127.0.0.1:{s.getsockname()[1]}"
+        args = ["--vary", "r=1,2"] if command == "sweep" else ["--vary", "r=1:2"]
+        if command == "optimize":
+            args += ["--minimize", "m.length", "--budget", "2"]
+        code = cli.main(
+            [command, str(tmp_path / "g.yaml"), *args, "--scheduler", address, "--out", str(out)]
+        )
+    err = capsys.readouterr().err
+    assert code == 1 and "cannot reach the Dask scheduler" in err
+    assert not out.exists()
