@@ -118,9 +118,11 @@ class Table:
         each reference in ``rounds`` interleaved rounds whose order turns by one each round.
 
         Each implementation is called once to warm up (imports, caches a user would also have
-        warm, JIT compilation); the number of calls per timing is fixed from that call so a
-        timing lasts about ``min_seconds``. ``warmup=False`` skips that call (a reference of
-        a minute: one call a round, its imports in its first). A reference that fails to
+        warm, JIT compilation); the number of calls per timing is fixed from a second call
+        (the first of a graph can take 400 ms of imports: sized on it, a 1 ms call was
+        timed once a round, just after ``gc.collect()``, and read 60% slow) so a
+        timing lasts about ``min_seconds``. ``warmup=False`` skips both calls (a reference
+        of a minute: one call a round, its imports in its first). A reference that fails to
         import is noted as not installed, never silently dropped. Returns the
         per-implementation :class:`Stat`.
         """
@@ -139,6 +141,7 @@ class Table:
                 numbers[name] = 1
                 continue
             try:
+                fn()  # the first call pays for imports: the timing is sized on a second
                 t0 = now()
                 fn()
                 first = now() - t0

@@ -165,6 +165,34 @@ def test_triangulate_node():
     assert box.n_faces == 12 and volume(box) == pytest.approx(1.0)
 
 
+def test_triangulate_node_tiles_a_large_concave_face_in_space_and_carries_face_data():
+    """A 300-corner star face on a tilted plane with a second, square face, through the
+    public API (a Mesh param): the star's triangles tile it (shapely's area, each inside),
+    face normal kept, and each triangle carries its face's attribute."""
+    shapely = pytest.importorskip("shapely")
+    k = 300
+    t = 2 * np.pi * np.arange(k) / k
+    r = np.where(np.arange(k) % 2 == 0, 1.0, 0.3 + 0.2 * np.sin(7 * t))
+    xy = np.column_stack([r * np.cos(t), r * np.sin(t)])
+    rot = Rotation.from_euler("xyz", [30, -50, 10], degrees=True).as_matrix()
+    square = np.array([[3.0, 0], [4, 0], [4, 1], [3, 1]])
+    v = np.column_stack([np.r_[xy, square], np.zeros(k + 4)]) @ rot.T
+    faces = [np.arange(k), np.arange(k, k + 4)]
+    g = fg.Graph()
+    g.add_param("m", type="Mesh")
+    g.add("t", "mesh.triangulate", mesh="=m")
+    m = g.evaluate("t", m=fg.Mesh(v, faces, face_data={"id": np.array([5.0, 7.0])}))
+    assert m.n_faces == (k - 2) + 2 and (m.face_sizes == 3).all()
+    assert np.array_equal(m.face_data["id"], np.r_[np.full(k - 2, 5.0), 7.0, 7.0])
+    tri = m.face_indices.reshape(-1, 3)[: k - 2]
+    flat = (m.vertices @ rot)[:, :2]  # back in the plane
+    a, b, c = flat[tri[:, 0]], flat[tri[:, 1]], flat[tri[:, 2]]
+    area = ((b - a)[:, 0] * (c - a)[:, 1] - (b - a)[:, 1] * (c - a)[:, 0]) / 2
+    star = shapely.Polygon(xy)
+    assert (area > 0).all() and area.sum() == pytest.approx(star.area, rel=1e-9)
+    assert shapely.covers(star.buffer(1e-9), shapely.polygons(flat[tri])).all()
+
+
 def test_merge_node():
     g = fg.Graph()
     g.add("a", "mesh.box")

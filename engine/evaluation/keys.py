@@ -58,7 +58,7 @@ def canonical(value: Any) -> Any:
     if isinstance(value, np.generic):
         return canonical(value.item())
     if isinstance(value, np.ndarray):
-        return {"a": str(value.dtype), "s": list(value.shape), "h": _hash_bytes(value)}
+        return {"a": _dtype_name(value.dtype), "s": list(value.shape), "h": _hash_bytes(value)}
     if isinstance(value, (list, tuple)):
         return [canonical(v) for v in value]
     if isinstance(value, dict):
@@ -157,9 +157,23 @@ _quote = json.encoder.encode_basestring_ascii  # what json.dumps writes a str as
 _JSON = json.JSONEncoder(sort_keys=True, separators=(",", ":"))
 
 
+_DTYPE_NAMES: dict[np.dtype, str] = {}
+
+
+def _dtype_name(dtype: np.dtype) -> str:
+    """``str(dtype)``, kept: numpy builds the name anew each time (3 us, twice an array of
+    every key), and the few dtypes that occur are named once."""
+    name = _DTYPE_NAMES.get(dtype)
+    if name is None:
+        name = str(dtype)
+        if len(_DTYPE_NAMES) < 64:  # (structured dtypes could be many: not all kept)
+            _DTYPE_NAMES[dtype] = name
+    return name
+
+
 def _hash_bytes(a: np.ndarray) -> str:
     h = hashlib.blake2b(digest_size=16)
-    h.update(str(a.dtype).encode() + str(a.shape).encode())
+    h.update(_dtype_name(a.dtype).encode() + str(a.shape).encode())
     h.update(np.ascontiguousarray(a).view(np.uint8).reshape(-1))
     return h.hexdigest()
 

@@ -27,6 +27,7 @@ import math
 import numpy as np
 
 from .measure import next_corner
+from .polygon import tiling
 
 __all__ = [
     "MAX_TWIST_STEP",
@@ -50,8 +51,9 @@ def cap_triangles(xy: np.ndarray, offsets: np.ndarray, hole: np.ndarray) -> np.n
 
     Each polygon (an outer ring and the holes after it) goes to mapbox_earcut (Mapbox's
     earcut: ear clipping with the holes bridged in, z-order hashed); its answer is taken when
-    it has the ``n + 2 h - 2`` triangles a tiling of ``n`` points and ``h`` holes has, none
-    turned clockwise, and their areas add up to the polygon's. Otherwise (rings that touch,
+    it tiles the polygon (:func:`~.polygon.tiling`: the ``n + 2 h - 2`` triangles of a
+    tiling of ``n`` points and ``h`` holes, none turned clockwise, their edges and the
+    rings' pairing up exactly). Otherwise (rings that touch,
     where earcut may drop or overlap triangles) the polygon goes to manifold3d's
     ``triangulate``, which always returns triangles running the input's edges.
     """
@@ -66,48 +68,11 @@ def cap_triangles(xy: np.ndarray, offsets: np.ndarray, hole: np.ndarray) -> np.n
         lo, hi = int(off[a]), int(off[b])
         pts = xy[lo:hi]
         ends = (off[a + 1 : b + 1] - lo).astype(np.uint32)
-        tri = np.asarray(mapbox_earcut.triangulate_float64(pts, ends), dtype=np.int64)
-        tri = tri.reshape(-1, 3)
-        if not _tiles(pts, ends, tri):
+        tri = tiling(pts, ends, mapbox_earcut.triangulate_float64(pts, ends))
+        if tri is None:
             tri = _manifold_triangles(pts, ends)
         out.append(tri + lo)
     return np.concatenate(out) if out else np.zeros((0, 3), np.int64)
-
-
-def _signed_areas(pts: np.ndarray, tri: np.ndarray) -> np.ndarray:
-    a, b, c = pts[tri[:, 0]], pts[tri[:, 1]], pts[tri[:, 2]]
-    return 0.5 * (
-        (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
-    )
-
-
-def _tiles(pts: np.ndarray, ends: np.ndarray, tri: np.ndarray) -> bool:
-    """Whether earcut's triangles (turned counter-clockwise in place) tile the polygon: the
-    count of a tiling, none turned over, no edge run twice the same way, and the edges
-    without a partner run the other way exactly the rings' edges. Then the triangles are a
-    chain whose boundary is the rings, each covering positively, so every point of the
-    region is covered once (its winding number) and the caps close on the sides."""
-    holes = len(ends) - 1
-    n = len(pts)
-    if len(tri) != n + 2 * holes - 2:
-        return False
-    area = _signed_areas(pts, tri)
-    if area.sum() < 0:  # earcut's own winding: made the region's
-        tri[:, [1, 2]] = tri[:, [2, 1]]
-        area = -area
-    if area.min(initial=0.0) < -1e-12 * float(np.abs(area).sum()):
-        return False
-    a, b = tri.reshape(-1), tri[:, [1, 2, 0]].reshape(-1)
-    key = np.sort(a * n + b)
-    if np.any(key[1:] == key[:-1]):
-        return False
-    off = np.concatenate([[0], ends.astype(np.int64)])
-    ring = np.arange(n) * n + next_corner(off)  # increasing: sorted queries
-    rev = np.sort(b * n + a)  # (sorted queries: searchsorted walks the keys once)
-    at = np.minimum(np.searchsorted(key, rev), len(key) - 1)
-    alone = np.count_nonzero(key[at] != rev)  # tri edges with no partner
-    at = np.minimum(np.searchsorted(key, ring), len(key) - 1)
-    return alone == n and bool(np.all(key[at] == ring))
 
 
 def _manifold_triangles(pts: np.ndarray, ends: np.ndarray) -> np.ndarray:

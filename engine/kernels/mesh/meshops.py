@@ -362,19 +362,18 @@ def triangulate(
         if k == 3:
             out[tri_off[faces]] = corners
             continue
+        if k > _BATCH_UP_TO and faces.size <= _ALONE_UP_TO:
+            # a few large faces (a polygon made a face): each tested and clipped in its
+            # own plane, made once (the batched test below costs a face's clipping again)
+            for f, start in zip(corners, tri_off[faces].tolist(), strict=True):
+                # (np.take: a fancy index of rows is 4x slower on (k, 3))
+                out[start : start + k - 2] = f[large_face(np.take(v, f, axis=0), max_tests)]
+            continue
         local = np.broadcast_to(
             np.stack([np.zeros(k - 2, dtype=np.int64), np.arange(1, k - 1), np.arange(2, k)], 1),
             (faces.size, k - 2, 3),
         ).copy()
         p = v[corners]
-        if k > _BATCH_UP_TO and faces.size <= _ALONE_UP_TO:
-            # a few large faces (a polygon made a face): each tested and clipped in its
-            # own plane, made once (the batched test below costs a face's clipping again)
-            for f in range(faces.size):
-                local[f] = large_face(p[f], max_tests)
-            rows = np.arange(faces.size)[:, None, None]
-            out[tri_off[faces][:, None] + np.arange(k - 2)] = corners[rows, local]
-            continue
         normal = _newell_normals(p)
         edge_in = p - np.roll(p, 1, axis=1)
         edge_out = np.roll(p, -1, axis=1) - p
