@@ -248,7 +248,7 @@ class _Vertices:
         columns: the lines' tables take them so without a copy): placed :data:`CHUNK` or more
         at a time (a group's are too few to be worth the calls)."""
         self.pending.append(edges)
-        self.waiting += len(edges[0])
+        self.waiting += edges[0].shape[1]
         if self.waiting >= CHUNK:
             self._flush()
 
