@@ -62,6 +62,10 @@ EDGE_PACK = EDGE_OWNER << 11 | EDGE_PLACE  # both in one gather (a place is belo
 TRI_ROWS = TRI_EDGES.reshape(-1, 3).astype(np.int32)  # case * 5 + triangle -> its edges
 
 
+# per bit of a 16-bit word: the mask of the bits below it, and of the count above them
+BELOW = (np.left_shift(1, np.arange(16), dtype=np.int64) - 1) | ~np.int64(0xFFFF)
+
+
 def _ranks(used: np.ndarray, hashes: list[np.ndarray], out: np.ndarray) -> int:
     """Each hash's rank among the ``used`` ones (its vertex number) written to ``out``
     (flat, one per hash, in order); returns their count.
@@ -82,9 +86,11 @@ def _ranks(used: np.ndarray, hashes: list[np.ndarray], out: np.ndarray) -> int:
     for h in hashes:
         h = h.reshape(-1)
         word = np.take(packed, h >> 4)
-        word &= (np.left_shift(1, h & 15, dtype=np.int64) - 1) | ~np.int64(0xFFFF)
-        out[at : at + h.size] = word >> 16
-        out[at : at + h.size] += np.bitwise_count(word & 0xFFFF)
+        word &= np.take(BELOW, h & 15)  # the count before the word, the bits below h's
+        rank = out[at : at + h.size]
+        np.right_shift(word, 16, out=rank)
+        word &= 0xFFFF
+        rank += np.bitwise_count(word)
         at += h.size
     return count
 
@@ -238,10 +244,10 @@ class _Vertices:
     def _points(self, ijk: np.ndarray, axis: np.ndarray, t: np.ndarray, out=None) -> np.ndarray:
         """The points at parameters ``t`` on edges ``(ijk, axis)`` (into ``out``)."""
         p = np.empty((len(t), 3)) if out is None else out
-        p[...] = ijk
-        p.reshape(-1)[np.arange(0, 3 * len(t), 3) + axis] += t
-        p *= self.lat.cell
+        cell = self.lat.cell
+        np.multiply(ijk, cell, out=p)
         p += self.lat.origin
+        p.reshape(-1)[np.arange(0, 3 * len(t), 3) + axis] += t * cell
         return p
 
     def _queue(self, *edges: np.ndarray) -> None:
