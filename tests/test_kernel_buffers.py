@@ -69,3 +69,11 @@ def test_all_finite_is_isfinite_all():
         a[517] = bad
         assert not all_finite(a)
         assert not all_finite(a.reshape(100, 10))
+
+
+@pytest.mark.parametrize("count, step", [(0, 3), (5, 1), (200_001, 3), (1 << 17, 1)])
+def test_frozen_arange_is_arange(count, step):
+    a = buffers.frozen_arange(count, step)
+    assert a.dtype == np.int64 and is_frozen(a)
+    np.testing.assert_array_equal(a, np.arange(0, step * count, step))
+    _cannot_be_made_writable(a)

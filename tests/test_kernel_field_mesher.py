@@ -231,3 +231,22 @@ def test_many_groups_of_blocks_number_every_vertex_once(dense):
     # the open sphere's rims (where it leaves the grid) are its only edges used once
     m = trimesh.Trimesh(v, t, process=False)
     assert m.is_winding_consistent and (use == 1).any()
+
+
+@pytest.mark.parametrize("dense", [False, True])
+def test_the_outputs_are_frozen_and_a_mesh_shares_them(dense):
+    # written straight into immutable buffers: a Mesh made of them copies nothing
+    from formgraph.geometry import Mesh, is_frozen
+    from formgraph.kernels.buffers import frozen_arange
+
+    def ball(p):
+        return sdf.sphere(p, 1.0, O)
+
+    grid = _lattices(ball) if dense else None
+    v, t = mesher.mesh_field(ball, [-1] * 3, [1] * 3, 0.05, grid=grid)
+    assert len(v) > 1000 and is_frozen(v) and is_frozen(t) and t.dtype == np.int64
+    m = Mesh.trusted(v, t.reshape(-1), frozen_arange(len(t) + 1, 3))
+    assert m.vertices is v and np.shares_memory(m.face_indices, t)
+    assert np.abs(np.linalg.norm(v, axis=1) - 1).max() <= 5e-4 * 0.05
+    with pytest.raises(ValueError):
+        v[0] = 0.0

@@ -10,6 +10,7 @@ from typing import Any, TypeVar
 import numpy as np
 
 from ..kernels.buffers import fill_bytes
+from ..kernels.finite import all_finite
 
 __all__ = [
     "STORABLE",
@@ -51,18 +52,6 @@ def frozen_array(values: Any, dtype: Any = np.float64) -> np.ndarray:
             return np.frombuffer(buf, dtype=dtype).reshape(values.shape)
     a = np.asarray(values, dtype=dtype)
     return np.frombuffer(a.tobytes(order="C"), dtype=a.dtype).reshape(a.shape)
-
-
-def all_finite(a: np.ndarray) -> bool:
-    """Whether every value of float array ``a`` is finite, in one pass and no temporary when
-    they are: a sum is finite only if every term is (a NaN or an infinity makes it NaN or
-    infinite); only a sum that overflows, or a bad value, takes the exact test."""
-    if a.size == 0:
-        return True
-    with np.errstate(all="ignore"):
-        if np.isfinite(np.add.reduce(a, axis=None)):
-            return True
-    return bool(np.isfinite(a).all())
 
 
 def as_xyz(values: Any, what: str = "points") -> np.ndarray:

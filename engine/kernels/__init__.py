@@ -9,5 +9,6 @@ benchmarked alone. One package per family, mirroring ``nodes/``:
 - ``offset``: distance fields, marching squares, loop clean-up and refinement;
 - ``field``: signed distance functions, mesh distances, adaptive meshing of zero sets;
 - ``io``: STL, OBJ, PLY, SVG, PDF and DXF writers and their number formatting;
-- ``buffers``: immutable ``bytes`` buffers filled in place (what frozen arrays stand on).
+- ``buffers``: immutable ``bytes`` buffers filled in place (what frozen arrays stand on);
+- ``finite``: whether an array is finite, in one pass.
 """

@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["MIN_BYTES", "fill_bytes", "fill_frozen", "filled_bytes"]
+__all__ = ["MIN_BYTES", "fill_bytes", "fill_frozen", "filled_bytes", "frozen_arange"]
 
 MIN_BYTES = 1 << 20  # below this a copy costs less than the ctypes calls
 
@@ -71,6 +71,20 @@ def fill_frozen(shape: Any, dtype: Any, fill: Callable[[np.ndarray], None]) -> n
     fill(out)
     del out, raw  # the only writable views: gone before the bytes are handed out
     return np.frombuffer(buf, dtype).reshape(shape)
+
+
+def frozen_arange(count: int, step: int = 1) -> np.ndarray:
+    """``0, step, 2 step, ...`` (``count`` int64 values), frozen and made in place: the
+    face offsets of a triangle mesh (``step`` 3), the face indices of a triangle soup."""
+    return fill_frozen(count, np.int64, lambda out: _arange(out, step))
+
+
+def _arange(out: np.ndarray, step: int, block: int = 1 << 16) -> None:
+    """``out[:] = 0, step, 2 step, ...`` a block at a time (no temporary of its size)."""
+    ramp = np.arange(0, step * block, step, dtype=np.int64)
+    for start in range(0, len(out), block):
+        part = out[start : start + block]
+        np.add(ramp[: len(part)], step * start, out=part)
 
 
 def filled_bytes(nbytes: int, fill: Callable[[memoryview], int]) -> bytes:

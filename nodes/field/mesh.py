@@ -13,6 +13,7 @@ from formgraph.core.errors import InputError
 from formgraph.core.registry import Context, Range, node
 from formgraph.geometry import Field, Mesh
 from formgraph.geometry.base import as_xyz
+from formgraph.kernels.buffers import frozen_arange
 from formgraph.kernels.field import mesher, planar
 from formgraph.nodes.field import _blend
 from formgraph.nodes.field._common import bounds_box
@@ -175,7 +176,7 @@ def mesh_of(
     if contradicted is not None:
         ctx.warn(f"parts of the surface may be missing: {contradicted}")
     _warn_moved_faces(field, v, cell, ctx)
-    return Mesh.trusted(v, t.reshape(-1), np.arange(0, 3 * len(t) + 1, 3))
+    return Mesh.trusted(v, t.reshape(-1), frozen_arange(len(t) + 1, 3))  # shared, no copy
 
 
 def _face_words(normal: np.ndarray, offset: float) -> str:

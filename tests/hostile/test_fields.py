@@ -179,6 +179,23 @@ def test_the_mesher_refuses_a_box_too_many_cells_across_to_number():
     assert len(v) and (np.unique(edges, axis=0, return_counts=True)[1] == 2).all()
 
 
+def test_a_field_that_fails_while_the_vertices_are_placed_hands_out_nothing():
+    """The vertices are written straight into an immutable buffer: a field finite at the
+    lattice's corners but not on the edges between them (the root-finding samples) is
+    refused with the field's message, and no half-placed vertices escape."""
+    from formgraph.kernels.field import mesher
+
+    f = Field.sphere(1.0)
+
+    def lines(origin, step, ijk, axis, t):
+        return np.full(len(t), np.nan)
+
+    with pytest.raises(ValueError, match="not finite"):
+        mesher.mesh_field(f.evaluate, [-1.2] * 3, [1.2] * 3, 0.1, grid=f.evaluate_grid, lines=lines)
+    v, t = mesher.mesh_field(f.evaluate, [-1.2] * 3, [1.2] * 3, 0.1, grid=f.evaluate_grid)
+    assert len(t) and np.abs(np.linalg.norm(v, axis=1) - 1).max() < 1e-4
+
+
 # ------------------------------------------------------------ recipes thousands deep
 
 DEPTH = 5000

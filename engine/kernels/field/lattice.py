@@ -30,6 +30,8 @@ from collections.abc import Callable
 
 import numpy as np
 
+from ..finite import all_finite
+
 __all__ = [
     "B",
     "B3",
@@ -92,7 +94,7 @@ def plan_grid(lo: np.ndarray, hi: np.ndarray, cell: float, coarse: int = 16):
 def checked(values: np.ndarray) -> np.ndarray:
     """A field's values as flat float64, refused (ValueError) where not finite."""
     v = np.asarray(values, dtype=np.float64).reshape(-1)
-    if not np.isfinite(v).all():
+    if not all_finite(v):
         raise ValueError("the field is not finite at some points (NaN or infinity)")
     return v
 

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..buffers import fill_frozen
 from .lattice import (
     B3,
     CHUNK,
@@ -61,8 +62,13 @@ EDGE_PACK = EDGE_OWNER << 11 | EDGE_PLACE  # both in one gather (a place is belo
 TRI_ROWS = TRI_EDGES.reshape(-1, 3).astype(np.int32)  # case * 5 + triangle -> its edges
 
 
-def _ranks(used: np.ndarray, hashes: list[np.ndarray], dtype) -> tuple[np.ndarray, int]:
-    """Each hash's rank among the ``used`` ones (its vertex number), flat, and their count.
+# per bit of a 16-bit word: the mask of the bits below it, and of the count above them
+BELOW = (np.left_shift(1, np.arange(16), dtype=np.int64) - 1) | ~np.int64(0xFFFF)
+
+
+def _ranks(used: np.ndarray, hashes: list[np.ndarray], out: np.ndarray) -> int:
+    """Each hash's rank among the ``used`` ones (its vertex number) written to ``out``
+    (flat, one per hash, in order); returns their count.
 
     The rank is the count of used entries before it: a prefix sum over 16-bit words of
     the packed marks plus the bits below it in its own word, so no array of the hash
@@ -76,16 +82,17 @@ def _ranks(used: np.ndarray, hashes: list[np.ndarray], dtype) -> tuple[np.ndarra
     packed -= pop
     packed <<= 16
     packed |= words
-    out = np.empty(sum(h.size for h in hashes), dtype=dtype)
     at = 0
     for h in hashes:
         h = h.reshape(-1)
         word = np.take(packed, h >> 4)
-        word &= (np.left_shift(1, h & 15, dtype=np.int64) - 1) | ~np.int64(0xFFFF)
-        out[at : at + h.size] = word >> 16
-        out[at : at + h.size] += np.bitwise_count(word & 0xFFFF)
+        word &= np.take(BELOW, h & 15)  # the count before the word, the bits below h's
+        rank = out[at : at + h.size]
+        np.right_shift(word, 16, out=rank)
+        word &= 0xFFFF
+        rank += np.bitwise_count(word)
         at += h.size
-    return out.reshape(-1, 3), count
+    return count
 
 
 def crossing_cells(f: Fn, lo, hi, cell: float, lipschitz: float = 1.0, max_cells=50_000_000):
@@ -139,10 +146,10 @@ class _Vertices:
     together at the end (:func:`.roots.roots`).
     """
 
-    def __init__(self, lat: Lattice, f: Fn, count: int, steps: int, lipschitz, lines, dense):
+    def __init__(self, lat: Lattice, f: Fn, out: np.ndarray, steps: int, lipschitz, lines, dense):
         self.lat, self.f, self.steps, self.lipschitz = lat, f, steps, lipschitz
         self.lines, self.dense = lines, dense
-        self.verts = np.empty((count, 3))
+        self.verts = out  # (count, 3), every row written
         self.placed = 0
         self.brackets = Brackets()
         self.pending: list[tuple[np.ndarray, ...]] = []
@@ -237,10 +244,10 @@ class _Vertices:
     def _points(self, ijk: np.ndarray, axis: np.ndarray, t: np.ndarray, out=None) -> np.ndarray:
         """The points at parameters ``t`` on edges ``(ijk, axis)`` (into ``out``)."""
         p = np.empty((len(t), 3)) if out is None else out
-        p[...] = ijk
-        p.reshape(-1)[np.arange(0, 3 * len(t), 3) + axis] += t
-        p *= self.lat.cell
+        cell = self.lat.cell
+        np.multiply(ijk, cell, out=p)
         p += self.lat.origin
+        p.reshape(-1)[np.arange(0, 3 * len(t), 3) + axis] += t * cell
         return p
 
     def _queue(self, *edges: np.ndarray) -> None:
@@ -248,7 +255,7 @@ class _Vertices:
         columns: the lines' tables take them so without a copy): placed :data:`CHUNK` or more
         at a time (a group's are too few to be worth the calls)."""
         self.pending.append(edges)
-        self.waiting += len(edges[0])
+        self.waiting += edges[0].shape[1]
         if self.waiting >= CHUNK:
             self._flush()
 
@@ -333,8 +340,9 @@ def mesh_field(
     Returns
     -------
     vertices : (n, 3) float64
-    triangles : (m, 3) int
-        Oriented so that normals point toward positive values.
+        Read-only, backed by immutable bytes (frozen: a Mesh shares it as it is).
+    triangles : (m, 3) int64
+        Oriented so that normals point toward positive values; frozen too.
     """
     if not (cell > 0 and np.isfinite(cell)):
         raise ValueError(f"cell must be > 0, got {cell:g}")
@@ -364,17 +372,29 @@ def mesh_field(
         edge = _edge_hashes(cells.astype(idx), case, nbr)  # a perfect hash of the edge
         used[edge] = True
         hashes.append(edge)
-    tri, count = _ranks(used, hashes, idx)
-    del hashes
+    # both outputs are written straight into immutable buffers (frozen arrays): a Mesh
+    # made of them shares them, where copying them there would cost a tenth of the meshing
+    count = 0
+
+    def number(out: np.ndarray) -> None:
+        nonlocal count
+        count = _ranks(used, hashes, out)
+
+    tri = fill_frozen(sum(h.size for h in hashes), np.int64, number).reshape(-1, 3)
+    hashes.clear()  # their ranks are written: let them go
     if not count:
         return empty
-    vertices = _Vertices(lat, f, count, root_steps, lipschitz, lines, grid is not None)
-    for s in range(0, nk, GROUP):
-        e = min(s + GROUP, nk)
-        own = np.flatnonzero(used[s * edges : e * edges])
-        if len(own):
-            vertices.own(s, e, own)
-    rest = np.flatnonzero(used[nk * edges :])
-    if len(rest):
-        vertices.others(rest + nk * edges)
-    return vertices.finish(), tri.reshape(-1, 3)
+
+    def place(out: np.ndarray) -> None:
+        vertices = _Vertices(lat, f, out, root_steps, lipschitz, lines, grid is not None)
+        for s in range(0, nk, GROUP):
+            e = min(s + GROUP, nk)
+            own = np.flatnonzero(used[s * edges : e * edges])
+            if len(own):
+                vertices.own(s, e, own)
+        rest = np.flatnonzero(used[nk * edges :])
+        if len(rest):
+            vertices.others(rest + nk * edges)
+        vertices.finish()
+
+    return fill_frozen((count, 3), np.float64, place), tri

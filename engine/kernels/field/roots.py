@@ -20,6 +20,8 @@ from collections.abc import Callable
 
 import numpy as np
 
+from .lattice import checked
+
 __all__ = ["ACCEPT", "END_GAP", "Brackets", "guess", "roots", "roots_on_segments"]
 
 Fn = Callable[[np.ndarray], np.ndarray]
@@ -29,13 +31,6 @@ Along = Callable[[np.ndarray, np.ndarray], np.ndarray]
 # float32 is 1e-4 of a cell)
 END_GAP = 5e-4
 ACCEPT = 5e-4  # a vertex is done once |f| there is surely below this (cells), see roots
-
-
-def _check(values: np.ndarray) -> np.ndarray:
-    v = np.asarray(values, dtype=np.float64).reshape(-1)
-    if not np.isfinite(v).all():
-        raise ValueError("the field is not finite at some points (NaN or infinity)")
-    return v
 
 
 def guess(fm, fa, fb, fq) -> np.ndarray:
@@ -168,7 +163,7 @@ def roots(along: Along, brackets: Brackets, steps: int, cell: float, lipschitz: 
         if not len(live):
             break
         c = t[live]
-        fc = _check(along(live, c))
+        fc = checked(along(live, c))
         done, nxt, a, b, f_a, f_b = _step(
             c, fc, lo[live], hi[live], flo[live], fhi[live], cell, lipschitz
         )
@@ -177,7 +172,7 @@ def roots(along: Along, brackets: Brackets, steps: int, cell: float, lipschitz: 
         live = live[~done]
     for _ in range(16 if len(live) else 0):
         t[live] = np.clip((lo[live] + hi[live]) / 2.0, END_GAP, 1 - END_GAP)
-        fp = _check(along(live, t[live]))
+        fp = checked(along(live, t[live]))
         low = (fp < 0) == (flo[live] < 0)
         lo[live[low]], flo[live[low]] = t[live[low]], fp[low]
         hi[live[~low]], fhi[live[~low]] = t[live[~low]], fp[~low]
@@ -202,7 +197,7 @@ def roots_on_segments(
     t = np.clip(start, END_GAP, 1 - END_GAP)
     if steps:
         br = Brackets()
-        fc = _check(f(pa + t[:, None] * d))
+        fc = checked(f(pa + t[:, None] * d))
         t = br.first(np.arange(len(t)), t, fc, fa, fb, cell, lipschitz, pa, d)
 
         def along(i, s):

@@ -14,7 +14,7 @@ import re
 
 import numpy as np
 
-from ..buffers import fill_frozen
+from ..buffers import fill_frozen, frozen_arange
 from .textscan import Lines, TokenError, ints_at, line_numbers, parse_floats, token_starts
 
 __all__ = [
@@ -105,17 +105,7 @@ def _cast(out: np.ndarray, corners: np.ndarray, block: int = 1 << 12) -> None:
 def soup_faces(count: int) -> tuple[np.ndarray, np.ndarray]:
     """``(face_indices, face_offsets)`` of ``count`` triangles on their own three vertices
     each (0, 1, 2, 3, 4, 5, ...), frozen, made in place (no array copied to freeze it)."""
-    fi = fill_frozen(3 * count, np.int64, lambda out: _arange(out, 1))
-    fo = fill_frozen(count + 1, np.int64, lambda out: _arange(out, 3))
-    return fi, fo
-
-
-def _arange(out: np.ndarray, step: int, block: int = 1 << 16) -> None:
-    """``out[:] = 0, step, 2 step, ...`` a block at a time (no temporary of its size)."""
-    ramp = np.arange(0, step * block, step, dtype=np.int64)
-    for start in range(0, len(out), block):
-        part = out[start : start + block]
-        np.add(ramp[: len(part)], step * start, out=part)
+    return frozen_arange(3 * count, 1), frozen_arange(count + 1, 3)
 
 
 def _stl_ascii(data: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
