@@ -576,7 +576,7 @@ def test_kerf_traces_on_the_first_grid(monkeypatch):
 
 
 _OFFSET_SETTINGS = settings(
-    max_examples=12, deadline=None, derandomize=True, suppress_health_check=list(HealthCheck)
+    max_examples=12, deadline=None, suppress_health_check=list(HealthCheck)
 )
 
 
