@@ -575,9 +575,7 @@ def test_kerf_traces_on_the_first_grid(monkeypatch):
         _check_against_buffer(offset_polylines([plate], [True], d), plate, d)
 
 
-_OFFSET_SETTINGS = settings(
-    max_examples=12, deadline=None, suppress_health_check=list(HealthCheck)
-)
+_OFFSET_SETTINGS = settings(max_examples=12, deadline=None, suppress_health_check=list(HealthCheck))
 
 
 @_OFFSET_SETTINGS
