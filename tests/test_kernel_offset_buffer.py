@@ -393,6 +393,12 @@ def test_random_stars_agree(star, d):
     ),
     st.sampled_from([0.05, 0.2, -0.05, -0.2]),
 )
+# Found exploring: spikes out and back (GEOS's buffer of a closed line lost the join at the
+# tip), and a ring running back over a stretch of itself (the region's repair kept a face
+# the ring crosses twice).
+@example([(0, 0), (0, -1), (2, 0), (-1, 0)], 0.2)
+@example([(0, 0), (-2, 0), (0, -2), (-3, 1), (-1, 0), (2, -1)], 0.05)
+@example([(0, 0), (0, -1), (2, 0), (-1, 0), (1, 0), (0, -2)], 0.05)
 def test_self_intersecting_loops_agree(points, d):
     # Integer vertices joined in the order drawn: crossings, collinear runs, lobes.
     pts = np.array(points, dtype=float) / 4
@@ -563,3 +569,20 @@ def test_every_vertex_is_within_the_simplification_of_the_offset():
     for d in (0.04, -0.04):
         for loop in buffer_polylines([star], [True], d):
             assert np.abs(tree.query(loop).dist - abs(d)).max() <= 0.01 * abs(d)
+
+
+def test_a_ring_of_one_point_goes_to_the_marching_path_as_a_disc():
+    # A closed polyline of one point repeated bounds no area: the region refused it
+    # (NoArea, a ValueError that escaped the path choice); its offset is the disc.
+    result = offset_loops([np.full((4, 2), 2.0)], [True], 0.5)
+    assert result.path == "marching" and "fewer than 3 distinct points" in result.declined
+    (loop,) = result.loops
+    assert np.abs(np.hypot(*(loop - 2.0).T) - 0.5).max() <= 1e-3
+
+
+def test_a_spike_out_and_back_keeps_the_round_join_at_its_tip():
+    # GEOS buffers a closed line as a ring and lost the join at the spike's tip (-0.25, 0):
+    # the band stopped at x = -0.25 instead of reaching -0.45.
+    ring = np.array([(0, 0), (0, -1), (2, 0), (-1, 0)], dtype=float) / 4
+    (loop,) = buffer_polylines([ring], [True], 0.2)
+    assert loop[:, 0].min() == pytest.approx(-0.45, abs=1e-3)

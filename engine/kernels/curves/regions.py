@@ -172,7 +172,37 @@ def _even_odd_each(
         if on_repair is not None:
             on_repair()
         polys[bad] = shapely.make_valid(polys[bad], method="linework")
+        for i in bad:  # one step per ring that is not simple
+            if _runs_over_itself(lr[i]):
+                polys[i] = _fan_xor(shapely.get_coordinates(lr[i]))
     return polys
+
+
+def _runs_over_itself(ring: shapely.Geometry) -> bool:
+    """Whether a ring runs over a stretch of itself (collinear edges that overlap): its
+    noded linework, where an overlap is kept once, is shorter than the ring."""
+    line = shapely.linestrings(shapely.get_coordinates(ring))
+    return bool(shapely.length(shapely.union_all(line)) < (1 - 1e-9) * shapely.length(line))
+
+
+def _fan_xor(ring: np.ndarray) -> shapely.Geometry:
+    """The even-odd region of a closed ring (first point repeated) as the symmetric
+    difference of the triangles fanned from its first point.
+
+    Where a ring runs over a stretch of itself, GEOS's ``linework`` repair nodes the
+    overlap into one edge and takes the faces alternately, so the faces on both sides of
+    an edge walked twice (which the even-odd rule puts on the same side) come out one in,
+    one out (a ring out along y = 0 and back over it kept a triangle whose points the
+    ring crosses twice). A point's crossing number is the sum of its triangles' (each 0
+    or 1 away from their edges), so its parity is the parity of how many triangles hold
+    it: the XOR of the triangles is the region, overlaps and all."""
+    p0 = ring[0]
+    tri = np.empty((len(ring) - 3, 4, 2))
+    tri[:, 0] = tri[:, 3] = p0
+    tri[:, 1], tri[:, 2] = ring[1:-2], ring[2:-1]
+    polys = shapely.polygons(tri)
+    polys = polys[shapely.area(polys) > 0]
+    return _xor_tree(polys) if len(polys) else shapely.Polygon()
 
 
 def _refuse_points(lr: np.ndarray) -> np.ndarray:

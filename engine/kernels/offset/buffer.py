@@ -259,13 +259,26 @@ def _multi(lines: list[np.ndarray]) -> shapely.Geometry:
 
 
 def _lines(pts: list[np.ndarray], closed: bool) -> shapely.Geometry:
-    """The polylines as lines (a lone point as a zero-length line: GEOS buffers it round)."""
+    """The polylines as lines (a lone point as a zero-length line: GEOS buffers it round).
+
+    A line that ends where it starts is given as two open ones, cut at a point away from
+    its start: GEOS buffers a closed line as a ring, one offset curve a side, and where the
+    ring runs back over itself (a spike out and back) that loses the round join at the
+    spike's tip (GEOS 3.14: the band of a ring with a spike to (-0.25, 0) stopped at
+    x = -0.25). The buffer of lines with round joins and caps is the set of points within
+    the distance of them, which cutting a line into pieces that share their ends keeps."""
     lines = []
     for p in pts:
         if len(p) == 1:
             p = np.concatenate([p, p])
         elif closed:
             p = np.concatenate([p, p[:1]])
+        if len(p) > 2 and p[0, 0] == p[-1, 0] and p[0, 1] == p[-1, 1]:
+            away = np.flatnonzero((p[1:-1, 0] != p[0, 0]) | (p[1:-1, 1] != p[0, 1]))
+            if len(away):  # (else one point repeated: a zero-length line, buffered round)
+                k = int(away[0]) + 1
+                lines += [p[: k + 1], p[k:]]
+                continue
         lines.append(p)
     return _multi(lines) if len(lines) > 1 else shapely.linestrings(lines[0])
 
