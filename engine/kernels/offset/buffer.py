@@ -41,7 +41,7 @@ from typing import NamedTuple
 import numpy as np
 import shapely
 
-from formgraph.kernels.curves.regions import NoArea, _star_shaped, even_odd_region, rings_of
+from formgraph.kernels.curves.regions import NoArea, even_odd_region, rings_of
 
 from .contour import split_loops
 from .loops import simplify as simplify_loops
@@ -171,11 +171,11 @@ def buffer_polylines(
             lines = _lines(pts, closed=False)
             _check_shallow(pts, False, distance, tol, scale)
             geom = shapely.buffer(lines, distance, quad_segs=q)
-        coords, offsets, _ = rings_of(geom)
-        if not _valid(geom, coords, offsets):
+        if not shapely.is_valid(geom):
             raise BufferDeclined("GEOS returned an invalid region")
     except shapely.errors.GEOSException as exc:
         raise BufferDeclined(f"GEOS failed: {exc}") from None
+    coords, offsets, _ = rings_of(geom)
     # An overlay can leave a ring of no area (a sliver hole of three collinear points);
     # the field has none: dropped.
     if len(offsets) < 2:
@@ -233,20 +233,6 @@ def _areal(region: shapely.Geometry) -> shapely.Geometry:
     parts = shapely.get_parts(region)
     polys = parts[np.isin(shapely.get_type_id(parts), (3, 6))]
     return shapely.union_all(polys) if len(polys) else shapely.Polygon()
-
-
-def _valid(geom: shapely.Geometry, coords: np.ndarray, offsets: np.ndarray) -> bool:
-    """Whether GEOS's result is a valid region: one polygon of one ring strictly
-    star-shaped about the centre of its box is (its ring is simple: see
-    :func:`~formgraph.kernels.curves.regions._star_shaped`; a quarter of the time of
-    GEOS's check); anything else is asked of ``is_valid``. ``coords, offsets`` are the
-    rings of ``geom`` as :func:`~formgraph.kernels.curves.regions.rings_of` reads them."""
-    if len(offsets) == 2 and shapely.get_type_id(geom) == 3 and len(coords) >= 4:
-        x, y = coords[:, 0], coords[:, 1]
-        box = np.array([x.min(), y.min(), x.max(), y.max()])
-        if _star_shaped(coords, box):
-            return True
-    return bool(shapely.is_valid(geom))
 
 
 def _multi(lines: list[np.ndarray]) -> shapely.Geometry:
