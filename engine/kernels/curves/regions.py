@@ -174,7 +174,7 @@ def _even_odd_each(
         polys[bad] = shapely.make_valid(polys[bad], method="linework")
         for i in bad:  # one step per ring that is not simple
             if _runs_over_itself(lr[i]):
-                polys[i] = _fan_xor(shapely.get_coordinates(lr[i]))
+                polys[i] = _odd_faces(shapely.get_coordinates(lr[i]))
     return polys
 
 
@@ -185,24 +185,32 @@ def _runs_over_itself(ring: shapely.Geometry) -> bool:
     return bool(shapely.length(shapely.union_all(line)) < (1 - 1e-9) * shapely.length(line))
 
 
-def _fan_xor(ring: np.ndarray) -> shapely.Geometry:
-    """The even-odd region of a closed ring (first point repeated) as the symmetric
-    difference of the triangles fanned from its first point.
+def _odd_faces(ring: np.ndarray) -> shapely.Geometry:
+    """The even-odd region of a closed ring (first point repeated) from its definition: the
+    faces of its noded linework whose inner point it crosses an odd number of times.
 
     Where a ring runs over a stretch of itself, GEOS's ``linework`` repair nodes the
     overlap into one edge and takes the faces alternately, so the faces on both sides of
     an edge walked twice (which the even-odd rule puts on the same side) come out one in,
-    one out (a ring out along y = 0 and back over it kept a triangle whose points the
-    ring crosses twice). A point's crossing number is the sum of its triangles' (each 0
-    or 1 away from their edges), so its parity is the parity of how many triangles hold
-    it: the XOR of the triangles is the region, overlaps and all."""
-    p0 = ring[0]
-    tri = np.empty((len(ring) - 3, 4, 2))
-    tri[:, 0] = tri[:, 3] = p0
-    tri[:, 1], tri[:, 2] = ring[1:-2], ring[2:-1]
-    polys = shapely.polygons(tri)
-    polys = polys[shapely.area(polys) > 0]
-    return _xor_tree(polys) if len(polys) else shapely.Polygon()
+    one out (a ring out along y = 0 and back over it kept a triangle it crosses twice).
+    Here each face's point is tested with a ray to +x against every edge (the faces share
+    the noded vertices exactly, so their union dissolves the edges between them)."""
+    faces = shapely.get_parts(
+        shapely.polygonize(shapely.get_parts(shapely.node(shapely.linestrings(ring))))
+    )
+    if len(faces) == 0:
+        return shapely.Polygon()
+    inner = shapely.get_coordinates(shapely.point_on_surface(faces))
+    a, b = ring[:-1], ring[1:]
+    odd = np.zeros(len(faces), dtype=bool)
+    step = max(1, (1 << 22) // max(len(a), 1))  # face rows per block: bounded memory
+    for k in range(0, len(faces), step):  # one step per block of faces
+        x, y = inner[k : k + step, :1], inner[k : k + step, 1:]
+        spans = (a[:, 1] > y) != (b[:, 1] > y)
+        dy = np.where(spans, b[:, 1] - a[:, 1], 1.0)
+        cut = a[:, 0] + (y - a[:, 1]) * (b[:, 0] - a[:, 0]) / dy
+        odd[k : k + step] = (spans & (cut > x)).sum(axis=1) % 2 == 1
+    return shapely.union_all(faces[odd]) if odd.any() else shapely.Polygon()
 
 
 def _refuse_points(lr: np.ndarray) -> np.ndarray:
