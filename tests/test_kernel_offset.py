@@ -575,9 +575,7 @@ def test_kerf_traces_on_the_first_grid(monkeypatch):
         _check_against_buffer(offset_polylines([plate], [True], d), plate, d)
 
 
-_OFFSET_SETTINGS = settings(
-    max_examples=12, deadline=None, derandomize=True, suppress_health_check=list(HealthCheck)
-)
+_OFFSET_SETTINGS = settings(max_examples=12, deadline=None, suppress_health_check=list(HealthCheck))
 
 
 @_OFFSET_SETTINGS
@@ -690,3 +688,13 @@ def test_messy_input_is_charged_against_the_budget():
     th = np.linspace(0, 2 * np.pi, 300, endpoint=False)
     (loop,) = offset_polylines([np.c_[np.cos(th), np.sin(th)] / 2 + 0.5], [True], 0.001)
     assert np.allclose(np.hypot(*(loop - 0.5).T).max(), 0.501, atol=1e-3)
+
+
+@pytest.mark.xfail(strict=True, reason="marching path defect found exploring, not yet fixed")
+def test_an_open_polyline_crossing_near_itself_at_a_coarse_cell():
+    # Found by the exploring property test (seed 153): at cell 0.1 (0.4 |d|) the band of
+    # this open polyline comes out 0.025 too large in area (2.3 % of it; GEOS's buffer and
+    # the marching path at its default cell agree with shapely to 1.6e-4).
+    pts = np.array([(0, 1), (0, -1), (3, 0), (2, 2)], dtype=float) / 4
+    loops = koffset.offset_polylines([pts], [False], 0.25, cell=0.1)
+    _check_against_buffer(loops, pts, 0.25, closed=False)

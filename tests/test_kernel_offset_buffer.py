@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import shapely
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from formgraph.kernels.offset import (
@@ -24,9 +24,7 @@ from formgraph.kernels.offset import (
 from formgraph.kernels.offset import buffer as kbuffer
 from formgraph.kernels.offset.distance import SegmentTree
 
-_SETTINGS = settings(
-    max_examples=20, deadline=None, derandomize=True, suppress_health_check=list(HealthCheck)
-)
+_SETTINGS = settings(max_examples=20, deadline=None, suppress_health_check=list(HealthCheck))
 
 
 def area(loop: np.ndarray) -> float:
@@ -105,6 +103,36 @@ def reference(polylines, closed, d) -> list[np.ndarray]:
     return [r for r in rings if len(r) >= 3]
 
 
+def region(loops: list[np.ndarray]) -> shapely.Geometry:
+    """The even-odd region of closed loops."""
+    shape = shapely.Polygon()
+    for lp in loops:
+        shape = shape.symmetric_difference(shapely.Polygon(lp))
+    return shape
+
+
+def _at_a_saddle(fast, exact, polylines, closed, d, tol) -> None:
+    """Where the GEOS offset is farther than the tolerance from the exact one, its region
+    must lie between the exact offsets at ``|d| - tol`` and ``|d| + tol``.
+
+    Near a saddle of the distance to the input (two holes about to part, two islands about
+    to meet) the offset's shape is not continuous in the distance: a level error far below
+    the tolerance joins two holes by a channel as long as the square root of it times the
+    radius (GEOS's chords lie inside their arcs, up to a tenth of the tolerance nearer the
+    input: nested stars, d 0.05, a 4.6e-3 channel from a 7.7e-5 deficit, tolerance
+    1.5e-3; hypothesis found it). No level-accurate method escapes that, so the promise there
+    is the level's: the loops are on the level set within the tolerance (checked by
+    `agree`), and the region they bound is sandwiched between the offsets a tolerance
+    nearer and farther."""
+    ours = region(fast)
+    slack = 1e-9 * extent(polylines) ** 2  # the references' own rounding
+    step = tol if d > 0 else -tol
+    nearer, farther = reference(polylines, closed, d - step), reference(polylines, closed, d + step)
+    small, big = (nearer, farther) if d > 0 else (farther, nearer)
+    assert region(small).difference(ours).area <= slack
+    assert ours.difference(region(big)).area <= slack
+
+
 def agree(polylines, closed, d) -> list[np.ndarray]:
     """Both paths' offsets within the 0.1 % tolerance of each other, and the GEOS one on
     the level set (every point of it at ``|d|`` from the input, to the tolerance); the GEOS
@@ -117,7 +145,21 @@ def agree(polylines, closed, d) -> list[np.ndarray]:
     size = extent(polylines)
     scale = size if size > 0 else 2 * abs(d)
     tol = 1e-3 * scale
-    fast = buffer_polylines(polylines, closed, d)
+    try:
+        fast = buffer_polylines(polylines, closed, d)
+    except BufferDeclined as exc:
+        # Above |d| = 5 % of the extent GEOS's dropping of vertices within 1 % of |d| of
+        # their neighbours' chord could move the result by more than half the tolerance,
+        # and the GEOS path declines where a vertex is that shallow (an offset's own arcs,
+        # offset again by 0.1 of a 1.8 extent: hypothesis found it). That is the promise
+        # working, not a disagreement: the offset is then the marching path's, which must
+        # be within the tolerance of the definition.
+        assert "within 1 % of the distance" in str(exc), str(exc)
+        assert kbuffer.GEOS_SIMPLIFY_FACTOR * abs(d) > kbuffer.SIMPLIFY_SHARE * tol
+        result = offset_loops(polylines, closed, d)
+        assert result.path == "marching" and result.declined == str(exc)
+        assert hausdorff(result.loops, reference(polylines, closed, d), tol) <= tol
+        return result.loops
     slow = offset_polylines(polylines, closed, d)
     assert all(shapely.Polygon(lp).is_valid for lp in fast)
     assert level_error(fast, polylines, closed, d, tol) <= tol
@@ -126,7 +168,8 @@ def agree(polylines, closed, d) -> list[np.ndarray]:
         # Both may be within the tolerance of it and still 2 tolerances apart (nested stars
         # shrunk 0.3, d 0.05: 1.2e-3 and 1.6e-4 from it, tolerance 1.3e-3): only the GEOS
         # path is held to it here; the marching path's own accuracy is tested elsewhere.
-        assert hausdorff(fast, exact, tol) <= tol
+        if hausdorff(fast, exact, tol) > tol:
+            _at_a_saddle(fast, exact, polylines, closed, d, tol)
         return fast
     # The same islands and holes: orientation by orientation, the same total area.
     for sign in (1, -1):
@@ -350,6 +393,12 @@ def test_random_stars_agree(star, d):
     ),
     st.sampled_from([0.05, 0.2, -0.05, -0.2]),
 )
+# Found exploring: spikes out and back (GEOS's buffer of a closed line lost the join at the
+# tip), and a ring running back over a stretch of itself (the region's repair kept a face
+# the ring crosses twice).
+@example([(0, 0), (0, -1), (2, 0), (-1, 0)], 0.2)
+@example([(0, 0), (-2, 0), (0, -2), (-3, 1), (-1, 0), (2, -1)], 0.05)
+@example([(0, 0), (0, -1), (2, 0), (-1, 0), (1, 0), (0, -2)], 0.05)
 def test_self_intersecting_loops_agree(points, d):
     # Integer vertices joined in the order drawn: crossings, collinear runs, lobes.
     pts = np.array(points, dtype=float) / 4
@@ -397,8 +446,41 @@ def test_a_join_meeting_an_edge_at_a_shallow_angle_keeps_its_corner():
     agree(polylines, [True, True], 0.05)
 
 
+# The hole shrinks to two holes joined at a saddle of the distance: GEOS's leaves them one
+# (see _at_a_saddle; found exploring).
+_SADDLE_OUTER = np.array(
+    [
+        [0.368369401, 0.51354611],
+        [-0.173404299, 0.512423358],
+        [-0.587426035, -0.120150659],
+        [0.114583141, -0.780443142],
+        [0.909205077, -0.38863729],
+        [0.769834591, -1.88555094e-16],
+    ]
+)
+_SADDLE_INNER = np.array(
+    [
+        [0.824318719, 0.566126002],
+        [0.452171907, 0.891930808],
+        [0.142314838, 0.989821442],
+        [-0.151723843, 0.332228873],
+        [-0.800541241, 0.599277667],
+        [-0.991221535, 0.132211455],
+        [-0.94388333, -0.330279062],
+        [-0.728409796, -0.685141715],
+        [-0.433883739, -0.900968868],
+        [0.142314838, -0.989821442],
+        [0.714282345, -0.699857651],
+        [0.891930808, -0.452171907],
+        [0.986712473, -0.162476136],
+        [0.3, -7.34788079e-17],
+    ]
+)
+
+
 @_SETTINGS
 @given(stars(), stars(), st.floats(0.3, 0.8), st.sampled_from([0.05, -0.03, -0.08]))
+@example(_SADDLE_OUTER, _SADDLE_INNER, 0.4184000365097209, 0.05)
 def test_nested_stars_agree(outer, inner, shrink, d):
     # A star with a star-shaped hole inside the circle the outer star's edges leave free
     # (an edge between far-apart corners passes close to the centre: the rings would cross).
@@ -417,12 +499,36 @@ def test_open_polylines_agree(points, d):
     agree([np.array(points, dtype=float) / 4], [False], d)
 
 
+# A first offset whose short steps at its joins leave vertices within 1 % of d2 of their
+# neighbours' chord, d2 over 5 % of its extent: the GEOS path declines (found exploring).
+_SHALLOW_KERF = np.array(
+    [
+        [0.767594976, 0.640935217],
+        [0.503134772, 0.864207962],
+        [0.178404095, 0.983957306],
+        [-0.33577015, 0.941943951],
+        [-0.701318358, 0.712848203],
+        [-0.936343958, 0.351084024],
+        [-0.997106253, -0.0760205267],
+        [-0.87229675, -0.48897687],
+        [-0.774516813, -0.632553323],
+        [-0.653365743, -0.757042407],
+        [-0.435981283, -0.899955733],
+        [-0.304878678, -0.952391197],
+        [0.0892020473, -0.491978653],
+        [0.299841788, -0.250365319],
+        [1.0, -2.4492936e-16],
+    ]
+)
+
+
 @_SETTINGS
 @given(
     stars(),
     st.sampled_from([0.2, 0.05, -0.1]),
     st.sampled_from([0.1, -0.1, 0.02, -0.02]),
 )
+@example(_SHALLOW_KERF, -0.1, 0.1)
 def test_offsets_of_offsets_agree(star, d1, d2):
     # The nameplate's kerf: an offset's own (dense) output, offset again.
     first = buffer_polylines([star], [True], d1)
@@ -463,3 +569,30 @@ def test_every_vertex_is_within_the_simplification_of_the_offset():
     for d in (0.04, -0.04):
         for loop in buffer_polylines([star], [True], d):
             assert np.abs(tree.query(loop).dist - abs(d)).max() <= 0.01 * abs(d)
+
+
+def test_a_ring_of_one_point_goes_to_the_marching_path_as_a_disc():
+    # A closed polyline of one point repeated bounds no area: the region refused it
+    # (NoArea, a ValueError that escaped the path choice); its offset is the disc.
+    result = offset_loops([np.full((4, 2), 2.0)], [True], 0.5)
+    assert result.path == "marching" and "fewer than 3 distinct points" in result.declined
+    (loop,) = result.loops
+    assert np.abs(np.hypot(*(loop - 2.0).T) - 0.5).max() <= 1e-3
+
+
+def test_a_spike_out_and_back_keeps_the_round_join_at_its_tip():
+    # GEOS buffers a closed line as a ring and lost the join at the spike's tip (-0.25, 0):
+    # the band stopped at x = -0.25 instead of reaching -0.45.
+    ring = np.array([(0, 0), (0, -1), (2, 0), (-1, 0)], dtype=float) / 4
+    (loop,) = buffer_polylines([ring], [True], 0.2)
+    assert loop[:, 0].min() == pytest.approx(-0.45, abs=1e-3)
+
+
+@pytest.mark.xfail(strict=True, reason="marching path accuracy on a tiny input, found exploring")
+def test_a_tiny_offset_offset_again_past_five_percent_of_its_extent():
+    # Found by the exploring property test (seed 105): a thin triangle shrunk by 0.1 to
+    # one of extent 2e-3, grown by 0.1 again: the GEOS path declines (50 times the
+    # extent) and the marching path is 7.6e-6 from the definition, tolerance 2e-6.
+    star = np.array([[-0.478726281, -0.230320885], [0.0667013338, -0.292490909], [0.30078125, 0.0]])
+    first = buffer_polylines([star], [True], -0.1)
+    agree(first, [True] * len(first), 0.1)

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import shapely
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from formgraph.kernels.curves import regions
@@ -118,18 +118,41 @@ def random_rings(draw):
     return np.array(pts, dtype=float)
 
 
+def even_odd_faces(ring: np.ndarray) -> shapely.Geometry:
+    """The even-odd region of a ring from its definition: the faces of its noded linework
+    whose inner point the ring's edges cross an odd number of times (a ray to +x)."""
+    noded = shapely.node(shapely.LineString(np.r_[ring, ring[:1]]))
+    faces = shapely.get_parts(shapely.polygonize(shapely.get_parts(noded)))
+    if len(faces) == 0:
+        return shapely.Polygon()
+    inner = shapely.get_coordinates(shapely.point_on_surface(faces))
+    a, b = ring, np.roll(ring, -1, axis=0)
+    x, y = inner[:, :1], inner[:, 1:]
+    spans = (a[:, 1] > y) != (b[:, 1] > y)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        cut = a[:, 0] + (y - a[:, 1]) * (b[:, 0] - a[:, 0]) / (b[:, 1] - a[:, 1])
+    odd = (spans & (cut > x)).sum(axis=1) % 2 == 1
+    return shapely.union_all(faces[odd]) if odd.any() else shapely.Polygon()
+
+
 @settings(max_examples=150, deadline=None)
+@example(np.array([(0, 0), (0, -1), (2, 0), (-1, 0), (1, 0), (0, -2)], dtype=float))
 @given(random_rings())
-def test_each_ring_is_its_even_odd_region_as_linework_repair_gives_it(ring):
+def test_each_ring_is_its_even_odd_region(ring):
+    # Against the definition, not GEOS's linework repair: that one takes the faces of the
+    # noded ring alternately, wrong where the ring runs back over a stretch of itself (the
+    # example: a triangle the ring crosses twice came out inside); elsewhere the two agree.
     poly = shapely.Polygon(ring)
     if regions.distinct_steps(np.r_[ring, ring[:1]]) < 3:
         with pytest.raises(regions.NoArea):
             regions.each_region([ring])
         return
     ours = regions.each_region([ring])
-    ref = shapely.make_valid(poly, method="linework")
     assert shapely.is_valid(ours)
-    assert shapely.symmetric_difference(ours, ref).area <= 1e-12
+    assert shapely.symmetric_difference(ours, even_odd_faces(ring)).area <= 1e-12
+    if not regions._runs_over_itself(shapely.linearrings(np.r_[ring, ring[:1]])):
+        ref = shapely.make_valid(poly, method="linework")
+        assert shapely.symmetric_difference(ours, ref).area <= 1e-12
 
 
 def test_a_simple_ring_is_taken_as_it_is():

@@ -11,6 +11,7 @@ import numpy as np
 from formgraph.core.errors import InputError
 from formgraph.core.registry import Context, Range, node
 from formgraph.geometry import Curve, NurbsCurve, frozen_array
+from formgraph.kernels.curves.regions import planar
 from formgraph.kernels.offset import (
     OffsetTraceError,
     WorkLimit,
@@ -27,6 +28,8 @@ _SAMPLE_SHARE = 0.1  # sampling error allowed, as a share of that (and of the ce
 
 MAX_SMOOTH = 100  # smoothing passes: each costs a pass over every vertex; more change nothing
 
+
+_TINY = np.finfo(np.float64).tiny
 
 _SMALLEST = 1e-9  # the smallest |distance| and cell, relative to the input's extent
 
@@ -103,10 +106,10 @@ def marching_squares(
 
     # A first, coarse sampling sizes the input; then each curve is sampled to a tolerance.
     rough = [_initial_samples(c) for c in curves]
-    pts = [r[1] for r in rough]
     # (Per coordinate: numpy reduces an (n, 3) array along its long axis slowly.)
-    lo = np.array([min(float(p[:, k].min()) for p in pts) for k in range(2)])
-    hi = np.array([max(float(p[:, k].max()) for p in pts) for k in range(2)])
+    cols = [[r[1][:, k] for r in rough] for k in range(2)]
+    lo = np.array([min(c.min() for c in col) for col in cols], dtype=float)
+    hi = np.array([max(c.max() for c in col) for col in cols], dtype=float)
     extent = float((hi - lo).max())
     if extent > 0 and abs(distance) < _SMALLEST * extent:
         raise InputError(
@@ -153,14 +156,24 @@ def _loop_curve(loop: np.ndarray) -> NurbsCurve:
     """A loop (first vertex not repeated, no two in a row the same) as a closed degree-1
     curve at z = 0, its parameter the running chord length: built valid, not re-checked."""
     m = len(loop)
-    xyz = np.zeros((m + 1, 3))
-    xyz[:m, :2] = loop
-    xyz[m, :2] = loop[0]
-    seg = np.hypot(xyz[1:, 0] - xyz[:-1, 0], xyz[1:, 1] - xyz[:-1, 1])
-    if not (seg > 0).all():  # (never from either path; kept safe)
+    xyz = np.empty((m + 1, 3))  # filled a column at a time (strided copies are slow)
+    x, y = xyz[:, 0], xyz[:, 1]
+    x[:m], y[:m] = loop[:, 0], loop[:, 1]
+    x[m], y[m] = loop[0, 0], loop[0, 1]
+    xyz[:, 2] = 0.0
+    seg = np.subtract(x[1:], x[:-1])
+    seg *= seg
+    dy = np.subtract(y[1:], y[:-1])
+    dy *= dy
+    seg += dy
+    # Steps under 1.5e-154 or over 1e154 square to nothing or to infinity: the general
+    # constructor, which takes them with hypot (never so from either path; kept safe).
+    if not (seg.min() > _TINY and seg.max() < np.inf):
         return NurbsCurve.polyline(xyz, closed=True)
-    knots = np.zeros(m + 3)
-    np.cumsum(seg, out=knots[2 : m + 2])
+    np.sqrt(seg, out=seg)
+    knots = np.empty(m + 3)
+    knots[:2] = 0.0
+    np.add.accumulate(seg, out=knots[2 : m + 2])
     knots[m + 2] = knots[m + 1]
     return NurbsCurve._of_valid(frozen_array(xyz), 1, frozen_array(knots))
 
@@ -189,7 +202,7 @@ def _adaptive(
     """
     closed = curve.closed
     if t is None:
-        p = xyz[:, :2]
+        p = planar(xyz)  # (a column at a time: a strided copy of rows of two is slow)
     else:
         for _ in range(40):
             mid = (t[:-1] + t[1:]) / 2
@@ -201,10 +214,12 @@ def _adaptive(
             order = np.argsort(np.concatenate([t, mid[far]]), kind="stable")
             t = np.concatenate([t, mid[far]])[order]
             xyz = np.concatenate([xyz, at[far]])[order]
-        p = xyz[:, :2]
-    if closed and len(p) > 1 and np.abs(p[0] - p[-1]).max() <= 1e-12 * max(1.0, np.abs(p).max()):
-        p = p[:-1]
-    return np.ascontiguousarray(p, dtype=float), closed
+        p = planar(xyz)
+    if closed and len(p) > 1:
+        gap = max(abs(p[0, 0] - p[-1, 0]), abs(p[0, 1] - p[-1, 1]))
+        if gap <= 1e-12 * max(1.0, np.abs(p).max()):
+            p = p[:-1]
+    return p, closed
 
 
 def _chord_gap(a: np.ndarray, b: np.ndarray, p: np.ndarray) -> np.ndarray:

@@ -21,7 +21,7 @@ rings become a region and how the result comes back.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 import shapely
@@ -148,7 +148,9 @@ def _star_shaped(ring: np.ndarray, box: np.ndarray) -> bool:
     return bool(det.max() < -bound) and np.count_nonzero(up[:-1] & ~up[1:]) == 1
 
 
-def _even_odd_each(lr: np.ndarray, closed: list[np.ndarray]) -> np.ndarray:
+def _even_odd_each(
+    lr: np.ndarray, closed: list[np.ndarray], on_repair: Callable[[], None] | None = None
+) -> np.ndarray:
     """Each ring as the region it bounds by the even-odd rule, a polygon each.
 
     A simple ring (no crossing nor touching of its own) of two or more distinct points
@@ -157,7 +159,8 @@ def _even_odd_each(lr: np.ndarray, closed: list[np.ndarray]) -> np.ndarray:
     quarters of what ``is_valid`` of its polygon costs, and :func:`_refuse_points` the
     rest. The others are repaired by the ``linework`` method (the faces of the noded
     ring, taken alternately); a ring of fewer than 3 distinct points is refused instead,
-    as bounding no area.
+    as bounding no area. ``on_repair`` is called before any repair (see
+    :func:`even_odd_region`).
     """
     simple = _simple(lr, closed, _refuse_points(lr))
     polys = shapely.polygons(lr)
@@ -166,8 +169,48 @@ def _even_odd_each(lr: np.ndarray, closed: list[np.ndarray]) -> np.ndarray:
         for i in bad:  # one step per ring that is not simple
             if distinct_steps(shapely.get_coordinates(lr[i])) < 3:
                 raise NoArea(int(i))
+        if on_repair is not None:
+            on_repair()
         polys[bad] = shapely.make_valid(polys[bad], method="linework")
+        for i in bad:  # one step per ring that is not simple
+            if _runs_over_itself(lr[i]):
+                polys[i] = _odd_faces(shapely.get_coordinates(lr[i]))
     return polys
+
+
+def _runs_over_itself(ring: shapely.Geometry) -> bool:
+    """Whether a ring runs over a stretch of itself (collinear edges that overlap): its
+    noded linework, where an overlap is kept once, is shorter than the ring."""
+    line = shapely.linestrings(shapely.get_coordinates(ring))
+    return bool(shapely.length(shapely.union_all(line)) < (1 - 1e-9) * shapely.length(line))
+
+
+def _odd_faces(ring: np.ndarray) -> shapely.Geometry:
+    """The even-odd region of a closed ring (first point repeated) from its definition: the
+    faces of its noded linework whose inner point it crosses an odd number of times.
+
+    Where a ring runs over a stretch of itself, GEOS's ``linework`` repair nodes the
+    overlap into one edge and takes the faces alternately, so the faces on both sides of
+    an edge walked twice (which the even-odd rule puts on the same side) come out one in,
+    one out (a ring out along y = 0 and back over it kept a triangle it crosses twice).
+    Here each face's point is tested with a ray to +x against every edge (the faces share
+    the noded vertices exactly, so their union dissolves the edges between them)."""
+    faces = shapely.get_parts(
+        shapely.polygonize(shapely.get_parts(shapely.node(shapely.linestrings(ring))))
+    )
+    if len(faces) == 0:
+        return shapely.Polygon()
+    inner = shapely.get_coordinates(shapely.point_on_surface(faces))
+    a, b = ring[:-1], ring[1:]
+    odd = np.zeros(len(faces), dtype=bool)
+    step = max(1, (1 << 22) // max(len(a), 1))  # face rows per block: bounded memory
+    for k in range(0, len(faces), step):  # one step per block of faces
+        x, y = inner[k : k + step, :1], inner[k : k + step, 1:]
+        spans = (a[:, 1] > y) != (b[:, 1] > y)
+        dy = np.where(spans, b[:, 1] - a[:, 1], 1.0)
+        cut = a[:, 0] + (y - a[:, 1]) * (b[:, 0] - a[:, 0]) / dy
+        odd[k : k + step] = (spans & (cut > x)).sum(axis=1) % 2 == 1
+    return shapely.union_all(faces[odd]) if odd.any() else shapely.Polygon()
 
 
 def _refuse_points(lr: np.ndarray) -> np.ndarray:
@@ -190,7 +233,9 @@ def _xor_tree(geoms: np.ndarray) -> shapely.Geometry:
     return g[0]
 
 
-def even_odd_region(rings: Sequence[np.ndarray]) -> shapely.Geometry:
+def even_odd_region(
+    rings: Sequence[np.ndarray], on_repair: Callable[[], None] | None = None
+) -> shapely.Geometry:
     """The region the rings bound by the even-odd rule, as a valid (Multi)Polygon.
 
     Parameters
@@ -198,6 +243,10 @@ def even_odd_region(rings: Sequence[np.ndarray]) -> shapely.Geometry:
     rings : sequence of (m, 2) or (m, 3) float
         Closed polylines, each with or without its closing point, any orientation (z, if
         given, is ignored).
+    on_repair : callable, optional
+        Called (with no argument) once the rings are found to cross or touch, themselves or
+        each other, before GEOS repairs them: whether they are simple is then known without
+        a second noding pass, and the caller may refuse the repair's cost by raising.
 
     Returns
     -------
@@ -206,11 +255,13 @@ def even_odd_region(rings: Sequence[np.ndarray]) -> shapely.Geometry:
     if len(rings) == 0:
         return shapely.Polygon()
     if len(rings) == 1:
-        return _even_odd_each(*_linearrings(rings))[0]
+        return _even_odd_each(*_linearrings(rings), on_repair)[0]
     lr, closed = _linearrings(rings)
     _refuse_points(lr)
     if shapely.is_simple(shapely.multilinestrings(lr)):
         return _nested(lr)
+    if on_repair is not None:
+        on_repair()
     return _xor_tree(_even_odd_each(lr, closed))
 
 

@@ -41,7 +41,7 @@ from typing import NamedTuple
 import numpy as np
 import shapely
 
-from formgraph.kernels.curves.regions import even_odd_region, rings_of
+from formgraph.kernels.curves.regions import NoArea, even_odd_region, rings_of
 
 from .contour import split_loops
 from .loops import simplify as simplify_loops
@@ -165,10 +165,7 @@ def buffer_polylines(
     pts = [np.asarray(p, dtype=float) for p in polylines]
     try:
         if all_closed:
-            simple = _simple(pts)
-            if not simple:
-                _check_crossings(a, b)
-            geom = _closed_offset(pts, simple, a, b, distance, q, tol, scale)
+            geom = _closed_offset(pts, a, b, distance, q, tol, scale)
         else:
             _check_crossings(a, b)
             lines = _lines(pts, closed=False)
@@ -191,10 +188,26 @@ def buffer_polylines(
     return [coords[offsets[i] : offsets[i + 1] - 1] for i in range(len(offsets) - 1) if keep[i]]
 
 
-def _closed_offset(pts, simple, a, b, distance, q, tol, scale):
-    """The offset of the even-odd region of closed polylines (see the module's notes)."""
+def _closed_offset(pts, a, b, distance, q, tol, scale):
+    """The offset of the even-odd region of closed polylines (see the module's notes).
+
+    Whether the rings are simple (none crosses or touches itself or another) comes out of
+    building the region: the crossings are counted only where they are not (before GEOS's
+    repair, whose cost they bound), and a simple ring is not noded twice."""
     rings = [p for p in pts if len(p) >= 3]
-    region = even_odd_region(rings) if rings else shapely.Polygon()
+    repaired = []
+
+    def on_repair() -> None:
+        repaired.append(True)
+        _check_crossings(a, b)
+
+    try:
+        region = even_odd_region(rings, on_repair) if rings else shapely.Polygon()
+    except NoArea as exc:  # the marching path offsets its linework (a point, a segment)
+        raise BufferDeclined(str(exc)) from None
+    simple = not repaired and len(rings) == len(pts)
+    if not simple and not repaired:
+        _check_crossings(a, b)
     area = _areal(region)
     # Rings that neither cross nor touch bound their region with all their linework.
     if simple or float(np.hypot(*(b - a).T).sum()) <= (1 + 1e-9) * float(shapely.length(area)):
@@ -222,17 +235,6 @@ def _areal(region: shapely.Geometry) -> shapely.Geometry:
     return shapely.union_all(polys) if len(polys) else shapely.Polygon()
 
 
-def _simple(pts: list[np.ndarray]) -> bool:
-    """Whether no ring crosses or touches itself or another (then nesting builds the region
-    and GEOS repairs nothing)."""
-    if any(len(p) < 3 for p in pts):
-        return False
-    rings = [np.concatenate([p, p[:1]]) for p in pts]
-    if len(rings) == 1:
-        return bool(shapely.is_simple(shapely.linearrings(rings[0])))
-    return bool(shapely.is_simple(_multi(rings)))
-
-
 def _multi(lines: list[np.ndarray]) -> shapely.Geometry:
     """One MultiLineString of point arrays of any lengths (made in one call)."""
     sizes = [len(p) for p in lines]
@@ -243,13 +245,26 @@ def _multi(lines: list[np.ndarray]) -> shapely.Geometry:
 
 
 def _lines(pts: list[np.ndarray], closed: bool) -> shapely.Geometry:
-    """The polylines as lines (a lone point as a zero-length line: GEOS buffers it round)."""
+    """The polylines as lines (a lone point as a zero-length line: GEOS buffers it round).
+
+    A line that ends where it starts is given as two open ones, cut at a point away from
+    its start: GEOS buffers a closed line as a ring, one offset curve a side, and where the
+    ring runs back over itself (a spike out and back) that loses the round join at the
+    spike's tip (GEOS 3.14: the band of a ring with a spike to (-0.25, 0) stopped at
+    x = -0.25). The buffer of lines with round joins and caps is the set of points within
+    the distance of them, which cutting a line into pieces that share their ends keeps."""
     lines = []
     for p in pts:
         if len(p) == 1:
             p = np.concatenate([p, p])
         elif closed:
             p = np.concatenate([p, p[:1]])
+        if len(p) > 2 and p[0, 0] == p[-1, 0] and p[0, 1] == p[-1, 1]:
+            away = np.flatnonzero((p[1:-1, 0] != p[0, 0]) | (p[1:-1, 1] != p[0, 1]))
+            if len(away):  # (else one point repeated: a zero-length line, buffered round)
+                k = int(away[0]) + 1
+                lines += [p[: k + 1], p[k:]]
+                continue
         lines.append(p)
     return _multi(lines) if len(lines) > 1 else shapely.linestrings(lines[0])
 

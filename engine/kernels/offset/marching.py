@@ -28,6 +28,7 @@ the default) can still be missed or cut; near-degenerate cusps converge slowly.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 import numpy as np
@@ -142,14 +143,15 @@ def grid_cells(lo: np.ndarray, hi: np.ndarray, distance: float, cell: float) -> 
     coarse cells. (Only a band of it is ever sampled; this is the size checked against
     ``max_cells``.)
     """
-    margin = abs(distance) + 2 * cell
-    size = (np.asarray(hi, float) - np.asarray(lo, float) + 2 * margin) / cell
-    if not np.all(np.isfinite(size)) or size.max() > 2.0**31:
+    # (In Python floats: numpy's calls on two numbers cost more than the arithmetic.)
+    margin = abs(float(distance)) + 2 * float(cell)
+    (x0, y0), (x1, y1) = np.asarray(lo, float).tolist(), np.asarray(hi, float).tolist()
+    sx, sy = (x1 - x0 + 2 * margin) / cell, (y1 - y0 + 2 * margin) / cell
+    big = max(sx, sy)
+    if not (math.isfinite(sx) and math.isfinite(sy)) or big > 2.0**31:
         return 2**62  # more than any budget (a cell tiny next to the input)
-    levels = max(0, int(np.ceil(np.log2(max(size.max() / _COARSE_CELLS, 1.0)))))
-    step = 2**levels
-    ncx, ncy = (np.ceil(size / step) * step).tolist()
-    return int(ncx * ncy)
+    step = 2 ** max(0, math.ceil(math.log2(max(big / _COARSE_CELLS, 1.0))))
+    return math.ceil(sx / step) * step * math.ceil(sy / step) * step
 
 
 def _trace(field: Field, ids, values, cells, ncx: int):
