@@ -576,11 +576,14 @@ class Running:
                     fut.release()
                     deliver(finished)
             # a worker that dies takes every task it holds with it: run each killed row
-            # alone, one after another, so only the one that kills is blamed
+            # alone, one after another, so only the one that kills is blamed. Each on a new
+            # key: under its own, the scheduler may still hold the KilledWorker it just gave
+            # (its release is asynchronous), and an innocent row would be blamed at once
             for key in suspects:
-                (alone,) = c.get(dsk, [key], sync=False, optimize_graph=False)
+                fresh = _again(dsk, chunks, key)
+                (alone,) = c.get(dsk, [fresh], sync=False, optimize_graph=False)
                 futures.append(alone)
-                finished = _chunk_result(alone, chunks[key])  # waits GATHER_SECONDS at most
+                finished = _chunk_result(alone, chunks[fresh])  # waits GATHER_SECONDS at most
                 alone.release()
                 deliver(finished)
             ended = True
@@ -603,6 +606,15 @@ def _killed(fut: Any) -> bool:
         return type(fut.exception()).__name__ == "KilledWorker"
     except Exception:  # lost with its worker: said when its result is asked for
         return False
+
+
+def _again(dsk: dict[str, Any], chunks: dict[str, list[str]], task_key: str) -> str:
+    """The task ``task_key`` put in ``dsk`` again under a key the scheduler has never seen
+    (the same rows, the same shared inputs); that key."""
+    fresh = f"again-{uuid.uuid4().hex}-{task_key}"
+    dsk[fresh] = dsk[task_key]
+    chunks[fresh] = chunks[task_key]
+    return fresh
 
 
 def _split(dsk: dict[str, Any], chunks: dict[str, list[str]], task_key: str) -> list[str]:
