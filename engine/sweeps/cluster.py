@@ -404,6 +404,7 @@ def connect(client: Any, workers: int | None) -> Iterator[Any]:
             scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},  # its HTTP routes, off 8787
             silence_logs=logging.ERROR,
             env=BLAS_ENV,
+            preload=["formgraph.sweeps.workerinit"],  # manifold3d's oneTBB: one thread too
         )
     try:
         c = Client(cluster, direct_to_workers=True)  # results straight from the workers
