@@ -54,11 +54,15 @@ def test_without_it_manifold3d_starts_a_thread_pool():
     assert done == "None" and int(added) >= 1
 
 
+@pytest.mark.skipif(
+    hasattr(os, "sched_getaffinity") and len(os.sched_getaffinity(0)) != 2,
+    reason="the preload applies when the workers fill the cores: two here",
+)
 def test_the_embedded_cluster_preloads_it(tmp_path):
     import formgraph as fg
     from formgraph.sweeps import cluster
 
-    with cluster.connect(None, workers=2) as client:
+    with cluster.connect(None, workers=2) as client:  # two workers on two cores
         workers = list(client.scheduler_info()["workers"])
         # each worker's task thread started (Dask starts it at the worker's first task)
         client.gather([client.submit(abs, -1, workers=[w], pure=False) for w in workers])
@@ -73,3 +77,12 @@ def test_the_embedded_cluster_preloads_it(tmp_path):
         after = client.run(lambda: len(os.listdir("/proc/self/task")))
     assert all(r["status"] == "ok" for r in s.rows)
     assert after == seen  # the booleans started no thread in any worker
+
+
+def test_a_lone_worker_keeps_the_threads():
+    # fewer workers than cores: manifold3d may use the cores the other workers would have
+    from formgraph.sweeps import cluster
+
+    with cluster.connect(None, workers=1) as client:
+        preloads = client.run(lambda dask_worker: [p.name for p in dask_worker.preloads])
+    assert all(p == [] for p in preloads.values())
