@@ -366,7 +366,9 @@ def test_ctrl_c_and_a_rerun_continue_the_study(tmp_path):
     ]
     assert all(float(r["per"]) == float(r["a"]) for r in table)
     calls = sweep_stubs.calls(log)
-    assert len(calls) <= 16 + 4  # kept trials are not run again (a batch cut short may be)
+    # kept trials are not run again; the batches in flight when it was cut short may be
+    # (two of them: batch b is asked while b - 1 still runs)
+    assert len(calls) <= 16 + 2 * 4
 
 
 def test_bad_objectives_and_constraints_are_located_errors(tmp_path):

@@ -404,6 +404,9 @@ def connect(client: Any, workers: int | None) -> Iterator[Any]:
             scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},  # its HTTP routes, off 8787
             silence_logs=logging.ERROR,
             env=BLAS_ENV,
+            # workers that fill the cores run manifold3d's oneTBB on one thread each, as BLAS;
+            # fewer workers than cores keep its threads (a lone worker uses every core)
+            preload=["formgraph.sweeps.workerinit"] if n >= _cores() else [],
         )
     try:
         c = Client(cluster, direct_to_workers=True)  # results straight from the workers
@@ -615,6 +618,13 @@ def _again(dsk: dict[str, Any], chunks: dict[str, list[str]], task_key: str) -> 
     dsk[fresh] = dsk[task_key]
     chunks[fresh] = chunks[task_key]
     return fresh
+
+
+def _cores() -> int:
+    """The cores this process may run on."""
+    if hasattr(os, "sched_getaffinity"):
+        return len(os.sched_getaffinity(0))
+    return os.cpu_count() or 1
 
 
 def _split(dsk: dict[str, Any], chunks: dict[str, list[str]], task_key: str) -> list[str]:
