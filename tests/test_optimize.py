@@ -37,7 +37,11 @@ pytest.importorskip("optuna")
 def cluster(n: int, processes: bool = True) -> LocalCluster:
     if not processes:  # in-process workers talk inproc://, no socket at all
         return LocalCluster(
-            n_workers=n, threads_per_worker=1, processes=False, dashboard_address=None
+            n_workers=n,
+            threads_per_worker=1,
+            processes=False,
+            dashboard_address=None,
+            scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
         )
     return LocalCluster(
         n_workers=n,

@@ -122,7 +122,11 @@ def test_a_second_study_over_the_shared_folder_computes_nothing_again(tmp_path):
     )
     with (
         LocalCluster(
-            n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None
+            n_workers=2,
+            threads_per_worker=1,
+            processes=False,
+            dashboard_address=None,
+            scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
         ) as c,
         Client(c) as cl,
     ):

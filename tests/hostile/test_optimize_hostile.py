@@ -81,7 +81,11 @@ def test_failing_trials_are_recorded_never_best_and_text_cells_stay_inert(tmp_pa
     g.add("f", "stub.fail_at", x="=a", bad=2.0)
     with (
         LocalCluster(
-            n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None
+            n_workers=2,
+            threads_per_worker=1,
+            processes=False,
+            dashboard_address=None,
+            scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
         ) as c,
         Client(c) as cl,
     ):

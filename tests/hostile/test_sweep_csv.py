@@ -17,7 +17,13 @@ HOSTILE = ["=cmd|' /C calc'!A0", "@SUM(1+1)", "+1+1", "-1", "'=x", "plain"]
 @pytest.fixture(scope="module")
 def client():
     with (
-        LocalCluster(n_workers=1, processes=False, dashboard_address=None, silence_logs=40) as c,
+        LocalCluster(
+            n_workers=1,
+            processes=False,
+            dashboard_address=None,
+            scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
+            silence_logs=40,
+        ) as c,
         Client(c) as cl,
     ):
         yield cl
